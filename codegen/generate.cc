@@ -1,0 +1,77 @@
+#include "codegen/generate.h"
+
+#include <algorithm>
+#include <ostream>
+#include <set>
+
+#include "codegen/emitter.h"
+#include "runtime/core/diagnostics.h"
+#include "runtime/model/description.h"
+
+namespace autoshovel::codegen {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> FindDescriptions(const std::string& models_dir) {
+  return model::FindMachineDescriptions(models_dir);
+}
+
+int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& err) {
+  std::vector<std::string> descriptions = request.descriptions;
+  if (!request.models_dir.empty()) {
+    const auto found = FindDescriptions(request.models_dir);
+    descriptions.insert(descriptions.end(), found.begin(), found.end());
+    if (found.empty()) {
+      err << request.models_dir << ": no machine descriptions found\n";
+      return 1;
+    }
+  }
+  if (descriptions.empty()) {
+    err << "codegen: no description given\n";
+    return 1;
+  }
+  // Load everything first: nothing is written unless every description is valid.
+  std::vector<model::MachineDescription> machines;
+  bool invalid = false;
+  for (const auto& path : descriptions) {
+    try {
+      machines.push_back(model::LoadMachineDescription(path, {request.materials_dir}));
+    } catch (const core::InputError& e) {
+      for (const auto& d : e.diagnostics()) err << d.ToString() << '\n';
+      invalid = true;
+    }
+  }
+  if (invalid) return 1;
+  std::set<std::string> names;
+  for (const auto& m : machines) {
+    if (!names.insert(m.name).second) {
+      err << m.source_file << ":1:1: name: machine name '" << m.name
+          << "' is used by another description\n";
+      return 1;
+    }
+  }
+  try {
+    EmitOptions options{request.output_dir, ""};
+    for (const auto& m : machines) {
+      out << "codegen: " << m.source_file << " -> " << (request.output_dir / m.name).string() << "/"
+          << std::endl;
+      EmitMachine(m, options);
+    }
+    if (request.clean && fs::is_directory(request.output_dir)) {
+      for (const auto& entry : fs::directory_iterator(request.output_dir)) {
+        if (entry.is_directory() && fs::exists(entry.path() / ".autoshovel-machine") &&
+            names.count(entry.path().filename().string()) == 0) {
+          out << "codegen: removing stale " << entry.path().string() << "/" << std::endl;
+          fs::remove_all(entry.path());
+        }
+      }
+      EmitRegistry(options);
+    }
+  } catch (const std::exception& e) {
+    err << e.what() << '\n';
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace autoshovel::codegen

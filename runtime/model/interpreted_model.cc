@@ -1,0 +1,138 @@
+#include "runtime/model/interpreted_model.h"
+
+#include <unsupported/Eigen/AutoDiff>
+
+#include <stdexcept>
+
+namespace autoshovel::model {
+
+ModelSizes SizesOf(const MachineDescription& machine) {
+  ModelSizes sizes;
+  sizes.num_links = static_cast<int>(machine.num_links());
+  sizes.num_joints = static_cast<int>(machine.num_joints());
+  sizes.num_angles = sizes.num_links + 1 + (machine.swing ? 1 : 0);
+  sizes.num_params = 2 * sizes.num_links;
+  sizes.num_states = 5 * sizes.num_joints;
+  sizes.num_inputs = 2 * sizes.num_joints + 2;
+  return sizes;
+}
+
+double BucketProfileArea(const MachineDescription& machine) {
+  const auto& polygon = machine.bucket.profile;
+  double twice_area = 0;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const auto& a = polygon[i];
+    const auto& b = polygon[(i + 1) % polygon.size()];
+    twice_area += a.x() * b.y() - b.x() * a.y();
+  }
+  return std::abs(twice_area) / 2.0;
+}
+
+Eigen::Vector2d BucketPayloadCenter(const MachineDescription& machine) {
+  // Shoelace centroid of the cross-section polygon.
+  const auto& polygon = machine.bucket.profile;
+  double twice_area = 0;
+  Eigen::Vector2d weighted = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const auto& a = polygon[i];
+    const auto& b = polygon[(i + 1) % polygon.size()];
+    const double cross = a.x() * b.y() - b.x() * a.y();
+    twice_area += cross;
+    weighted += cross * (a + b);
+  }
+  if (twice_area == 0) throw std::invalid_argument("bucket profile has zero area");
+  return weighted / (3.0 * twice_area);
+}
+
+InterpretedModel::InterpretedModel(const MachineDescription& machine)
+    : machine_(machine), sizes_(SizesOf(machine)), payload_center_(BucketPayloadCenter(machine)) {
+  for (int j = 0; j < sizes_.num_joints; ++j) {
+    const int actuator = machine.ActuatorOfJoint(j);
+    if (actuator < 0)
+      throw std::invalid_argument("joint " + std::to_string(j) + " has no actuator");
+    actuator_of_joint_.push_back(actuator);
+  }
+}
+
+std::vector<double> InterpretedModel::NominalParams() const {
+  std::vector<double> params(sizes_.num_params);
+  for (int k = 0; k < sizes_.num_links; ++k) {
+    params[k] = machine_.links[k].length;
+    params[sizes_.num_links + k] = machine_.links[k].imu_offset;
+  }
+  return params;
+}
+
+std::vector<double> InterpretedModel::AnglesFromJoints(const double* q,
+                                                       const double* params) const {
+  const int n = sizes_.num_links;
+  std::vector<double> angles(sizes_.num_angles, 0.0);
+  double phi = 0;
+  for (int k = 0; k < n; ++k) {
+    phi = k == 0 ? q[0] : phi + q[k];
+    angles[k + 1] = phi - params[n + k];  // inverse of Eq. (1) with θ_cab = 0
+  }
+  if (machine_.swing) angles[n + 1] = q[n];
+  return angles;
+}
+
+Eigen::Vector4d InterpretedModel::TipFromJoints(const double* q) const {
+  const std::vector<double> params = NominalParams();
+  const std::vector<double> angles = AnglesFromJoints(q, params.data());
+  Eigen::Vector4d pose;
+  ForwardKinematics(angles.data(), params.data(), pose.data());
+  return pose;
+}
+
+std::vector<double> InterpretedModel::GravityTorques(const double* q, double payload,
+                                                     double pitch) const {
+  // The plant's acceleration with zero velocities, pressures, commands and end-stop forces is
+  // gravity over inertia; a unit-torque probe gives the inertia. Keeping one implementation of
+  // the gravity terms (PlantRhs) avoids a second copy drifting from it.
+  const int J = sizes_.num_joints;
+  std::vector<double> x(sizes_.num_states, 0.0), u(sizes_.num_inputs, 0.0);
+  std::vector<double> rest(sizes_.num_states), probe(sizes_.num_states);
+  for (int j = 0; j < J; ++j) x[j] = q[j];
+  u[2 * J] = payload;
+  u[2 * J + 1] = pitch;
+  // At zero pressure the only hydraulic force left is the (smooth, tiny) end-stop spring,
+  // removed explicitly below.
+  PlantRhs(x.data(), u.data(), rest.data());
+  std::vector<double> torques(J, 0.0);
+  for (int j = 0; j < sizes_.num_links; ++j) {
+    std::fill(u.begin(), u.begin() + 2 * J, 0.0);
+    u[J + j] = 1.0;
+    PlantRhs(x.data(), u.data(), probe.data());
+    const double inverse_inertia = probe[J + j] - rest[J + j];
+    torques[j] = rest[J + j] / inverse_inertia;
+    u[J + j] = 0.0;
+  }
+  // Remove the hydraulic contribution at zero pressure (end-stop spring only).
+  for (int j = 0; j < J; ++j) {
+    const int actuator = actuator_of_joint_[j];
+    const Actuator& act = machine_.hydraulics.actuators[actuator];
+    if (act.kind == ActuatorKind::kMotor) continue;
+    const double s = CylinderLength(actuator, q) - act.retracted_length;
+    const double end_force = act.count * plant::kEndStopStiffness *
+                             (internal::SmoothPositive(-s, plant::kEndStopSmoothing) -
+                              internal::SmoothPositive(s - act.stroke, plant::kEndStopSmoothing));
+    const std::vector<double> lever = LeverArms(actuator, q);
+    for (int i = 0; i < sizes_.num_links; ++i) torques[i] -= end_force * lever[i];
+  }
+  return torques;
+}
+
+void InterpretedModel::PlantJacobian(const double* x, const double* u, double* jacobian) const {
+  using Scalar = Eigen::AutoDiffScalar<Eigen::VectorXd>;
+  const int N = sizes_.num_states;
+  std::vector<Scalar> xs(N), xdot(N);
+  for (int i = 0; i < N; ++i) xs[i] = Scalar(x[i], N, i);
+  PlantRhs(xs.data(), u, xdot.data());
+  for (int r = 0; r < N; ++r) {
+    for (int c = 0; c < N; ++c) {
+      jacobian[r * N + c] = xdot[r].derivatives().size() > 0 ? xdot[r].derivatives()[c] : 0.0;
+    }
+  }
+}
+
+}  // namespace autoshovel::model

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# The CLI as a user meets it: describe works for every shipped machine; a malformed
+# description gives exactly one line `file:line:column: ...` and a non-zero exit.
+# usage: cli_test.sh AUTOSHOVEL SOURCE_DIR
+set -uo pipefail
+autoshovel=$1 source_dir=$2
+fail() { echo "FAIL: $*"; exit 1; }
+for machine in xcmg_968ev sdlg_l955he excavator_25t; do
+  out=$("$autoshovel" --models "$source_dir/models" describe "$machine") || fail "describe $machine"
+  grep -q "max reach" <<<"$out" || fail "describe $machine: no reach"
+  grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
+done
+for level in "" describe gen; do
+  "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
+done
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$tmp/models/loaders"
+cp -r "$source_dir/models/materials" "$tmp/models/"
+sed 's/^  track_width: 2.25 /  track_width: -2.25 /' "$source_dir/models/loaders/xcmg_968ev.yaml" \
+  > "$tmp/models/loaders/broken.yaml"
+"$autoshovel" gen "$tmp/models/loaders/broken.yaml" -o "$tmp/out" 2>"$tmp/err" >/dev/null
+status=$?
+[ "$status" -ne 0 ] || fail "malformed description accepted"
+[ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "expected one line, got: $(cat "$tmp/err")"
+grep -qE "broken.yaml:[0-9]+:[0-9]+: chassis.track_width: must be > 0 m, got -2.25 m" "$tmp/err" \
+  || fail "unexpected message: $(cat "$tmp/err")"
+[ ! -e "$tmp/out" ] || fail "output written for a malformed description"
+"$autoshovel" --models "$source_dir/models" describe no_such_machine 2>/dev/null && fail "unknown machine accepted"
+echo "cli ok"

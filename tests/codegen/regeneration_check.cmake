@@ -1,0 +1,31 @@
+# Regenerates every machine of models/ into WORK_DIR and compares with generated/ byte for byte
+# (symforce's compare_or_update_directory, as a ctest). Fails with the files that differ.
+file(REMOVE_RECURSE "${WORK_DIR}")
+execute_process(
+  COMMAND "${CODEGEN}" --clean --models "${SOURCE_DIR}/models" -o "${WORK_DIR}"
+  WORKING_DIRECTORY "${SOURCE_DIR}"
+  RESULT_VARIABLE result OUTPUT_QUIET ERROR_VARIABLE errors)
+if(NOT result EQUAL 0)
+  message(FATAL_ERROR "codegen failed (${result}):\n${errors}")
+endif()
+file(GLOB_RECURSE expected RELATIVE "${SOURCE_DIR}/generated" "${SOURCE_DIR}/generated/*")
+file(GLOB_RECURSE actual RELATIVE "${WORK_DIR}" "${WORK_DIR}/*")
+list(SORT expected)
+list(SORT actual)
+set(stale "")
+if(NOT expected STREQUAL actual)
+  set(stale "file sets differ:\n  committed: ${expected}\n  regenerated: ${actual}\n")
+endif()
+foreach(file IN LISTS expected)
+  if(EXISTS "${WORK_DIR}/${file}")
+    file(SHA256 "${SOURCE_DIR}/generated/${file}" a)
+    file(SHA256 "${WORK_DIR}/${file}" b)
+    if(NOT a STREQUAL b)
+      string(APPEND stale "  differs: generated/${file}\n")
+    endif()
+  endif()
+endforeach()
+if(stale)
+  message(FATAL_ERROR "generated/ is stale: run `cmake --build build --target regen`\n${stale}")
+endif()
+message(STATUS "generated/ matches a fresh regeneration")

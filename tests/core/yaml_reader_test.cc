@@ -1,0 +1,74 @@
+#include "runtime/core/yaml_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace autoshovel::core {
+namespace {
+
+std::filesystem::path WriteTemp(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(NumberRule, MessagesNameTheBoundTheUnitAndTheValue) {
+  EXPECT_EQ(NumberRule::Positive("m").Check(1.0), "");
+  EXPECT_EQ(NumberRule::Positive("m").Check(-1.3), "must be > 0 m, got -1.3 m");
+  EXPECT_EQ(NumberRule::NonNegative("kg").Check(0.0), "");
+  EXPECT_EQ(NumberRule::Closed(-180, 180, "deg").Check(200),
+            "must be in [-180, 180] deg, got 200 deg");
+  EXPECT_EQ(NumberRule::Open(0, 1, "").Check(1), "must be in (0, 1), got 1");
+}
+
+TEST(MapReader, ReportsMissingWrongAndUnknownKeysWithLocations) {
+  const auto path = WriteTemp("autoshovel_reader_test.yaml",
+                              "a: 1.5\n"
+                              "b: text\n"
+                              "lenght: 2\n"
+                              "nested:\n"
+                              "  c: -1\n");
+  DiagnosticSink sink;
+  const YamlFile file(path, sink);
+  MapReader root = MapReader::Root(file, nullptr);
+  EXPECT_DOUBLE_EQ(root.Number("a", NumberRule::Positive("m")), 1.5);
+  root.Number("b", NumberRule::Any());
+  root.Number("length", NumberRule::Positive("m"));
+  MapReader nested = root.Map("nested");
+  nested.Number("c", NumberRule::Positive("m"));
+  nested.Finish();
+  root.Finish();
+  const auto& d = sink.diagnostics();
+  ASSERT_EQ(d.size(), 4u);
+  EXPECT_EQ(d[0].ToString(), path.string() + ":2:4: b: expected a number, got 'text'");
+  EXPECT_EQ(d[1].ToString(), path.string() + ":1:1: length: missing required key 'length'");
+  EXPECT_EQ(d[2].ToString(), path.string() + ":5:6: nested.c: must be > 0 m, got -1 m");
+  EXPECT_EQ(d[3].ToString(),
+            path.string() + ":3:1: lenght: unknown key 'lenght' (did you mean 'length'?)");
+}
+
+TEST(MapReader, RefusesNonFiniteNumbers) {
+  const auto path = WriteTemp("autoshovel_reader_nan.yaml", "a: .nan\nb: .inf\n");
+  DiagnosticSink sink;
+  const YamlFile file(path, sink);
+  MapReader root = MapReader::Root(file, nullptr);
+  root.Number("a", NumberRule::Any());
+  root.Number("b", NumberRule::Any());
+  ASSERT_EQ(sink.diagnostics().size(), 2u);
+  EXPECT_EQ(sink.diagnostics()[0].message, "expected a finite number, got '.nan'");
+}
+
+TEST(YamlFile, SyntaxErrorsCarryTheirLocation) {
+  const auto path = WriteTemp("autoshovel_reader_syntax.yaml", "a: [1, 2\nb: 3\n");
+  DiagnosticSink sink;
+  const YamlFile file(path, sink);
+  EXPECT_FALSE(file.ok());
+  ASSERT_EQ(sink.diagnostics().size(), 1u);
+  EXPECT_GT(sink.diagnostics()[0].where.line, 0);
+  EXPECT_NE(sink.diagnostics()[0].message.find("YAML syntax error"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace autoshovel::core

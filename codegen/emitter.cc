@@ -20,7 +20,7 @@ using GiNaC::ex;
 // Style passed inline so that output formatting does not depend on where the output lands.
 constexpr const char* kClangFormatStyle =
     "{BasedOnStyle: Google, ColumnLimit: 100, DerivePointerAlignment: false, "
-    "PointerAlignment: Left}";
+    "PointerAlignment: Left}";  // keep equal to the project's .clang-format
 constexpr const char* kMarkerFile = ".autoshovel-machine";
 
 std::string Banner(const std::string& source, const std::string& sha256) {
@@ -51,12 +51,17 @@ void WriteFormatted(const fs::path& path, const std::string& text, const std::st
     if (!out) throw std::runtime_error(temporary.string() + ": cannot write");
     out << text;
   }
-  const std::string command =
-      formatter + " -i --style=\"" + kClangFormatStyle + "\" '" + temporary.string() + "'";
+  // Through standard input so that --assume-filename holds: include sorting must see the final
+  // name to recognise the file's own header.
+  const fs::path formatted = path.string() + ".formatted";
+  const std::string command = formatter + " --style=\"" + kClangFormatStyle +
+                              "\" --assume-filename='" + path.string() + "' < '" +
+                              temporary.string() + "' > '" + formatted.string() + "'";
   if (std::system(command.c_str()) != 0) {
     throw std::runtime_error("codegen: clang-format failed on " + temporary.string());
   }
-  fs::rename(temporary, path);  // atomic: a half-written file never replaces a good one
+  fs::remove(temporary);
+  fs::rename(formatted, path);  // atomic: a half-written file never replaces a good one
 }
 
 std::string Doubles(const std::vector<double>& values) {

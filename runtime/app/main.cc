@@ -1,11 +1,9 @@
 // autoshovel: the command line of the framework. Every level has --help.
-#include <CLI/CLI.hpp>
-
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstring>
-
 #include <filesystem>
 #include <iostream>
 #include <string>

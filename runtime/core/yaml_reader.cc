@@ -140,10 +140,7 @@ std::optional<YAML::Node> MapReader::Value(std::string_view key, bool required) 
   if (!valid_) return std::nullopt;
   const YAML::Node value = node_[std::string(key)];
   if (!value.IsDefined() || value.IsNull()) {
-    if (required) {
-      file_->sink().Add(location(), key_path_.empty() ? std::string(key) : key_path_,
-                        "missing required key '" + std::string(key) + "'");
-    }
+    if (required) missing_keys_.emplace_back(key);
     return std::nullopt;
   }
   Record(key, value);
@@ -330,15 +327,23 @@ std::vector<MapReader> MapReader::MapList(std::string_view key, bool required) {
 void MapReader::Finish() {
   if (!valid_) return;
   const std::vector<std::string> known(known_keys_.begin(), known_keys_.end());
+  std::set<std::string> explained;  // missing keys that an unknown key probably misspells
   for (auto it = node_.begin(); it != node_.end(); ++it) {
     const std::string key = it->first.as<std::string>();
     if (known_keys_.count(key) > 0) continue;
     std::string message = "unknown key '" + key + "'";
     if (const std::string near = NearestWord(key, known); !near.empty()) {
       message += " (did you mean '" + near + "'?)";
+      explained.insert(near);
     }
     file_->sink().Add(core::LocationOf(file_->file(), it->first), PathOf(key), message);
   }
+  for (const auto& key : missing_keys_) {
+    if (explained.count(key) > 0) continue;
+    file_->sink().Add(location(), key_path_.empty() ? key : key_path_,
+                      "missing required key '" + key + "'");
+  }
+  missing_keys_.clear();
 }
 
 }  // namespace autoshovel::core

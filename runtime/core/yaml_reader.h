@@ -110,7 +110,8 @@ class MapReader {
   /// A non-empty list of mappings.
   std::vector<MapReader> MapList(std::string_view key, bool required);
 
-  /// Reports every key that no getter asked for, suggesting the nearest known key.
+  /// Reports missing required keys and every key that no getter asked for, suggesting the
+  /// nearest known key. Must be called once all values are read.
   void Finish();
 
   /// Reports a problem with `key`'s value at its location.
@@ -128,6 +129,9 @@ class MapReader {
   LocationIndex* index_;
   bool valid_ = false;
   std::set<std::string, std::less<>> known_keys_;
+  /// Required keys found missing; reported by Finish() unless an unknown key is a likely typo
+  /// of one (then the single "did you mean" line says it all).
+  std::vector<std::string> missing_keys_;
 };
 
 template <std::size_t N>

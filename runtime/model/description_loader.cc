@@ -310,6 +310,7 @@ class Validator {
     for (const auto& link : m_.links) joints.push_back(link.name);
     if (m_.swing) joints.push_back("swing");
     std::vector<int> drivers(joints.size(), 0);
+    bool all_joints_known = true;  // else "no actuator drives" would repeat the same mistake
     std::set<std::string> seen;
     for (std::size_t i = 0; i < m_.hydraulics.actuators.size(); ++i) {
       const Actuator& a = m_.hydraulics.actuators[i];
@@ -320,6 +321,7 @@ class Validator {
         Error(path + ".joint", "unknown joint '" + a.joint + "', expected one of the links" +
                                    std::string(m_.swing ? " or 'swing'" : "") +
                                    Suggest(a.joint, joints));
+        all_joints_known = false;
         continue;
       }
       const std::size_t joint = static_cast<std::size_t>(it - joints.begin());
@@ -340,7 +342,7 @@ class Validator {
       }
       CheckMounts(a, path, static_cast<int>(joint));
     }
-    for (std::size_t j = 0; j < joints.size(); ++j) {
+    for (std::size_t j = 0; j < joints.size() && all_joints_known; ++j) {
       if (drivers[j] == 0) {
         Error("hydraulics.actuators", "no actuator drives joint '" + joints[j] + "'");
       } else if (drivers[j] > 1) {
@@ -414,6 +416,7 @@ class Validator {
     std::vector<std::string> bodies{"chassis"};
     for (const auto& link : m_.links) bodies.push_back(link.name);
     std::vector<int> count(bodies.size(), 0);
+    bool all_bodies_known = true;
     for (std::size_t i = 0; i < m_.sensors.imus.size(); ++i) {
       const Imu& imu = m_.sensors.imus[i];
       const auto it = std::find(bodies.begin(), bodies.end(), imu.body);
@@ -421,11 +424,12 @@ class Validator {
         Error("sensors.imus[" + std::to_string(i) + "].body",
               "unknown body '" + imu.body + "', expected 'chassis' or a link name" +
                   Suggest(imu.body, bodies));
+        all_bodies_known = false;
         continue;
       }
       ++count[it - bodies.begin()];
     }
-    for (std::size_t b = 0; b < bodies.size(); ++b) {
+    for (std::size_t b = 0; b < bodies.size() && all_bodies_known; ++b) {
       if (count[b] != 1) {
         Error("sensors.imus", "Eq. (1) needs exactly one IMU on '" + bodies[b] + "', got " +
                                   std::to_string(count[b]));

@@ -77,6 +77,16 @@ bool operator>(const Dual<S>& a, const Dual<S>& b) {
 }
 
 template <typename S>
+Dual<S> operator/(double a, const Dual<S>& b) {
+  return {a / b.v, -a * b.d / (b.v * b.v)};
+}
+template <typename S>
+Dual<S> pow(const Dual<S>& a, double exponent) {
+  using std::pow;
+  return {pow(a.v, exponent), exponent * pow(a.v, exponent - 1.0) * a.d};
+}
+
+template <typename S>
 Dual<S> sin(const Dual<S>& a) {
   using std::cos;
   using std::sin;

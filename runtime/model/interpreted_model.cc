@@ -1,7 +1,5 @@
 #include "runtime/model/interpreted_model.h"
 
-#include <unsupported/Eigen/AutoDiff>
-
 #include <stdexcept>
 
 namespace autoshovel::model {
@@ -123,15 +121,14 @@ std::vector<double> InterpretedModel::GravityTorques(const double* q, double pay
 }
 
 void InterpretedModel::PlantJacobian(const double* x, const double* u, double* jacobian) const {
-  using Scalar = Eigen::AutoDiffScalar<Eigen::VectorXd>;
-  const int N = sizes_.num_states;
-  std::vector<Scalar> xs(N), xdot(N);
-  for (int i = 0; i < N; ++i) xs[i] = Scalar(x[i], N, i);
-  PlantRhs(xs.data(), u, xdot.data());
-  for (int r = 0; r < N; ++r) {
-    for (int c = 0; c < N; ++c) {
-      jacobian[r * N + c] = xdot[r].derivatives().size() > 0 ? xdot[r].derivatives()[c] : 0.0;
-    }
+  // Forward mode, one column per pass, with the same dual numbers the lever arms use (Eigen's
+  // dynamic AutoDiffScalar mixes empty and sized derivative vectors badly in this code).
+  const int n = sizes_.num_states;
+  std::vector<Dual<double>> xs(n), xdot(n);
+  for (int c = 0; c < n; ++c) {
+    for (int i = 0; i < n; ++i) xs[i] = Dual<double>(x[i], i == c ? 1.0 : 0.0);
+    PlantRhs(xs.data(), u, xdot.data());
+    for (int r = 0; r < n; ++r) jacobian[r * n + c] = xdot[r].d;
   }
 }
 

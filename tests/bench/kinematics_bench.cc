@@ -3,11 +3,11 @@
 // plant right-hand side and Jacobian, for every generated machine.
 //   build/tests/bench/kinematics_bench --benchmark_min_time=0.2
 #include <benchmark/benchmark.h>
-#include <Eigen/Core>
-#include <unsupported/Eigen/AutoDiff>
 
+#include <Eigen/Core>
 #include <memory>
 #include <random>
+#include <unsupported/Eigen/AutoDiff>
 
 #include "generated/registry.h"
 #include "runtime/model/interpreted_model.h"

@@ -2,10 +2,10 @@
 // against the interpreted reference model and central finite differences, for every generated
 // machine over 10,000 seeded random configurations each.
 #include <gtest/gtest.h>
-#include <Eigen/Core>
-#include <unsupported/Eigen/AutoDiff>
 
+#include <Eigen/Core>
 #include <cmath>
+#include <unsupported/Eigen/AutoDiff>
 
 #include "tests/codegen/generated_test_support.h"
 

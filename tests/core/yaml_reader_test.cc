@@ -41,12 +41,28 @@ TEST(MapReader, ReportsMissingWrongAndUnknownKeysWithLocations) {
   nested.Finish();
   root.Finish();
   const auto& d = sink.diagnostics();
-  ASSERT_EQ(d.size(), 4u);
+  // The misspelt 'lenght' explains the missing 'length': one line, not two.
+  ASSERT_EQ(d.size(), 3u);
   EXPECT_EQ(d[0].ToString(), path.string() + ":2:4: b: expected a number, got 'text'");
-  EXPECT_EQ(d[1].ToString(), path.string() + ":1:1: length: missing required key 'length'");
-  EXPECT_EQ(d[2].ToString(), path.string() + ":5:6: nested.c: must be > 0 m, got -1 m");
-  EXPECT_EQ(d[3].ToString(),
+  EXPECT_EQ(d[1].ToString(), path.string() + ":5:6: nested.c: must be > 0 m, got -1 m");
+  EXPECT_EQ(d[2].ToString(),
             path.string() + ":3:1: lenght: unknown key 'lenght' (did you mean 'length'?)");
+}
+
+TEST(MapReader, ReportsAMissingKeyAtItsMapping) {
+  const auto path = WriteTemp("autoshovel_reader_missing.yaml", "a: 1\nnested:\n  b: 2\n");
+  DiagnosticSink sink;
+  const YamlFile file(path, sink);
+  MapReader root = MapReader::Root(file, nullptr);
+  root.Number("a", NumberRule::Any());
+  MapReader nested = root.Map("nested");
+  nested.Number("b", NumberRule::Any());
+  nested.Number("c", NumberRule::Any());
+  nested.Finish();
+  root.Finish();
+  ASSERT_EQ(sink.diagnostics().size(), 1u);
+  EXPECT_EQ(sink.diagnostics()[0].ToString(),
+            path.string() + ":3:3: nested: missing required key 'c'");
 }
 
 TEST(MapReader, RefusesNonFiniteNumbers) {

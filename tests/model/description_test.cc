@@ -1,10 +1,11 @@
 // The shipped machine descriptions load, validate and mean what they say.
+#include "runtime/model/description.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "runtime/model/description.h"
 #include "runtime/model/machine_summary.h"
 
 namespace autoshovel::model {

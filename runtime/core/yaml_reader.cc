@@ -101,7 +101,9 @@ MapReader::MapReader(const YamlFile& file, const YAML::Node& node, std::string k
                      LocationIndex* index)
     : file_(&file), node_(node), key_path_(std::move(key_path)), index_(index) {
   valid_ = node_.IsMap();
-  if (!valid_ && node_.IsDefined()) {
+  // A missing or empty value arrives as a null node: the parent reports it as a missing key
+  // (with its location), so it is not a second "expected a mapping" here.
+  if (!valid_ && node_.IsDefined() && !node_.IsNull()) {
     file_->sink().Add(core::LocationOf(file_->file(), node_), key_path_,
                       "expected a mapping, got " + Describe(node_));
   }

@@ -32,6 +32,11 @@ ex Smooth(const ex& value, double width) {
   return (value + GiNaC::sqrt(value * value + width * width)) / 2;
 }
 
+// d Smooth / d value: a smooth step from 0 to 1 over `width`.
+ex Step(const ex& value, double width) {
+  return (1 + value / GiNaC::sqrt(value * value + width * width)) / 2;
+}
+
 // Link frames in M from joint positions: φ_1 = q_1, φ_k = φ_{k−1} + q_k.
 struct Frames {
   std::vector<P2> origins;  // n + 1
@@ -237,8 +242,11 @@ void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
       rate = 0;
       for (int i = 0; i < J; ++i) rate += lever[i] * qd[i];
       end_force = a.count * model::plant::kEndStopStiffness *
-                  (Smooth(-extension, model::plant::kEndStopSmoothing) -
-                   Smooth(extension - a.stroke, model::plant::kEndStopSmoothing));
+                      (Smooth(-extension, model::plant::kEndStopSmoothing) -
+                       Smooth(extension - a.stroke, model::plant::kEndStopSmoothing)) -
+                  a.count * model::plant::kEndStopDamping * rate *
+                      (Step(-extension, model::plant::kEndStopSmoothing) +
+                       Step(extension - a.stroke, model::plant::kEndStopSmoothing));
     }
     const double t = model::plant::kOrificeTransitionPressure;
     auto orifice = [t](const ex& dp) {
@@ -246,7 +254,8 @@ void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
     };
     const ex open_a = Smooth(xs, model::plant::kSpoolUnderlap);
     const ex open_b = Smooth(-xs, model::plant::kSpoolUnderlap);
-    const double pp = hyd.pump_pressure, pt = hyd.tank_pressure, kv = a.valve.flow_gain;
+    const ex pp = s.u[2 * J + 2 + j];  // this valve section's supply pressure (an input)
+    const double pt = hyd.tank_pressure, kv = a.valve.flow_gain;
     const ex flow_a = kv * (open_a * orifice(pp - pa) - open_b * orifice(pa - pt));
     const ex flow_b = kv * (open_b * orifice(pp - pb) - open_a * orifice(pb - pt));
     const double relief_gain = a.valve.rated_flow / model::plant::kReliefFullFlowOverpressure;

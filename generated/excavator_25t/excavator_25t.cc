@@ -357,276 +357,288 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t0 = cos(x[0]);
   const double t1 = sin(x[0]);
   const double t2 = (-0.35 * t0 - t1 * 2.6);
-  const double t3 = sin(u[9]);
+  const double t3 = 5.7 * t0;
   const double t4 = (x[0] + x[1]);
-  const double t5 = cos(t4);
-  const double t6 = sin(t4);
-  const double t7 = (x[2] + x[0] + x[1]);
-  const double t8 = sin(t7);
-  const double t9 = cos(t7);
-  const double t10 = (0.315 * t5 + t6 * 0.15700000000000003 - 0.016 * t8 + 0.552 * t9);
-  const double t11 = (t10 * t10);
-  const double t12 = (-0.016) * t9;
-  const double t13 = t8 * (-0.552);
-  const double t14 = (t12 + t13 + 0.15700000000000003 * t5 - t6 * 0.315);
-  const double t15 = (t14 * t14);
-  const double t16 = (0.21712699999999996 + t11 + t15);
-  const double t17 = (t11 + t15);
-  const double t18 = (1.0 / sqrt(t17));
-  const double t19 = (1.0 / (t17));
-  const double t20 = (t16 * t16);
-  const double t21 = (-0.25 * t19 * t20 + 0.48441599999999996);
-  const double t22 = sqrt(t21);
-  const double t23 = (t16 * t18 * t10 + 2.0 * t22 * t14);
-  const double t24 = (-2.0 * t10 * t22 + t16 * t18 * t14);
-  const double t25 = atan2(t23 * 0.5 * t18, t24 * 0.5 * t18);
-  const double t26 = sin(t25);
-  const double t27 = (0.696 * t26 - 0.623 * t5 + t6 * 3.081);
-  const double t28 = t6 * 0.623;
-  const double t29 = 3.081 * t5;
-  const double t30 = cos(t25);
-  const double t31 = (t28 + t29 + 0.696 * t30);
-  const double t32 = ((t27 * t27) + (t31 * t31));
-  const double t33 = (1.0 / sqrt(t32));
-  const double t34 = sqrt(t32);
-  const double t35 = (t34 - 3.71);
-  const double t36 = (t34 - 2.525);
-  const double t37 = (623500000.0 - t34 * 2e+08 - sqrt((1e-06 + (t35 * t35))) * 1e+08 +
-                      1e+08 * sqrt(((t36 * t36) + 1e-06)) + x[14] * 0.013273228961416876 -
-                      x[18] * 0.006911503837897547);
-  const double t38 = pow(t17, (-1.5));
-  const double t39 = 0.016 * t8;
-  const double t40 = t9 * (-0.552);
-  const double t41 = (-0.315 * t5 + t39 + t40 - t6 * 0.15700000000000003);
-  const double t42 = (t10 * t14 + t41 * t14);
-  const double t43 = (1.0 / (t17 * t17));
-  const double t44 = (t16 * 2.0 * t19 * t42 - t43 * t20 * t42);
-  const double t45 = (1.0 / sqrt(t21));
-  const double t46 = (1.0 / (((t19 * (t24 * t24) + t19 * (t23 * t23)))));
-  const double t47 =
-      (t23 *
-           ((t24 * 2.0 * t38 * t42 -
-             ((t44 * t45 * t10 + t16 * 2.0 * t41 * t18 - t16 * 2.0 * t38 * t42 * t14 -
-               4.0 * t22 * t14 + 4.0 * t18 * t42 * t14)) *
-                 t18)) *
-           t18 * t46 +
-       t24 *
-           ((t18 * ((t16 * 2.0 * t18 * t14 + 4.0 * t18 * t42 * t10 + 4.0 * t41 * t22 -
-                     t16 * 2.0 * t38 * t42 * t10 - t44 * t45 * t14)) -
-             2.0 * t23 * t38 * t42)) *
-           t18 * t46);
-  const double t48 = (((0.348 * t30 * t47 + t28 + t29)) * t27 +
-                      t31 * ((-t6 * 3.081 - 0.348 * t47 * t26 + 0.623 * t5)));
-  const double t49 = t33 * t37 * t48;
-  const double t50 = t6 * (-2.9);
-  const double t51 = t1 * (-5.7);
-  const double t52 = t9 * (-0.0578571428571429);
-  const double t53 = t8 * (-0.567857142857143);
-  const double t54 = (t50 + t51 + t52 + t53);
-  const double t55 = t9 * 0.567857142857143;
-  const double t56 = t8 * (-0.0578571428571429);
-  const double t57 = 5.7 * t0;
-  const double t58 = 2.9 * t5;
-  const double t59 = (t55 + t56 + t57 + t58);
-  const double t60 = cos(u[9]);
-  const double t61 = t8 * (-0.3);
-  const double t62 = t9 * 0.7;
-  const double t63 = (t61 + t57 + t58 + t62);
-  const double t64 = t8 * (-0.7);
-  const double t65 = t9 * (-0.3);
-  const double t66 = (t64 + t50 + t51 + t65);
-  const double t67 = t5 * (-0.8);
-  const double t68 = t6 * (-0.104);
-  const double t69 = (1.11 * t1 + t67 + 3.136 * t0 + t68);
-  const double t70 = (-t6 * 0.8 + 3.136 * t1 + 0.104 * t5 - 1.11 * t0);
-  const double t71 = ((t69 * t69) + (t70 * t70));
+  const double t5 = sin(t4);
+  const double t6 = t5 * (-0.1);
+  const double t7 = cos(t4);
+  const double t8 = 1.1 * t7;
+  const double t9 = (t3 + t6 + t8);
+  const double t10 = t1 * (-0.35);
+  const double t11 = 2.6 * t0;
+  const double t12 = (t10 + t11);
+  const double t13 = t1 * (-5.7);
+  const double t14 = t7 * (-0.1);
+  const double t15 = t5 * (-1.1);
+  const double t16 = (t13 + t14 + t15);
+  const double t17 = (x[2] + x[0] + x[1]);
+  const double t18 = sin(t17);
+  const double t19 = t18 * (-0.7);
+  const double t20 = t5 * (-2.9);
+  const double t21 = cos(t17);
+  const double t22 = t21 * (-0.3);
+  const double t23 = (t19 + t20 + t13 + t22);
+  const double t24 = t21 * 0.567857142857143;
+  const double t25 = t18 * (-0.0578571428571429);
+  const double t26 = 2.9 * t7;
+  const double t27 = (t24 + t25 + t3 + t26);
+  const double t28 = t21 * (-0.0578571428571429);
+  const double t29 = t18 * (-0.567857142857143);
+  const double t30 = (t20 + t13 + t28 + t29);
+  const double t31 = t18 * (-0.3);
+  const double t32 = t21 * 0.7;
+  const double t33 = (t31 + t3 + t26 + t32);
+  const double t34 = sin(u[9]);
+  const double t35 = cos(u[9]);
+  const double t36 = (1.09 - 0.236 * t0 + t1 * 2.979);
+  const double t37 = 0.236 * t1;
+  const double t38 = t0 * 2.979;
+  const double t39 = (-0.356 + t37 + t38);
+  const double t40 = ((t36 * t36) + (t39 * t39));
+  const double t41 = (1.0 / sqrt(t40));
+  const double t42 = (((t37 + t38)) * t36 + t39 * ((-t1 * 2.979 + 0.236 * t0)));
+  const double t43 = sqrt(t40);
+  const double t44 = (-3.775 + t43);
+  const double t45 = (1e-06 + (t44 * t44));
+  const double t46 = (-2.03 + t43);
+  const double t47 = (1e-06 + (t46 * t46));
+  const double t48 = t7 * (-0.8);
+  const double t49 = t5 * (-0.104);
+  const double t50 = (1.11 * t1 + t48 + 3.136 * t0 + t49);
+  const double t51 = (-t5 * 0.8 + 3.136 * t1 + 0.104 * t7 - 1.11 * t0);
+  const double t52 = ((t50 * t50) + (t51 * t51));
+  const double t53 = (1.0 / sqrt(t52));
+  const double t54 = sqrt(t52);
+  const double t55 = (-4.005 + t54);
+  const double t56 = (1e-06 + (t55 * t55));
+  const double t57 = (t54 - 2.595);
+  const double t58 = (1e-06 + (t57 * t57));
+  const double t59 = (-0.104) * t7;
+  const double t60 = t5 * 0.8;
+  const double t61 = (t50 * ((t59 + t60)) + ((t48 + t49)) * t51);
+  const double t62 = (t50 * ((t59 + t60 - 3.136 * t1 + 1.11 * t0)) + t51 * t50);
+  const double t63 = (-0.035342917352885174 * x[13] + 4e+08 * t54 - 1.32e+09 + sqrt(t56) * 2e+08 -
+                      sqrt(t58) * 2e+08 + x[17] * 0.01802488784997144 +
+                      (((1.0 / sqrt(t56)) * t55 - (1.0 / sqrt(t58)) * t57 + 2.0)) *
+                          ((t53 * 2e+06 * x[5] * t61 + t53 * 2e+06 * t62 * x[4])));
+  const double t64 = (0.315 * t7 + t5 * 0.15700000000000003 - 0.016 * t18 + 0.552 * t21);
+  const double t65 = (t64 * t64);
+  const double t66 = (-0.016) * t21;
+  const double t67 = t18 * (-0.552);
+  const double t68 = (t66 + t67 + 0.15700000000000003 * t7 - t5 * 0.315);
+  const double t69 = (t68 * t68);
+  const double t70 = (0.21712699999999996 + t65 + t69);
+  const double t71 = (t65 + t69);
   const double t72 = (1.0 / sqrt(t71));
-  const double t73 = (-0.104) * t5;
-  const double t74 = t6 * 0.8;
-  const double t75 = (t69 * ((t73 + t74 - 3.136 * t1 + 1.11 * t0)) + t70 * t69);
-  const double t76 = sqrt(t71);
-  const double t77 = (-4.005 + t76);
-  const double t78 = (t76 - 2.595);
-  const double t79 =
-      (x[13] * 0.017671458676442587 - sqrt((1e-06 + (t77 * t77))) * 1e+08 + 6.6e+08 - 2e+08 * t76 +
-       sqrt((1e-06 + (t78 * t78))) * 1e+08 - x[17] * 0.00901244392498572);
-  const double t80 = (1.09 - 0.236 * t0 + t1 * 2.979);
-  const double t81 = 0.236 * t1;
-  const double t82 = t0 * 2.979;
-  const double t83 = (-0.356 + t81 + t82);
-  const double t84 = ((t80 * t80) + (t83 * t83));
-  const double t85 = (1.0 / sqrt(t84));
-  const double t86 = sqrt(t84);
-  const double t87 = (-3.775 + t86);
-  const double t88 = (-2.03 + t86);
-  const double t89 = (((t81 + t82)) * t80 + t83 * ((-t1 * 2.979 + 0.236 * t0)));
-  const double t90 = t6 * (-0.1);
-  const double t91 = 1.1 * t5;
-  const double t92 = (t57 + t90 + t91);
-  const double t93 = t5 * (-0.1);
-  const double t94 = t6 * (-1.1);
-  const double t95 = (t51 + t93 + t94);
-  const double t96 = t1 * (-0.35);
-  const double t97 = 2.6 * t0;
-  const double t98 = (t96 + t97);
-  const double t99 = (t93 + t94);
-  const double t100 = (t50 + t52 + t53);
-  const double t101 = (t55 + t56 + t58);
-  const double t102 = (t64 + t50 + t65);
-  const double t103 = (t61 + t58 + t62);
-  const double t104 = (t90 + t91);
-  const double t105 = (t69 * ((t73 + t74)) + ((t67 + t68)) * t70);
-  const double t106 = (t64 + t65);
-  const double t107 = (t61 + t62);
-  const double t108 = (t55 + t56);
-  const double t109 = (t52 + t53);
-  const double t110 = (t39 + t40);
-  const double t111 = (t12 + t13);
-  const double t112 = (t110 * t14 + t111 * t10);
-  const double t113 = (t16 * 2.0 * t19 * t112 - t43 * t20 * t112);
-  const double t114 =
-      (t24 *
-           ((((-4.0 * t110 * t22 - 4.0 * t18 * t10 * t112 + t113 * t45 * t14 +
-               t16 * 2.0 * t38 * t10 * t112 - t16 * 2.0 * t111 * t18)) *
-                 t18 +
-             2.0 * t23 * t38 * t112)) *
-           t18 * t46 -
-       ((-t18 * ((t16 * 2.0 * t18 * t110 + t113 * t45 * t10 - t16 * 2.0 * t38 * t112 * t14 +
-                  4.0 * t18 * t112 * t14 - 4.0 * t111 * t22)) +
-         t24 * 2.0 * t38 * t112)) *
-           t23 * t18 * t46);
-  const double t115 = (-t114 * 0.696 * t30 * t27 + t114 * t31 * 0.696 * t26);
-  const double t116 = (t55 + t56 + t57 + t58 + 0.15);
-  const double t117 = (x[12] - 2e+05);
-  const double t118 = (t117 * t117);
-  const double t119 = (x[12] - 3.7e+07);
-  const double t120 = sqrt(((x[8] * x[8]) + 1e-04));
-  const double t121 = (t120 - x[8]);
-  const double t122 = (x[12] - 34300000.0);
-  const double t123 = (t120 + x[8]);
-  const double t124 = (x[13] - 3.7e+07);
-  const double t125 = (x[13] - 34300000.0);
-  const double t126 = sqrt((1e-04 + (x[9] * x[9])));
-  const double t127 = (x[9] + t126);
-  const double t128 = (x[13] - 2e+05);
-  const double t129 = (t128 * t128);
-  const double t130 = (-x[9] + t126);
-  const double t131 = (x[14] - 2e+05);
-  const double t132 = (t131 * t131);
-  const double t133 = sqrt((1e-04 + (x[10] * x[10])));
-  const double t134 = (-t133 + x[10]);
-  const double t135 = (x[10] + t133);
-  const double t136 = (x[14] - 34300000.0);
-  const double t137 = (x[14] - 3.7e+07);
-  const double t138 = (x[15] - 2e+05);
-  const double t139 = (t138 * t138);
-  const double t140 = (-2.9e+07 + x[15]);
-  const double t141 = sqrt((1e-04 + (x[11] * x[11])));
-  const double t142 = (t141 + x[11]);
-  const double t143 = (x[15] - 34300000.0);
-  const double t144 = (-t141 + x[11]);
-  const double t145 = (x[16] - 34300000.0);
-  const double t146 = (x[16] - 3.7e+07);
-  const double t147 = (x[16] - 2e+05);
-  const double t148 = (t147 * t147);
-  const double t149 = (x[17] - 2e+05);
-  const double t150 = (t149 * t149);
-  const double t151 = (x[17] - 3.7e+07);
-  const double t152 = (x[17] - 34300000.0);
-  const double t153 = (x[18] - 3.7e+07);
-  const double t154 = (x[18] - 34300000.0);
-  const double t155 = (x[18] - 2e+05);
-  const double t156 = (t155 * t155);
-  const double t157 = (x[19] - 34300000.0);
-  const double t158 = (x[19] - 2e+05);
-  const double t159 = (t158 * t158);
-  const double t160 = (-2.9e+07 + x[19]);
+  const double t73 = (1.0 / (t71));
+  const double t74 = (t70 * t70);
+  const double t75 = (-0.25 * t73 * t74 + 0.48441599999999996);
+  const double t76 = sqrt(t75);
+  const double t77 = (t70 * t72 * t64 + 2.0 * t76 * t68);
+  const double t78 = (-2.0 * t64 * t76 + t70 * t72 * t68);
+  const double t79 = atan2(t77 * 0.5 * t72, t78 * 0.5 * t72);
+  const double t80 = sin(t79);
+  const double t81 = (0.696 * t80 - 0.623 * t7 + t5 * 3.081);
+  const double t82 = t5 * 0.623;
+  const double t83 = 3.081 * t7;
+  const double t84 = cos(t79);
+  const double t85 = (t82 + t83 + 0.696 * t84);
+  const double t86 = ((t81 * t81) + (t85 * t85));
+  const double t87 = (1.0 / sqrt(t86));
+  const double t88 = sqrt(t86);
+  const double t89 = (t88 - 2.525);
+  const double t90 = ((t89 * t89) + 1e-06);
+  const double t91 = (t88 - 3.71);
+  const double t92 = (1e-06 + (t91 * t91));
+  const double t93 = pow(t71, (-1.5));
+  const double t94 = 0.016 * t18;
+  const double t95 = t21 * (-0.552);
+  const double t96 = (-0.315 * t7 + t94 + t95 - t5 * 0.15700000000000003);
+  const double t97 = (t64 * t68 + t96 * t68);
+  const double t98 = (1.0 / (t71 * t71));
+  const double t99 = (t70 * 2.0 * t73 * t97 - t98 * t74 * t97);
+  const double t100 = (1.0 / sqrt(t75));
+  const double t101 = (1.0 / (((t73 * (t78 * t78) + t73 * (t77 * t77)))));
+  const double t102 =
+      (t77 *
+           ((t78 * 2.0 * t93 * t97 -
+             ((t99 * t100 * t64 + t70 * 2.0 * t96 * t72 - t70 * 2.0 * t93 * t97 * t68 -
+               4.0 * t76 * t68 + 4.0 * t72 * t97 * t68)) *
+                 t72)) *
+           t72 * t101 +
+       t78 *
+           ((t72 * ((t70 * 2.0 * t72 * t68 + 4.0 * t72 * t97 * t64 + 4.0 * t96 * t76 -
+                     t70 * 2.0 * t93 * t97 * t64 - t99 * t100 * t68)) -
+             2.0 * t77 * t93 * t97)) *
+           t72 * t101);
+  const double t103 = (((0.348 * t84 * t102 + t82 + t83)) * t81 +
+                       t85 * ((-t5 * 3.081 - 0.348 * t102 * t80 + 0.623 * t7)));
+  const double t104 = (t94 + t95);
+  const double t105 = (t66 + t67);
+  const double t106 = (t104 * t68 + t105 * t64);
+  const double t107 = (t70 * 2.0 * t73 * t106 - t98 * t74 * t106);
+  const double t108 =
+      (t78 *
+           ((((-4.0 * t104 * t76 - 4.0 * t72 * t64 * t106 + t107 * t100 * t68 +
+               t70 * 2.0 * t93 * t64 * t106 - t70 * 2.0 * t105 * t72)) *
+                 t72 +
+             2.0 * t77 * t93 * t106)) *
+           t72 * t101 -
+       ((-t72 * ((t70 * 2.0 * t72 * t104 + t107 * t100 * t64 - t70 * 2.0 * t93 * t106 * t68 +
+                  4.0 * t72 * t106 * t68 - 4.0 * t105 * t76)) +
+         t78 * 2.0 * t93 * t106)) *
+           t77 * t72 * t101);
+  const double t109 = (-t108 * 0.696 * t84 * t81 + t108 * t85 * 0.696 * t80);
+  const double t110 =
+      (4e+08 * t88 + 0.013823007675795093 * x[18] - 1.247e+09 - 2e+08 * sqrt(t90) -
+       0.026546457922833753 * x[14] + 2e+08 * sqrt(t92) +
+       ((t87 * 2e+06 * x[4] * t103 + t87 * 2e+06 * x[5] * t103 + t87 * t109 * 1e+06 * x[6])) *
+           ((2.0 + (1.0 / sqrt(t92)) * t91 - t89 * (1.0 / sqrt(t90)))));
+  const double t111 = (t14 + t15);
+  const double t112 = (t6 + t8);
+  const double t113 = (t31 + t26 + t32);
+  const double t114 = (t20 + t28 + t29);
+  const double t115 = (t24 + t25 + t26);
+  const double t116 = (t19 + t20 + t22);
+  const double t117 = (t19 + t22);
+  const double t118 = (t31 + t32);
+  const double t119 = (t24 + t25);
+  const double t120 = (t28 + t29);
+  const double t121 = (t24 + t25 + t3 + t26 + 0.15);
+  const double t122 = (x[12] - 2e+05);
+  const double t123 = (t122 * t122);
+  const double t124 = (x[12] - 3.7e+07);
+  const double t125 = (-x[12] + u[10]);
+  const double t126 = sqrt(((x[8] * x[8]) + 1e-06));
+  const double t127 = (t126 + x[8]);
+  const double t128 = (-t126 + x[8]);
+  const double t129 = (x[13] - 3.7e+07);
+  const double t130 = (u[11] - x[13]);
+  const double t131 = sqrt((1e-06 + (x[9] * x[9])));
+  const double t132 = (x[9] + t131);
+  const double t133 = (x[13] - 2e+05);
+  const double t134 = (t133 * t133);
+  const double t135 = (-x[9] + t131);
+  const double t136 = (x[14] - 3.7e+07);
+  const double t137 = (x[14] - 2e+05);
+  const double t138 = (t137 * t137);
+  const double t139 = sqrt((1e-06 + (x[10] * x[10])));
+  const double t140 = (x[10] - t139);
+  const double t141 = (x[10] + t139);
+  const double t142 = (u[12] - x[14]);
+  const double t143 = sqrt((1e-06 + (x[11] * x[11])));
+  const double t144 = (t143 - x[11]);
+  const double t145 = (x[15] - 2e+05);
+  const double t146 = (t145 * t145);
+  const double t147 = (t143 + x[11]);
+  const double t148 = (u[13] - x[15]);
+  const double t149 = (-2.9e+07 + x[15]);
+  const double t150 = (x[16] - 3.7e+07);
+  const double t151 = (x[16] - 2e+05);
+  const double t152 = (t151 * t151);
+  const double t153 = (x[16] - u[10]);
+  const double t154 = (x[17] - 2e+05);
+  const double t155 = (t154 * t154);
+  const double t156 = (x[17] - 3.7e+07);
+  const double t157 = (u[11] - x[17]);
+  const double t158 = (x[18] - 3.7e+07);
+  const double t159 = (x[18] - 2e+05);
+  const double t160 = (t159 * t159);
+  const double t161 = (u[12] - x[18]);
+  const double t162 = (x[19] - u[13]);
+  const double t163 = (x[19] - 2e+05);
+  const double t164 = (t163 * t163);
+  const double t165 = (-2.9e+07 + x[19]);
   xdot[0] = x[4];
   xdot[1] = x[5];
   xdot[2] = x[6];
   xdot[3] = x[7];
-  xdot[4] =
-      ((-t2 * t3 * 21574.629999999997 + t49 + u[8] * ((-t3 * t54 * 9.80665 - t59 * t60 * 9.80665)) -
-        t63 * t60 * 9316.3175 - x[4] * 6000.0 - t3 * t66 * 9316.3175 + t72 * t75 * t79 +
-        t85 *
-            ((-2e+08 * sqrt((1e-06 + (t87 * t87))) + sqrt((1e-06 + (t88 * t88))) * 2e+08 -
-              0.015079644737231009 * x[16] + 1.161e+09 - 4e+08 * t86 +
-              x[12] * 0.03078760800517998)) *
-            t89 +
-        u[4] - t92 * t60 * 10787.314999999999 - t3 * t95 * 10787.314999999999 -
-        t98 * t60 * 21574.629999999997)) /
-      (((7650.0 + 2200.0 * (t2 * t2) + (t92 * t92) * 1100.0 + (t98 * t98) * 2200.0 +
-         1100.0 * (t95 * t95) + 950.0 * (t66 * t66) + (((t59 * t59) + (t54 * t54))) * u[8] +
-         (t63 * t63) * 950.0)));
+  xdot[4] = ((t34 * 21574.629999999997 * t16 + 18632.635 * t33 * t35 -
+              2.0 * u[8] * ((-t34 * t30 * 9.80665 - t27 * t35 * 9.80665)) -
+              t41 * 2.0 * t42 *
+                  ((-t41 * 2e+06 * x[4] *
+                        ((2.0 + (1.0 / sqrt(t45)) * t44 - t46 * (1.0 / sqrt(t47)))) * t42 -
+                    2e+08 * sqrt(t45) + sqrt(t47) * 2e+08 - 0.015079644737231009 * x[16] +
+                    1.161e+09 - 4e+08 * t43 + x[12] * 0.03078760800517998)) +
+              t34 * 18632.635 * t23 + x[4] * 12000.0 - 2.0 * u[4] + t53 * t63 * t62 +
+              t12 * t35 * 43149.259999999995 + t9 * t35 * 21574.629999999997 +
+              t2 * t34 * 43149.259999999995 + t87 * t110 * t103)) *
+            (-0.5) /
+            (((7650.0 + 2200.0 * (t2 * t2) + (t9 * t9) * 1100.0 + (t12 * t12) * 2200.0 +
+               1100.0 * (t16 * t16) + 950.0 * (t23 * t23) + (((t27 * t27) + (t30 * t30))) * u[8] +
+               (t33 * t33) * 950.0)));
   xdot[5] =
-      ((-t103 * t60 * 9316.3175 - t3 * t102 * 9316.3175 + t49 +
-        ((-t3 * 9.80665 * t100 - t60 * t101 * 9.80665)) * u[8] - 2500.0 * x[5] + t72 * t79 * t105 -
-        t3 * 10787.314999999999 * t99 + u[5] - t104 * t60 * 10787.314999999999)) /
-      ((((t99 * t99) * 1100.0 + 1150.0 + u[8] * (((t100 * t100) + (t101 * t101))) +
-         950.0 * (t102 * t102) + (t103 * t103) * 950.0 + 1100.0 * (t104 * t104))));
+      ((-t34 * 21574.629999999997 * t111 - t112 * t35 * 21574.629999999997 -
+        t113 * 18632.635 * t35 - t87 * t110 * t103 - 5000.0 * x[5] - t53 * t63 * t61 + 2.0 * u[5] +
+        2.0 * ((-t34 * 9.80665 * t114 - t35 * t115 * 9.80665)) * u[8] - t34 * 18632.635 * t116)) *
+      0.5 /
+      ((((t111 * t111) * 1100.0 + 1150.0 + u[8] * (((t114 * t114) + (t115 * t115))) +
+         950.0 * (t116 * t116) + (t113 * t113) * 950.0 + 1100.0 * (t112 * t112))));
   xdot[6] =
-      ((-((-t108 * t60 * 9.80665 - t3 * 9.80665 * t109)) * 2.0 * u[8] + 18632.635 * t60 * t107 -
-        t33 * t37 * t115 - 2.0 * u[6] + t106 * t3 * 18632.635 + 1600.0 * x[6])) *
-      (-0.5) /
-      ((((t106 * t106) * 950.0 + 250.0 + (t107 * t107) * 950.0 +
-         u[8] * (((t108 * t108) + (t109 * t109))))));
+      (-0.25) *
+      ((3200.0 * x[6] + t87 * t109 * t110 - 4.0 * u[6] + 37265.27 * t117 * t34 -
+        ((-t119 * t35 * 9.80665 - t34 * 9.80665 * t120)) * 4.0 * u[8] + 37265.27 * t35 * t118)) /
+      ((((t117 * t117) * 950.0 + 250.0 + (t118 * t118) * 950.0 +
+         u[8] * (((t119 * t119) + (t120 * t120))))));
   xdot[7] = ((-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 + u[7])) /
-            (((((t57 + t90 + t91 + 0.15)) * ((-t6 * 110.0 + t5 * 1210.0 + 6270.0 * t0 + 165.0)) +
-               60000.0 + (t116 * t116) * u[8] +
-               ((t61 + t57 + t58 + 0.15 + t62)) *
-                   ((-t8 * 285.0 + 665.0 * t9 + t5 * 2755.0 + 142.5 + 5415.0 * t0)) +
-               ((5720.0 * t0 + 330.0 - t1 * 770.0)) * ((t96 + 0.15 + t97)))));
+            (((((t3 + t6 + t8 + 0.15)) * ((-t5 * 110.0 + t7 * 1210.0 + 6270.0 * t0 + 165.0)) +
+               60000.0 + (t121 * t121) * u[8] +
+               ((t31 + t3 + t26 + 0.15 + t32)) *
+                   ((-t18 * 285.0 + 665.0 * t21 + t7 * 2755.0 + 142.5 + 5415.0 * t0)) +
+               ((5720.0 * t0 + 330.0 - t1 * 770.0)) * ((t10 + 0.15 + t11)))));
   xdot[8] = (-x[8] * 16.666666666666668 + u[0] * 16.666666666666668);
   xdot[9] = (-x[9] * 16.666666666666668 + u[1] * 16.666666666666668);
   xdot[10] = (-x[10] * 16.666666666666668 + u[2] * 16.666666666666668);
   xdot[11] = (-12.5 * x[11] + 12.5 * u[3]);
-  xdot[12] = ((sqrt((t118 + 1e+10)) * 3.5e-09 - t85 * x[4] * 0.03078760800517998 * t89 -
-               sqrt(((t119 * t119) + 1e+10)) * 3.5e-09 - x[12] * 7e-09 -
-               pow((4e+10 + t118), (-0.25)) * t117 * 2.8577380332470414e-06 * t121 + 0.1302 -
-               pow((4e+10 + (t122 * t122)), (-0.25)) * 2.8577380332470414e-06 * t122 * t123)) *
-             1.2e+09 / (((t86 * 0.03078760800517998 - 0.059498844250515354)));
-  xdot[13] = ((-sqrt((1e+10 + (t124 * t124))) * 3.5e-09 - t72 * 0.017671458676442587 * x[5] * t105 -
-               t72 * t75 * 0.017671458676442587 * x[4] - x[13] * 7e-09 -
-               pow((4e+10 + (t125 * t125)), (-0.25)) * 2.8577380332470414e-06 * t125 * t127 +
-               0.1302 + sqrt((1e+10 + t129)) * 3.5e-09 -
-               pow((4e+10 + t129), (-0.25)) * t128 * 2.8577380332470414e-06 * t130)) *
-             1.2e+09 / (((0.017671458676442587 * t76 - 0.04285743526536852)));
-  xdot[14] =
-      ((-t33 * t115 * 0.006636614480708438 * x[6] + 0.093 -
-        t33 * x[5] * 0.013273228961416876 * t48 - t33 * x[4] * 0.013273228961416876 * t48 +
-        pow((4e+10 + t132), (-0.25)) * t131 * t134 * 2.0412414523193154e-06 -
-        t135 * pow((4e+10 + (t136 * t136)), (-0.25)) * t136 * 2.0412414523193154e-06 -
-        sqrt(((t137 * t137) + 1e+10)) * 2.5e-09 - x[14] * 5e-09 + 2.5e-09 * sqrt((1e+10 + t132)))) *
-      1.2e+09 / (((t34 * 0.013273228961416876 - 0.03151490312757761)));
-  xdot[15] =
-      (1.825e+10 + 625.0 * sqrt((1e+10 + t139)) - 625.0 * sqrt(((t140 * t140) + 1e+10)) -
-       7.5e+08 * x[7] - t142 * t143 * pow((4e+10 + (t143 * t143)), (-0.25)) * 510310.3630798288 +
-       t138 * pow((4e+10 + t139), (-0.25)) * t144 * 510310.3630798288 - x[15] * 1250.0);
-  xdot[16] = 1.2e+09 *
-             ((0.015079644737231009 * t85 * x[4] * t89 -
-               2.8577380332470414e-06 * pow((4e+10 + (t145 * t145)), (-0.25)) * t145 * t121 -
-               sqrt(((t146 * t146) + 1e+10)) * 3.5e-09 -
-               pow((4e+10 + t148), (-0.25)) * t147 * 2.8577380332470414e-06 * t123 - x[16] * 7e-09 +
-               0.1302 + sqrt((1e+10 + t148)) * 3.5e-09)) /
-             (((0.05992565888304706 - 0.015079644737231009 * t86)));
-  xdot[17] = ((sqrt((t150 + 1e+10)) * 3.5e-09 - sqrt((1e+10 + (t151 * t151))) * 3.5e-09 -
-               2.8577380332470414e-06 * t152 * pow((4e+10 + (t152 * t152)), (-0.25)) * t130 +
-               t72 * t75 * x[4] * 0.00901244392498572 + 0.1302 -
-               pow((4e+10 + t150), (-0.25)) * t149 * 2.8577380332470414e-06 * t127 - x[17] * 7e-09 +
-               t72 * x[5] * t105 * 0.00901244392498572)) *
-             1.2e+09 / (((0.03909483791956781 - t76 * 0.00901244392498572)));
-  xdot[18] =
+  xdot[12] = 1.2e+09 *
+             ((sqrt((t123 + 1e+10)) * 3.5e-09 - t41 * x[4] * 0.03078760800517998 * t42 -
+               sqrt(((t124 * t124) + 1e+10)) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
+               t125 * 2.8577380332470414e-06 * pow(((t125 * t125) + 4e+10), (-0.25)) * t127 +
+               pow((4e+10 + t123), (-0.25)) * t122 * 2.8577380332470414e-06 * t128)) /
+             (((t43 * 0.03078760800517998 - 0.059498844250515354)));
+  xdot[13] = ((-sqrt((1e+10 + (t129 * t129))) * 3.5e-09 +
+               2.8577380332470414e-06 * t130 * t132 * pow((4e+10 + (t130 * t130)), (-0.25)) -
+               t53 * 0.017671458676442587 * x[5] * t61 - t53 * t62 * 0.017671458676442587 * x[4] -
+               x[13] * 7e-09 + 0.1302 + sqrt((1e+10 + t134)) * 3.5e-09 -
+               pow((4e+10 + t134), (-0.25)) * t133 * 2.8577380332470414e-06 * t135)) *
+             1.2e+09 / (((0.017671458676442587 * t54 - 0.04285743526536852)));
+  xdot[14] = 1.2e+09 *
+             ((-t87 * t109 * 0.006636614480708438 * x[6] + 0.093 -
+               t87 * x[5] * 0.013273228961416876 * t103 - t87 * x[4] * 0.013273228961416876 * t103 -
+               sqrt(((t136 * t136) + 1e+10)) * 2.5e-09 +
+               pow((4e+10 + t138), (-0.25)) * t137 * t140 * 2.0412414523193154e-06 - x[14] * 5e-09 +
+               2.5e-09 * sqrt((1e+10 + t138)) +
+               t141 * t142 * pow((4e+10 + (t142 * t142)), (-0.25)) * 2.0412414523193154e-06)) /
+             (((t88 * 0.013273228961416876 - 0.03151490312757761)));
+  xdot[15] = (-t144 * t145 * pow((4e+10 + t146), (-0.25)) * 510310.3630798288 +
+              t147 * t148 * 510310.3630798288 * pow((4e+10 + (t148 * t148)), (-0.25)) + 1.825e+10 +
+              625.0 * sqrt((1e+10 + t146)) - 625.0 * sqrt(((t149 * t149) + 1e+10)) -
+              7.5e+08 * x[7] - x[15] * 1250.0);
+  xdot[16] =
       1.2e+09 *
-      ((-2.5e-09 * sqrt((1e+10 + (t153 * t153))) +
-        pow((4e+10 + (t154 * t154)), (-0.25)) * t134 * t154 * 2.0412414523193154e-06 + 0.093 +
-        t33 * 0.006911503837897547 * x[5] * t48 + 2.5e-09 * sqrt((t156 + 1e+10)) +
-        t33 * 0.006911503837897547 * x[4] * t48 + t33 * t115 * 0.0034557519189487734 * x[6] -
-        x[18] * 5e-09 - pow((4e+10 + t156), (-0.25)) * t155 * t135 * 2.0412414523193154e-06)) /
-      (((0.0276416792385999 - t34 * 0.006911503837897547)));
-  xdot[19] = (1.825e+10 + pow((4e+10 + (t157 * t157)), (-0.25)) * t144 * t157 * 510310.3630798288 -
-              pow((4e+10 + t159), (-0.25)) * t142 * t158 * 510310.3630798288 +
-              625.0 * sqrt((t159 + 1e+10)) - 625.0 * sqrt(((t160 * t160) + 1e+10)) +
-              7.5e+08 * x[7] - x[19] * 1250.0);
+      ((0.015079644737231009 * t41 * x[4] * t42 - sqrt(((t150 * t150) + 1e+10)) * 3.5e-09 -
+        pow((4e+10 + t152), (-0.25)) * t151 * 2.8577380332470414e-06 * t127 - x[16] * 7e-09 +
+        0.1302 + pow((4e+10 + (t153 * t153)), (-0.25)) * 2.8577380332470414e-06 * t153 * t128 +
+        sqrt((1e+10 + t152)) * 3.5e-09)) /
+      (((0.05992565888304706 - 0.015079644737231009 * t43)));
+  xdot[17] = 1.2e+09 *
+             ((sqrt((t155 + 1e+10)) * 3.5e-09 - sqrt((1e+10 + (t156 * t156))) * 3.5e-09 +
+               t53 * t62 * x[4] * 0.00901244392498572 + 0.1302 +
+               t157 * 2.8577380332470414e-06 * t135 * pow((4e+10 + (t157 * t157)), (-0.25)) -
+               pow((4e+10 + t155), (-0.25)) * t154 * 2.8577380332470414e-06 * t132 - x[17] * 7e-09 +
+               t53 * x[5] * t61 * 0.00901244392498572)) /
+             (((0.03909483791956781 - t54 * 0.00901244392498572)));
+  xdot[18] =
+      ((-2.5e-09 * sqrt((1e+10 + (t158 * t158))) + 0.093 +
+        t87 * 0.006911503837897547 * x[5] * t103 + 2.5e-09 * sqrt((t160 + 1e+10)) +
+        t87 * 0.006911503837897547 * x[4] * t103 + t87 * t109 * 0.0034557519189487734 * x[6] -
+        t140 * t161 * 2.0412414523193154e-06 * pow((4e+10 + (t161 * t161)), (-0.25)) -
+        x[18] * 5e-09 - pow((4e+10 + t160), (-0.25)) * t159 * t141 * 2.0412414523193154e-06)) *
+      1.2e+09 / (((0.0276416792385999 - t88 * 0.006911503837897547)));
+  xdot[19] = (-t144 * t162 * 510310.3630798288 * pow((4e+10 + (t162 * t162)), (-0.25)) + 1.825e+10 +
+              625.0 * sqrt((t164 + 1e+10)) - 625.0 * sqrt(((t165 * t165) + 1e+10)) -
+              pow((4e+10 + t164), (-0.25)) * t163 * t147 * 510310.3630798288 + 7.5e+08 * x[7] -
+              x[19] * 1250.0);
 }
 
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
@@ -674,745 +686,817 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t34 = (7650.0 + 2200.0 * (t2 * t2) + (t9 * t9) * 1100.0 + (t12 * t12) * 2200.0 +
                       1100.0 * (t16 * t16) + 950.0 * (t23 * t23) +
                       (((t27 * t27) + (t30 * t30))) * u[8] + (t33 * t33) * 950.0);
-  const double t35 = (1.0 / (t34));
-  const double t36 = (1.09 - 0.236 * t0 + t1 * 2.979);
-  const double t37 = 0.236 * t1;
-  const double t38 = t0 * 2.979;
-  const double t39 = (-0.356 + t37 + t38);
-  const double t40 = ((t36 * t36) + (t39 * t39));
-  const double t41 = pow(t40, (-1.5));
-  const double t42 = (t37 + t38);
-  const double t43 = (-t1 * 2.979 + 0.236 * t0);
-  const double t44 = (t42 * t36 + t39 * t43);
-  const double t45 = (t44 * t44);
-  const double t46 = sqrt(t40);
-  const double t47 = (-3.775 + t46);
-  const double t48 = (1e-06 + (t47 * t47));
-  const double t49 = (-2.03 + t46);
-  const double t50 = (1e-06 + (t49 * t49));
-  const double t51 = (-2e+08 * sqrt(t48) + sqrt(t50) * 2e+08 - 0.015079644737231009 * x[16] +
-                      1.161e+09 - 4e+08 * t46 + x[12] * 0.03078760800517998);
-  const double t52 = sin(u[9]);
-  const double t53 = (t1 * 0.35 - t11);
-  const double t54 = (0.315 * t7 + t5 * 0.15700000000000003 - 0.016 * t18 + 0.552 * t21);
-  const double t55 = (t54 * t54);
-  const double t56 = (-0.016) * t21;
-  const double t57 = t18 * (-0.552);
-  const double t58 = (t56 + t57 + 0.15700000000000003 * t7 - t5 * 0.315);
-  const double t59 = (t58 * t58);
-  const double t60 = (0.21712699999999996 + t55 + t59);
-  const double t61 = (t55 + t59);
-  const double t62 = (1.0 / sqrt(t61));
-  const double t63 = (1.0 / (t61));
-  const double t64 = (t60 * t60);
-  const double t65 = (-0.25 * t63 * t64 + 0.48441599999999996);
-  const double t66 = sqrt(t65);
-  const double t67 = (t60 * t62 * t54 + 2.0 * t66 * t58);
-  const double t68 = (-2.0 * t54 * t66 + t60 * t62 * t58);
-  const double t69 = atan2(t67 * 0.5 * t62, t68 * 0.5 * t62);
-  const double t70 = sin(t69);
-  const double t71 = (0.696 * t70 - 0.623 * t7 + t5 * 3.081);
-  const double t72 = t5 * 0.623;
-  const double t73 = 3.081 * t7;
-  const double t74 = cos(t69);
-  const double t75 = (t72 + t73 + 0.696 * t74);
-  const double t76 = ((t71 * t71) + (t75 * t75));
-  const double t77 = pow(t76, (-1.5));
-  const double t78 = sqrt(t76);
-  const double t79 = (t78 - 3.71);
-  const double t80 = (1e-06 + (t79 * t79));
-  const double t81 = (t78 - 2.525);
-  const double t82 = ((t81 * t81) + 1e-06);
-  const double t83 = (623500000.0 - t78 * 2e+08 - sqrt(t80) * 1e+08 + 1e+08 * sqrt(t82) +
-                      x[14] * 0.013273228961416876 - x[18] * 0.006911503837897547);
-  const double t84 = pow(t61, (-1.5));
-  const double t85 = 0.016 * t18;
-  const double t86 = t21 * (-0.552);
-  const double t87 = (-0.315 * t7 + t85 + t86 - t5 * 0.15700000000000003);
-  const double t88 = (t54 * t58 + t87 * t58);
-  const double t89 = (1.0 / (t61 * t61));
-  const double t90 = (t60 * 2.0 * t63 * t88 - t89 * t64 * t88);
-  const double t91 = (1.0 / sqrt(t65));
-  const double t92 = (t90 * t91 * t54 + t60 * 2.0 * t87 * t62 - t60 * 2.0 * t84 * t88 * t58 -
-                      4.0 * t66 * t58 + 4.0 * t62 * t88 * t58);
-  const double t93 = (t68 * 2.0 * t84 * t88 - t92 * t62);
-  const double t94 = (t68 * t68);
-  const double t95 = (t67 * t67);
-  const double t96 = (t63 * t94 + t63 * t95);
-  const double t97 = (1.0 / (t96));
-  const double t98 = (t60 * 2.0 * t62 * t58 + 4.0 * t62 * t88 * t54 + 4.0 * t87 * t66 -
-                      t60 * 2.0 * t84 * t88 * t54 - t90 * t91 * t58);
-  const double t99 = (t62 * t98 - 2.0 * t67 * t84 * t88);
-  const double t100 = (t67 * t93 * t62 * t97 + t68 * t99 * t62 * t97);
-  const double t101 = (0.348 * t74 * t100 + t72 + t73);
-  const double t102 = (-3.081) * t5;
-  const double t103 = 0.623 * t7;
-  const double t104 = (t102 - 0.348 * t100 * t70 + t103);
-  const double t105 = (t101 * t71 + t75 * t104);
-  const double t106 = (t105 * t105);
-  const double t107 = t77 * t83 * t106 * (-1.0);
-  const double t108 = (1.0 / sqrt(t76));
-  const double t109 = (1.0 / sqrt(t80));
-  const double t110 = (1.0 / sqrt(t82));
-  const double t111 =
-      (-t108 * 1e+08 * t109 * t79 * t105 + t108 * 1e+08 * t81 * t110 * t105 - t108 * 2e+08 * t105);
-  const double t112 = t108 * t111 * t105;
-  const double t113 = cos(u[9]);
-  const double t114 = (-2.9) * t7;
-  const double t115 = t18 * 0.0578571428571429;
-  const double t116 = (-5.7) * t0;
-  const double t117 = (-0.567857142857143) * t21;
-  const double t118 = (t114 + t115 + t116 + t117);
-  const double t119 = t7 * (-0.8);
-  const double t120 = t5 * (-0.104);
-  const double t121 = (1.11 * t1 + t119 + 3.136 * t0 + t120);
-  const double t122 = (t121 * t121);
-  const double t123 = (-t5 * 0.8 + 3.136 * t1 + 0.104 * t7 - 1.11 * t0);
-  const double t124 = (t122 + (t123 * t123));
-  const double t125 = (1.0 / sqrt(t124));
-  const double t126 = (-0.104) * t7;
-  const double t127 = t5 * 0.8;
-  const double t128 = (t126 + t127 - 3.136 * t1 + 1.11 * t0);
-  const double t129 = (t121 * t128 + t123 * t121);
-  const double t130 = sqrt(t124);
-  const double t131 = (t130 - 2.595);
-  const double t132 = (1e-06 + (t131 * t131));
-  const double t133 = (1.0 / sqrt(t132));
-  const double t134 = (-4.005 + t130);
-  const double t135 = (1e-06 + (t134 * t134));
-  const double t136 = (1.0 / sqrt(t135));
-  const double t137 = (-t125 * 2e+08 * t129 + t133 * t125 * t131 * t129 * 1e+08 -
-                       t125 * t129 * 1e+08 * t136 * t134);
-  const double t138 = (1.0 / (t96 * t96));
-  const double t139 =
-      (2.0 * t89 * t88 * t95 + 2.0 * t89 * t88 * t94 - t67 * t63 * t98 - t68 * t92 * t63);
-  const double t140 = pow(t61, (-2.5));
-  const double t141 = (t88 * t88);
-  const double t142 = 0.016 * t21;
-  const double t143 = t18 * 0.552;
-  const double t144 = (t142 + t143 - 0.15700000000000003 * t7 + t5 * 0.315);
-  const double t145 = (t87 * t54 + (t87 * t87) + t144 * t58 + t59);
-  const double t146 = (1.0 / (t61 * t61 * t61));
-  const double t147 = (-t145 * t89 * t64 + 4.0 * t63 * t141 + t60 * t145 * 2.0 * t63 +
-                       t146 * 4.0 * t64 * t141 - t60 * t89 * t141 * 8.0);
-  const double t148 = (t90 * t90);
-  const double t149 = pow(t65, (-1.5));
-  const double t150 =
-      (t68 * t138 * 4.0 * t99 * t62 * t139 - t67 * t93 * 4.0 * t84 * t97 * t88 +
-       t138 * t67 * t93 * 4.0 * t62 * t139 - t68 * 4.0 * t99 * t84 * t97 * t88 -
-       ((-t67 * 24.0 * t140 * t141 + t84 * t88 * t98 * 8.0 -
-         ((-4.0 * t91 * t147 * t58 - t148 * t149 * t58 + 32.0 * t62 * t88 * t58 -
-           32.0 * t84 * t141 * t54 + t145 * 16.0 * t62 * t54 - t60 * 16.0 * t84 * t88 * t58 +
-           t60 * t87 * t62 * 8.0 + t60 * 24.0 * t140 * t141 * t54 - t90 * t87 * t91 * 8.0 +
-           16.0 * t144 * t66 - t60 * t145 * t84 * 8.0 * t54)) *
-             t62 +
-         t145 * t67 * t84 * 8.0)) *
-           t68 * t62 * t97 +
-       2.0 * t93 * t62 * t97 * t98 +
-       t67 * t62 * t97 *
-           ((t68 * t145 * t84 * 8.0 - t68 * 24.0 * t140 * t141 + t92 * t84 * t88 * 8.0 -
-             t62 * ((t60 * t144 * t62 * 8.0 + t148 * t149 * t54 + t90 * t91 * 8.0 * t58 -
-                     16.0 * t87 * t66 + 32.0 * t87 * t62 * t88 - 32.0 * t84 * t141 * t58 -
-                     t60 * 16.0 * t87 * t84 * t88 + t60 * 24.0 * t140 * t141 * t58 -
-                     t60 * t145 * t84 * 8.0 * t58 + 4.0 * t91 * t147 * t54 +
-                     t145 * 16.0 * t62 * t58)))) +
-       t92 * 2.0 * t99 * t62 * t97);
-  const double t151 = (t100 * t100);
-  const double t152 = (((-t72 - 0.087 * t150 * t70 - t73 - 0.174 * t74 * t151)) * t75 +
-                       t71 * ((t102 - 0.174 * t151 * t70 + t103 + 0.087 * t150 * t74)) +
-                       (t101 * t101) + (t104 * t104));
-  const double t153 = t108 * t83 * t152;
-  const double t154 = (1.0 / sqrt(t40));
-  const double t155 = (x[13] * 0.017671458676442587 - sqrt(t135) * 1e+08 + 6.6e+08 - 2e+08 * t130 +
-                       sqrt(t132) * 1e+08 - x[17] * 0.00901244392498572);
-  const double t156 = 0.8 * t7;
-  const double t157 = t5 * 0.104;
-  const double t158 =
-      (t121 * ((-3.136 * t0 + t156 - 1.11 * t1 + t157)) + t123 * t128 + t122 + (t128 * t128));
-  const double t159 = t18 * 0.3;
-  const double t160 = t21 * (-0.7);
-  const double t161 = (t159 + t114 + t116 + t160);
-  const double t162 = t5 * 0.1;
-  const double t163 = t7 * (-1.1);
-  const double t164 = (t162 + t163 + t116);
-  const double t165 = ((t42 * t42) + t36 * t43 + ((-t38 - t37)) * t39 + (t43 * t43));
-  const double t166 = pow(t124, (-1.5));
-  const double t167 = (t129 * t129);
-  const double t168 = t108 * t83 * t105;
+  const double t35 = (1.0 / (t34 * t34));
+  const double t36 = sin(u[9]);
+  const double t37 = cos(u[9]);
+  const double t38 = (1.09 - 0.236 * t0 + t1 * 2.979);
+  const double t39 = 0.236 * t1;
+  const double t40 = t0 * 2.979;
+  const double t41 = (-0.356 + t39 + t40);
+  const double t42 = ((t38 * t38) + (t41 * t41));
+  const double t43 = (1.0 / sqrt(t42));
+  const double t44 = (t39 + t40);
+  const double t45 = (-t1 * 2.979 + 0.236 * t0);
+  const double t46 = (t44 * t38 + t41 * t45);
+  const double t47 = sqrt(t42);
+  const double t48 = (-3.775 + t47);
+  const double t49 = (t48 * t48);
+  const double t50 = (1e-06 + t49);
+  const double t51 = (1.0 / sqrt(t50));
+  const double t52 = (-2.03 + t47);
+  const double t53 = (t52 * t52);
+  const double t54 = (1e-06 + t53);
+  const double t55 = (1.0 / sqrt(t54));
+  const double t56 = (2.0 + t51 * t48 - t52 * t55);
+  const double t57 =
+      (-t43 * 2e+06 * x[4] * t56 * t46 - 2e+08 * sqrt(t50) + sqrt(t54) * 2e+08 -
+       0.015079644737231009 * x[16] + 1.161e+09 - 4e+08 * t47 + x[12] * 0.03078760800517998);
+  const double t58 = t7 * (-0.8);
+  const double t59 = t5 * (-0.104);
+  const double t60 = (1.11 * t1 + t58 + 3.136 * t0 + t59);
+  const double t61 = (t60 * t60);
+  const double t62 = (-t5 * 0.8 + 3.136 * t1 + 0.104 * t7 - 1.11 * t0);
+  const double t63 = (t61 + (t62 * t62));
+  const double t64 = (1.0 / sqrt(t63));
+  const double t65 = sqrt(t63);
+  const double t66 = (-4.005 + t65);
+  const double t67 = (t66 * t66);
+  const double t68 = (1e-06 + t67);
+  const double t69 = (t65 - 2.595);
+  const double t70 = (t69 * t69);
+  const double t71 = (1e-06 + t70);
+  const double t72 = (1.0 / sqrt(t68));
+  const double t73 = (1.0 / sqrt(t71));
+  const double t74 = (t72 * t66 - t73 * t69 + 2.0);
+  const double t75 = (-0.104) * t7;
+  const double t76 = t5 * 0.8;
+  const double t77 = (t75 + t76);
+  const double t78 = (t58 + t59);
+  const double t79 = (t60 * t77 + t78 * t62);
+  const double t80 = (t75 + t76 - 3.136 * t1 + 1.11 * t0);
+  const double t81 = (t60 * t80 + t62 * t60);
+  const double t82 = (t64 * 2e+06 * x[5] * t79 + t64 * 2e+06 * t81 * x[4]);
+  const double t83 = (-0.035342917352885174 * x[13] + 4e+08 * t65 - 1.32e+09 + sqrt(t68) * 2e+08 -
+                      sqrt(t71) * 2e+08 + x[17] * 0.01802488784997144 + t74 * t82);
+  const double t84 = (0.315 * t7 + t5 * 0.15700000000000003 - 0.016 * t18 + 0.552 * t21);
+  const double t85 = (t84 * t84);
+  const double t86 = (-0.016) * t21;
+  const double t87 = t18 * (-0.552);
+  const double t88 = (t86 + t87 + 0.15700000000000003 * t7 - t5 * 0.315);
+  const double t89 = (t88 * t88);
+  const double t90 = (0.21712699999999996 + t85 + t89);
+  const double t91 = (t85 + t89);
+  const double t92 = (1.0 / sqrt(t91));
+  const double t93 = (1.0 / (t91));
+  const double t94 = (t90 * t90);
+  const double t95 = (-0.25 * t93 * t94 + 0.48441599999999996);
+  const double t96 = sqrt(t95);
+  const double t97 = (t90 * t92 * t84 + 2.0 * t96 * t88);
+  const double t98 = (-2.0 * t84 * t96 + t90 * t92 * t88);
+  const double t99 = atan2(t97 * 0.5 * t92, t98 * 0.5 * t92);
+  const double t100 = sin(t99);
+  const double t101 = (0.696 * t100 - 0.623 * t7 + t5 * 3.081);
+  const double t102 = t5 * 0.623;
+  const double t103 = 3.081 * t7;
+  const double t104 = cos(t99);
+  const double t105 = (t102 + t103 + 0.696 * t104);
+  const double t106 = ((t101 * t101) + (t105 * t105));
+  const double t107 = (1.0 / sqrt(t106));
+  const double t108 = sqrt(t106);
+  const double t109 = (t108 - 2.525);
+  const double t110 = (t109 * t109);
+  const double t111 = (t110 + 1e-06);
+  const double t112 = (t108 - 3.71);
+  const double t113 = (t112 * t112);
+  const double t114 = (1e-06 + t113);
+  const double t115 = pow(t91, (-1.5));
+  const double t116 = 0.016 * t18;
+  const double t117 = t21 * (-0.552);
+  const double t118 = (-0.315 * t7 + t116 + t117 - t5 * 0.15700000000000003);
+  const double t119 = (t84 * t88 + t118 * t88);
+  const double t120 = (1.0 / (t91 * t91));
+  const double t121 = (t90 * 2.0 * t93 * t119 - t120 * t94 * t119);
+  const double t122 = (1.0 / sqrt(t95));
+  const double t123 = (t121 * t122 * t84 + t90 * 2.0 * t118 * t92 - t90 * 2.0 * t115 * t119 * t88 -
+                       4.0 * t96 * t88 + 4.0 * t92 * t119 * t88);
+  const double t124 = (t98 * 2.0 * t115 * t119 - t123 * t92);
+  const double t125 = (t98 * t98);
+  const double t126 = (t97 * t97);
+  const double t127 = (t93 * t125 + t93 * t126);
+  const double t128 = (1.0 / (t127));
+  const double t129 = (t90 * 2.0 * t92 * t88 + 4.0 * t92 * t119 * t84 + 4.0 * t118 * t96 -
+                       t90 * 2.0 * t115 * t119 * t84 - t121 * t122 * t88);
+  const double t130 = (t92 * t129 - 2.0 * t97 * t115 * t119);
+  const double t131 = (t97 * t124 * t92 * t128 + t98 * t130 * t92 * t128);
+  const double t132 = (0.348 * t104 * t131 + t102 + t103);
+  const double t133 = (-3.081) * t5;
+  const double t134 = 0.623 * t7;
+  const double t135 = (t133 - 0.348 * t131 * t100 + t134);
+  const double t136 = (t132 * t101 + t105 * t135);
+  const double t137 = (t116 + t117);
+  const double t138 = (t86 + t87);
+  const double t139 = (t137 * t88 + t138 * t84);
+  const double t140 = (t90 * 2.0 * t93 * t139 - t120 * t94 * t139);
+  const double t141 = (-4.0 * t137 * t96 - 4.0 * t92 * t84 * t139 + t140 * t122 * t88 +
+                       t90 * 2.0 * t115 * t84 * t139 - t90 * 2.0 * t138 * t92);
+  const double t142 = (t141 * t92 + 2.0 * t97 * t115 * t139);
+  const double t143 = (t90 * 2.0 * t92 * t137 + t140 * t122 * t84 - t90 * 2.0 * t115 * t139 * t88 +
+                       4.0 * t92 * t139 * t88 - 4.0 * t138 * t96);
+  const double t144 = (-t92 * t143 + t98 * 2.0 * t115 * t139);
+  const double t145 = (t98 * t142 * t92 * t128 - t144 * t97 * t92 * t128);
+  const double t146 = (-t145 * 0.696 * t104 * t101 + t145 * t105 * 0.696 * t100);
+  const double t147 =
+      (t107 * 2e+06 * x[4] * t136 + t107 * 2e+06 * x[5] * t136 + t107 * t146 * 1e+06 * x[6]);
+  const double t148 = (1.0 / sqrt(t114));
+  const double t149 = (1.0 / sqrt(t111));
+  const double t150 = (2.0 + t148 * t112 - t109 * t149);
+  const double t151 =
+      (4e+08 * t108 + 0.013823007675795093 * x[18] - 1.247e+09 - 2e+08 * sqrt(t111) -
+       0.026546457922833753 * x[14] + 2e+08 * sqrt(t114) + t147 * t150);
+  const double t152 =
+      (t36 * 21574.629999999997 * t16 + 18632.635 * t33 * t37 -
+       2.0 * u[8] * ((-t36 * t30 * 9.80665 - t27 * t37 * 9.80665)) - t43 * 2.0 * t46 * t57 +
+       t36 * 18632.635 * t23 + x[4] * 12000.0 - 2.0 * u[4] + t64 * t83 * t81 +
+       t12 * t37 * 43149.259999999995 + t9 * t37 * 21574.629999999997 +
+       t2 * t36 * 43149.259999999995 + t107 * t151 * t136);
+  const double t153 = (t1 * 0.35 - t11);
+  const double t154 = (-2.9) * t7;
+  const double t155 = t18 * 0.0578571428571429;
+  const double t156 = (-5.7) * t0;
+  const double t157 = (-0.567857142857143) * t21;
+  const double t158 = (t154 + t155 + t156 + t157);
+  const double t159 = t5 * 0.1;
+  const double t160 = t7 * (-1.1);
+  const double t161 = (t159 + t160 + t156);
+  const double t162 = t18 * 0.3;
+  const double t163 = t21 * (-0.7);
+  const double t164 = (t162 + t154 + t156 + t163);
+  const double t165 = (1.0 / (t34));
+  const double t166 = pow(t111, (-1.5));
+  const double t167 = pow(t114, (-1.5));
+  const double t168 = (1.0 / (t127 * t127));
   const double t169 =
-      (-t2 * t52 * 21574.629999999997 + t168 +
-       u[8] * ((-t52 * t30 * 9.80665 - t27 * t113 * 9.80665)) - t33 * t113 * 9316.3175 -
-       x[4] * 6000.0 - t52 * t23 * 9316.3175 + t125 * t129 * t155 + t154 * t51 * t44 + u[4] -
-       t9 * t113 * 10787.314999999999 - t52 * t16 * 10787.314999999999 -
-       t12 * t113 * 21574.629999999997);
-  const double t170 = (1.0 / (t34 * t34));
-  const double t171 = (t159 + t114 + t160);
-  const double t172 = (t19 + t20 + t22);
-  const double t173 = (t20 + t28 + t29);
-  const double t174 = (t114 + t115 + t117);
-  const double t175 = (t162 + t163);
-  const double t176 = (t14 + t15);
-  const double t177 = t52 * t171 * (-9316.3175);
-  const double t178 = ((-t113 * 9.80665 * t173 - t52 * t174 * 9.80665)) * u[8];
-  const double t179 = (t126 + t127);
-  const double t180 = (t119 + t120);
-  const double t181 = (t121 * t179 + t180 * t123);
-  const double t182 = (-t125 * 2e+08 * t181 + t133 * t125 * t131 * 1e+08 * t181 -
-                       t125 * 1e+08 * t136 * t181 * t134);
-  const double t183 = t121 * ((t156 + t157));
-  const double t184 = t123 * t179;
-  const double t185 = (t183 + t184 + t180 * t121 + t179 * t128);
-  const double t186 = t125 * t155 * t185;
-  const double t187 = t175 * t52 * (-10787.314999999999);
-  const double t188 = (-10787.314999999999) * t113 * t176;
-  const double t189 = t166 * t129 * t155 * t181 * (-1.0);
-  const double t190 = t113 * t172 * (-9316.3175);
-  const double t191 = (t19 + t22);
-  const double t192 = (t115 + t117);
-  const double t193 = (t28 + t29);
-  const double t194 = (-t52 * t192 * 9.80665 - t113 * 9.80665 * t193);
-  const double t195 = (t159 + t160);
-  const double t196 = (t85 + t86);
-  const double t197 = (t56 + t57);
-  const double t198 = (t196 * t58 + t197 * t54);
-  const double t199 = (t60 * 2.0 * t63 * t198 - t89 * t64 * t198);
-  const double t200 = (-4.0 * t196 * t66 - 4.0 * t62 * t54 * t198 + t199 * t91 * t58 +
-                       t60 * 2.0 * t84 * t54 * t198 - t60 * 2.0 * t197 * t62);
-  const double t201 = (t200 * t62 + 2.0 * t67 * t84 * t198);
-  const double t202 = (t60 * 2.0 * t62 * t196 + t199 * t91 * t54 - t60 * 2.0 * t84 * t198 * t58 +
-                       4.0 * t62 * t198 * t58 - 4.0 * t197 * t66);
-  const double t203 = (-t62 * t202 + t68 * 2.0 * t84 * t198);
-  const double t204 = (t68 * t201 * t62 * t97 - t203 * t67 * t62 * t97);
-  const double t205 = (-t204 * 0.696 * t74 * t71 + t204 * t75 * 0.696 * t70);
-  const double t206 =
-      (-t108 * t205 * t109 * t79 * 5e+07 - t108 * t205 * 1e+08 + t108 * t205 * t81 * t110 * 5e+07);
-  const double t207 =
-      (2.0 * t89 * t94 * t198 + 2.0 * t89 * t95 * t198 - t68 * t63 * t202 + t67 * t200 * t63);
-  const double t208 = t54 * t196;
-  const double t209 = (t142 + t143);
-  const double t210 = t209 * t58;
-  const double t211 = (t87 * t196 + t208 + t210 + t197 * t58);
+      (2.0 * t120 * t119 * t126 + 2.0 * t120 * t119 * t125 - t97 * t93 * t129 - t98 * t123 * t93);
+  const double t170 = pow(t91, (-2.5));
+  const double t171 = (t119 * t119);
+  const double t172 = 0.016 * t21;
+  const double t173 = t18 * 0.552;
+  const double t174 = (t172 + t173 - 0.15700000000000003 * t7 + t5 * 0.315);
+  const double t175 = (t118 * t84 + (t118 * t118) + t174 * t88 + t89);
+  const double t176 = (1.0 / (t91 * t91 * t91));
+  const double t177 = (-t175 * t120 * t94 + 4.0 * t93 * t171 + t90 * t175 * 2.0 * t93 +
+                       t176 * 4.0 * t94 * t171 - t90 * t120 * t171 * 8.0);
+  const double t178 = (t121 * t121);
+  const double t179 = pow(t95, (-1.5));
+  const double t180 =
+      (t98 * t168 * 4.0 * t130 * t92 * t169 - t97 * t124 * 4.0 * t115 * t128 * t119 +
+       t168 * t97 * t124 * 4.0 * t92 * t169 - t98 * 4.0 * t130 * t115 * t128 * t119 -
+       ((-t97 * 24.0 * t170 * t171 + t115 * t119 * t129 * 8.0 -
+         ((-4.0 * t122 * t177 * t88 - t178 * t179 * t88 + 32.0 * t92 * t119 * t88 -
+           32.0 * t115 * t171 * t84 + t175 * 16.0 * t92 * t84 - t90 * 16.0 * t115 * t119 * t88 +
+           t90 * t118 * t92 * 8.0 + t90 * 24.0 * t170 * t171 * t84 - t121 * t118 * t122 * 8.0 +
+           16.0 * t174 * t96 - t90 * t175 * t115 * 8.0 * t84)) *
+             t92 +
+         t175 * t97 * t115 * 8.0)) *
+           t98 * t92 * t128 +
+       2.0 * t124 * t92 * t128 * t129 +
+       t97 * t92 * t128 *
+           ((t98 * t175 * t115 * 8.0 - t98 * 24.0 * t170 * t171 + t123 * t115 * t119 * 8.0 -
+             t92 * ((t90 * t174 * t92 * 8.0 + t178 * t179 * t84 + t121 * t122 * 8.0 * t88 -
+                     16.0 * t118 * t96 + 32.0 * t118 * t92 * t119 - 32.0 * t115 * t171 * t88 -
+                     t90 * 16.0 * t118 * t115 * t119 + t90 * 24.0 * t170 * t171 * t88 -
+                     t90 * t175 * t115 * 8.0 * t88 + 4.0 * t122 * t177 * t84 +
+                     t175 * 16.0 * t92 * t88)))) +
+       t123 * 2.0 * t130 * t92 * t128);
+  const double t181 = (t131 * t131);
+  const double t182 = (((-t102 - 0.087 * t180 * t100 - t103 - 0.174 * t104 * t181)) * t105 +
+                       t101 * ((t133 - 0.174 * t181 * t100 + t134 + 0.087 * t180 * t104)) +
+                       (t132 * t132) + (t135 * t135));
+  const double t183 = pow(t106, (-1.5));
+  const double t184 = (t136 * t136);
+  const double t185 = t84 * t137;
+  const double t186 = (t172 + t173);
+  const double t187 = t186 * t88;
+  const double t188 = (t118 * t137 + t185 + t187 + t138 * t88);
+  const double t189 =
+      (4.0 * t93 * t119 * t139 + t90 * 2.0 * t93 * t188 - t90 * t120 * t119 * 8.0 * t139 -
+       t120 * t94 * t188 + t176 * 4.0 * t94 * t119 * t139);
+  const double t190 = (-16.0) * t186 * t96;
+  const double t191 = t90 * (-8.0) * t92 * t137;
+  const double t192 = (-t97 * t115 * t188 * 8.0 + 4.0 * t141 * t115 * t119 -
+                       4.0 * t115 * t129 * t139 + t97 * 24.0 * t170 * t119 * t139 -
+                       ((4.0 * t122 * t189 * t88 - 16.0 * t138 * t92 * t119 -
+                         16.0 * t92 * t139 * t88 + t140 * 4.0 * t118 * t122 +
+                         t90 * t115 * t188 * 8.0 * t84 + 32.0 * t115 * t119 * t84 * t139 +
+                         t121 * 4.0 * t122 * t137 + t90 * t115 * 8.0 * t139 * t88 + t190 +
+                         t121 * t140 * t179 * t88 + t90 * t138 * t115 * t119 * 8.0 -
+                         16.0 * t188 * t92 * t84 - t90 * 24.0 * t170 * t119 * t84 * t139 + t191)) *
+                           t92);
+  const double t193 = (-16.0) * t137 * t96;
+  const double t194 = t90 * t186 * t92 * 8.0;
+  const double t195 =
+      (4.0 * t115 * t119 * t143 -
+       t92 * ((16.0 * t188 * t92 * t88 - t90 * t115 * t119 * 8.0 * t137 + 16.0 * t92 * t119 * t137 +
+               t193 + t194 - 32.0 * t115 * t119 * t139 * t88 + 4.0 * t122 * t84 * t189 +
+               t90 * 24.0 * t170 * t119 * t139 * t88 - t90 * t115 * t188 * 8.0 * t88 +
+               t140 * 4.0 * t122 * t88 + 16.0 * t118 * t92 * t139 + t121 * t140 * t179 * t84 -
+               t90 * t118 * t115 * 8.0 * t139 + t121 * 4.0 * t138 * t122)) -
+       t98 * 24.0 * t170 * t119 * t139 + t98 * t115 * t188 * 8.0 + t123 * 4.0 * t115 * t139);
+  const double t196 =
+      (t98 * t92 * t128 * t192 - t142 * t123 * 2.0 * t92 * t128 -
+       t144 * t97 * 4.0 * t115 * t128 * t119 + t168 * t144 * t97 * 4.0 * t92 * t169 +
+       t98 * t142 * 4.0 * t115 * t128 * t119 - t98 * t142 * t168 * 4.0 * t92 * t169 +
+       t97 * t195 * t92 * t128 + t144 * 2.0 * t92 * t128 * t129);
+  const double t197 =
+      (t145 * 0.348 * t131 * t101 * t100 + t145 * 0.696 * t100 * t135 - t145 * 0.696 * t104 * t132 +
+       0.174 * t196 * t104 * t101 - 0.174 * t105 * t196 * t100 + t145 * 0.348 * t105 * t104 * t131);
+  const double t198 = (t107 * 4e+08 * t136 - t107 * 2e+08 * t109 * t149 * t136 +
+                       t147 * ((-t107 * t149 * t136 + t107 * t148 * t136 +
+                                t107 * t110 * t166 * t136 - t107 * t167 * t136 * t113)) +
+                       t107 * 2e+08 * t148 * t112 * t136 +
+                       ((t107 * t182 * 2e+06 * x[4] + t107 * t182 * 2e+06 * x[5] -
+                         t183 * t146 * 1e+06 * x[6] * t136 - t183 * t184 * 2e+06 * x[4] -
+                         t183 * t184 * 2e+06 * x[5] + t107 * t197 * 1e+06 * x[6])) *
+                           t150);
+  const double t199 = t107 * (-1.0) * t136 * t198;
+  const double t200 = pow(t63, (-1.5));
+  const double t201 = (t81 * t81);
+  const double t202 = 0.8 * t7;
+  const double t203 = t5 * 0.104;
+  const double t204 =
+      (t60 * ((-3.136 * t0 + t202 - 1.11 * t1 + t203)) + t62 * t80 + t61 + (t80 * t80));
+  const double t205 = ((t44 * t44) + t38 * t45 + ((-t40 - t39)) * t41 + (t45 * t45));
+  const double t206 = t107 * t182 * t151 * (-1.0);
+  const double t207 = pow(t71, (-1.5));
+  const double t208 = pow(t68, (-1.5));
+  const double t209 = t60 * ((t202 + t203));
+  const double t210 = t62 * t77;
+  const double t211 = (t209 + t210 + t78 * t60 + t77 * t80);
   const double t212 =
-      (4.0 * t63 * t88 * t198 + t60 * 2.0 * t63 * t211 - t60 * t89 * t88 * 8.0 * t198 -
-       t89 * t64 * t211 + t146 * 4.0 * t64 * t88 * t198);
-  const double t213 = (-16.0) * t209 * t66;
-  const double t214 = t60 * (-8.0) * t62 * t196;
-  const double t215 =
-      (-t67 * t84 * t211 * 8.0 + 4.0 * t200 * t84 * t88 - 4.0 * t84 * t98 * t198 +
-       t67 * 24.0 * t140 * t88 * t198 -
-       ((4.0 * t91 * t212 * t58 - 16.0 * t197 * t62 * t88 - 16.0 * t62 * t198 * t58 +
-         t199 * 4.0 * t87 * t91 + t60 * t84 * t211 * 8.0 * t54 + 32.0 * t84 * t88 * t54 * t198 +
-         t90 * 4.0 * t91 * t196 + t60 * t84 * 8.0 * t198 * t58 + t213 + t90 * t199 * t149 * t58 +
-         t60 * t197 * t84 * t88 * 8.0 - 16.0 * t211 * t62 * t54 -
-         t60 * 24.0 * t140 * t88 * t54 * t198 + t214)) *
-           t62);
-  const double t216 = (-16.0) * t196 * t66;
-  const double t217 = t60 * t209 * t62 * 8.0;
-  const double t218 =
-      (4.0 * t84 * t88 * t202 -
-       t62 * ((16.0 * t211 * t62 * t58 - t60 * t84 * t88 * 8.0 * t196 + 16.0 * t62 * t88 * t196 +
-               t216 + t217 - 32.0 * t84 * t88 * t198 * t58 + 4.0 * t91 * t54 * t212 +
-               t60 * 24.0 * t140 * t88 * t198 * t58 - t60 * t84 * t211 * 8.0 * t58 +
-               t199 * 4.0 * t91 * t58 + 16.0 * t87 * t62 * t198 + t90 * t199 * t149 * t54 -
-               t60 * t87 * t84 * 8.0 * t198 + t90 * 4.0 * t197 * t91)) -
-       t68 * 24.0 * t140 * t88 * t198 + t68 * t84 * t211 * 8.0 + t92 * 4.0 * t84 * t198);
-  const double t219 = (-t68 * t138 * 4.0 * t99 * t207 * t62 - t68 * t62 * t97 * t215 +
-                       2.0 * t93 * t200 * t62 * t97 - 2.0 * t99 * t62 * t97 * t202 +
-                       t67 * t93 * 4.0 * t84 * t97 * t198 - t138 * t67 * t93 * 4.0 * t207 * t62 +
-                       t68 * 4.0 * t99 * t84 * t97 * t198 - t67 * t218 * t62 * t97);
-  const double t220 = (((t204 * 0.174 * t74 * t100 + 0.087 * t219 * t70)) * t75 +
-                       ((-0.087 * t219 * t74 + t204 * 0.174 * t100 * t70)) * t71 +
-                       t204 * 0.348 * t70 * t104 - t204 * 0.348 * t74 * t101);
-  const double t221 =
-      (-t191 * 18632.635 * t113 + t194 * 2.0 * u[8] - t195 * t52 * 18632.635 +
-       t108 * 2.0 * t206 * t105 + t108 * t83 * 2.0 * t220 - t77 * t83 * t205 * t105);
-  const double t222 = (t24 + t25 + t26);
-  const double t223 = (t31 + t26 + t32);
-  const double t224 = (t6 + t8);
-  const double t225 = ((t176 * t176) * 1100.0 + 1150.0 + u[8] * (((t173 * t173) + (t222 * t222))) +
-                       950.0 * (t172 * t172) + (t223 * t223) * 950.0 + 1100.0 * (t224 * t224));
-  const double t226 = (1.0 / (t225));
-  const double t227 = (1.0 / (t225 * t225));
-  const double t228 = (-t223 * t113 * 9316.3175 - t52 * t172 * 9316.3175 + t168 +
-                       ((-t52 * 9.80665 * t173 - t113 * t222 * 9.80665)) * u[8] - 2500.0 * x[5] +
-                       t125 * t155 * t181 - t52 * 10787.314999999999 * t176 + u[5] -
-                       t224 * t113 * 10787.314999999999);
-  const double t229 = t227 *
-                      ((((t174 * t173 + t222 * t173)) * 2.0 * u[8] + t223 * 1900.0 * t172 +
-                        t175 * 2200.0 * t176 + 1900.0 * t171 * t172 + t224 * 2200.0 * t176)) *
-                      t228 * (-1.0);
-  const double t230 = (t183 + t184 + (t180 * t180) + (t179 * t179));
-  const double t231 = (t181 * t181);
-  const double t232 = (t31 + t32);
-  const double t233 = (t24 + t25);
-  const double t234 = ((t191 * t191) * 950.0 + 250.0 + (t232 * t232) * 950.0 +
-                       u[8] * (((t233 * t233) + (t193 * t193))));
-  const double t235 = (1.0 / (t234));
-  const double t236 = (t68 * t62 * t97 * t215 - t201 * t92 * 2.0 * t62 * t97 -
-                       t203 * t67 * 4.0 * t84 * t97 * t88 + t138 * t203 * t67 * 4.0 * t62 * t139 +
-                       t68 * t201 * 4.0 * t84 * t97 * t88 - t68 * t201 * t138 * 4.0 * t62 * t139 +
-                       t67 * t218 * t62 * t97 + t203 * 2.0 * t62 * t97 * t98);
-  const double t237 =
-      (t204 * 0.348 * t100 * t71 * t70 + t204 * 0.696 * t70 * t104 - t204 * 0.696 * t74 * t101 +
-       0.174 * t236 * t74 * t71 - 0.174 * t75 * t236 * t70 + t204 * 0.348 * t75 * t74 * t100);
-  const double t238 =
-      ((-((-t233 * t113 * 9.80665 - t52 * 9.80665 * t193)) * 2.0 * u[8] + 18632.635 * t113 * t232 -
-        t108 * t83 * t205 - 2.0 * u[6] + t191 * t52 * 18632.635 + 1600.0 * x[6])) *
-      0.5 *
-      ((2.0 * u[8] * ((t233 * t193 + t192 * t193)) + t191 * t195 * 1900.0 + t191 * 1900.0 * t232)) /
-      (t234 * t234);
-  const double t239 =
-      (-t235 *
-           ((-t194 * 2.0 * u[8] + t77 * t83 * t205 * t105 - t108 * t205 * t111 - t108 * t83 * t237 +
-             t191 * 18632.635 * t113 + t195 * t52 * 18632.635)) *
-           0.5 +
-       t238);
-  const double t240 = (t204 * t204);
-  const double t241 = (t198 * t198);
-  const double t242 = ((t197 * t197) + t208 + (t196 * t196) + t210);
-  const double t243 = (t199 * t199);
-  const double t244 = (t146 * 4.0 * t241 * t64 - t89 * t64 * t242 + t60 * 2.0 * t63 * t242 +
-                       4.0 * t241 * t63 - t60 * t89 * t241 * 8.0);
-  const double t245 =
-      (-t203 * t67 * 4.0 * t84 * t97 * t198 -
-       t68 *
-           ((-t67 * 24.0 * t140 * t241 - t200 * t84 * 8.0 * t198 + t67 * t84 * t242 * 8.0 +
-             t62 * ((32.0 * t241 * t84 * t54 - 16.0 * t62 * t242 * t54 + t199 * t91 * 8.0 * t196 +
-                     t60 * 16.0 * t197 * t84 * t198 + t243 * t149 * t58 + t213 +
-                     t60 * t84 * t242 * 8.0 * t54 + 4.0 * t91 * t244 * t58 + t214 -
-                     32.0 * t197 * t62 * t198 - t60 * 24.0 * t140 * t241 * t54)))) *
-           t62 * t97 +
-       t67 * t62 * t97 *
-           ((t84 * 8.0 * t198 * t202 - t68 * 24.0 * t140 * t241 -
-             t62 * ((-t60 * 16.0 * t84 * t196 * t198 + 4.0 * t91 * t244 * t54 + t216 + t217 +
-                     t243 * t149 * t54 + t199 * t197 * t91 * 8.0 - t60 * t84 * t242 * 8.0 * t58 +
-                     t60 * 24.0 * t140 * t241 * t58 + 32.0 * t62 * t196 * t198 +
-                     16.0 * t62 * t242 * t58 - 32.0 * t241 * t84 * t58)) +
-             t68 * t84 * t242 * 8.0)) -
-       t203 * 2.0 * t200 * t62 * t97 - t68 * t201 * t138 * 4.0 * t207 * t62 +
-       t68 * t201 * 4.0 * t84 * t97 * t198 + t138 * t203 * t67 * 4.0 * t207 * t62 -
-       t201 * 2.0 * t62 * t97 * t202);
-  const double t246 =
-      ((t70 * t70) * 0.24220799999999998 * t240 + 0.24220799999999998 * (t74 * t74) * t240 -
-       0.348 * t75 * t74 * t240 - 0.174 * t245 * t75 * t70 - 0.348 * t71 * t70 * t240 +
-       0.174 * t245 * t74 * t71);
-  const double t247 = (t205 * t205);
-  const double t248 = (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 + u[7]);
-  const double t249 = (t3 + t6 + t8 + 0.15);
-  const double t250 = (-t5 * 110.0 + t7 * 1210.0 + 6270.0 * t0 + 165.0);
-  const double t251 = (t24 + t25 + t3 + t26 + 0.15);
-  const double t252 = (t31 + t3 + t26 + 0.15 + t32);
-  const double t253 = (-t18 * 285.0 + 665.0 * t21 + t7 * 2755.0 + 142.5 + 5415.0 * t0);
-  const double t254 = (5720.0 * t0 + 330.0 - t1 * 770.0);
-  const double t255 = (t10 + 0.15 + t11);
-  const double t256 = (t249 * t250 + 60000.0 + (t251 * t251) * u[8] + t252 * t253 + t254 * t255);
-  const double t257 = (1.0 / (t256 * t256));
-  const double t258 = t18 * (-665.0);
-  const double t259 = t21 * (-285.0);
-  const double t260 = t5 * (-2755.0);
-  const double t261 = (-110.0) * t7;
-  const double t262 = t5 * (-1210.0);
-  const double t263 = (1.0 / (t256));
-  const double t264 = (t46 * 0.03078760800517998 - 0.059498844250515354);
+      (-t73 * t64 * t69 * 2e+08 * t81 + 4e+08 * t64 * t81 + t64 * 2e+08 * t81 * t72 * t66 -
+       t82 * ((-t207 * t64 * t81 * t70 - t64 * t81 * t72 + t73 * t64 * t81 +
+               t64 * t67 * t81 * t208)) +
+       ((t64 * 2e+06 * x[5] * t211 + t64 * 2e+06 * x[4] * t204 - t200 * 2e+06 * t81 * x[5] * t79 -
+         t200 * t201 * 2e+06 * x[4])) *
+           t74);
+  const double t213 = pow(t42, (-1.5));
+  const double t214 = (t46 * t46);
+  const double t215 = t183 * t184 * t151;
+  const double t216 = t200 * t83 * t81 * t79 * (-1.0);
+  const double t217 = (t20 + t28 + t29);
+  const double t218 = (t154 + t155 + t157);
+  const double t219 = (-t37 * 9.80665 * t217 - t36 * t218 * 9.80665);
+  const double t220 = t219 * (-2.0) * u[8];
+  const double t221 = (t159 + t160);
+  const double t222 = t221 * t36 * 21574.629999999997;
+  const double t223 = t107 * t136 * t198;
+  const double t224 = (t19 + t20 + t22);
+  const double t225 = 18632.635 * t37 * t224;
+  const double t226 = (t14 + t15);
+  const double t227 = t37 * 21574.629999999997 * t226;
+  const double t228 = (t209 + t210 + (t78 * t78) + (t77 * t77));
+  const double t229 = (t79 * t79);
+  const double t230 =
+      (t64 * 2e+08 * t72 * t79 * t66 +
+       ((-t73 * t64 * t79 - t64 * t67 * t208 * t79 + t207 * t64 * t70 * t79 + t64 * t72 * t79)) *
+           t82 +
+       4e+08 * t64 * t79 - t73 * t64 * t69 * 2e+08 * t79 +
+       t74 * ((t64 * 2e+06 * x[4] * t211 + t64 * t228 * 2e+06 * x[5] -
+               t200 * 2e+06 * t81 * x[4] * t79 - t200 * 2e+06 * x[5] * t229)));
+  const double t231 = (t162 + t154 + t163);
+  const double t232 = t36 * 18632.635 * t231;
+  const double t233 = t183 * t184 * t151 * (-1.0);
+  const double t234 = t64 * t83 * t211;
+  const double t235 = t107 * t182 * t151;
+  const double t236 = (t162 + t163);
+  const double t237 = 37265.27 * t236 * t36;
+  const double t238 = (t155 + t157);
+  const double t239 = (t28 + t29);
+  const double t240 = (-t36 * t238 * 9.80665 - t37 * 9.80665 * t239);
+  const double t241 = t240 * (-4.0) * u[8];
+  const double t242 = (t19 + t22);
+  const double t243 = 37265.27 * t242 * t37;
+  const double t244 = (t145 * t145);
+  const double t245 = (t139 * t139);
+  const double t246 = ((t138 * t138) + t185 + (t137 * t137) + t187);
+  const double t247 = (t140 * t140);
+  const double t248 = (t176 * 4.0 * t245 * t94 - t120 * t94 * t246 + t90 * 2.0 * t93 * t246 +
+                       4.0 * t245 * t93 - t90 * t120 * t245 * 8.0);
+  const double t249 =
+      (2.0 * t120 * t125 * t139 + 2.0 * t120 * t126 * t139 - t98 * t93 * t143 + t97 * t141 * t93);
+  const double t250 =
+      (-t144 * t97 * 4.0 * t115 * t128 * t139 -
+       t98 *
+           ((-t97 * 24.0 * t170 * t245 - t141 * t115 * 8.0 * t139 + t97 * t115 * t246 * 8.0 +
+             t92 * ((32.0 * t245 * t115 * t84 - 16.0 * t92 * t246 * t84 + t140 * t122 * 8.0 * t137 +
+                     t90 * 16.0 * t138 * t115 * t139 + t247 * t179 * t88 + t190 +
+                     t90 * t115 * t246 * 8.0 * t84 + 4.0 * t122 * t248 * t88 + t191 -
+                     32.0 * t138 * t92 * t139 - t90 * 24.0 * t170 * t245 * t84)))) *
+           t92 * t128 +
+       t97 * t92 * t128 *
+           ((t115 * 8.0 * t139 * t143 - t98 * 24.0 * t170 * t245 -
+             t92 * ((-t90 * 16.0 * t115 * t137 * t139 + 4.0 * t122 * t248 * t84 + t193 + t194 +
+                     t247 * t179 * t84 + t140 * t138 * t122 * 8.0 - t90 * t115 * t246 * 8.0 * t88 +
+                     t90 * 24.0 * t170 * t245 * t88 + 32.0 * t92 * t137 * t139 +
+                     16.0 * t92 * t246 * t88 - 32.0 * t245 * t115 * t88)) +
+             t98 * t115 * t246 * 8.0)) -
+       t144 * 2.0 * t141 * t92 * t128 - t98 * t142 * t168 * 4.0 * t249 * t92 +
+       t98 * t142 * 4.0 * t115 * t128 * t139 + t168 * t144 * t97 * 4.0 * t249 * t92 -
+       t142 * 2.0 * t92 * t128 * t143);
+  const double t251 =
+      ((t100 * t100) * 0.24220799999999998 * t244 + 0.24220799999999998 * (t104 * t104) * t244 -
+       0.348 * t105 * t104 * t244 - 0.174 * t250 * t105 * t100 - 0.348 * t101 * t100 * t244 +
+       0.174 * t250 * t104 * t101);
+  const double t252 = (t146 * t146);
+  const double t253 =
+      (-t98 * t168 * 4.0 * t130 * t249 * t92 - t98 * t92 * t128 * t192 +
+       2.0 * t124 * t141 * t92 * t128 - 2.0 * t130 * t92 * t128 * t143 +
+       t97 * t124 * 4.0 * t115 * t128 * t139 - t168 * t97 * t124 * 4.0 * t249 * t92 +
+       t98 * 4.0 * t130 * t115 * t128 * t139 - t97 * t195 * t92 * t128);
+  const double t254 = (((t145 * 0.174 * t104 * t131 + 0.087 * t253 * t100)) * t105 +
+                       ((-0.087 * t253 * t104 + t145 * 0.174 * t131 * t100)) * t101 +
+                       t145 * 0.348 * t100 * t135 - t145 * 0.348 * t104 * t132);
+  const double t255 = (-t107 * t146 * 2e+08 * t109 * t149 +
+                       ((-t183 * t146 * 1e+06 * x[4] * t136 - t183 * t146 * 1e+06 * x[5] * t136 +
+                         t107 * 1e+06 * x[6] * t251 - t183 * t252 * x[6] * 5e+05 +
+                         t107 * 2e+06 * t254 * x[4] + t107 * 2e+06 * t254 * x[5])) *
+                           2.0 * t150 +
+                       t107 * t146 * 2e+08 * t148 * t112 + t107 * 4e+08 * t146 -
+                       ((-t107 * t110 * t146 * t166 + t107 * t146 * t167 * t113 -
+                         t107 * t146 * t148 + t107 * t146 * t149)) *
+                           t147);
+  const double t256 = t183 * t146 * t151 * (-1.0) * t136;
+  const double t257 = (t237 + t241 + t243 + t107 * t255 * t136 + t107 * 2.0 * t254 * t151 + t256);
+  const double t258 = (1.0 / (t63));
+  const double t259 = (1.0 / (t106));
+  const double t260 = t259 * t184 * 2e+06 * t150;
+  const double t261 = (t24 + t25 + t26);
+  const double t262 = (t31 + t26 + t32);
+  const double t263 = (t6 + t8);
+  const double t264 = ((t226 * t226) * 1100.0 + 1150.0 + u[8] * (((t217 * t217) + (t261 * t261))) +
+                       950.0 * (t224 * t224) + (t262 * t262) * 950.0 + 1100.0 * (t263 * t263));
   const double t265 = (1.0 / (t264));
-  const double t266 = (x[12] - 2e+05);
-  const double t267 = (t266 * t266);
-  const double t268 = (t267 + 1e+10);
-  const double t269 = (x[12] - 3.7e+07);
-  const double t270 = ((t269 * t269) + 1e+10);
-  const double t271 = (4e+10 + t267);
-  const double t272 = pow(t271, (-0.25));
-  const double t273 = ((x[8] * x[8]) + 1e-04);
-  const double t274 = sqrt(t273);
-  const double t275 = (t274 - x[8]);
-  const double t276 = (x[12] - 34300000.0);
-  const double t277 = (4e+10 + (t276 * t276));
-  const double t278 = pow(t277, (-0.25));
-  const double t279 = (t274 + x[8]);
-  const double t280 = x[8] * (1.0 / sqrt(t273));
-  const double t281 = (t280 + 1.0);
-  const double t282 = (t280 - 1.0);
-  const double t283 = x[12] * 2.0;
-  const double t284 = (t283 - 4e+05);
-  const double t285 = (x[13] - 3.7e+07);
-  const double t286 = (1e+10 + (t285 * t285));
-  const double t287 = (x[13] - 34300000.0);
-  const double t288 = (4e+10 + (t287 * t287));
-  const double t289 = pow(t288, (-0.25));
-  const double t290 = (1e-04 + (x[9] * x[9]));
-  const double t291 = sqrt(t290);
-  const double t292 = (x[9] + t291);
-  const double t293 = (x[13] - 2e+05);
-  const double t294 = (t293 * t293);
-  const double t295 = (1e+10 + t294);
-  const double t296 = (4e+10 + t294);
-  const double t297 = pow(t296, (-0.25));
-  const double t298 = (-x[9] + t291);
-  const double t299 = (-sqrt(t286) * 3.5e-09 - t125 * 0.017671458676442587 * x[5] * t181 -
-                       t125 * t129 * 0.017671458676442587 * x[4] - x[13] * 7e-09 -
-                       t289 * 2.8577380332470414e-06 * t287 * t292 + 0.1302 + sqrt(t295) * 3.5e-09 -
-                       t297 * t293 * 2.8577380332470414e-06 * t298);
-  const double t300 = (0.017671458676442587 * t130 - 0.04285743526536852);
-  const double t301 = (1.0 / (t300 * t300));
-  const double t302 = (1.0 / (t300));
-  const double t303 = (1.0 / sqrt(t290)) * x[9];
-  const double t304 = (t303 - 1.0);
-  const double t305 = (t303 + 1.0);
-  const double t306 = x[13] * 2.0;
-  const double t307 = (t306 - 4e+05);
-  const double t308 = (x[14] - 2e+05);
-  const double t309 = (t308 * t308);
-  const double t310 = (4e+10 + t309);
-  const double t311 = pow(t310, (-0.25));
-  const double t312 = (1e-04 + (x[10] * x[10]));
-  const double t313 = sqrt(t312);
-  const double t314 = (-t313 + x[10]);
-  const double t315 = (x[10] + t313);
-  const double t316 = (x[14] - 34300000.0);
-  const double t317 = (4e+10 + (t316 * t316));
-  const double t318 = pow(t317, (-0.25));
-  const double t319 = (x[14] - 3.7e+07);
-  const double t320 = ((t319 * t319) + 1e+10);
-  const double t321 = (1e+10 + t309);
-  const double t322 =
-      (-t108 * t205 * 0.006636614480708438 * x[6] + 0.093 -
-       t108 * x[5] * 0.013273228961416876 * t105 - t108 * x[4] * 0.013273228961416876 * t105 +
-       t311 * t308 * t314 * 2.0412414523193154e-06 - t315 * t318 * t316 * 2.0412414523193154e-06 -
-       sqrt(t320) * 2.5e-09 - x[14] * 5e-09 + 2.5e-09 * sqrt(t321));
-  const double t323 = (t78 * 0.013273228961416876 - 0.03151490312757761);
-  const double t324 = (1.0 / (t323 * t323));
-  const double t325 = (1.0 / (t323));
-  const double t326 =
-      (-t108 * 15927874.753700253 * t322 * t105 * t324 +
-       ((-t108 * t237 * 0.006636614480708438 * x[6] +
-         t77 * t205 * 0.006636614480708438 * x[6] * t105 +
-         t77 * t106 * x[4] * 0.013273228961416876 - t108 * t152 * x[5] * 0.013273228961416876 -
-         t108 * t152 * x[4] * 0.013273228961416876 + t77 * t106 * x[5] * 0.013273228961416876)) *
-           1.2e+09 * t325);
-  const double t327 = t108 * (-15927874.753700253) * t325 * t105;
-  const double t328 = x[10] * (1.0 / sqrt(t312));
-  const double t329 = (t328 - 1.0);
-  const double t330 = (t328 + 1.0);
-  const double t331 = x[14] * 2.0;
-  const double t332 = (t331 - 4e+05);
-  const double t333 = (x[15] - 2e+05);
-  const double t334 = (t333 * t333);
-  const double t335 = (4e+10 + t334);
-  const double t336 = pow(t335, (-0.25));
-  const double t337 = (1e-04 + (x[11] * x[11]));
-  const double t338 = x[11] * (1.0 / sqrt(t337));
-  const double t339 = (t338 - 1.0);
-  const double t340 = (t338 + 1.0);
-  const double t341 = (x[15] - 34300000.0);
-  const double t342 = (4e+10 + (t341 * t341));
-  const double t343 = pow(t342, (-0.25));
-  const double t344 = x[15] * 2.0;
-  const double t345 = (t344 - 4e+05);
-  const double t346 = sqrt(t337);
-  const double t347 = (t346 + x[11]);
-  const double t348 = (-t346 + x[11]);
-  const double t349 = (-2.9e+07 + x[15]);
-  const double t350 = (0.05992565888304706 - 0.015079644737231009 * t46);
-  const double t351 = (1.0 / (t350));
-  const double t352 = (x[16] - 34300000.0);
-  const double t353 = (4e+10 + (t352 * t352));
-  const double t354 = pow(t353, (-0.25));
-  const double t355 = (x[16] - 3.7e+07);
-  const double t356 = ((t355 * t355) + 1e+10);
-  const double t357 = (x[16] - 2e+05);
-  const double t358 = (t357 * t357);
-  const double t359 = (4e+10 + t358);
-  const double t360 = pow(t359, (-0.25));
-  const double t361 = (1e+10 + t358);
-  const double t362 = x[16] * 2.0;
-  const double t363 = (t362 - 4e+05);
-  const double t364 = (0.03909483791956781 - t130 * 0.00901244392498572);
-  const double t365 = (1.0 / (t364));
-  const double t366 = (1.0 / (t364 * t364));
-  const double t367 = (x[17] - 2e+05);
-  const double t368 = (t367 * t367);
-  const double t369 = (t368 + 1e+10);
-  const double t370 = (x[17] - 3.7e+07);
-  const double t371 = (1e+10 + (t370 * t370));
-  const double t372 = (x[17] - 34300000.0);
-  const double t373 = (4e+10 + (t372 * t372));
-  const double t374 = pow(t373, (-0.25));
-  const double t375 = (4e+10 + t368);
+  const double t266 =
+      (-t36 * 21574.629999999997 * t226 - t263 * t37 * 21574.629999999997 - t262 * 18632.635 * t37 -
+       t107 * t151 * t136 - 5000.0 * x[5] - t64 * t83 * t79 + 2.0 * u[5] +
+       2.0 * ((-t36 * 9.80665 * t217 - t37 * t261 * 9.80665)) * u[8] - t36 * 18632.635 * t224);
+  const double t267 = (1.0 / (t264 * t264));
+  const double t268 = t266 * t267 *
+                      ((((t218 * t217 + t261 * t217)) * 2.0 * u[8] + t262 * 1900.0 * t224 +
+                        t221 * 2200.0 * t226 + 1900.0 * t231 * t224 + t263 * 2200.0 * t226)) *
+                      (-0.5);
+  const double t269 = t259 * t184 * (-2e+06) * t150;
+  const double t270 = (t31 + t32);
+  const double t271 = (t24 + t25);
+  const double t272 = ((t242 * t242) * 950.0 + 250.0 + (t270 * t270) * 950.0 +
+                       u[8] * (((t271 * t271) + (t239 * t239))));
+  const double t273 = (1.0 / (t272));
+  const double t274 =
+      0.25 *
+      ((3200.0 * x[6] + t107 * t146 * t151 - 4.0 * u[6] + 37265.27 * t242 * t36 -
+        ((-t271 * t37 * 9.80665 - t36 * 9.80665 * t239)) * 4.0 * u[8] + 37265.27 * t37 * t270)) *
+      ((2.0 * u[8] * ((t271 * t239 + t238 * t239)) + t242 * t236 * 1900.0 + t242 * 1900.0 * t270)) /
+      (t272 * t272);
+  const double t275 =
+      (-t273 * ((t237 + t107 * t197 * t151 + t241 + t243 + t107 * t146 * t198 + t256)) * 0.25 +
+       t274);
+  const double t276 = t259 * (-5e+05) * t146 * t273 * t150 * t136;
+  const double t277 = (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 + u[7]);
+  const double t278 = (t3 + t6 + t8 + 0.15);
+  const double t279 = (-t5 * 110.0 + t7 * 1210.0 + 6270.0 * t0 + 165.0);
+  const double t280 = (t24 + t25 + t3 + t26 + 0.15);
+  const double t281 = (t31 + t3 + t26 + 0.15 + t32);
+  const double t282 = (-t18 * 285.0 + 665.0 * t21 + t7 * 2755.0 + 142.5 + 5415.0 * t0);
+  const double t283 = (5720.0 * t0 + 330.0 - t1 * 770.0);
+  const double t284 = (t10 + 0.15 + t11);
+  const double t285 = (t278 * t279 + 60000.0 + (t280 * t280) * u[8] + t281 * t282 + t283 * t284);
+  const double t286 = (1.0 / (t285 * t285));
+  const double t287 = t18 * (-665.0);
+  const double t288 = t21 * (-285.0);
+  const double t289 = t5 * (-2755.0);
+  const double t290 = (-110.0) * t7;
+  const double t291 = t5 * (-1210.0);
+  const double t292 = (1.0 / (t285));
+  const double t293 = (t47 * 0.03078760800517998 - 0.059498844250515354);
+  const double t294 = (1.0 / (t293));
+  const double t295 = (x[12] - 2e+05);
+  const double t296 = (t295 * t295);
+  const double t297 = (t296 + 1e+10);
+  const double t298 = (x[12] - 3.7e+07);
+  const double t299 = ((t298 * t298) + 1e+10);
+  const double t300 = (-x[12] + u[10]);
+  const double t301 = (t300 * t300);
+  const double t302 = (t301 + 4e+10);
+  const double t303 = pow(t302, (-0.25));
+  const double t304 = ((x[8] * x[8]) + 1e-06);
+  const double t305 = sqrt(t304);
+  const double t306 = (t305 + x[8]);
+  const double t307 = (4e+10 + t296);
+  const double t308 = pow(t307, (-0.25));
+  const double t309 = (-t305 + x[8]);
+  const double t310 = x[8] * (1.0 / sqrt(t304));
+  const double t311 = (t310 - 1.0);
+  const double t312 = (t310 + 1.0);
+  const double t313 = x[12] * 2.0;
+  const double t314 = (t313 - 4e+05);
+  const double t315 = (x[13] - 3.7e+07);
+  const double t316 = (1e+10 + (t315 * t315));
+  const double t317 = (u[11] - x[13]);
+  const double t318 = (1e-06 + (x[9] * x[9]));
+  const double t319 = sqrt(t318);
+  const double t320 = (x[9] + t319);
+  const double t321 = (t317 * t317);
+  const double t322 = (4e+10 + t321);
+  const double t323 = pow(t322, (-0.25));
+  const double t324 = (x[13] - 2e+05);
+  const double t325 = (t324 * t324);
+  const double t326 = (1e+10 + t325);
+  const double t327 = (4e+10 + t325);
+  const double t328 = pow(t327, (-0.25));
+  const double t329 = (-x[9] + t319);
+  const double t330 =
+      (-sqrt(t316) * 3.5e-09 + 2.8577380332470414e-06 * t317 * t320 * t323 -
+       t64 * 0.017671458676442587 * x[5] * t79 - t64 * t81 * 0.017671458676442587 * x[4] -
+       x[13] * 7e-09 + 0.1302 + sqrt(t326) * 3.5e-09 - t328 * t324 * 2.8577380332470414e-06 * t329);
+  const double t331 = (0.017671458676442587 * t65 - 0.04285743526536852);
+  const double t332 = (1.0 / (t331 * t331));
+  const double t333 = (1.0 / (t331));
+  const double t334 = (1.0 / sqrt(t318)) * x[9];
+  const double t335 = (t334 + 1.0);
+  const double t336 = (t334 - 1.0);
+  const double t337 = x[13] * 2.0;
+  const double t338 = (t337 - 4e+05);
+  const double t339 = (t108 * 0.013273228961416876 - 0.03151490312757761);
+  const double t340 = (1.0 / (t339 * t339));
+  const double t341 = (x[14] - 3.7e+07);
+  const double t342 = ((t341 * t341) + 1e+10);
+  const double t343 = (x[14] - 2e+05);
+  const double t344 = (t343 * t343);
+  const double t345 = (4e+10 + t344);
+  const double t346 = pow(t345, (-0.25));
+  const double t347 = (1e-06 + (x[10] * x[10]));
+  const double t348 = sqrt(t347);
+  const double t349 = (x[10] - t348);
+  const double t350 = (1e+10 + t344);
+  const double t351 = (x[10] + t348);
+  const double t352 = (u[12] - x[14]);
+  const double t353 = (t352 * t352);
+  const double t354 = (4e+10 + t353);
+  const double t355 = pow(t354, (-0.25));
+  const double t356 =
+      (-t107 * t146 * 0.006636614480708438 * x[6] + 0.093 -
+       t107 * x[5] * 0.013273228961416876 * t136 - t107 * x[4] * 0.013273228961416876 * t136 -
+       sqrt(t342) * 2.5e-09 + t346 * t343 * t349 * 2.0412414523193154e-06 - x[14] * 5e-09 +
+       2.5e-09 * sqrt(t350) + t351 * t352 * t355 * 2.0412414523193154e-06);
+  const double t357 = (1.0 / (t339));
+  const double t358 =
+      (-t107 * 15927874.753700253 * t136 * t340 * t356 +
+       ((-t107 * t197 * 0.006636614480708438 * x[6] +
+         t183 * t146 * 0.006636614480708438 * x[6] * t136 +
+         t183 * t184 * x[4] * 0.013273228961416876 - t107 * t182 * x[5] * 0.013273228961416876 -
+         t107 * t182 * x[4] * 0.013273228961416876 + t183 * t184 * x[5] * 0.013273228961416876)) *
+           1.2e+09 * t357);
+  const double t359 = t107 * (-15927874.753700253) * t357 * t136;
+  const double t360 = x[10] * (1.0 / sqrt(t347));
+  const double t361 = (t360 - 1.0);
+  const double t362 = (t360 + 1.0);
+  const double t363 = x[14] * 2.0;
+  const double t364 = (t363 - 4e+05);
+  const double t365 = (1e-06 + (x[11] * x[11]));
+  const double t366 = x[11] * (1.0 / sqrt(t365));
+  const double t367 = (t366 + 1.0);
+  const double t368 = (u[13] - x[15]);
+  const double t369 = (t368 * t368);
+  const double t370 = (4e+10 + t369);
+  const double t371 = pow(t370, (-0.25));
+  const double t372 = (t366 - 1.0);
+  const double t373 = (x[15] - 2e+05);
+  const double t374 = (t373 * t373);
+  const double t375 = (4e+10 + t374);
   const double t376 = pow(t375, (-0.25));
-  const double t377 =
-      (sqrt(t369) * 3.5e-09 - sqrt(t371) * 3.5e-09 - 2.8577380332470414e-06 * t372 * t374 * t298 +
-       t125 * t129 * x[4] * 0.00901244392498572 + 0.1302 -
-       t376 * t367 * 2.8577380332470414e-06 * t292 - x[17] * 7e-09 +
-       t125 * x[5] * t181 * 0.00901244392498572);
-  const double t378 = x[17] * 2.0;
-  const double t379 = (t378 - 4e+05);
-  const double t380 = (0.0276416792385999 - t78 * 0.006911503837897547);
-  const double t381 = (1.0 / (t380));
-  const double t382 = (1.0 / (t380 * t380));
-  const double t383 = (x[18] - 3.7e+07);
-  const double t384 = (1e+10 + (t383 * t383));
-  const double t385 = (x[18] - 34300000.0);
-  const double t386 = (4e+10 + (t385 * t385));
-  const double t387 = pow(t386, (-0.25));
-  const double t388 = (x[18] - 2e+05);
-  const double t389 = (t388 * t388);
-  const double t390 = (t389 + 1e+10);
-  const double t391 = (4e+10 + t389);
-  const double t392 = pow(t391, (-0.25));
-  const double t393 =
-      (-2.5e-09 * sqrt(t384) + t387 * t314 * t385 * 2.0412414523193154e-06 + 0.093 +
-       t108 * 0.006911503837897547 * x[5] * t105 + 2.5e-09 * sqrt(t390) +
-       t108 * 0.006911503837897547 * x[4] * t105 + t108 * t205 * 0.0034557519189487734 * x[6] -
-       x[18] * 5e-09 - t392 * t388 * t315 * 2.0412414523193154e-06);
-  const double t394 =
-      (((t108 * t152 * 0.006911503837897547 * x[4] + t108 * t152 * 0.006911503837897547 * x[5] -
-         t77 * 0.006911503837897547 * t106 * x[5] - t77 * 0.006911503837897547 * t106 * x[4] -
-         t77 * t205 * 0.0034557519189487734 * x[6] * t105 +
-         t108 * t237 * 0.0034557519189487734 * x[6])) *
-           1.2e+09 * t381 +
-       t108 * 8293804.6054770565 * t382 * t393 * t105);
-  const double t395 = t108 * 8293804.6054770565 * t381 * t105;
-  const double t396 = x[18] * 2.0;
+  const double t377 = sqrt(t365);
+  const double t378 = (t377 - x[11]);
+  const double t379 = x[15] * 2.0;
+  const double t380 = (t379 - 4e+05);
+  const double t381 = (t377 + x[11]);
+  const double t382 = (-2.9e+07 + x[15]);
+  const double t383 = (0.05992565888304706 - 0.015079644737231009 * t47);
+  const double t384 = (1.0 / (t383));
+  const double t385 = (x[16] - 3.7e+07);
+  const double t386 = ((t385 * t385) + 1e+10);
+  const double t387 = (x[16] - 2e+05);
+  const double t388 = (t387 * t387);
+  const double t389 = (4e+10 + t388);
+  const double t390 = pow(t389, (-0.25));
+  const double t391 = (x[16] - u[10]);
+  const double t392 = (t391 * t391);
+  const double t393 = (4e+10 + t392);
+  const double t394 = pow(t393, (-0.25));
+  const double t395 = (1e+10 + t388);
+  const double t396 = x[16] * 2.0;
   const double t397 = (t396 - 4e+05);
-  const double t398 = (x[19] - 34300000.0);
-  const double t399 = (4e+10 + (t398 * t398));
-  const double t400 = pow(t399, (-0.25));
-  const double t401 = (x[19] - 2e+05);
+  const double t398 = (0.03909483791956781 - t65 * 0.00901244392498572);
+  const double t399 = (1.0 / (t398));
+  const double t400 = (1.0 / (t398 * t398));
+  const double t401 = (x[17] - 2e+05);
   const double t402 = (t401 * t401);
-  const double t403 = (4e+10 + t402);
-  const double t404 = pow(t403, (-0.25));
-  const double t405 = x[19] * 2.0;
-  const double t406 = (-2.9e+07 + x[19]);
-  const double t407 = (t405 - 4e+05);
+  const double t403 = (t402 + 1e+10);
+  const double t404 = (x[17] - 3.7e+07);
+  const double t405 = (1e+10 + (t404 * t404));
+  const double t406 = (u[11] - x[17]);
+  const double t407 = (t406 * t406);
+  const double t408 = (4e+10 + t407);
+  const double t409 = pow(t408, (-0.25));
+  const double t410 = (4e+10 + t402);
+  const double t411 = pow(t410, (-0.25));
+  const double t412 =
+      (sqrt(t403) * 3.5e-09 - sqrt(t405) * 3.5e-09 + t64 * t81 * x[4] * 0.00901244392498572 +
+       0.1302 + t406 * 2.8577380332470414e-06 * t329 * t409 -
+       t411 * t401 * 2.8577380332470414e-06 * t320 - x[17] * 7e-09 +
+       t64 * x[5] * t79 * 0.00901244392498572);
+  const double t413 = x[17] * 2.0;
+  const double t414 = (t413 - 4e+05);
+  const double t415 = (x[18] - 3.7e+07);
+  const double t416 = (1e+10 + (t415 * t415));
+  const double t417 = (x[18] - 2e+05);
+  const double t418 = (t417 * t417);
+  const double t419 = (t418 + 1e+10);
+  const double t420 = (u[12] - x[18]);
+  const double t421 = (t420 * t420);
+  const double t422 = (4e+10 + t421);
+  const double t423 = pow(t422, (-0.25));
+  const double t424 = (4e+10 + t418);
+  const double t425 = pow(t424, (-0.25));
+  const double t426 =
+      (-2.5e-09 * sqrt(t416) + 0.093 + t107 * 0.006911503837897547 * x[5] * t136 +
+       2.5e-09 * sqrt(t419) + t107 * 0.006911503837897547 * x[4] * t136 +
+       t107 * t146 * 0.0034557519189487734 * x[6] - t349 * t420 * 2.0412414523193154e-06 * t423 -
+       x[18] * 5e-09 - t425 * t417 * t351 * 2.0412414523193154e-06);
+  const double t427 = (0.0276416792385999 - t108 * 0.006911503837897547);
+  const double t428 = (1.0 / (t427 * t427));
+  const double t429 = (1.0 / (t427));
+  const double t430 =
+      (t107 * 8293804.6054770565 * t426 * t428 * t136 +
+       ((t107 * t182 * 0.006911503837897547 * x[4] + t107 * t182 * 0.006911503837897547 * x[5] -
+         t183 * 0.006911503837897547 * t184 * x[5] - t183 * 0.006911503837897547 * t184 * x[4] -
+         t183 * t146 * 0.0034557519189487734 * x[6] * t136 +
+         t107 * t197 * 0.0034557519189487734 * x[6])) *
+           1.2e+09 * t429);
+  const double t431 = t107 * 8293804.6054770565 * t429 * t136;
+  const double t432 = x[18] * 2.0;
+  const double t433 = (t432 - 4e+05);
+  const double t434 = (x[19] - u[13]);
+  const double t435 = (t434 * t434);
+  const double t436 = (4e+10 + t435);
+  const double t437 = pow(t436, (-0.25));
+  const double t438 = (x[19] - 2e+05);
+  const double t439 = (t438 * t438);
+  const double t440 = (4e+10 + t439);
+  const double t441 = pow(t440, (-0.25));
+  const double t442 = x[19] * 2.0;
+  const double t443 = (-2.9e+07 + x[19]);
+  const double t444 = (t442 - 4e+05);
   jacobian[4] = 1.0;
   jacobian[25] = 1.0;
   jacobian[46] = 1.0;
   jacobian[67] = 1.0;
   jacobian[80] =
-      (t35 * ((-t41 * t45 * t51 - t52 * 21574.629999999997 * t53 + t107 + t112 -
-               t23 * t113 * 9316.3175 + ((-t118 * t52 * 9.80665 - t30 * t113 * 9.80665)) * u[8] -
-               t113 * t16 * 10787.314999999999 + t137 * t125 * t129 + t153 -
-               t2 * t113 * 21574.629999999997 +
-               t154 *
-                   ((t154 * t49 * (1.0 / sqrt(t50)) * 2e+08 * t44 - 4e+08 * t154 * t44 -
-                     t154 * 2e+08 * (1.0 / sqrt(t48)) * t47 * t44)) *
-                   t44 +
-               t125 * t155 * t158 - t52 * t161 * 9316.3175 - t52 * t164 * 10787.314999999999 +
-               t154 * t51 * t165 - t166 * t167 * t155)) -
-       t169 * t170 *
-           ((t2 * t12 * 4400.0 + t2 * t53 * 4400.0 + t9 * 2200.0 * t16 + t23 * t33 * 1900.0 +
-             ((t118 * t30 + t27 * t30)) * 2.0 * u[8] + 2200.0 * t164 * t16 + t23 * t161 * 1900.0)));
+      (t35 * 0.5 * t152 *
+           ((t2 * t12 * 4400.0 + t2 * t153 * 4400.0 + t9 * 2200.0 * t16 + t23 * t33 * 1900.0 +
+             ((t158 * t30 + t27 * t30)) * 2.0 * u[8] + 2200.0 * t161 * t16 + t23 * t164 * 1900.0)) +
+       t165 *
+           ((t199 + t200 * t83 * t201 - t36 * 18632.635 * t164 - t64 * t83 * t204 -
+             t37 * 21574.629999999997 * t16 + t43 * 2.0 * t205 * t57 + t206 - t64 * t81 * t212 +
+             ((-t158 * t36 * 9.80665 - t30 * t37 * 9.80665)) * 2.0 * u[8] +
+             t43 *
+                 ((-t43 * 2e+06 * t205 * x[4] * t56 + t43 * t52 * t55 * 2e+08 * t46 -
+                   4e+08 * t43 * t46 + t213 * t214 * 2e+06 * x[4] * t56 -
+                   t43 * 2e+06 * x[4] * t46 *
+                       ((t43 * t51 * t46 - t43 * t49 * pow(t50, (-1.5)) * t46 +
+                         pow(t54, (-1.5)) * t43 * t53 * t46 - t43 * t55 * t46)) -
+                   t43 * 2e+08 * t51 * t48 * t46)) *
+                 2.0 * t46 -
+             t36 * t161 * 21574.629999999997 - 18632.635 * t23 * t37 - t213 * t214 * 2.0 * t57 +
+             t215 - t2 * t37 * 43149.259999999995 - t36 * t153 * 43149.259999999995)) *
+           0.5);
   jacobian[81] =
-      (-t169 * t170 *
-           ((t23 * 1900.0 * t171 + t33 * 1900.0 * t172 + 2.0 * u[8] * ((t27 * t173 + t30 * t174)) +
-             t175 * 2200.0 * t16 + t9 * 2200.0 * t176)) +
-       ((t177 + t178 + t107 + t112 + t125 * t129 * t182 + t153 + t186 + t187 + t188 + t189 +
-         t190)) *
-           t35);
+      (-((t216 + t220 + t222 + t223 + t225 + t227 + t230 * t64 * t81 + t232 + t233 + t234 + t235)) *
+           t165 * 0.5 +
+       t35 *
+           ((t23 * 1900.0 * t231 + t33 * 1900.0 * t224 + 2.0 * u[8] * ((t27 * t217 + t30 * t218)) +
+             t221 * 2200.0 * t16 + t9 * 2200.0 * t226)) *
+           0.5 * t152);
   jacobian[82] =
-      (t221 * t35 * 0.5 -
-       ((2.0 * ((t27 * t193 + t192 * t30)) * u[8] + t195 * t23 * 1900.0 + t191 * t33 * 1900.0)) *
-           t169 * t170);
-  jacobian[84] = t35 * (-6000.0);
-  jacobian[92] = t154 * t35 * 0.03078760800517998 * t44;
-  jacobian[93] = t125 * t35 * t129 * 0.017671458676442587;
-  jacobian[94] = t108 * t35 * 0.013273228961416876 * t105;
-  jacobian[96] = t154 * t35 * (-0.015079644737231009) * t44;
-  jacobian[97] = (-0.00901244392498572) * t125 * t35 * t129;
-  jacobian[98] = t108 * (-0.006911503837897547) * t35 * t105;
-  jacobian[100] = (t226 * ((t177 + t178 + t107 + t112 + t153 + t186 + t187 + t188 + t189 + t190 +
-                            t137 * t125 * t181)) +
-                   t229);
-  jacobian[101] = (t226 * ((t177 + t178 + t107 + t112 + t153 + t125 * t230 * t155 + t187 -
-                            t166 * t155 * t231 + t188 + t190 + t125 * t182 * t181)) +
-                   t229);
-  jacobian[102] = (t221 * t226 * 0.5 - t227 *
-                                           ((((t222 * t193 + t192 * t173)) * 2.0 * u[8] +
-                                             t223 * t191 * 1900.0 + t195 * 1900.0 * t172)) *
-                                           t228);
-  jacobian[105] = (-2500.0) * t226;
-  jacobian[113] = t125 * t226 * 0.017671458676442587 * t181;
-  jacobian[114] = t108 * t226 * 0.013273228961416876 * t105;
-  jacobian[117] = (-0.00901244392498572) * t125 * t226 * t181;
-  jacobian[118] = t108 * t226 * (-0.006911503837897547) * t105;
-  jacobian[120] = t239;
-  jacobian[121] = t239;
-  jacobian[122] = (-t235 *
-                       ((-t108 * t83 * 2.0 * t246 + 37265.27 * t195 * t52 - t194 * 4.0 * u[8] +
-                         37265.27 * t191 * t113 - t108 * t205 * 2.0 * t206 + t77 * t83 * t247)) *
-                       0.25 +
-                   t238);
-  jacobian[126] = t235 * (-800.0);
-  jacobian[134] = t108 * t205 * t235 * 0.006636614480708438;
-  jacobian[138] = t108 * t205 * t235 * (-0.0034557519189487734);
-  jacobian[140] = t248 * (-1.0) * t257 *
-                  ((t2 * t254 + ((-t1 * 5720.0 - 770.0 * t0)) * t255 + t23 * t253 + t16 * t250 +
-                    ((t258 + t259 + t260 - t1 * 5415.0)) * t252 + t30 * 2.0 * u[8] * t251 +
-                    t249 * ((t261 + t262 - t1 * 6270.0))));
-  jacobian[141] = ((t249 * ((t261 + t262)) + t172 * t253 + 2.0 * u[8] * t251 * t173 + t176 * t250 +
-                    t252 * ((t258 + t259 + t260)))) *
-                  t248 * (-1.0) * t257;
+      (-t257 * t165 * 0.25 +
+       ((2.0 * ((t27 * t239 + t238 * t30)) * u[8] + t236 * t23 * 1900.0 + t242 * t33 * 1900.0)) *
+           t35 * 0.5 * t152);
+  jacobian[84] =
+      ((t258 * t201 * 2e+06 * t74 + 4e+06 * t214 * t56 / (t42) + t260 + 12000.0)) * t165 * (-0.5);
+  jacobian[85] = t165 * ((t258 * 2e+06 * t81 * t74 * t79 + t260)) * (-0.5);
+  jacobian[86] = t259 * (-5e+05) * t146 * t165 * t150 * t136;
+  jacobian[92] = t43 * t165 * 0.03078760800517998 * t46;
+  jacobian[93] = t64 * t165 * t81 * 0.017671458676442587;
+  jacobian[94] = t107 * t165 * 0.013273228961416876 * t136;
+  jacobian[96] = t43 * t165 * (-0.015079644737231009) * t46;
+  jacobian[97] = (-0.00901244392498572) * t64 * t165 * t81;
+  jacobian[98] = t107 * (-0.006911503837897547) * t165 * t136;
+  jacobian[100] = (-t265 *
+                       ((t64 * t212 * t79 + t216 + t220 + t222 + t223 + t225 + t227 + t232 + t233 +
+                         t234 + t235)) *
+                       0.5 +
+                   t268);
+  jacobian[101] = (t265 *
+                       ((t199 - t222 + t206 + 2.0 * t219 * u[8] - t230 * t64 * t79 +
+                         t200 * t83 * t229 - t225 - t227 + t215 - t232 - t64 * t83 * t228)) *
+                       0.5 +
+                   t268);
+  jacobian[102] = (-t266 * t267 *
+                       ((((t261 * t239 + t238 * t217)) * 2.0 * u[8] + t262 * t242 * 1900.0 +
+                         t236 * 1900.0 * t224)) *
+                       0.5 -
+                   t257 * t265 * 0.25);
+  jacobian[104] = t265 * ((-t258 * 2e+06 * t81 * t74 * t79 + t269)) * 0.5;
+  jacobian[105] = t265 * ((t269 - 5000.0 - t258 * 2e+06 * t74 * t229)) * 0.5;
+  jacobian[106] = t259 * (-5e+05) * t146 * t265 * t150 * t136;
+  jacobian[113] = t64 * t265 * 0.017671458676442587 * t79;
+  jacobian[114] = t107 * t265 * 0.013273228961416876 * t136;
+  jacobian[117] = (-0.00901244392498572) * t64 * t265 * t79;
+  jacobian[118] = t107 * t265 * (-0.006911503837897547) * t136;
+  jacobian[120] = t275;
+  jacobian[121] = t275;
+  jacobian[122] = (-0.125 *
+                       ((-t183 * t252 * t151 + t107 * 2.0 * t251 * t151 + 74530.54 * t236 * t36 +
+                         t107 * t255 * t146 + 74530.54 * t242 * t37 - t240 * u[8] * 8.0)) *
+                       t273 +
+                   t274);
+  jacobian[124] = t276;
+  jacobian[125] = t276;
+  jacobian[126] = ((t259 * t252 * 1e+06 * t150 + 3200.0)) * t273 * (-0.25);
+  jacobian[134] = t107 * t146 * t273 * 0.006636614480708438;
+  jacobian[138] = t107 * t146 * t273 * (-0.0034557519189487734);
+  jacobian[140] = t277 * (-1.0) * t286 *
+                  ((t2 * t283 + ((-t1 * 5720.0 - 770.0 * t0)) * t284 + t23 * t282 + t16 * t279 +
+                    ((t287 + t288 + t289 - t1 * 5415.0)) * t281 + t30 * 2.0 * u[8] * t280 +
+                    t278 * ((t290 + t291 - t1 * 6270.0))));
+  jacobian[141] = ((t278 * ((t290 + t291)) + t224 * t282 + 2.0 * u[8] * t280 * t217 + t226 * t279 +
+                    t281 * ((t287 + t288 + t289)))) *
+                  t277 * (-1.0) * t286;
   jacobian[142] =
-      t248 * ((2.0 * u[8] * t251 * t193 + t252 * ((t258 + t259)) + t191 * t253)) * (-1.0) * t257;
-  jacobian[147] = t263 * (-20000.0);
-  jacobian[155] = t263 * 0.0025;
-  jacobian[159] = t263 * (-0.0025);
+      t277 * ((2.0 * u[8] * t280 * t239 + t281 * ((t287 + t288)) + t242 * t282)) * (-1.0) * t286;
+  jacobian[147] = t292 * (-20000.0);
+  jacobian[155] = t292 * 0.0025;
+  jacobian[159] = t292 * (-0.0025);
   jacobian[168] = (-16.666666666666668);
   jacobian[189] = (-16.666666666666668);
   jacobian[210] = (-16.666666666666668);
   jacobian[231] = (-12.5);
   jacobian[240] =
-      (((-t154 * t165 * x[4] * 0.03078760800517998 + t41 * t45 * x[4] * 0.03078760800517998)) *
-           1.2e+09 * t265 -
-       t154 * 36945129.606215976 *
-           ((sqrt(t268) * 3.5e-09 - t154 * x[4] * 0.03078760800517998 * t44 - sqrt(t270) * 3.5e-09 -
-             x[12] * 7e-09 - t272 * t266 * 2.8577380332470414e-06 * t275 + 0.1302 -
-             t278 * 2.8577380332470414e-06 * t276 * t279)) *
-           t44 / (t264 * t264));
-  jacobian[244] = (-36945129.606215976) * t154 * t265 * t44;
+      (((-t43 * t205 * x[4] * 0.03078760800517998 + t213 * t214 * x[4] * 0.03078760800517998)) *
+           1.2e+09 * t294 -
+       t43 * 36945129.606215976 *
+           ((sqrt(t297) * 3.5e-09 - t43 * x[4] * 0.03078760800517998 * t46 - sqrt(t299) * 3.5e-09 -
+             x[12] * 7e-09 + 0.1302 + t300 * 2.8577380332470414e-06 * t303 * t306 +
+             t308 * t295 * 2.8577380332470414e-06 * t309)) *
+           t46 / (t293 * t293));
+  jacobian[244] = (-36945129.606215976) * t43 * t294 * t46;
   jacobian[248] = 1.2e+09 *
-                  ((-t278 * 2.8577380332470414e-06 * t276 * t281 -
-                    t282 * t272 * t266 * 2.8577380332470414e-06)) *
-                  t265;
-  jacobian[252] =
-      ((7.144345083117603e-07 * t276 * pow(t277, (-1.25)) * t279 * ((t283 - 68600000.0)) +
-        7.144345083117603e-07 * t266 * t275 * t284 * pow(t271, (-1.25)) -
-        ((-7.4e+07 + t283)) * (1.0 / sqrt(t270)) * 1.75e-09 - t272 * 2.8577380332470414e-06 * t275 +
-        (1.0 / sqrt(t268)) * t284 * 1.75e-09 - t278 * 2.8577380332470414e-06 * t279 - 7e-09)) *
-      1.2e+09 * t265;
-  jacobian[260] = (-t299 * t125 * t129 * t301 * 21205750.411731105 +
-                   t302 * 1.2e+09 *
-                       ((-t125 * 0.017671458676442587 * x[5] * t185 +
-                         t166 * t167 * 0.017671458676442587 * x[4] +
-                         t166 * t129 * 0.017671458676442587 * x[5] * t181 -
-                         t125 * 0.017671458676442587 * x[4] * t158)));
+                  ((-t311 * t308 * t295 * 2.8577380332470414e-06 +
+                    t300 * 2.8577380332470414e-06 * t303 * t312)) *
+                  t294;
+  jacobian[252] = 1.2e+09 *
+                  ((-2.8577380332470414e-06 * t303 * t306 -
+                    7.144345083117603e-07 * t295 * t314 * pow(t307, (-1.25)) * t309 -
+                    ((-7.4e+07 + t313)) * (1.0 / sqrt(t299)) * 1.75e-09 +
+                    t308 * 2.8577380332470414e-06 * t309 + (1.0 / sqrt(t297)) * t314 * 1.75e-09 +
+                    t301 * 1.4288690166235207e-06 * t306 * pow(t302, (-1.25)) - 7e-09)) *
+                  t294;
+  jacobian[260] =
+      (-t64 * t330 * t81 * t332 * 21205750.411731105 +
+       t333 * 1.2e+09 *
+           ((-t64 * 0.017671458676442587 * x[5] * t211 + t200 * t201 * 0.017671458676442587 * x[4] +
+             t200 * t81 * 0.017671458676442587 * x[5] * t79 -
+             t64 * 0.017671458676442587 * x[4] * t204)));
   jacobian[261] =
-      (-t299 * t125 * t301 * 21205750.411731105 * t181 +
-       t302 * 1.2e+09 *
-           ((t166 * 0.017671458676442587 * x[5] * t231 - t125 * t230 * 0.017671458676442587 * x[5] +
-             t166 * t129 * 0.017671458676442587 * x[4] * t181 -
-             t125 * 0.017671458676442587 * x[4] * t185)));
-  jacobian[264] = t302 * t125 * t129 * (-21205750.411731105);
-  jacobian[265] = t302 * t125 * t181 * (-21205750.411731105);
-  jacobian[269] = t302 * 1.2e+09 *
-                  ((-t297 * t293 * 2.8577380332470414e-06 * t304 -
-                    t289 * t305 * 2.8577380332470414e-06 * t287));
-  jacobian[273] =
-      t302 * 1.2e+09 *
-      ((-(1.0 / sqrt(t286)) * ((t306 - 7.4e+07)) * 1.75e-09 - t297 * 2.8577380332470414e-06 * t298 +
-        7.144345083117603e-07 * t293 * t307 * pow(t296, (-1.25)) * t298 -
-        t289 * 2.8577380332470414e-06 * t292 + t307 * (1.0 / sqrt(t295)) * 1.75e-09 +
-        7.144345083117603e-07 * ((t306 - 68600000.0)) * t287 * t292 * pow(t288, (-1.25)) - 7e-09));
-  jacobian[280] = t326;
-  jacobian[281] = t326;
+      (-t64 * t330 * t332 * 21205750.411731105 * t79 +
+       t333 * 1.2e+09 *
+           ((t200 * 0.017671458676442587 * x[5] * t229 - t64 * t228 * 0.017671458676442587 * x[5] +
+             t200 * t81 * 0.017671458676442587 * x[4] * t79 -
+             t64 * 0.017671458676442587 * x[4] * t211)));
+  jacobian[264] = t333 * t64 * t81 * (-21205750.411731105);
+  jacobian[265] = t333 * t64 * t79 * (-21205750.411731105);
+  jacobian[269] = ((2.8577380332470414e-06 * t317 * t323 * t335 -
+                    t328 * t324 * 2.8577380332470414e-06 * t336)) *
+                  t333 * 1.2e+09;
+  jacobian[273] = t333 * 1.2e+09 *
+                  ((-(1.0 / sqrt(t316)) * ((t337 - 7.4e+07)) * 1.75e-09 +
+                    pow(t322, (-1.25)) * t321 * t320 * 1.4288690166235207e-06 -
+                    2.8577380332470414e-06 * t320 * t323 - t328 * 2.8577380332470414e-06 * t329 +
+                    7.144345083117603e-07 * t324 * t338 * pow(t327, (-1.25)) * t329 +
+                    t338 * (1.0 / sqrt(t326)) * 1.75e-09 - 7e-09));
+  jacobian[280] = t358;
+  jacobian[281] = t358;
   jacobian[282] =
-      (-t108 * t205 * t322 * 7963937.376850126 * t324 +
-       1.2e+09 * t325 *
-           ((t77 * t247 * 0.003318307240354219 * x[6] +
-             t77 * t205 * 0.006636614480708438 * x[4] * t105 -
-             t108 * t220 * x[4] * 0.013273228961416876 - t108 * t220 * x[5] * 0.013273228961416876 +
-             t77 * t205 * 0.006636614480708438 * x[5] * t105 -
-             t108 * 0.006636614480708438 * x[6] * t246)));
-  jacobian[284] = t327;
-  jacobian[285] = t327;
-  jacobian[286] = t108 * t205 * (-7963937.376850126) * t325;
-  jacobian[290] = ((-t311 * t308 * t329 * 2.0412414523193154e-06 -
-                    t330 * t318 * t316 * 2.0412414523193154e-06)) *
-                  1.2e+09 * t325;
-  jacobian[294] =
-      1.2e+09 * t325 *
-      ((-t315 * t318 * 2.0412414523193154e-06 +
-        pow(t317, (-1.25)) * ((t331 - 68600000.0)) * 5.103103630798288e-07 * t315 * t316 +
-        (1.0 / sqrt(t321)) * t332 * 1.25e-09 -
-        t332 * t308 * 5.103103630798288e-07 * t314 * pow(t310, (-1.25)) -
-        (1.0 / sqrt(t320)) * 1.25e-09 * ((t331 - 7.4e+07)) + t311 * t314 * 2.0412414523193154e-06 -
-        5e-09));
+      (-t107 * t146 * 7963937.376850126 * t340 * t356 +
+       1.2e+09 * t357 *
+           ((t183 * t252 * 0.003318307240354219 * x[6] +
+             t183 * t146 * 0.006636614480708438 * x[4] * t136 -
+             t107 * t254 * x[4] * 0.013273228961416876 - t107 * t254 * x[5] * 0.013273228961416876 +
+             t183 * t146 * 0.006636614480708438 * x[5] * t136 -
+             t107 * 0.006636614480708438 * x[6] * t251)));
+  jacobian[284] = t359;
+  jacobian[285] = t359;
+  jacobian[286] = t107 * t146 * (-7963937.376850126) * t357;
+  jacobian[290] = 1.2e+09 *
+                  ((-t346 * t343 * t361 * 2.0412414523193154e-06 +
+                    t362 * t352 * t355 * 2.0412414523193154e-06)) *
+                  t357;
+  jacobian[294] = 1.2e+09 * t357 *
+                  ((-t364 * t343 * 5.103103630798288e-07 * t349 * pow(t345, (-1.25)) +
+                    pow(t354, (-1.25)) * t351 * 1.0206207261596577e-06 * t353 +
+                    t346 * t349 * 2.0412414523193154e-06 + (1.0 / sqrt(t350)) * t364 * 1.25e-09 -
+                    (1.0 / sqrt(t342)) * 1.25e-09 * ((t363 - 7.4e+07)) -
+                    t351 * t355 * 2.0412414523193154e-06 - 5e-09));
   jacobian[307] = (-7.5e+08);
-  jacobian[311] =
-      (-t333 * t336 * 510310.3630798288 * t339 - t340 * t341 * t343 * 510310.3630798288);
-  jacobian[315] =
-      (t345 * (1.0 / sqrt((1e+10 + t334))) * 312.5 - 1250.0 - t347 * t343 * 510310.3630798288 -
-       t345 * t333 * 127577.5907699572 * t348 * pow(t335, (-1.25)) +
-       t336 * t348 * 510310.3630798288 +
-       pow(t342, (-1.25)) * t347 * 127577.5907699572 * t341 * ((t344 - 68600000.0)) -
-       ((t344 - 5.8e+07)) * (1.0 / sqrt(((t349 * t349) + 1e+10))) * 312.5);
-  jacobian[320] =
-      (1.2e+09 * t351 *
-           ((0.015079644737231009 * t154 * t165 * x[4] - 0.015079644737231009 * t41 * t45 * x[4])) +
-       t154 * 18095573.68467721 * t44 *
-           ((0.015079644737231009 * t154 * x[4] * t44 -
-             2.8577380332470414e-06 * t354 * t352 * t275 - sqrt(t356) * 3.5e-09 -
-             t360 * t357 * 2.8577380332470414e-06 * t279 - x[16] * 7e-09 + 0.1302 +
-             sqrt(t361) * 3.5e-09)) /
-           (t350 * t350));
-  jacobian[324] = t154 * t351 * 18095573.68467721 * t44;
-  jacobian[328] = ((-t282 * 2.8577380332470414e-06 * t354 * t352 -
-                    t360 * t357 * 2.8577380332470414e-06 * t281)) *
-                  1.2e+09 * t351;
-  jacobian[336] =
-      1.2e+09 * t351 *
-      ((7.144345083117603e-07 * t357 * t363 * t279 * pow(t359, (-1.25)) +
-        (1.0 / sqrt(t361)) * t363 * 1.75e-09 +
-        pow(t353, (-1.25)) * 7.144345083117603e-07 * t352 * t275 * ((t362 - 68600000.0)) -
-        2.8577380332470414e-06 * t354 * t275 - t360 * 2.8577380332470414e-06 * t279 -
-        ((t362 - 7.4e+07)) * (1.0 / sqrt(t356)) * 1.75e-09 - 7e-09));
+  jacobian[311] = (t367 * t368 * 510310.3630798288 * t371 - t372 * t373 * t376 * 510310.3630798288);
+  jacobian[315] = (t378 * t380 * t373 * 127577.5907699572 * pow(t375, (-1.25)) +
+                   t369 * pow(t370, (-1.25)) * t381 * 255155.1815399144 +
+                   t380 * (1.0 / sqrt((1e+10 + t374))) * 312.5 - 1250.0 -
+                   t381 * 510310.3630798288 * t371 - t378 * t376 * 510310.3630798288 -
+                   ((t379 - 5.8e+07)) * (1.0 / sqrt(((t382 * t382) + 1e+10))) * 312.5);
+  jacobian[320] = (1.2e+09 * t384 *
+                       ((0.015079644737231009 * t43 * t205 * x[4] -
+                         0.015079644737231009 * t213 * t214 * x[4])) +
+                   t43 * 18095573.68467721 *
+                       ((0.015079644737231009 * t43 * x[4] * t46 - sqrt(t386) * 3.5e-09 -
+                         t390 * t387 * 2.8577380332470414e-06 * t306 - x[16] * 7e-09 + 0.1302 +
+                         t394 * 2.8577380332470414e-06 * t391 * t309 + sqrt(t395) * 3.5e-09)) *
+                       t46 / (t383 * t383));
+  jacobian[324] = t43 * t384 * 18095573.68467721 * t46;
+  jacobian[328] = ((-t311 * t394 * 2.8577380332470414e-06 * t391 -
+                    t390 * t387 * 2.8577380332470414e-06 * t312)) *
+                  1.2e+09 * t384;
+  jacobian[336] = ((-t392 * 1.4288690166235207e-06 * pow(t393, (-1.25)) * t309 +
+                    (1.0 / sqrt(t395)) * t397 * 1.75e-09 + t394 * 2.8577380332470414e-06 * t309 +
+                    7.144345083117603e-07 * t387 * t397 * t306 * pow(t389, (-1.25)) -
+                    t390 * 2.8577380332470414e-06 * t306 -
+                    ((t396 - 7.4e+07)) * (1.0 / sqrt(t386)) * 1.75e-09 - 7e-09)) *
+                  1.2e+09 * t384;
   jacobian[340] =
-      (((t125 * x[5] * t185 * 0.00901244392498572 + t125 * x[4] * t158 * 0.00901244392498572 -
-         t166 * t129 * x[5] * t181 * 0.00901244392498572 -
-         t166 * t167 * x[4] * 0.00901244392498572)) *
-           1.2e+09 * t365 +
-       t366 * t125 * t377 * 10814932.709982865 * t129);
+      (((t64 * x[5] * t211 * 0.00901244392498572 + t64 * x[4] * t204 * 0.00901244392498572 -
+         t200 * t81 * x[5] * t79 * 0.00901244392498572 -
+         t200 * t201 * x[4] * 0.00901244392498572)) *
+           1.2e+09 * t399 +
+       t400 * t64 * 10814932.709982865 * t412 * t81);
   jacobian[341] =
-      (t366 * t125 * t377 * 10814932.709982865 * t181 +
+      (t400 * t64 * 10814932.709982865 * t412 * t79 +
        1.2e+09 *
-           ((-t166 * t129 * x[4] * t181 * 0.00901244392498572 +
-             t125 * t230 * x[5] * 0.00901244392498572 + t125 * x[4] * t185 * 0.00901244392498572 -
-             t166 * x[5] * t231 * 0.00901244392498572)) *
-           t365);
-  jacobian[344] = t125 * 10814932.709982865 * t129 * t365;
-  jacobian[345] = t125 * 10814932.709982865 * t365 * t181;
-  jacobian[349] = ((-t376 * t305 * t367 * 2.8577380332470414e-06 -
-                    2.8577380332470414e-06 * t372 * t374 * t304)) *
-                  1.2e+09 * t365;
+           ((-t200 * t81 * x[4] * t79 * 0.00901244392498572 +
+             t64 * t228 * x[5] * 0.00901244392498572 + t64 * x[4] * t211 * 0.00901244392498572 -
+             t200 * x[5] * t229 * 0.00901244392498572)) *
+           t399);
+  jacobian[344] = t64 * 10814932.709982865 * t81 * t399;
+  jacobian[345] = t64 * 10814932.709982865 * t399 * t79;
+  jacobian[349] =
+      1.2e+09 * t399 *
+      ((t406 * 2.8577380332470414e-06 * t336 * t409 - t411 * t401 * 2.8577380332470414e-06 * t335));
   jacobian[357] =
-      1.2e+09 *
-      ((7.144345083117603e-07 * t367 * t379 * t292 * pow(t375, (-1.25)) -
-        2.8577380332470414e-06 * t374 * t298 - ((-7.4e+07 + t378)) * (1.0 / sqrt(t371)) * 1.75e-09 +
-        t379 * (1.0 / sqrt(t369)) * 1.75e-09 +
-        7.144345083117603e-07 * pow(t373, (-1.25)) * ((t378 - 68600000.0)) * t372 * t298 -
-        t376 * 2.8577380332470414e-06 * t292 - 7e-09)) *
-      t365;
-  jacobian[360] = t394;
-  jacobian[361] = t394;
+      ((pow(t408, (-1.25)) * 1.4288690166235207e-06 * t407 * t329 +
+        7.144345083117603e-07 * t401 * t414 * t320 * pow(t410, (-1.25)) -
+        ((-7.4e+07 + t413)) * (1.0 / sqrt(t405)) * 1.75e-09 + t414 * (1.0 / sqrt(t403)) * 1.75e-09 -
+        2.8577380332470414e-06 * t329 * t409 - t411 * 2.8577380332470414e-06 * t320 - 7e-09)) *
+      1.2e+09 * t399;
+  jacobian[360] = t430;
+  jacobian[361] = t430;
   jacobian[362] =
-      (1.2e+09 * t381 *
-           ((t108 * 0.006911503837897547 * t220 * x[5] + t108 * 0.006911503837897547 * t220 * x[4] -
-             t77 * t247 * 0.0017278759594743867 * x[6] +
-             t108 * 0.0034557519189487734 * x[6] * t246 -
-             t77 * t205 * 0.0034557519189487734 * x[5] * t105 -
-             t77 * t205 * 0.0034557519189487734 * x[4] * t105)) +
-       t108 * t205 * t382 * t393 * 4146902.3027385282);
-  jacobian[364] = t395;
-  jacobian[365] = t395;
-  jacobian[366] = t108 * t205 * t381 * 4146902.3027385282;
-  jacobian[370] = 1.2e+09 * t381 *
-                  ((-t387 * t385 * t329 * 2.0412414523193154e-06 -
-                    t392 * t388 * t330 * 2.0412414523193154e-06));
-  jacobian[378] =
-      1.2e+09 * t381 *
-      ((-((-7.4e+07 + t396)) * 1.25e-09 * (1.0 / sqrt(t384)) -
-        ((t396 - 68600000.0)) * 5.103103630798288e-07 * t314 * t385 * pow(t386, (-1.25)) +
-        t388 * 5.103103630798288e-07 * t397 * t315 * pow(t391, (-1.25)) -
-        t392 * t315 * 2.0412414523193154e-06 + t387 * t314 * 2.0412414523193154e-06 +
-        t397 * 1.25e-09 * (1.0 / sqrt(t390)) - 5e-09));
+      (1.2e+09 * t429 *
+           ((t107 * 0.006911503837897547 * t254 * x[5] + t107 * 0.006911503837897547 * t254 * x[4] -
+             t183 * t252 * 0.0017278759594743867 * x[6] +
+             t107 * 0.0034557519189487734 * x[6] * t251 -
+             t183 * t146 * 0.0034557519189487734 * x[5] * t136 -
+             t183 * t146 * 0.0034557519189487734 * x[4] * t136)) +
+       t107 * t146 * t426 * t428 * 4146902.3027385282);
+  jacobian[364] = t431;
+  jacobian[365] = t431;
+  jacobian[366] = t107 * t146 * t429 * 4146902.3027385282;
+  jacobian[370] = 1.2e+09 *
+                  ((t420 * t361 * 2.0412414523193154e-06 * t423 -
+                    t425 * t362 * t417 * 2.0412414523193154e-06)) *
+                  t429;
+  jacobian[378] = 1.2e+09 * t429 *
+                  ((-((-7.4e+07 + t432)) * 1.25e-09 * (1.0 / sqrt(t416)) -
+                    t421 * t349 * pow(t422, (-1.25)) * 1.0206207261596577e-06 +
+                    t349 * 2.0412414523193154e-06 * t423 - t425 * t351 * 2.0412414523193154e-06 +
+                    t417 * 5.103103630798288e-07 * t433 * t351 * pow(t424, (-1.25)) +
+                    t433 * 1.25e-09 * (1.0 / sqrt(t419)) - 5e-09));
   jacobian[387] = 7.5e+08;
   jacobian[391] =
-      (-t400 * t398 * 510310.3630798288 * t339 - t340 * t404 * t401 * 510310.3630798288);
-  jacobian[399] = (-((t405 - 5.8e+07)) * (1.0 / sqrt(((t406 * t406) + 1e+10))) * 312.5 - 1250.0 -
-                   127577.5907699572 * ((t405 - 68600000.0)) * t348 * t398 * pow(t399, (-1.25)) +
-                   t347 * t407 * t401 * 127577.5907699572 * pow(t403, (-1.25)) +
-                   (1.0 / sqrt((t402 + 1e+10))) * t407 * 312.5 - t404 * t347 * 510310.3630798288 +
-                   t400 * t348 * 510310.3630798288);
+      (-t372 * t434 * 510310.3630798288 * t437 - t441 * t438 * t367 * 510310.3630798288);
+  jacobian[399] =
+      (-((t442 - 5.8e+07)) * (1.0 / sqrt(((t443 * t443) + 1e+10))) * 312.5 - 1250.0 -
+       t441 * t381 * 510310.3630798288 +
+       t444 * t438 * 127577.5907699572 * t381 * pow(t440, (-1.25)) +
+       (1.0 / sqrt((t439 + 1e+10))) * t444 * 312.5 +
+       t378 * pow(t436, (-1.25)) * t435 * 255155.1815399144 - t378 * 510310.3630798288 * t437);
 }
 
 namespace {

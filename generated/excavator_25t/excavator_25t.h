@@ -18,7 +18,7 @@ inline constexpr int kNumJoints = 4;
 inline constexpr int kNumAngles = 5;
 inline constexpr int kNumParams = 6;
 inline constexpr int kNumStates = 20;
-inline constexpr int kNumInputs = 10;
+inline constexpr int kNumInputs = 14;
 inline constexpr int kNumActuators = 4;
 /// Nominal [l_1 ... l_n, alpha_1 ... alpha_n] [m, rad].
 inline constexpr double kNominalParams[kNumParams] = {

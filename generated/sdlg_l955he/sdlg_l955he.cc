@@ -83,45 +83,46 @@ int InverseKinematics(const double* target, const double* params, double* q) {
   using std::pow;
   using std::sin;
   using std::sqrt;
-  const double t0 = (target[0] - 1.1);
-  const double t1 = (target[2] - 2.0);
+  const double t0 = (target[2] - 2.0);
+  const double t1 = (target[0] - 1.1);
   const double cos_elbow =
-      (((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) * 0.5 /
+      (-0.5) * ((-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1))) /
       (params[1] * params[0]);
   if (!(cos_elbow >= -1.0 && cos_elbow <= 1.0)) return 1;
   double branch[2][kNumJoints];
   {
     double* solution = branch[0];
-    const double t0 = (target[0] - 1.1);
-    const double t1 = (target[2] - 2.0);
-    const double t2 = ((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]));
+    const double t0 = (target[2] - 2.0);
+    const double t1 = (target[0] - 1.1);
+    const double t2 = (-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1));
     const double t3 = (1.0 / (params[0]));
     solution[0] =
-        (-atan2(sqrt((-0.25 * (t2 * t2) / (params[0] * params[0] * params[1] * params[1]) + 1.0)) *
+        (-atan2(sqrt((1.0 - (t2 * t2) * 0.25 / (params[0] * params[0] * params[1] * params[1]))) *
                     params[1],
-                (t2 * t3 * 0.5 + params[0])) +
-         atan2(t1, t0));
-    solution[1] = acos(t2 * t3 * 0.5 / (params[1]));
+                (params[0] - t3 * 0.5 * t2)) +
+         atan2(t0, t1));
+    solution[1] = acos(t3 * (-0.5) * t2 / (params[1]));
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
   }
   {
     double* solution = branch[1];
-    const double t0 = (target[0] - 1.1);
-    const double t1 = (target[2] - 2.0);
+    const double t0 = (target[2] - 2.0);
+    const double t1 = (target[0] - 1.1);
     solution[0] =
-        (-atan2(
-             sin(acos(
-                     (((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) *
-                     0.5 / (params[1] * params[0])) *
-                 (-1.0)) *
-                 params[1],
-             (params[0] + params[1] * cos(acos((((t0 * t0) + (t1 * t1) - (params[0] * params[0]) -
-                                                 (params[1] * params[1]))) *
-                                               0.5 / (params[1] * params[0])) *
-                                          (-1.0)))) +
-         atan2(t1, t0));
+        (-atan2(params[1] * sin(acos((-0.5) *
+                                     ((-(t0 * t0) + (params[0] * params[0]) +
+                                       (params[1] * params[1]) - (t1 * t1))) /
+                                     (params[1] * params[0])) *
+                                (-1.0)),
+                (params[0] + params[1] * cos(acos((-0.5) *
+                                                  ((-(t0 * t0) + (params[0] * params[0]) +
+                                                    (params[1] * params[1]) - (t1 * t1))) /
+                                                  (params[1] * params[0])) *
+                                             (-1.0)))) +
+         atan2(t0, t1));
     solution[1] =
-        acos((((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) * 0.5 /
+        acos((-0.5) *
+             ((-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1))) /
              (params[1] * params[0])) *
         (-1.0);
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
@@ -225,26 +226,26 @@ double LeverArm(int actuator, const double* q) {
       const double t22 = sin(t20);
       const double t23 = (-t0 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
       const double t24 = (-0.853 * t21 + t0 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
-      const double t25 = (-0.389 * t4 - 0.159 * t2);
-      const double t26 = (t3 + t5);
-      const double t27 = (t25 * t7 + t9 * t26);
-      const double t28 = (t27 * t14 / (t11 * t11) - t27 * t13 * 2.0 * t15);
-      const double t29 = (1.0 / sqrt(t16));
-      const double t30 = pow(t11, (-1.5));
-      const double t31 = (1.0 / (((t15 * (t19 * t19) + (t18 * t18) * t15))));
+      const double t25 = (1.0 / (((t15 * (t19 * t19) + (t18 * t18) * t15))));
+      const double t26 = (-0.389 * t4 - 0.159 * t2);
+      const double t27 = (t3 + t5);
+      const double t28 = (t26 * t7 + t9 * t27);
+      const double t29 = pow(t11, (-1.5));
+      const double t30 = (1.0 / sqrt(t16));
+      const double t31 = (t28 * t13 * 2.0 * t15 - t28 * t14 / (t11 * t11));
       const double t32 =
-          (t12 *
-               ((t12 * ((-t17 * t25 * 4.0 - t27 * t12 * 4.0 * t9 - t12 * t13 * 2.0 * t26 -
-                         t7 * t28 * t29 + t27 * t13 * 2.0 * t30 * t9)) +
-                 t27 * 2.0 * t30 * t18)) *
-               t19 * t31 -
-           t12 * t31 * t18 *
-               ((t12 * ((t27 * t12 * t7 * 4.0 + t25 * t12 * t13 * 2.0 - t17 * 4.0 * t26 -
-                         t28 * t9 * t29 - t27 * t7 * t13 * 2.0 * t30)) +
-                 t27 * t19 * 2.0 * t30)));
+          (t12 * t25 *
+               ((t28 * t19 * 2.0 * t29 +
+                 t12 * ((t28 * t12 * t7 * 4.0 + t26 * t12 * t13 * 2.0 - t17 * 4.0 * t27 +
+                         t9 * t30 * t31 - t28 * t7 * t13 * 2.0 * t29)))) *
+               t18 +
+           t12 * t19 * t25 *
+               ((-t28 * 2.0 * t29 * t18 +
+                 t12 * ((t12 * t13 * 2.0 * t27 + t28 * t12 * 4.0 * t9 - t28 * t13 * 2.0 * t29 * t9 -
+                         t7 * t30 * t31 + t17 * t26 * 4.0)))));
       const double lever = (1.0 / sqrt(((t23 * t23) + (t24 * t24)))) *
-                           ((((0.0705 * t32 * t21 + t32 * 0.4265 * t22)) * t24 +
-                             t23 * ((0.0705 * t32 * t22 - t32 * 0.4265 * t21))));
+                           ((t23 * ((t32 * 0.4265 * t21 - 0.0705 * t32 * t22)) +
+                             t24 * ((-0.0705 * t32 * t21 - t32 * 0.4265 * t22))));
       return lever;
     }
     default:
@@ -287,181 +288,188 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::pow;
   using std::sin;
   using std::sqrt;
-  const double t0 = cos(x[0]);
-  const double t1 = 3.11 * t0;
-  const double t2 = (x[0] + x[1]);
-  const double t3 = sin(t2);
-  const double t4 = t3 * (-0.25);
-  const double t5 = cos(t2);
-  const double t6 = 0.55 * t5;
-  const double t7 = (t1 + t4 + t6);
-  const double t8 = cos(u[5]);
-  const double t9 = sin(x[0]);
-  const double t10 = (-1.55 * t9 - 0.1 * t0);
-  const double t11 = sin(u[5]);
-  const double t12 = t3 * (-0.4011545671438309);
-  const double t13 = (-0.16343387866394005) * t5;
-  const double t14 = t9 * (-3.11);
-  const double t15 = (t12 + t13 + t14);
-  const double t16 = t3 * (-0.16343387866394005);
-  const double t17 = 0.4011545671438309 * t5;
-  const double t18 = (t16 + t1 + t17);
-  const double t19 = (0.389 * t5 + t9 * 0.5249999999999999 - 0.365 * t0 + t3 * 0.159);
-  const double t20 = 0.159 * t5;
-  const double t21 = t3 * (-0.389);
-  const double t22 = (0.365 * t9 + t20 + t21 + t0 * 0.5249999999999999);
-  const double t23 = (t22 * t22);
-  const double t24 = (t19 * t19);
-  const double t25 = (t23 + t24 - 0.38752);
-  const double t26 = (t23 + t24);
-  const double t27 = (1.0 / sqrt(t26));
-  const double t28 = (t25 * t25);
-  const double t29 = (1.0 / (t26));
-  const double t30 = (0.567009 - 0.25 * t28 * t29);
-  const double t31 = sqrt(t30);
-  const double t32 = (t19 * t25 * t27 + 2.0 * t22 * t31);
-  const double t33 = (t19 * 2.0 * t31 - t25 * t22 * t27);
-  const double t34 = atan2(0.5 * t32 * t27, t33 * (-0.5) * t27);
-  const double t35 = cos(t34);
-  const double t36 = sin(t34);
-  const double t37 = (-0.141 * t35 - t36 * 0.853 - 0.15500000000000003 * t0 + t9 * 2.093);
-  const double t38 = t9 * 0.15500000000000003;
-  const double t39 = 2.093 * t0;
-  const double t40 = (t38 + t36 * 0.141 - 0.853 * t35 + t39);
-  const double t41 = ((t37 * t37) + (t40 * t40));
-  const double t42 = sqrt(t41);
-  const double t43 = (-2.9000000000000004 + t42);
-  const double t44 = (-1.59 + t42);
-  const double t45 =
-      (-2e+08 * t42 - sqrt(((t43 * t43) + 1e-06)) * 1e+08 + 0.031415926535897934 * x[7] +
-       sqrt((1e-06 + (t44 * t44))) * 1e+08 - 0.023561944901923454 * x[9] + 4.49e+08);
-  const double t46 = (-0.389) * t5;
-  const double t47 = t3 * (-0.159);
-  const double t48 = (t46 - t9 * 0.5249999999999999 + 0.365 * t0 + t47);
-  const double t49 = (1.0 / sqrt(t30));
-  const double t50 = (t48 * t22 + t19 * t22);
-  const double t51 = (1.0 / (t26 * t26));
-  const double t52 = (-2.0 * t25 * t50 * t29 + t51 * t50 * t28);
-  const double t53 = pow(t26, (-1.5));
-  const double t54 = (1.0 / ((((t33 * t33) * t29 + (t32 * t32) * t29))));
-  const double t55 = (((((t48 * 4.0 * t31 + t49 * t52 * t22 - t19 * 2.0 * t25 * t50 * t53 +
-                          t19 * 4.0 * t50 * t27 + 2.0 * t25 * t22 * t27)) *
-                            t27 -
-                        2.0 * t50 * t32 * t53)) *
-                          t54 * t33 * t27 +
-                      t54 *
-                          ((-((2.0 * t25 * t22 * t50 * t53 + t19 * t49 * t52 -
-                               4.0 * t22 * t50 * t27 + 4.0 * t22 * t31 - t48 * 2.0 * t25 * t27)) *
-                                t27 +
-                            2.0 * t33 * t50 * t53)) *
-                          t32 * t27);
-  const double t56 =
-      (t37 * ((t38 - t36 * 0.0705 * t55 + 0.4265 * t35 * t55 + t39)) +
-       t40 * ((-0.0705 * t35 * t55 - t9 * 2.093 + 0.15500000000000003 * t0 - t36 * 0.4265 * t55)));
-  const double t57 = (1.0 / sqrt(t41));
-  const double t58 = (-t9 * 0.1 + 1.55 * t0);
-  const double t59 = (0.194 * t0 + 1.595 + t9 * 0.857);
-  const double t60 = (-0.194) * t9;
-  const double t61 = 0.857 * t0;
-  const double t62 = (t60 + t61 - 1.339);
-  const double t63 = (t59 * ((t60 + t61)) + ((-t9 * 0.857 - 0.194 * t0)) * t62);
-  const double t64 = ((t59 * t59) + (t62 * t62));
-  const double t65 = (1.0 / sqrt(t64));
-  const double t66 = sqrt(t64);
-  const double t67 = (-2.51 + t66);
-  const double t68 = (t66 - 1.4);
-  const double t69 = t3 * (-0.55);
-  const double t70 = (-0.25) * t5;
-  const double t71 = (t69 + t70 + t14);
-  const double t72 = (t20 + t21);
-  const double t73 = (t46 + t47);
-  const double t74 = (t72 * t19 + t73 * t22);
-  const double t75 = (-2.0 * t25 * t29 * t74 + t51 * t28 * t74);
-  const double t76 = (-t54 *
-                          ((((-t19 * t75 * t49 - 2.0 * t25 * t22 * t53 * t74 +
-                              2.0 * t25 * t73 * t27 + 4.0 * t22 * t74 * t27 - t72 * 4.0 * t31)) *
-                                t27 +
-                            2.0 * t33 * t53 * t74)) *
-                          t32 * t27 +
-                      t54 *
-                          ((-((-t19 * 2.0 * t25 * t53 * t74 + t75 * t49 * t22 +
-                               t72 * 2.0 * t25 * t27 + t19 * 4.0 * t74 * t27 + 4.0 * t73 * t31)) *
-                                t27 +
-                            2.0 * t32 * t53 * t74)) *
-                          t33 * t27);
-  const double t77 = (((t36 * 0.0705 * t76 - 0.4265 * t76 * t35)) * t37 +
-                      t40 * ((t36 * 0.4265 * t76 + 0.0705 * t76 * t35)));
-  const double t78 = (t4 + t6);
-  const double t79 = (t16 + t17);
-  const double t80 = (t12 + t13);
-  const double t81 = (t69 + t70);
-  const double t82 = (-2.8e+07 + x[6]);
-  const double t83 = sqrt(((x[4] * x[4]) + 1e-04));
-  const double t84 = (x[4] + t83);
-  const double t85 = (x[6] - 2.5e+07);
-  const double t86 = (-x[4] + t83);
-  const double t87 = (x[6] - 2e+05);
-  const double t88 = (t87 * t87);
-  const double t89 = (x[7] - 2e+05);
-  const double t90 = (t89 * t89);
-  const double t91 = sqrt(((x[5] * x[5]) + 1e-04));
-  const double t92 = (-t91 + x[5]);
-  const double t93 = (-2.8e+07 + x[7]);
-  const double t94 = (t91 + x[5]);
-  const double t95 = (x[7] - 2.5e+07);
-  const double t96 = (x[8] - 2e+05);
+  const double t0 = sin(x[0]);
+  const double t1 = cos(x[0]);
+  const double t2 = (-t0 * 0.1 + 1.55 * t1);
+  const double t3 = (x[0] + x[1]);
+  const double t4 = sin(t3);
+  const double t5 = t4 * (-0.55);
+  const double t6 = cos(t3);
+  const double t7 = (-0.25) * t6;
+  const double t8 = t0 * (-3.11);
+  const double t9 = (t5 + t7 + t8);
+  const double t10 = t4 * (-0.16343387866394005);
+  const double t11 = 3.11 * t1;
+  const double t12 = 0.4011545671438309 * t6;
+  const double t13 = (t10 + t11 + t12);
+  const double t14 = t4 * (-0.4011545671438309);
+  const double t15 = (-0.16343387866394005) * t6;
+  const double t16 = (t14 + t15 + t8);
+  const double t17 = t4 * (-0.25);
+  const double t18 = 0.55 * t6;
+  const double t19 = (t11 + t17 + t18);
+  const double t20 = (-1.55 * t0 - 0.1 * t1);
+  const double t21 = cos(u[5]);
+  const double t22 = (0.194 * t1 + 1.595 + t0 * 0.857);
+  const double t23 = (-0.194) * t0;
+  const double t24 = 0.857 * t1;
+  const double t25 = (t23 + t24 - 1.339);
+  const double t26 = (t22 * ((t23 + t24)) + ((-t0 * 0.857 - 0.194 * t1)) * t25);
+  const double t27 = ((t22 * t22) + (t25 * t25));
+  const double t28 = (1.0 / sqrt(t27));
+  const double t29 = sqrt(t27);
+  const double t30 = (-2.51 + t29);
+  const double t31 = (1e-06 + (t30 * t30));
+  const double t32 = (t29 - 1.4);
+  const double t33 = (1e-06 + (t32 * t32));
+  const double t34 = sin(u[5]);
+  const double t35 = (0.389 * t6 + t0 * 0.5249999999999999 - 0.365 * t1 + t4 * 0.159);
+  const double t36 = 0.159 * t6;
+  const double t37 = t4 * (-0.389);
+  const double t38 = (0.365 * t0 + t36 + t37 + t1 * 0.5249999999999999);
+  const double t39 = (t38 * t38);
+  const double t40 = (t35 * t35);
+  const double t41 = (t39 + t40 - 0.38752);
+  const double t42 = (t39 + t40);
+  const double t43 = (1.0 / sqrt(t42));
+  const double t44 = (t41 * t41);
+  const double t45 = (1.0 / (t42));
+  const double t46 = (0.567009 - 0.25 * t44 * t45);
+  const double t47 = sqrt(t46);
+  const double t48 = (t35 * t41 * t43 + 2.0 * t38 * t47);
+  const double t49 = (-t35 * 2.0 * t47 + t41 * t38 * t43);
+  const double t50 = atan2(0.5 * t48 * t43, t49 * 0.5 * t43);
+  const double t51 = cos(t50);
+  const double t52 = sin(t50);
+  const double t53 = (-0.15500000000000003 * t1 - 0.141 * t51 + t0 * 2.093 - t52 * 0.853);
+  const double t54 = t0 * 0.15500000000000003;
+  const double t55 = 2.093 * t1;
+  const double t56 = (0.141 * t52 + t54 - 0.853 * t51 + t55);
+  const double t57 = ((t53 * t53) + (t56 * t56));
+  const double t58 = (1.0 / sqrt(t57));
+  const double t59 = sqrt(t57);
+  const double t60 = (-1.59 + t59);
+  const double t61 = ((t60 * t60) + 1e-06);
+  const double t62 = (1.0 / sqrt(t46));
+  const double t63 = (1.0 / (t42 * t42));
+  const double t64 = (t36 + t37);
+  const double t65 = (-0.389) * t6;
+  const double t66 = t4 * (-0.159);
+  const double t67 = (t65 + t66);
+  const double t68 = (t64 * t35 + t67 * t38);
+  const double t69 = (-t63 * t44 * t68 + 2.0 * t41 * t45 * t68);
+  const double t70 = pow(t42, (-1.5));
+  const double t71 = (1.0 / ((((t48 * t48) * t45 + (t49 * t49) * t45))));
+  const double t72 = (((((-t35 * t62 * t69 - 2.0 * t41 * t67 * t43 - 4.0 * t38 * t68 * t43 +
+                          2.0 * t41 * t38 * t70 * t68 + t64 * 4.0 * t47)) *
+                            t43 +
+                        t49 * 2.0 * t70 * t68)) *
+                          t48 * t71 * t43 +
+                      t49 * t71 *
+                          ((((-t35 * 2.0 * t41 * t70 * t68 + t64 * 2.0 * t41 * t43 +
+                              t35 * 4.0 * t68 * t43 - t62 * t38 * t69 + 4.0 * t67 * t47)) *
+                                t43 -
+                            2.0 * t48 * t70 * t68)) *
+                          t43);
+  const double t73 = (t53 * ((-t72 * 0.4265 * t51 + 0.0705 * t72 * t52)) +
+                      ((0.0705 * t72 * t51 + t72 * t52 * 0.4265)) * t56);
+  const double t74 = (t65 - t0 * 0.5249999999999999 + 0.365 * t1 + t66);
+  const double t75 = (t74 * t38 + t35 * t38);
+  const double t76 = (-2.0 * t41 * t75 * t45 + t63 * t75 * t44);
+  const double t77 = (((((2.0 * t41 * t38 * t75 * t70 + t35 * t62 * t76 - 4.0 * t38 * t75 * t43 +
+                          4.0 * t38 * t47 - t74 * 2.0 * t41 * t43)) *
+                            t43 +
+                        t49 * 2.0 * t75 * t70)) *
+                          t48 * t71 * t43 +
+                      t49 *
+                          ((((t74 * 4.0 * t47 + t62 * t76 * t38 - t35 * 2.0 * t41 * t75 * t70 +
+                              t35 * 4.0 * t75 * t43 + 2.0 * t41 * t38 * t43)) *
+                                t43 -
+                            2.0 * t75 * t48 * t70)) *
+                          t71 * t43);
+  const double t78 =
+      (((-t0 * 2.093 + 0.15500000000000003 * t1 + t52 * 0.4265 * t77 + 0.0705 * t51 * t77)) * t56 +
+       t53 * ((t54 + 0.0705 * t52 * t77 + t55 - 0.4265 * t51 * t77)));
+  const double t79 = (t59 - 2.9000000000000004);
+  const double t80 = ((t79 * t79) + 1e-06);
+  const double t81 = (-sqrt(t61) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] +
+                      ((t58 * t73 * 2e+06 * x[3] + t58 * 2e+06 * x[2] * t78)) *
+                          ((2.0 + t79 * (1.0 / sqrt(t80)) - t60 * (1.0 / sqrt(t61)))) +
+                      sqrt(t80) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t59);
+  const double t82 = (t10 + t12);
+  const double t83 = (t14 + t15);
+  const double t84 = (t17 + t18);
+  const double t85 = (t5 + t7);
+  const double t86 = (-2.8e+07 + x[6]);
+  const double t87 = sqrt(((x[4] * x[4]) + 1e-06));
+  const double t88 = (x[4] + t87);
+  const double t89 = (x[6] - u[6]);
+  const double t90 = (x[6] - 2e+05);
+  const double t91 = (t90 * t90);
+  const double t92 = (-t87 + x[4]);
+  const double t93 = sqrt(((x[5] * x[5]) + 1e-06));
+  const double t94 = (t93 + x[5]);
+  const double t95 = (x[7] - u[7]);
+  const double t96 = (x[7] - 2e+05);
   const double t97 = (t96 * t96);
-  const double t98 = (-2.8e+07 + x[8]);
-  const double t99 = (x[8] - 2.5e+07);
-  const double t100 = (x[9] - 2e+05);
-  const double t101 = (t100 * t100);
-  const double t102 = (-2.8e+07 + x[9]);
-  const double t103 = (x[9] - 2.5e+07);
+  const double t98 = (-t93 + x[5]);
+  const double t99 = (-2.8e+07 + x[7]);
+  const double t100 = (x[8] - u[6]);
+  const double t101 = (x[8] - 2e+05);
+  const double t102 = (t101 * t101);
+  const double t103 = (-2.8e+07 + x[8]);
+  const double t104 = (x[9] - 2e+05);
+  const double t105 = (t104 * t104);
+  const double t106 = (-2.8e+07 + x[9]);
+  const double t107 = (-x[9] + u[7]);
   xdot[0] = x[2];
   xdot[1] = x[3];
-  xdot[2] =
-      ((-2000.0 * x[2] - t7 * t8 * 15200.307499999999 - t10 * t11 * 25497.289999999997 +
-        ((-t11 * t15 * 9.80665 - t18 * t8 * 9.80665)) * u[4] + t45 * t56 * t57 + u[2] -
-        t58 * t8 * 25497.289999999997 +
-        t63 * t65 *
-            ((-2e+08 * sqrt((1e-06 + (t67 * t67))) + x[6] * 0.04021238596594936 + 7.82e+08 -
-              x[8] * 0.027488935718910694 + 2e+08 * sqrt((1e-06 + (t68 * t68))) - 4e+08 * t66)) -
-        t11 * t71 * 15200.307499999999)) /
-      (((2600.0 * (t58 * t58) + 1550.0 * (t71 * t71) + (((t18 * t18) + (t15 * t15))) * u[4] +
-         1550.0 * (t7 * t7) + 2600.0 * (t10 * t10) + 2900.0)));
-  xdot[3] = ((t45 * t77 * t57 - t78 * t8 * 15200.307499999999 +
-              ((-t79 * t8 * 9.80665 - t11 * t80 * 9.80665)) * u[4] - 800.0 * x[3] + u[3] -
-              t11 * t81 * 15200.307499999999)) /
-            ((((t81 * t81) * 1550.0 + 600.0 + (((t80 * t80) + (t79 * t79))) * u[4] +
-               1550.0 * (t78 * t78))));
+  xdot[2] = 0.5 *
+            ((-t2 * 50994.579999999994 * t21 - t19 * t21 * 30400.614999999998 - x[2] * 4000.0 +
+              2.0 * u[2] +
+              t26 * t28 * 2.0 *
+                  ((-2e+08 * sqrt(t31) + x[6] * 0.04021238596594936 -
+                    ((-(1.0 / sqrt(t33)) * t32 + 2.0 + (1.0 / sqrt(t31)) * t30)) * t26 * t28 *
+                        2e+06 * x[2] +
+                    7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t33) - 4e+08 * t29)) -
+              t34 * t9 * 30400.614999999998 - t20 * 50994.579999999994 * t34 +
+              2.0 * ((-t34 * t16 * 9.80665 - t13 * t21 * 9.80665)) * u[4] - t58 * t81 * t78)) /
+            (((2600.0 * (t2 * t2) + 1550.0 * (t9 * t9) + (((t13 * t13) + (t16 * t16))) * u[4] +
+               1550.0 * (t19 * t19) + 2600.0 * (t20 * t20) + 2900.0)));
+  xdot[3] = ((t58 * t73 * t81 - 2.0 * ((-t82 * t21 * 9.80665 - t34 * t83 * 9.80665)) * u[4] +
+              t84 * t21 * 30400.614999999998 - 2.0 * u[3] + 1600.0 * x[3] +
+              t34 * 30400.614999999998 * t85)) *
+            (-0.5) /
+            ((((t85 * t85) * 1550.0 + 600.0 + (((t83 * t83) + (t82 * t82))) * u[4] +
+               1550.0 * (t84 * t84))));
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
   xdot[6] = 1.2e+09 *
-            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t82 * t82))) -
-              t84 * pow(((t85 * t85) + 4e+10), (-0.25)) * t85 * 2.721655269759087e-06 + 0.094 -
-              t86 * pow((4e+10 + t88), (-0.25)) * 2.721655269759087e-06 * t87 -
-              6.666666666666667e-09 * x[6] - t63 * t65 * x[2] * 0.04021238596594936 +
-              3.3333333333333334e-09 * sqrt((t88 + 1e+10)))) /
-            (((t66 * 0.04021238596594936 - 0.0522973403523291)));
-  xdot[7] = ((-x[7] * 5e-09 + 0.07050000000000001 + sqrt((1e+10 + t90)) * 2.5e-09 +
-              t92 * 2.0412414523193154e-06 * t89 * pow((4e+10 + t90), (-0.25)) -
-              0.031415926535897934 * t56 * x[2] * t57 - 2.5e-09 * sqrt((1e+10 + (t93 * t93))) -
-              t94 * t95 * 2.0412414523193154e-06 * pow((4e+10 + (t95 * t95)), (-0.25)) -
-              0.031415926535897934 * x[3] * t77 * t57)) *
-            1.2e+09 / (((0.031415926535897934 * t42 - 0.04695132319207772)));
-  xdot[8] = 1.2e+09 *
-            ((0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t97 + 1e+10)) +
-              t63 * t65 * x[2] * 0.027488935718910694 -
-              pow((4e+10 + t97), (-0.25)) * t84 * 2.721655269759087e-06 * t96 -
-              3.3333333333333334e-09 * sqrt(((t98 * t98) + 1e+10)) -
-              t86 * pow((4e+10 + (t99 * t99)), (-0.25)) * 2.721655269759087e-06 * t99)) /
-            (((-t66 * 0.027488935718910694 + 0.07299722865446584)));
-  xdot[9] =
-      ((sqrt((1e+10 + t101)) * 2.5e-09 + t56 * 0.023561944901923454 * x[2] * t57 - x[9] * 5e-09 +
-        0.07050000000000001 - t94 * 2.0412414523193154e-06 * pow((4e+10 + t101), (-0.25)) * t100 -
-        2.5e-09 * sqrt(((t102 * t102) + 1e+10)) + 0.023561944901923454 * x[3] * t77 * t57 +
-        t92 * pow(((t103 * t103) + 4e+10), (-0.25)) * t103 * 2.0412414523193154e-06)) *
-      1.2e+09 / (((0.07132964021557801 - 0.023561944901923454 * t42)));
+            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t86 * t86))) + 0.094 -
+              6.666666666666667e-09 * x[6] - t26 * t28 * x[2] * 0.04021238596594936 -
+              t88 * 2.721655269759087e-06 * pow((4e+10 + (t89 * t89)), (-0.25)) * t89 +
+              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) +
+              t92 * pow((4e+10 + t91), (-0.25)) * 2.721655269759087e-06 * t90)) /
+            (((t29 * 0.04021238596594936 - 0.0522973403523291)));
+  xdot[7] = ((-t94 * pow((4e+10 + (t95 * t95)), (-0.25)) * 2.0412414523193154e-06 * t95 -
+              x[7] * 5e-09 + 0.07050000000000001 - t58 * 0.031415926535897934 * x[2] * t78 +
+              sqrt((1e+10 + t97)) * 2.5e-09 +
+              t98 * 2.0412414523193154e-06 * t96 * pow((4e+10 + t97), (-0.25)) -
+              2.5e-09 * sqrt((1e+10 + (t99 * t99))) - t58 * 0.031415926535897934 * t73 * x[3])) *
+            1.2e+09 / (((0.031415926535897934 * t59 - 0.04695132319207772)));
+  xdot[8] = ((t92 * pow((4e+10 + (t100 * t100)), (-0.25)) * 2.721655269759087e-06 * t100 + 0.094 -
+              6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t102 + 1e+10)) +
+              t26 * t28 * x[2] * 0.027488935718910694 -
+              pow((4e+10 + t102), (-0.25)) * t88 * 2.721655269759087e-06 * t101 -
+              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) *
+            1.2e+09 / (((-t29 * 0.027488935718910694 + 0.07299722865446584)));
+  xdot[9] = 1.2e+09 *
+            ((t58 * 0.023561944901923454 * x[2] * t78 + sqrt((1e+10 + t105)) * 2.5e-09 -
+              x[9] * 5e-09 - t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
+              0.07050000000000001 - 2.5e-09 * sqrt(((t106 * t106) + 1e+10)) -
+              t107 * t98 * pow(((t107 * t107) + 4e+10), (-0.25)) * 2.0412414523193154e-06 +
+              t58 * t73 * 0.023561944901923454 * x[3])) /
+            (((0.07132964021557801 - 0.023561944901923454 * t59)));
 }
 
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
@@ -473,488 +481,520 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   using std::sqrt;
   std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);
   const double t0 = cos(x[0]);
-  const double t1 = sin(x[0]);
-  const double t2 = (0.194 * t0 + 1.595 + t1 * 0.857);
-  const double t3 = (-0.194) * t1;
-  const double t4 = 0.857 * t0;
-  const double t5 = (t3 + t4 - 1.339);
-  const double t6 = ((t2 * t2) + (t5 * t5));
-  const double t7 = (1.0 / sqrt(t6));
-  const double t8 = (-t1 * 0.857 - 0.194 * t0);
-  const double t9 = (t3 + t4);
-  const double t10 = ((t8 * t8) + (t9 * t9) + t5 * ((0.194 * t1 - t4)) + t8 * t2);
-  const double t11 = sqrt(t6);
-  const double t12 = (-2.51 + t11);
-  const double t13 = (1e-06 + (t12 * t12));
-  const double t14 = (t11 - 1.4);
-  const double t15 = (1e-06 + (t14 * t14));
-  const double t16 = (-2e+08 * sqrt(t13) + x[6] * 0.04021238596594936 + 7.82e+08 -
-                      x[8] * 0.027488935718910694 + 2e+08 * sqrt(t15) - 4e+08 * t11);
-  const double t17 = (x[0] + x[1]);
-  const double t18 = sin(t17);
-  const double t19 = t18 * (-0.55);
-  const double t20 = cos(t17);
-  const double t21 = (-0.25) * t20;
-  const double t22 = t1 * (-3.11);
-  const double t23 = (t19 + t21 + t22);
-  const double t24 = cos(u[5]);
-  const double t25 = sin(u[5]);
-  const double t26 = (t1 * 0.1 - 1.55 * t0);
-  const double t27 = (0.389 * t20 + t1 * 0.5249999999999999 - 0.365 * t0 + t18 * 0.159);
-  const double t28 = 0.159 * t20;
-  const double t29 = t18 * (-0.389);
-  const double t30 = (0.365 * t1 + t28 + t29 + t0 * 0.5249999999999999);
+  const double t1 = (x[0] + x[1]);
+  const double t2 = cos(t1);
+  const double t3 = sin(x[0]);
+  const double t4 = sin(t1);
+  const double t5 = (0.389 * t2 + t3 * 0.5249999999999999 - 0.365 * t0 + t4 * 0.159);
+  const double t6 = 0.159 * t2;
+  const double t7 = t4 * (-0.389);
+  const double t8 = (0.365 * t3 + t6 + t7 + t0 * 0.5249999999999999);
+  const double t9 = (t8 * t8);
+  const double t10 = (t5 * t5);
+  const double t11 = (t9 + t10 - 0.38752);
+  const double t12 = (t9 + t10);
+  const double t13 = (1.0 / sqrt(t12));
+  const double t14 = (t11 * t11);
+  const double t15 = (1.0 / (t12));
+  const double t16 = (0.567009 - 0.25 * t14 * t15);
+  const double t17 = sqrt(t16);
+  const double t18 = (t5 * t11 * t13 + 2.0 * t8 * t17);
+  const double t19 = (-t5 * 2.0 * t17 + t11 * t8 * t13);
+  const double t20 = atan2(0.5 * t18 * t13, t19 * 0.5 * t13);
+  const double t21 = cos(t20);
+  const double t22 = sin(t20);
+  const double t23 = (-0.15500000000000003 * t0 - 0.141 * t21 + t3 * 2.093 - t22 * 0.853);
+  const double t24 = t3 * 0.15500000000000003;
+  const double t25 = 2.093 * t0;
+  const double t26 = (0.141 * t22 + t24 - 0.853 * t21 + t25);
+  const double t27 = ((t23 * t23) + (t26 * t26));
+  const double t28 = (1.0 / sqrt(t27));
+  const double t29 = sqrt(t27);
+  const double t30 = (-1.59 + t29);
   const double t31 = (t30 * t30);
-  const double t32 = (t27 * t27);
-  const double t33 = (t31 + t32 - 0.38752);
-  const double t34 = (t31 + t32);
-  const double t35 = (1.0 / sqrt(t34));
-  const double t36 = (t33 * t33);
-  const double t37 = (1.0 / (t34));
-  const double t38 = (0.567009 - 0.25 * t36 * t37);
-  const double t39 = sqrt(t38);
-  const double t40 = (t27 * t33 * t35 + 2.0 * t30 * t39);
-  const double t41 = (t27 * 2.0 * t39 - t33 * t30 * t35);
-  const double t42 = atan2(0.5 * t40 * t35, t41 * (-0.5) * t35);
-  const double t43 = cos(t42);
-  const double t44 = sin(t42);
-  const double t45 = (-0.141 * t43 - t44 * 0.853 - 0.15500000000000003 * t0 + t1 * 2.093);
-  const double t46 = t1 * 0.15500000000000003;
-  const double t47 = 2.093 * t0;
-  const double t48 = (t46 + t44 * 0.141 - 0.853 * t43 + t47);
-  const double t49 = ((t45 * t45) + (t48 * t48));
-  const double t50 = sqrt(t49);
-  const double t51 = (-2.9000000000000004 + t50);
-  const double t52 = ((t51 * t51) + 1e-06);
-  const double t53 = (-1.59 + t50);
-  const double t54 = (1e-06 + (t53 * t53));
-  const double t55 = (-2e+08 * t50 - sqrt(t52) * 1e+08 + 0.031415926535897934 * x[7] +
-                      sqrt(t54) * 1e+08 - 0.023561944901923454 * x[9] + 4.49e+08);
-  const double t56 = pow(t49, (-1.5));
-  const double t57 = (-0.389) * t20;
-  const double t58 = t18 * (-0.159);
-  const double t59 = (t57 - t1 * 0.5249999999999999 + 0.365 * t0 + t58);
-  const double t60 = (1.0 / sqrt(t38));
-  const double t61 = (t59 * t30 + t27 * t30);
-  const double t62 = (1.0 / (t34 * t34));
-  const double t63 = (-2.0 * t33 * t61 * t37 + t62 * t61 * t36);
-  const double t64 = pow(t34, (-1.5));
-  const double t65 = (t59 * 4.0 * t39 + t60 * t63 * t30 - t27 * 2.0 * t33 * t61 * t64 +
-                      t27 * 4.0 * t61 * t35 + 2.0 * t33 * t30 * t35);
-  const double t66 = (t65 * t35 - 2.0 * t61 * t40 * t64);
-  const double t67 = (t41 * t41);
-  const double t68 = (t40 * t40);
-  const double t69 = (t67 * t37 + t68 * t37);
-  const double t70 = (1.0 / (t69));
-  const double t71 = (2.0 * t33 * t30 * t61 * t64 + t27 * t60 * t63 - 4.0 * t30 * t61 * t35 +
-                      4.0 * t30 * t39 - t59 * 2.0 * t33 * t35);
-  const double t72 = (-t71 * t35 + 2.0 * t41 * t61 * t64);
-  const double t73 = (t66 * t70 * t41 * t35 + t70 * t72 * t40 * t35);
-  const double t74 = (t46 - t44 * 0.0705 * t73 + 0.4265 * t43 * t73 + t47);
-  const double t75 = t1 * (-2.093);
-  const double t76 = 0.15500000000000003 * t0;
-  const double t77 = (-0.0705 * t43 * t73 + t75 + t76 - t44 * 0.4265 * t73);
-  const double t78 = (t45 * t74 + t48 * t77);
-  const double t79 = (t78 * t78);
-  const double t80 = t18 * 0.25;
-  const double t81 = (-3.11) * t0;
-  const double t82 = (-0.55) * t20;
-  const double t83 = (t80 + t81 + t82);
-  const double t84 = (1.0 / sqrt(t52));
-  const double t85 = (1.0 / sqrt(t49));
-  const double t86 = (1.0 / sqrt(t54));
+  const double t32 = (t31 + 1e-06);
+  const double t33 = (1.0 / sqrt(t16));
+  const double t34 = (1.0 / (t12 * t12));
+  const double t35 = (t6 + t7);
+  const double t36 = (-0.389) * t2;
+  const double t37 = t4 * (-0.159);
+  const double t38 = (t36 + t37);
+  const double t39 = (t35 * t5 + t38 * t8);
+  const double t40 = (-t34 * t14 * t39 + 2.0 * t11 * t15 * t39);
+  const double t41 = pow(t12, (-1.5));
+  const double t42 = (-t5 * t33 * t40 - 2.0 * t11 * t38 * t13 - 4.0 * t8 * t39 * t13 +
+                      2.0 * t11 * t8 * t41 * t39 + t35 * 4.0 * t17);
+  const double t43 = (t42 * t13 + t19 * 2.0 * t41 * t39);
+  const double t44 = (t18 * t18);
+  const double t45 = (t19 * t19);
+  const double t46 = (t44 * t15 + t45 * t15);
+  const double t47 = (1.0 / (t46));
+  const double t48 = (-t5 * 2.0 * t11 * t41 * t39 + t35 * 2.0 * t11 * t13 + t5 * 4.0 * t39 * t13 -
+                      t33 * t8 * t40 + 4.0 * t38 * t17);
+  const double t49 = (t48 * t13 - 2.0 * t18 * t41 * t39);
+  const double t50 = (t43 * t18 * t47 * t13 + t19 * t47 * t49 * t13);
+  const double t51 = (-t50 * 0.4265 * t21 + 0.0705 * t50 * t22);
+  const double t52 = (0.0705 * t50 * t21 + t50 * t22 * 0.4265);
+  const double t53 = (t23 * t51 + t52 * t26);
+  const double t54 = t3 * (-2.093);
+  const double t55 = 0.15500000000000003 * t0;
+  const double t56 = (t36 - t3 * 0.5249999999999999 + 0.365 * t0 + t37);
+  const double t57 = (t56 * t8 + t5 * t8);
+  const double t58 = (-2.0 * t11 * t57 * t15 + t34 * t57 * t14);
+  const double t59 = (2.0 * t11 * t8 * t57 * t41 + t5 * t33 * t58 - 4.0 * t8 * t57 * t13 +
+                      4.0 * t8 * t17 - t56 * 2.0 * t11 * t13);
+  const double t60 = (t59 * t13 + t19 * 2.0 * t57 * t41);
+  const double t61 = (t56 * 4.0 * t17 + t33 * t58 * t8 - t5 * 2.0 * t11 * t57 * t41 +
+                      t5 * 4.0 * t57 * t13 + 2.0 * t11 * t8 * t13);
+  const double t62 = (t61 * t13 - 2.0 * t57 * t18 * t41);
+  const double t63 = (t60 * t18 * t47 * t13 + t19 * t62 * t47 * t13);
+  const double t64 = (t54 + t55 + t22 * 0.4265 * t63 + 0.0705 * t21 * t63);
+  const double t65 = (t24 + 0.0705 * t22 * t63 + t25 - 0.4265 * t21 * t63);
+  const double t66 = (t64 * t26 + t23 * t65);
+  const double t67 = (t28 * t53 * 2e+06 * x[3] + t28 * 2e+06 * x[2] * t66);
+  const double t68 = (t29 - 2.9000000000000004);
+  const double t69 = (t68 * t68);
+  const double t70 = (t69 + 1e-06);
+  const double t71 = (1.0 / sqrt(t70));
+  const double t72 = (1.0 / sqrt(t32));
+  const double t73 = (2.0 + t68 * t71 - t30 * t72);
+  const double t74 = (-sqrt(t32) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + t67 * t73 +
+                      sqrt(t70) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t29);
+  const double t75 =
+      (-2.0 * t45 * t34 * t57 - 2.0 * t44 * t34 * t57 - t19 * t59 * t15 + t18 * t15 * t61);
+  const double t76 = (1.0 / (t46 * t46));
+  const double t77 = (-0.159) * t2;
+  const double t78 = t4 * 0.389;
+  const double t79 = (t77 - t0 * 0.5249999999999999 - 0.365 * t3 + t78);
+  const double t80 = (t79 * t8 + t9 + (t56 * t56) + t56 * t5);
+  const double t81 = (t57 * t57);
+  const double t82 = pow(t12, (-2.5));
+  const double t83 = (1.0 / (t12 * t12 * t12));
+  const double t84 = (-t11 * t81 * t34 * 8.0 - t34 * t80 * t14 + 2.0 * t11 * t80 * t15 +
+                      4.0 * t81 * t15 + 4.0 * t83 * t81 * t14);
+  const double t85 = pow(t16, (-1.5));
+  const double t86 = (t58 * t58);
   const double t87 =
-      (-t78 * t84 * 1e+08 * t85 * t51 - t78 * 2e+08 * t85 + t78 * 1e+08 * t53 * t86 * t85);
-  const double t88 = t18 * (-0.4011545671438309);
-  const double t89 = (-0.16343387866394005) * t20;
-  const double t90 = (t88 + t89 + t22);
-  const double t91 = t18 * 0.16343387866394005;
-  const double t92 = (-0.4011545671438309) * t20;
-  const double t93 = (t81 + t91 + t92);
-  const double t94 = (t73 * t73);
-  const double t95 =
-      (-2.0 * t62 * t67 * t61 - 2.0 * t68 * t62 * t61 + t40 * t37 * t65 + t41 * t71 * t37);
-  const double t96 = (1.0 / (t69 * t69));
-  const double t97 = (-0.159) * t20;
-  const double t98 = t18 * 0.389;
-  const double t99 = (t97 - t0 * 0.5249999999999999 - 0.365 * t1 + t98);
-  const double t100 = (t99 * t30 + t31 + (t59 * t59) + t59 * t27);
-  const double t101 = (t61 * t61);
-  const double t102 = pow(t34, (-2.5));
-  const double t103 = (1.0 / (t34 * t34 * t34));
-  const double t104 = (-t33 * t101 * t62 * 8.0 - t62 * t100 * t36 + 2.0 * t33 * t100 * t37 +
-                       4.0 * t101 * t37 + 4.0 * t103 * t101 * t36);
-  const double t105 = pow(t38, (-1.5));
-  const double t106 = (t63 * t63);
-  const double t107 =
-      (-t95 * t66 * t96 * 4.0 * t41 * t35 + t66 * 2.0 * t70 * t71 * t35 +
-       t70 *
-           ((t41 * 8.0 * t100 * t64 - 24.0 * t101 * t102 * t41 + 8.0 * t61 * t71 * t64 +
-             ((-t59 * 16.0 * t39 + t27 * 4.0 * t60 * t104 - t59 * 16.0 * t33 * t61 * t64 +
-               t59 * 32.0 * t61 * t35 - t33 * 8.0 * t100 * t30 * t64 - t60 * 8.0 * t63 * t30 +
-               16.0 * t100 * t30 * t35 - 32.0 * t101 * t30 * t64 + 24.0 * t33 * t101 * t102 * t30 +
-               t99 * t33 * 8.0 * t35 + t27 * t105 * t106)) *
-                 t35)) *
-           t40 * t35 +
-       ((((-t27 * t33 * 8.0 * t100 * t64 - 16.0 * t33 * t30 * t61 * t64 - t27 * 32.0 * t101 * t64 +
-           t27 * 16.0 * t100 * t35 + t59 * t33 * 8.0 * t35 + t27 * 24.0 * t33 * t101 * t102 +
-           32.0 * t30 * t61 * t35 - 4.0 * t60 * t104 * t30 - t105 * t30 * t106 + t99 * 16.0 * t39 +
-           t59 * t60 * 8.0 * t63)) *
-             t35 -
-         8.0 * t100 * t40 * t64 + 24.0 * t101 * t102 * t40 - 8.0 * t61 * t64 * t65)) *
-           t70 * t41 * t35 +
-       2.0 * t70 * t72 * t65 * t35 - t95 * t96 * 4.0 * t72 * t40 * t35 -
-       t70 * 4.0 * t72 * t61 * t40 * t64 - t66 * t70 * 4.0 * t41 * t61 * t64);
-  const double t108 = (t45 * ((t44 * 0.21325 * t94 - t44 * t107 * 0.017625 + t94 * t43 * 0.03525 +
-                               t75 + 0.106625 * t107 * t43 + t76)) +
-                       (t77 * t77) + (t74 * t74) +
-                       ((-t44 * t94 * 0.03525 + 0.21325 * t94 * t43 - t44 * 0.106625 * t107 - t47 -
-                         t46 - t107 * 0.017625 * t43)) *
-                           t48);
-  const double t109 = (t2 * t9 + t8 * t5);
-  const double t110 = (-1.55 * t1 - 0.1 * t0);
-  const double t111 = pow(t6, (-1.5));
-  const double t112 = (t109 * t109);
-  const double t113 = (-t1 * 0.1 + 1.55 * t0);
-  const double t114 = t18 * (-0.16343387866394005);
-  const double t115 = 3.11 * t0;
-  const double t116 = 0.4011545671438309 * t20;
-  const double t117 = (t114 + t115 + t116);
-  const double t118 = t18 * (-0.25);
-  const double t119 = 0.55 * t20;
-  const double t120 = (t115 + t118 + t119);
-  const double t121 =
-      (2600.0 * (t113 * t113) + 1550.0 * (t23 * t23) + (((t117 * t117) + (t90 * t90))) * u[4] +
-       1550.0 * (t120 * t120) + 2600.0 * (t110 * t110) + 2900.0);
-  const double t122 = (1.0 / (t121));
-  const double t123 =
-      (-2000.0 * x[2] - t120 * t24 * 15200.307499999999 - t110 * t25 * 25497.289999999997 +
-       ((-t25 * t90 * 9.80665 - t117 * t24 * 9.80665)) * u[4] + t55 * t78 * t85 + u[2] -
-       t113 * t24 * 25497.289999999997 + t109 * t7 * t16 - t25 * t23 * 15200.307499999999);
-  const double t124 = (1.0 / (t121 * t121));
-  const double t125 = (t19 + t21);
-  const double t126 = (t28 + t29);
-  const double t127 = (t57 + t58);
-  const double t128 = (t126 * t27 + t127 * t30);
-  const double t129 = (-2.0 * t33 * t37 * t128 + t62 * t36 * t128);
-  const double t130 = (-t27 * t129 * t60 - 2.0 * t33 * t30 * t64 * t128 + 2.0 * t33 * t127 * t35 +
-                       4.0 * t30 * t128 * t35 - t126 * 4.0 * t39);
-  const double t131 = (t130 * t35 + 2.0 * t41 * t64 * t128);
-  const double t132 = (-t27 * 2.0 * t33 * t64 * t128 + t129 * t60 * t30 + t126 * 2.0 * t33 * t35 +
-                       t27 * 4.0 * t128 * t35 + 4.0 * t127 * t39);
-  const double t133 = (-t132 * t35 + 2.0 * t40 * t64 * t128);
-  const double t134 = (-t70 * t131 * t40 * t35 + t70 * t133 * t41 * t35);
-  const double t135 = (t44 * 0.0705 * t134 - 0.4265 * t134 * t43);
-  const double t136 = (t44 * 0.4265 * t134 + 0.0705 * t134 * t43);
-  const double t137 = (t135 * t45 + t48 * t136);
-  const double t138 = (t80 + t82);
-  const double t139 = (t88 + t89);
-  const double t140 = (t91 + t92);
-  const double t141 = (-t139 * t24 * 9.80665 - t25 * t140 * 9.80665);
-  const double t142 =
-      (-t84 * 1e+08 * t137 * t85 * t51 + 1e+08 * t53 * t86 * t137 * t85 - 2e+08 * t137 * t85);
-  const double t143 =
-      (-t132 * t40 * t37 + 2.0 * t68 * t62 * t128 + 2.0 * t62 * t67 * t128 + t41 * t130 * t37);
-  const double t144 = t27 * t127;
-  const double t145 = (t97 + t98);
-  const double t146 = t145 * t30;
-  const double t147 = (t59 * t127 + t126 * t30 + t144 + t146);
-  const double t148 = (2.0 * t147 * t33 * t37 + 4.0 * t103 * t61 * t36 * t128 +
-                       4.0 * t61 * t37 * t128 - t147 * t62 * t36 - t33 * t62 * 8.0 * t61 * t128);
-  const double t149 =
-      (24.0 * t102 * t61 * t40 * t128 +
-       ((t33 * t127 * 8.0 * t35 + t27 * 16.0 * t147 * t35 - t33 * 8.0 * t30 * t64 * t128 -
-         t27 * 32.0 * t61 * t64 * t128 + t59 * t129 * 4.0 * t60 +
-         t27 * 24.0 * t33 * t102 * t61 * t128 + 16.0 * t30 * t128 * t35 + 16.0 * t145 * t39 +
-         4.0 * t127 * t60 * t63 - t148 * 4.0 * t60 * t30 - t129 * t105 * t63 * t30 +
-         t126 * 16.0 * t61 * t35 - t126 * t33 * 8.0 * t61 * t64 - t27 * t147 * t33 * 8.0 * t64)) *
-           t35 -
-       4.0 * t132 * t61 * t64 - t147 * 8.0 * t40 * t64 - 4.0 * t64 * t128 * t65);
-  const double t150 = t145 * t33 * 8.0 * t35;
-  const double t151 = (-16.0) * t127 * t39;
-  const double t152 =
-      (t147 * t41 * 8.0 * t64 - 4.0 * t61 * t130 * t64 +
-       ((t150 + t151 - t33 * t127 * 8.0 * t61 * t64 - t126 * 4.0 * t60 * t63 +
-         t59 * 16.0 * t128 * t35 - t129 * 4.0 * t60 * t30 + t27 * t148 * 4.0 * t60 -
-         32.0 * t30 * t61 * t64 * t128 + 16.0 * t127 * t61 * t35 - t59 * t33 * 8.0 * t64 * t128 +
-         16.0 * t147 * t30 * t35 + 24.0 * t33 * t102 * t30 * t61 * t128 + t27 * t129 * t105 * t63 -
-         t147 * t33 * 8.0 * t30 * t64)) *
-           t35 +
-       4.0 * t71 * t64 * t128 - 24.0 * t102 * t41 * t61 * t128);
-  const double t153 = (t66 * t70 * 4.0 * t41 * t64 * t128 + t70 * 4.0 * t72 * t40 * t64 * t128 +
-                       t66 * 2.0 * t70 * t130 * t35 - t66 * t96 * 4.0 * t143 * t41 * t35 -
-                       2.0 * t70 * t72 * t132 * t35 - t96 * 4.0 * t143 * t72 * t40 * t35 -
-                       t149 * t70 * t41 * t35 - t70 * t152 * t40 * t35);
-  const double t154 = t44 * t134 * t73 * 0.03525;
-  const double t155 = (-0.21325) * t134 * t43 * t73;
-  const double t156 = t136 * t77;
-  const double t157 = t135 * t74;
-  const double t158 = (-0.21325) * t44 * t134 * t73;
-  const double t159 = t134 * t43 * t73 * (-0.03525);
-  const double t160 =
-      (((t153 * 0.017625 * t43 + t154 + t44 * 0.106625 * t153 + t155)) * t48 + t156 + t157 +
-       t45 * ((-0.106625 * t153 * t43 + t158 + t159 + t44 * t153 * 0.017625)));
-  const double t161 = (t114 + t116);
-  const double t162 = (t118 + t119);
-  const double t163 = ((t125 * t125) * 1550.0 + 600.0 + (((t139 * t139) + (t161 * t161))) * u[4] +
-                       1550.0 * (t162 * t162));
+      (-t19 * t62 * t75 * 4.0 * t76 * t13 - t19 * t62 * 4.0 * t57 * t41 * t47 +
+       t60 * 2.0 * t47 * t61 * t13 - t75 * t60 * 4.0 * t76 * t18 * t13 -
+       t62 * 2.0 * t59 * t47 * t13 +
+       t19 *
+           ((-8.0 * t80 * t18 * t41 -
+             ((-t5 * 24.0 * t11 * t81 * t82 - t56 * t11 * 8.0 * t13 - t79 * 16.0 * t17 -
+               32.0 * t8 * t57 * t13 + 4.0 * t33 * t84 * t8 + t85 * t8 * t86 +
+               t5 * t11 * 8.0 * t80 * t41 + 16.0 * t11 * t8 * t57 * t41 - t5 * 16.0 * t80 * t13 +
+               t5 * 32.0 * t81 * t41 - t56 * t33 * 8.0 * t58)) *
+                 t13 +
+             24.0 * t81 * t82 * t18 - 8.0 * t57 * t41 * t61)) *
+           t47 * t13 +
+       ((t19 * 8.0 * t80 * t41 +
+         ((-t5 * 4.0 * t33 * t84 - 24.0 * t11 * t81 * t82 * t8 + t56 * 16.0 * t11 * t57 * t41 -
+           16.0 * t80 * t8 * t13 + t56 * 16.0 * t17 + t11 * 8.0 * t80 * t8 * t41 -
+           t79 * t11 * 8.0 * t13 + 32.0 * t81 * t8 * t41 - t5 * t85 * t86 + t33 * 8.0 * t58 * t8 -
+           t56 * 32.0 * t57 * t13)) *
+             t13 -
+         t19 * 24.0 * t81 * t82 - 8.0 * t57 * t59 * t41)) *
+           t18 * t47 * t13 -
+       t60 * 4.0 * t57 * t18 * t41 * t47);
+  const double t88 = (t63 * t63);
+  const double t89 = (t23 * ((t87 * t22 * 0.017625 - t87 * 0.106625 * t21 + t54 + t55 +
+                              t21 * t88 * 0.03525 + 0.21325 * t22 * t88)) +
+                      ((t87 * t22 * 0.106625 - t22 * t88 * 0.03525 - t25 - t24 +
+                        t87 * 0.017625 * t21 + 0.21325 * t21 * t88)) *
+                          t26 +
+                      (t65 * t65) + (t64 * t64));
+  const double t90 = (0.194 * t0 + 1.595 + t3 * 0.857);
+  const double t91 = (-0.194) * t3;
+  const double t92 = 0.857 * t0;
+  const double t93 = (t91 + t92 - 1.339);
+  const double t94 = ((t90 * t90) + (t93 * t93));
+  const double t95 = pow(t94, (-1.5));
+  const double t96 = sqrt(t94);
+  const double t97 = (-2.51 + t96);
+  const double t98 = (t97 * t97);
+  const double t99 = (1e-06 + t98);
+  const double t100 = (t96 - 1.4);
+  const double t101 = (t100 * t100);
+  const double t102 = (1e-06 + t101);
+  const double t103 = (1.0 / sqrt(t102));
+  const double t104 = (1.0 / sqrt(t99));
+  const double t105 = (-t103 * t100 + 2.0 + t104 * t97);
+  const double t106 = (t91 + t92);
+  const double t107 = (-t3 * 0.857 - 0.194 * t0);
+  const double t108 = (t90 * t106 + t107 * t93);
+  const double t109 = (1.0 / sqrt(t94));
+  const double t110 =
+      (-2e+08 * sqrt(t99) + x[6] * 0.04021238596594936 - t105 * t108 * t109 * 2e+06 * x[2] +
+       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t102) - 4e+08 * t96);
+  const double t111 = (t108 * t108);
+  const double t112 = (-1.55 * t3 - 0.1 * t0);
+  const double t113 = cos(u[5]);
+  const double t114 = sin(u[5]);
+  const double t115 = t4 * 0.25;
+  const double t116 = (-3.11) * t0;
+  const double t117 = (-0.55) * t2;
+  const double t118 = (t115 + t116 + t117);
+  const double t119 = (t3 * 0.1 - 1.55 * t0);
+  const double t120 = t65 * t51;
+  const double t121 = t52 * t64;
+  const double t122 = 0.21325 * t50 * t21 * t63;
+  const double t123 = t5 * t38;
+  const double t124 = (t77 + t78);
+  const double t125 = t124 * t8;
+  const double t126 = (t56 * t38 + t35 * t8 + t123 + t125);
+  const double t127 = (-2.0 * t126 * t11 * t15 - 4.0 * t83 * t57 * t14 * t39 + t126 * t34 * t14 -
+                       4.0 * t57 * t15 * t39 + t11 * t34 * 8.0 * t57 * t39);
+  const double t128 = t11 * (-8.0) * t38 * t13;
+  const double t129 = (-16.0) * t124 * t17;
+  const double t130 =
+      ((((t5 * t126 * t11 * 8.0 * t41 - t5 * 16.0 * t126 * t13 - t85 * t58 * t8 * t40 +
+          t5 * 32.0 * t57 * t41 * t39 - 16.0 * t8 * t39 * t13 + t11 * 8.0 * t8 * t41 * t39 -
+          4.0 * t33 * t8 * t127 - t5 * 24.0 * t11 * t82 * t57 * t39 + t56 * 4.0 * t33 * t40 +
+          t35 * t11 * 8.0 * t57 * t41 + t128 + t129 - t35 * 16.0 * t57 * t13 -
+          4.0 * t38 * t33 * t58)) *
+            t13 +
+        t126 * 8.0 * t18 * t41 + 4.0 * t48 * t57 * t41 + 4.0 * t41 * t39 * t61 -
+        24.0 * t82 * t57 * t18 * t39)) *
+      t19 * t47 * t13;
+  const double t131 =
+      ((-((t35 * 4.0 * t33 * t58 + t5 * 4.0 * t33 * t127 + t56 * t11 * 8.0 * t41 * t39 -
+           24.0 * t11 * t82 * t8 * t57 * t39 - t124 * t11 * 8.0 * t13 +
+           32.0 * t8 * t57 * t41 * t39 - 16.0 * t38 * t57 * t13 + t5 * t85 * t58 * t40 -
+           4.0 * t33 * t8 * t40 + 16.0 * t38 * t17 - 16.0 * t126 * t8 * t13 +
+           t11 * t38 * 8.0 * t57 * t41 + t126 * t11 * 8.0 * t8 * t41 - t56 * 16.0 * t39 * t13)) *
+            t13 +
+        t19 * 24.0 * t82 * t57 * t39 - t19 * t126 * 8.0 * t41 + 4.0 * t59 * t41 * t39 +
+        4.0 * t42 * t57 * t41)) *
+      t18 * t47 * t13;
+  const double t132 =
+      (t19 * t75 * 4.0 * t76 * t49 * t13 + 2.0 * t59 * t47 * t49 * t13 +
+       t75 * 4.0 * t76 * t43 * t18 * t13 + t130 + 4.0 * t43 * t57 * t18 * t41 * t47 +
+       t19 * 4.0 * t57 * t41 * t47 * t49 + t131 - 2.0 * t43 * t47 * t61 * t13);
+  const double t133 = t50 * t22 * t63 * (-0.03525);
+  const double t134 = 0.21325 * t50 * t22 * t63;
+  const double t135 = t50 * t21 * t63 * 0.03525;
+  const double t136 =
+      (t120 + t121 + ((t122 - t22 * 0.106625 * t132 + t133 - 0.017625 * t21 * t132)) * t26 +
+       ((t134 + 0.106625 * t21 * t132 + t135 - t22 * 0.017625 * t132)) * t23);
+  const double t137 = pow(t27, (-1.5));
+  const double t138 = (t66 * t66);
+  const double t139 = pow(t70, (-1.5));
+  const double t140 = pow(t32, (-1.5));
+  const double t141 =
+      (((t28 * t136 * 2e+06 * x[3] + t28 * 2e+06 * t89 * x[2] - t137 * 2e+06 * x[2] * t138 -
+         t137 * t53 * 2e+06 * x[3] * t66)) *
+           t73 +
+       t28 * 4e+08 * t66 + t28 * t68 * 2e+08 * t71 * t66 - t30 * t28 * t72 * 2e+08 * t66 +
+       t67 * ((-t28 * t72 * t66 - t28 * t69 * t139 * t66 + t28 * t71 * t66 +
+               t28 * t31 * t140 * t66)));
+  const double t142 = t4 * (-0.4011545671438309);
+  const double t143 = (-0.16343387866394005) * t2;
+  const double t144 = t3 * (-3.11);
+  const double t145 = (t142 + t143 + t144);
+  const double t146 = t4 * 0.16343387866394005;
+  const double t147 = (-0.4011545671438309) * t2;
+  const double t148 = (t116 + t146 + t147);
+  const double t149 = ((t107 * t107) + (t106 * t106) + t93 * ((0.194 * t3 - t92)) + t107 * t90);
+  const double t150 = t4 * (-0.55);
+  const double t151 = (-0.25) * t2;
+  const double t152 = (t150 + t151 + t144);
+  const double t153 = (-t3 * 0.1 + 1.55 * t0);
+  const double t154 = t4 * (-0.16343387866394005);
+  const double t155 = 3.11 * t0;
+  const double t156 = 0.4011545671438309 * t2;
+  const double t157 = (t154 + t155 + t156);
+  const double t158 = t4 * (-0.25);
+  const double t159 = 0.55 * t2;
+  const double t160 = (t155 + t158 + t159);
+  const double t161 =
+      (2600.0 * (t153 * t153) + 1550.0 * (t152 * t152) + (((t157 * t157) + (t145 * t145))) * u[4] +
+       1550.0 * (t160 * t160) + 2600.0 * (t112 * t112) + 2900.0);
+  const double t162 = (1.0 / (t161));
+  const double t163 = (1.0 / (t161 * t161));
   const double t164 =
-      ((2.0 * ((t139 * t140 + t139 * t161)) * u[4] + t162 * 3100.0 * t125 + 3100.0 * t138 * t125)) *
-      ((t55 * t137 * t85 - t162 * t24 * 15200.307499999999 +
-        ((-t161 * t24 * 9.80665 - t25 * t139 * 9.80665)) * u[4] - 800.0 * x[3] + u[3] -
-        t25 * t125 * 15200.307499999999)) *
-      (-1.0) / (t163 * t163);
-  const double t165 = t24 * t125 * 15200.307499999999;
-  const double t166 = t25 * t138 * 15200.307499999999;
-  const double t167 = u[4] * t141 * (-1.0);
-  const double t168 =
-      (-2.0 * t70 * t133 * t71 * t35 + t149 * t70 * t41 * t35 + t95 * t96 * 4.0 * t133 * t41 * t35 -
-       t70 * 4.0 * t131 * t61 * t40 * t64 + t70 * 4.0 * t133 * t41 * t61 * t64 +
-       2.0 * t70 * t131 * t65 * t35 + t70 * t152 * t40 * t35 - t95 * t96 * 4.0 * t131 * t40 * t35);
-  const double t169 =
-      (t156 + t157 + ((-t44 * t168 * 0.017625 + t158 + 0.106625 * t168 * t43 + t159)) * t45 +
-       t48 * ((t154 + t155 - t168 * 0.017625 * t43 - t44 * 0.106625 * t168)));
-  const double t170 = (1.0 / (t163));
-  const double t171 = (t137 * t137);
-  const double t172 = ((t127 * t127) + (t126 * t126) + t144 + t146);
-  const double t173 = (t128 * t128);
-  const double t174 = (2.0 * t172 * t33 * t37 + 4.0 * t173 * t37 - t172 * t62 * t36 -
-                       t33 * t62 * t173 * 8.0 + 4.0 * t103 * t173 * t36);
-  const double t175 = (t129 * t129);
-  const double t176 =
-      (t96 * 4.0 * t143 * t131 * t40 * t35 - t70 * 4.0 * t131 * t40 * t64 * t128 -
-       t96 * 4.0 * t133 * t143 * t41 * t35 + 2.0 * t70 * t132 * t131 * t35 -
-       t70 * t41 *
-           ((((-t126 * 32.0 * t128 * t35 - t33 * t127 * 8.0 * t35 - 16.0 * t145 * t39 -
-               t129 * t127 * t60 * 8.0 - t27 * 16.0 * t172 * t35 + t126 * 16.0 * t33 * t64 * t128 +
-               4.0 * t60 * t30 * t174 + t27 * t172 * t33 * 8.0 * t64 + t27 * 32.0 * t173 * t64 +
-               t175 * t105 * t30 - t27 * 24.0 * t33 * t102 * t173)) *
-                 t35 -
-             24.0 * t102 * t173 * t40 + t132 * 8.0 * t64 * t128 + t172 * 8.0 * t40 * t64)) *
-           t35 +
-       2.0 * t70 * t133 * t130 * t35 + t70 * 4.0 * t133 * t41 * t64 * t128 -
-       ((-t172 * t41 * 8.0 * t64 -
-         ((t150 + t151 + t27 * 4.0 * t60 * t174 + 32.0 * t127 * t128 * t35 -
-           16.0 * t33 * t127 * t64 * t128 - t126 * t129 * t60 * 8.0 - 32.0 * t173 * t30 * t64 +
-           24.0 * t33 * t102 * t173 * t30 - t172 * t33 * 8.0 * t30 * t64 + 16.0 * t172 * t30 * t35 +
-           t27 * t175 * t105)) *
-             t35 +
-         8.0 * t130 * t64 * t128 + 24.0 * t102 * t41 * t173)) *
-           t70 * t40 * t35);
-  const double t177 = (t134 * t134);
-  const double t178 = ((t136 * t136) + (t135 * t135) +
-                       t45 * ((0.106625 * t176 * t43 + t177 * t43 * 0.03525 + t44 * 0.21325 * t177 -
-                               t44 * 0.017625 * t176)) +
-                       ((-0.017625 * t176 * t43 - t44 * t177 * 0.03525 - t44 * 0.106625 * t176 +
-                         0.21325 * t177 * t43)) *
-                           t48);
-  const double t179 = (t11 * 0.04021238596594936 - 0.0522973403523291);
-  const double t180 = (1.0 / (t179));
-  const double t181 = (-2.8e+07 + x[6]);
-  const double t182 = (1e+10 + (t181 * t181));
-  const double t183 = ((x[4] * x[4]) + 1e-04);
-  const double t184 = sqrt(t183);
-  const double t185 = (x[4] + t184);
-  const double t186 = (x[6] - 2.5e+07);
-  const double t187 = ((t186 * t186) + 4e+10);
-  const double t188 = pow(t187, (-0.25));
-  const double t189 = (-x[4] + t184);
-  const double t190 = (x[6] - 2e+05);
-  const double t191 = (t190 * t190);
-  const double t192 = (4e+10 + t191);
-  const double t193 = pow(t192, (-0.25));
-  const double t194 = (t191 + 1e+10);
-  const double t195 = (1.0 / sqrt(t183)) * x[4];
-  const double t196 = (1.0 + t195);
-  const double t197 = (t195 - 1.0);
-  const double t198 = 2.0 * x[6];
-  const double t199 = (-4e+05 + t198);
-  const double t200 = (0.031415926535897934 * t50 - 0.04695132319207772);
-  const double t201 = (1.0 / (t200));
-  const double t202 = (1.0 / (t200 * t200));
-  const double t203 = (x[7] - 2e+05);
-  const double t204 = (t203 * t203);
-  const double t205 = (1e+10 + t204);
-  const double t206 = ((x[5] * x[5]) + 1e-04);
-  const double t207 = sqrt(t206);
-  const double t208 = (-t207 + x[5]);
-  const double t209 = (4e+10 + t204);
-  const double t210 = pow(t209, (-0.25));
-  const double t211 = (-2.8e+07 + x[7]);
-  const double t212 = (1e+10 + (t211 * t211));
-  const double t213 = (t207 + x[5]);
-  const double t214 = (x[7] - 2.5e+07);
-  const double t215 = (4e+10 + (t214 * t214));
-  const double t216 = pow(t215, (-0.25));
-  const double t217 =
-      (-x[7] * 5e-09 + 0.07050000000000001 + sqrt(t205) * 2.5e-09 +
-       t208 * 2.0412414523193154e-06 * t203 * t210 - 0.031415926535897934 * t78 * x[2] * t85 -
-       2.5e-09 * sqrt(t212) - t213 * t214 * 2.0412414523193154e-06 * t216 -
-       0.031415926535897934 * x[3] * t137 * t85);
-  const double t218 = (1.0 / sqrt(t206)) * x[5];
-  const double t219 = (t218 + 1.0);
-  const double t220 = (t218 - 1.0);
-  const double t221 = 2.0 * x[7];
-  const double t222 = (-4e+05 + t221);
-  const double t223 = (-t11 * 0.027488935718910694 + 0.07299722865446584);
-  const double t224 = (1.0 / (t223));
-  const double t225 = (x[8] - 2e+05);
-  const double t226 = (t225 * t225);
-  const double t227 = (t226 + 1e+10);
-  const double t228 = (4e+10 + t226);
-  const double t229 = pow(t228, (-0.25));
-  const double t230 = (-2.8e+07 + x[8]);
-  const double t231 = ((t230 * t230) + 1e+10);
-  const double t232 = (x[8] - 2.5e+07);
-  const double t233 = (4e+10 + (t232 * t232));
-  const double t234 = pow(t233, (-0.25));
-  const double t235 = 2.0 * x[8];
+      (-t153 * 50994.579999999994 * t113 - t160 * t113 * 30400.614999999998 - x[2] * 4000.0 +
+       2.0 * u[2] + t108 * t109 * 2.0 * t110 - t114 * t152 * 30400.614999999998 -
+       t112 * 50994.579999999994 * t114 +
+       2.0 * ((-t114 * t145 * 9.80665 - t157 * t113 * 9.80665)) * u[4] - t28 * t74 * t66);
+  const double t165 = (t142 + t143);
+  const double t166 = (t146 + t147);
+  const double t167 = (t115 + t117);
+  const double t168 = (t150 + t151);
+  const double t169 = t113 * (-30400.614999999998) * t168;
+  const double t170 = t114 * (-30400.614999999998) * t167;
+  const double t171 = t137 * t53 * t74 * t66;
+  const double t172 =
+      (-t19 * t42 * t15 - 2.0 * t44 * t34 * t39 - 2.0 * t45 * t34 * t39 + t48 * t18 * t15);
+  const double t173 =
+      (t172 * t60 * 4.0 * t76 * t18 * t13 + t19 * t62 * t172 * 4.0 * t76 * t13 + t130 +
+       t60 * 4.0 * t18 * t41 * t47 * t39 + t131 + t62 * 2.0 * t42 * t47 * t13 -
+       t60 * 2.0 * t48 * t47 * t13 + t19 * t62 * 4.0 * t41 * t47 * t39);
+  const double t174 =
+      (((-t173 * t22 * 0.106625 - t173 * 0.017625 * t21 + t122 + t133)) * t26 +
+       ((t173 * 0.106625 * t21 + t134 + t135 - t173 * t22 * 0.017625)) * t23 + t120 + t121);
+  const double t175 = 2.0 * u[4] * ((-t165 * t113 * 9.80665 - t114 * t166 * 9.80665));
+  const double t176 = (t53 * t53);
+  const double t177 = (t39 * t39);
+  const double t178 = ((t38 * t38) + (t35 * t35) + t123 + t125);
+  const double t179 = (t11 * t34 * t177 * 8.0 - 4.0 * t83 * t177 * t14 - 4.0 * t177 * t15 -
+                       2.0 * t178 * t11 * t15 + t178 * t34 * t14);
+  const double t180 = (t40 * t40);
+  const double t181 =
+      (t19 * 4.0 * t41 * t47 * t39 * t49 +
+       ((t13 * ((t124 * t11 * 8.0 * t13 - 16.0 * t38 * t17 + 32.0 * t38 * t39 * t13 -
+                 t5 * t179 * 4.0 * t33 - 16.0 * t11 * t38 * t41 * t39 - 32.0 * t177 * t8 * t41 +
+                 t35 * t33 * 8.0 * t40 + 24.0 * t11 * t82 * t177 * t8 -
+                 t178 * t11 * 8.0 * t8 * t41 + t5 * t85 * t180 + 16.0 * t178 * t8 * t13)) +
+         t19 * 24.0 * t82 * t177 - t19 * t178 * 8.0 * t41 + t42 * 8.0 * t41 * t39)) *
+           t18 * t47 * t13 -
+       2.0 * t48 * t43 * t47 * t13 +
+       t19 *
+           ((-24.0 * t82 * t177 * t18 + t48 * 8.0 * t41 * t39 + t178 * 8.0 * t18 * t41 +
+             ((-t35 * 32.0 * t39 * t13 - t179 * 4.0 * t33 * t8 + t128 + t129 -
+               t5 * 16.0 * t178 * t13 + t85 * t180 * t8 + t35 * 16.0 * t11 * t41 * t39 +
+               t38 * t33 * 8.0 * t40 + t5 * t178 * t11 * 8.0 * t41 + t5 * 32.0 * t177 * t41 -
+               t5 * 24.0 * t11 * t82 * t177)) *
+                 t13)) *
+           t47 * t13 +
+       2.0 * t42 * t47 * t49 * t13 + t19 * t172 * 4.0 * t76 * t49 * t13 +
+       t172 * 4.0 * t76 * t43 * t18 * t13 + 4.0 * t43 * t18 * t41 * t47 * t39);
+  const double t182 = (t50 * t50);
+  const double t183 = ((t52 * t52) +
+                       ((-t22 * 0.106625 * t181 - t22 * t182 * 0.03525 - 0.017625 * t21 * t181 +
+                         0.21325 * t21 * t182)) *
+                           t26 +
+                       (t51 * t51) +
+                       ((-t22 * 0.017625 * t181 + 0.21325 * t22 * t182 + 0.106625 * t21 * t181 +
+                         t21 * t182 * 0.03525)) *
+                           t23);
+  const double t184 =
+      (t73 * ((-t137 * t53 * 2e+06 * x[2] * t66 - t137 * t176 * 2e+06 * x[3] +
+               t28 * 2e+06 * x[3] * t183 + t28 * 2e+06 * x[2] * t174)) +
+       ((t28 * t53 * t71 - t28 * t53 * t69 * t139 - t28 * t53 * t72 + t28 * t53 * t31 * t140)) *
+           t67 +
+       t28 * t53 * t68 * 2e+08 * t71 - t30 * t28 * t53 * t72 * 2e+08 + t28 * t53 * 4e+08);
+  const double t185 = (1.0 / (t27));
+  const double t186 = (t154 + t156);
+  const double t187 = (t158 + t159);
+  const double t188 = ((t168 * t168) * 1550.0 + 600.0 + (((t165 * t165) + (t186 * t186))) * u[4] +
+                       1550.0 * (t187 * t187));
+  const double t189 =
+      ((2.0 * ((t165 * t166 + t165 * t186)) * u[4] + t187 * 3100.0 * t168 + 3100.0 * t167 * t168)) *
+      ((t28 * t53 * t74 - 2.0 * ((-t186 * t113 * 9.80665 - t114 * t165 * 9.80665)) * u[4] +
+        t187 * t113 * 30400.614999999998 - 2.0 * u[3] + 1600.0 * x[3] +
+        t114 * 30400.614999999998 * t168)) *
+      0.5 / (t188 * t188);
+  const double t190 = (1.0 / (t188));
+  const double t191 = (t96 * 0.04021238596594936 - 0.0522973403523291);
+  const double t192 = (1.0 / (t191));
+  const double t193 = (-2.8e+07 + x[6]);
+  const double t194 = (1e+10 + (t193 * t193));
+  const double t195 = ((x[4] * x[4]) + 1e-06);
+  const double t196 = sqrt(t195);
+  const double t197 = (x[4] + t196);
+  const double t198 = (x[6] - u[6]);
+  const double t199 = (t198 * t198);
+  const double t200 = (4e+10 + t199);
+  const double t201 = pow(t200, (-0.25));
+  const double t202 = (x[6] - 2e+05);
+  const double t203 = (t202 * t202);
+  const double t204 = (t203 + 1e+10);
+  const double t205 = (-t196 + x[4]);
+  const double t206 = (4e+10 + t203);
+  const double t207 = pow(t206, (-0.25));
+  const double t208 = (1.0 / sqrt(t195)) * x[4];
+  const double t209 = (1.0 + t208);
+  const double t210 = (t208 - 1.0);
+  const double t211 = 2.0 * x[6];
+  const double t212 = (-4e+05 + t211);
+  const double t213 = ((x[5] * x[5]) + 1e-06);
+  const double t214 = sqrt(t213);
+  const double t215 = (t214 + x[5]);
+  const double t216 = (x[7] - u[7]);
+  const double t217 = (t216 * t216);
+  const double t218 = (4e+10 + t217);
+  const double t219 = pow(t218, (-0.25));
+  const double t220 = (x[7] - 2e+05);
+  const double t221 = (t220 * t220);
+  const double t222 = (1e+10 + t221);
+  const double t223 = (-t214 + x[5]);
+  const double t224 = (4e+10 + t221);
+  const double t225 = pow(t224, (-0.25));
+  const double t226 = (-2.8e+07 + x[7]);
+  const double t227 = (1e+10 + (t226 * t226));
+  const double t228 = (-t215 * t219 * 2.0412414523193154e-06 * t216 - x[7] * 5e-09 +
+                       0.07050000000000001 - t28 * 0.031415926535897934 * x[2] * t66 +
+                       sqrt(t222) * 2.5e-09 + t223 * 2.0412414523193154e-06 * t220 * t225 -
+                       2.5e-09 * sqrt(t227) - t28 * 0.031415926535897934 * t53 * x[3]);
+  const double t229 = (0.031415926535897934 * t29 - 0.04695132319207772);
+  const double t230 = (1.0 / (t229 * t229));
+  const double t231 = (1.0 / (t229));
+  const double t232 = (1.0 / sqrt(t213)) * x[5];
+  const double t233 = (t232 - 1.0);
+  const double t234 = (t232 + 1.0);
+  const double t235 = 2.0 * x[7];
   const double t236 = (-4e+05 + t235);
-  const double t237 = (0.07132964021557801 - 0.023561944901923454 * t50);
+  const double t237 = (-t96 * 0.027488935718910694 + 0.07299722865446584);
   const double t238 = (1.0 / (t237));
-  const double t239 = (x[9] - 2e+05);
+  const double t239 = (x[8] - u[6]);
   const double t240 = (t239 * t239);
-  const double t241 = (1e+10 + t240);
-  const double t242 = (4e+10 + t240);
-  const double t243 = pow(t242, (-0.25));
-  const double t244 = (-2.8e+07 + x[9]);
-  const double t245 = ((t244 * t244) + 1e+10);
-  const double t246 = (x[9] - 2.5e+07);
-  const double t247 = ((t246 * t246) + 4e+10);
-  const double t248 = pow(t247, (-0.25));
-  const double t249 =
-      (sqrt(t241) * 2.5e-09 + t78 * 0.023561944901923454 * x[2] * t85 - x[9] * 5e-09 +
-       0.07050000000000001 - t213 * 2.0412414523193154e-06 * t243 * t239 - 2.5e-09 * sqrt(t245) +
-       0.023561944901923454 * x[3] * t137 * t85 + t208 * t248 * t246 * 2.0412414523193154e-06);
-  const double t250 = (1.0 / (t237 * t237));
-  const double t251 = 2.0 * x[9];
-  const double t252 = (-4e+05 + t251);
+  const double t241 = (4e+10 + t240);
+  const double t242 = pow(t241, (-0.25));
+  const double t243 = (x[8] - 2e+05);
+  const double t244 = (t243 * t243);
+  const double t245 = (t244 + 1e+10);
+  const double t246 = (4e+10 + t244);
+  const double t247 = pow(t246, (-0.25));
+  const double t248 = (-2.8e+07 + x[8]);
+  const double t249 = ((t248 * t248) + 1e+10);
+  const double t250 = 2.0 * x[8];
+  const double t251 = (-4e+05 + t250);
+  const double t252 = (0.07132964021557801 - 0.023561944901923454 * t29);
+  const double t253 = (1.0 / (t252));
+  const double t254 = (1.0 / (t252 * t252));
+  const double t255 = (x[9] - 2e+05);
+  const double t256 = (t255 * t255);
+  const double t257 = (1e+10 + t256);
+  const double t258 = (4e+10 + t256);
+  const double t259 = pow(t258, (-0.25));
+  const double t260 = (-2.8e+07 + x[9]);
+  const double t261 = ((t260 * t260) + 1e+10);
+  const double t262 = (-x[9] + u[7]);
+  const double t263 = (t262 * t262);
+  const double t264 = (t263 + 4e+10);
+  const double t265 = pow(t264, (-0.25));
+  const double t266 =
+      (t28 * 0.023561944901923454 * x[2] * t66 + sqrt(t257) * 2.5e-09 - x[9] * 5e-09 -
+       t215 * 2.0412414523193154e-06 * t259 * t255 + 0.07050000000000001 - 2.5e-09 * sqrt(t261) -
+       t262 * t223 * t265 * 2.0412414523193154e-06 + t28 * t53 * 0.023561944901923454 * x[3]);
+  const double t267 = 2.0 * x[9];
+  const double t268 = (-4e+05 + t267);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[20] =
-      (((t7 * t10 * t16 - t23 * t24 * 15200.307499999999 - t25 * t26 * 25497.289999999997 -
-         t55 * t56 * t79 - t25 * t83 * 15200.307499999999 + t78 * t87 * t85 +
-         u[4] * ((-t90 * t24 * 9.80665 - t25 * t93 * 9.80665)) + t55 * t108 * t85 +
-         t109 * t7 *
-             ((-t109 * 4e+08 * t7 - t109 * t7 * 2e+08 * (1.0 / sqrt(t13)) * t12 +
-               t109 * t7 * 2e+08 * (1.0 / sqrt(t15)) * t14)) -
-         t110 * t24 * 25497.289999999997 - t111 * t16 * t112)) *
-           t122 -
-       ((t110 * 5200.0 * t26 + t83 * 3100.0 * t23 + 2.0 * ((t90 * t93 + t117 * t90)) * u[4] +
-         3100.0 * t23 * t120 + t113 * t110 * 5200.0)) *
-           t123 * t124);
-  jacobian[21] =
-      (((-t165 - t55 * t78 * t56 * t137 - t166 + u[4] * t141 + t142 * t78 * t85 +
-         t55 * t160 * t85)) *
-           t122 -
-       ((((t117 * t139 + t90 * t140)) * 2.0 * u[4] + 3100.0 * t23 * t138 + 3100.0 * t120 * t125)) *
-           t123 * t124);
-  jacobian[22] = (-2000.0) * t122;
-  jacobian[26] = t109 * t7 * 0.04021238596594936 * t122;
-  jacobian[27] = 0.031415926535897934 * t78 * t122 * t85;
-  jacobian[28] = t109 * (-0.027488935718910694) * t7 * t122;
-  jacobian[29] = t78 * (-0.023561944901923454) * t122 * t85;
+      (((-t28 * t74 * t89 - 2.0 * t95 * t110 * t111 - t112 * 50994.579999999994 * t113 -
+         t114 * t118 * 30400.614999999998 - 50994.579999999994 * t114 * t119 - t28 * t141 * t66 +
+         2.0 * u[4] * ((-t145 * t113 * 9.80665 - t114 * t148 * 9.80665)) +
+         t108 * t109 * 2.0 *
+             ((-t108 * 4e+08 * t109 - t108 * t109 * 2e+08 * t104 * t97 +
+               t108 * t109 * 2e+08 * t103 * t100 +
+               t108 *
+                   ((t108 * t109 * t103 - t108 * t109 * t101 * pow(t102, (-1.5)) +
+                     t108 * pow(t99, (-1.5)) * t109 * t98 - t108 * t109 * t104)) *
+                   t109 * 2e+06 * x[2] -
+               t105 * t109 * 2e+06 * t149 * x[2] + t105 * 2e+06 * t95 * x[2] * t111)) +
+         t109 * 2.0 * t149 * t110 - t152 * t113 * 30400.614999999998 + t137 * t74 * t138)) *
+           0.5 * t162 -
+       ((t112 * 5200.0 * t119 + t118 * 3100.0 * t152 + 2.0 * ((t145 * t148 + t157 * t145)) * u[4] +
+         3100.0 * t152 * t160 + t153 * t112 * 5200.0)) *
+           t163 * 0.5 * t164);
+  jacobian[21] = (-((((t157 * t165 + t145 * t166)) * 2.0 * u[4] + 3100.0 * t152 * t167 +
+                     3100.0 * t160 * t168)) *
+                      t163 * 0.5 * t164 +
+                  ((t169 + t170 + t171 - t28 * t74 * t174 + t175 - t28 * t66 * t184)) * 0.5 * t162);
+  jacobian[22] = ((-t185 * 2e+06 * t73 * t138 - 4000.0 - t105 * 4e+06 * t111 / (t94))) * 0.5 * t162;
+  jacobian[23] = t185 * t53 * (-1e+06) * t73 * t162 * t66;
+  jacobian[26] = t108 * t109 * 0.04021238596594936 * t162;
+  jacobian[27] = t28 * 0.031415926535897934 * t162 * t66;
+  jacobian[28] = t108 * (-0.027488935718910694) * t109 * t162;
+  jacobian[29] = t28 * (-0.023561944901923454) * t162 * t66;
   jacobian[30] =
-      (t164 -
-       ((t165 + t166 + t167 - t87 * t137 * t85 + t55 * t78 * t56 * t137 - t55 * t169 * t85)) *
-           t170);
+      (t189 + ((-t28 * t136 * t74 + t169 + t170 + t171 + t175 - t28 * t53 * t141)) * t190 * 0.5);
   jacobian[31] =
-      (-t170 * ((t165 + t166 + t55 * t171 * t56 + t167 - t142 * t137 * t85 - t55 * t178 * t85)) +
-       t164);
-  jacobian[33] = (-800.0) * t170;
-  jacobian[37] = 0.031415926535897934 * t170 * t137 * t85;
-  jacobian[39] = (-0.023561944901923454) * t170 * t137 * t85;
+      (t189 + ((t169 - t28 * t53 * t184 + t170 + t137 * t176 * t74 - t28 * t74 * t183 + t175)) *
+                  t190 * 0.5);
+  jacobian[32] = t185 * t53 * (-1e+06) * t190 * t73 * t66;
+  jacobian[33] = ((1600.0 + t185 * t176 * 2e+06 * t73)) * t190 * (-0.5);
+  jacobian[37] = t28 * 0.031415926535897934 * t53 * t190;
+  jacobian[39] = t28 * t53 * (-0.023561944901923454) * t190;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
-      (1.2e+09 * t180 *
-           ((t111 * x[2] * 0.04021238596594936 * t112 - t7 * t10 * x[2] * 0.04021238596594936)) -
-       t109 * t7 *
-           ((-3.3333333333333334e-09 * sqrt(t182) - t185 * t188 * t186 * 2.721655269759087e-06 +
-             0.094 - t189 * t193 * 2.721655269759087e-06 * t190 - 6.666666666666667e-09 * x[6] -
-             t109 * t7 * x[2] * 0.04021238596594936 + 3.3333333333333334e-09 * sqrt(t194))) *
-           48254863.15913923 / (t179 * t179));
-  jacobian[62] = t109 * (-48254863.15913923) * t180 * t7;
+      (1.2e+09 * t192 *
+           ((t95 * x[2] * 0.04021238596594936 * t111 - t109 * t149 * x[2] * 0.04021238596594936)) -
+       t108 * t109 *
+           ((-3.3333333333333334e-09 * sqrt(t194) + 0.094 - 6.666666666666667e-09 * x[6] -
+             t108 * t109 * x[2] * 0.04021238596594936 - t197 * 2.721655269759087e-06 * t201 * t198 +
+             3.3333333333333334e-09 * sqrt(t204) + t205 * t207 * 2.721655269759087e-06 * t202)) *
+           48254863.15913923 / (t191 * t191));
+  jacobian[62] = t108 * (-48254863.15913923) * t192 * t109;
   jacobian[64] =
-      ((-t188 * t186 * 2.721655269759087e-06 * t196 - t197 * t193 * 2.721655269759087e-06 * t190)) *
-      1.2e+09 * t180;
-  jacobian[66] =
-      1.2e+09 * t180 *
-      ((-t189 * t193 * 2.721655269759087e-06 +
-        t199 * pow(t192, (-1.25)) * t189 * t190 * 6.804138174397718e-07 -
-        t185 * t188 * 2.721655269759087e-06 + t199 * 1.6666666666666667e-09 * (1.0 / sqrt(t194)) -
-        6.666666666666667e-09 - 1.6666666666666667e-09 * ((-5.6e+07 + t198)) * (1.0 / sqrt(t182)) +
-        pow(t187, (-1.25)) * t185 * t186 * ((-5e+07 + t198)) * 6.804138174397718e-07));
+      ((-2.721655269759087e-06 * t201 * t198 * t209 - t210 * t207 * 2.721655269759087e-06 * t202)) *
+      1.2e+09 * t192;
+  jacobian[66] = 1.2e+09 * t192 *
+                 ((-t197 * 2.721655269759087e-06 * t201 -
+                   t212 * pow(t206, (-1.25)) * t205 * t202 * 6.804138174397718e-07 +
+                   t212 * 1.6666666666666667e-09 * (1.0 / sqrt(t204)) - 6.666666666666667e-09 -
+                   1.6666666666666667e-09 * ((-5.6e+07 + t211)) * (1.0 / sqrt(t194)) +
+                   t205 * t207 * 2.721655269759087e-06 +
+                   pow(t200, (-1.25)) * 1.3608276348795436e-06 * t199 * t197));
   jacobian[70] =
-      (t201 * 1.2e+09 *
-           ((-0.031415926535897934 * t108 * x[2] * t85 + 0.031415926535897934 * x[2] * t56 * t79 +
-             0.031415926535897934 * t78 * x[3] * t56 * t137 -
-             0.031415926535897934 * t169 * x[3] * t85)) -
-       t202 * t217 * t78 * 37699111.84307752 * t85);
-  jacobian[71] =
-      (t201 * 1.2e+09 *
-           ((0.031415926535897934 * t78 * x[2] * t56 * t137 -
-             0.031415926535897934 * t160 * x[2] * t85 + 0.031415926535897934 * t171 * x[3] * t56 -
-             0.031415926535897934 * t178 * x[3] * t85)) -
-       t202 * t217 * 37699111.84307752 * t137 * t85);
-  jacobian[72] = (-37699111.84307752) * t201 * t78 * t85;
-  jacobian[73] = (-37699111.84307752) * t201 * t137 * t85;
-  jacobian[75] = t201 *
-                 ((-t219 * t214 * 2.0412414523193154e-06 * t216 -
-                   t220 * 2.0412414523193154e-06 * t203 * t210)) *
-                 1.2e+09;
-  jacobian[77] = t201 *
-                 ((t208 * 2.0412414523193154e-06 * t210 -
-                   t208 * t222 * 5.103103630798288e-07 * pow(t209, (-1.25)) * t203 -
-                   t213 * 2.0412414523193154e-06 * t216 + (1.0 / sqrt(t205)) * t222 * 1.25e-09 +
-                   5.103103630798288e-07 * t213 * pow(t215, (-1.25)) * ((-5e+07 + t221)) * t214 -
-                   (1.0 / sqrt(t212)) * 1.25e-09 * ((-5.6e+07 + t221)) - 5e-09)) *
-                 1.2e+09;
+      (-t28 * t228 * 37699111.84307752 * t66 * t230 +
+       ((t137 * 0.031415926535897934 * x[2] * t138 - t28 * 0.031415926535897934 * t89 * x[2] -
+         t28 * 0.031415926535897934 * t136 * x[3] +
+         t137 * 0.031415926535897934 * t53 * x[3] * t66)) *
+           t231 * 1.2e+09);
+  jacobian[71] = (-t28 * t53 * t228 * 37699111.84307752 * t230 +
+                  t231 * 1.2e+09 *
+                      ((-t28 * 0.031415926535897934 * x[3] * t183 +
+                        t137 * 0.031415926535897934 * t53 * x[2] * t66 +
+                        t137 * 0.031415926535897934 * t176 * x[3] -
+                        t28 * 0.031415926535897934 * x[2] * t174)));
+  jacobian[72] = t28 * (-37699111.84307752) * t231 * t66;
+  jacobian[73] = t28 * t53 * (-37699111.84307752) * t231;
+  jacobian[75] = t231 * 1.2e+09 *
+                 ((-2.0412414523193154e-06 * t233 * t220 * t225 -
+                   t234 * t219 * 2.0412414523193154e-06 * t216));
+  jacobian[77] = t231 * 1.2e+09 *
+                 ((-t215 * t219 * 2.0412414523193154e-06 -
+                   t236 * 5.103103630798288e-07 * pow(t224, (-1.25)) * t223 * t220 +
+                   (1.0 / sqrt(t222)) * t236 * 1.25e-09 + t223 * 2.0412414523193154e-06 * t225 +
+                   pow(t218, (-1.25)) * t215 * t217 * 1.0206207261596577e-06 -
+                   (1.0 / sqrt(t227)) * 1.25e-09 * ((-5.6e+07 + t235)) - 5e-09));
   jacobian[80] =
-      (1.2e+09 * t224 *
-           ((-t111 * x[2] * t112 * 0.027488935718910694 + t7 * t10 * x[2] * 0.027488935718910694)) +
-       t109 * t7 * 32986722.862692833 *
-           ((0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt(t227) +
-             t109 * t7 * x[2] * 0.027488935718910694 - t229 * t185 * 2.721655269759087e-06 * t225 -
-             3.3333333333333334e-09 * sqrt(t231) - t189 * t234 * 2.721655269759087e-06 * t232)) /
-           (t223 * t223));
-  jacobian[82] = t109 * t7 * 32986722.862692833 * t224;
+      (1.2e+09 * t238 *
+           ((-t95 * x[2] * t111 * 0.027488935718910694 +
+             t109 * t149 * x[2] * 0.027488935718910694)) +
+       t108 *
+           ((t205 * t242 * 2.721655269759087e-06 * t239 + 0.094 - 6.666666666666667e-09 * x[8] +
+             3.3333333333333334e-09 * sqrt(t245) + t108 * t109 * x[2] * 0.027488935718910694 -
+             t247 * t197 * 2.721655269759087e-06 * t243 - 3.3333333333333334e-09 * sqrt(t249))) *
+           t109 * 32986722.862692833 / (t237 * t237));
+  jacobian[82] = t108 * t109 * 32986722.862692833 * t238;
   jacobian[84] =
-      1.2e+09 * t224 *
-      ((-t229 * 2.721655269759087e-06 * t196 * t225 - t197 * t234 * 2.721655269759087e-06 * t232));
-  jacobian[88] = 1.2e+09 * t224 *
-                 ((-1.6666666666666667e-09 * (1.0 / sqrt(t231)) * ((-5.6e+07 + t235)) -
-                   t229 * t185 * 2.721655269759087e-06 +
-                   t236 * 1.6666666666666667e-09 * (1.0 / sqrt(t227)) - 6.666666666666667e-09 +
-                   pow(t233, (-1.25)) * t189 * ((-5e+07 + t235)) * t232 * 6.804138174397718e-07 +
-                   t236 * t185 * t225 * pow(t228, (-1.25)) * 6.804138174397718e-07 -
-                   t189 * t234 * 2.721655269759087e-06));
+      1.2e+09 *
+      ((-t247 * 2.721655269759087e-06 * t209 * t243 - t242 * t210 * 2.721655269759087e-06 * t239)) *
+      t238;
+  jacobian[88] =
+      1.2e+09 * t238 *
+      ((-1.3608276348795436e-06 * t205 * t240 * pow(t241, (-1.25)) -
+        1.6666666666666667e-09 * (1.0 / sqrt(t249)) * ((-5.6e+07 + t250)) -
+        t247 * t197 * 2.721655269759087e-06 + t251 * 1.6666666666666667e-09 * (1.0 / sqrt(t245)) +
+        t205 * t242 * 2.721655269759087e-06 - 6.666666666666667e-09 +
+        t251 * t197 * t243 * pow(t246, (-1.25)) * 6.804138174397718e-07));
   jacobian[90] =
-      (t238 *
-           ((-0.023561944901923454 * x[2] * t56 * t79 + t108 * 0.023561944901923454 * x[2] * t85 +
-             0.023561944901923454 * t169 * x[3] * t85 -
-             t78 * 0.023561944901923454 * x[3] * t56 * t137)) *
-           1.2e+09 +
-       t249 * t78 * 28274333.882308144 * t250 * t85);
+      (((-t137 * t53 * 0.023561944901923454 * x[3] * t66 -
+         t137 * 0.023561944901923454 * x[2] * t138 + t28 * 0.023561944901923454 * t89 * x[2] +
+         t28 * 0.023561944901923454 * t136 * x[3])) *
+           t253 * 1.2e+09 +
+       t28 * 28274333.882308144 * t254 * t66 * t266);
   jacobian[91] =
-      (t238 * 1.2e+09 *
-           ((-t78 * 0.023561944901923454 * x[2] * t56 * t137 +
-             0.023561944901923454 * t160 * x[2] * t85 - 0.023561944901923454 * t171 * x[3] * t56 +
-             t178 * 0.023561944901923454 * x[3] * t85)) +
-       t249 * 28274333.882308144 * t250 * t137 * t85);
-  jacobian[92] = t238 * t78 * 28274333.882308144 * t85;
-  jacobian[93] = t238 * 28274333.882308144 * t137 * t85;
-  jacobian[95] = t238 *
-                 ((-t219 * 2.0412414523193154e-06 * t243 * t239 -
-                   t248 * t246 * t220 * 2.0412414523193154e-06)) *
-                 1.2e+09;
-  jacobian[99] = t238 *
-                 ((-(1.0 / sqrt(t245)) * 1.25e-09 * ((-5.6e+07 + t251)) -
-                   t213 * 2.0412414523193154e-06 * t243 -
-                   t208 * pow(t247, (-1.25)) * 5.103103630798288e-07 * ((-5e+07 + t251)) * t246 +
-                   t208 * t248 * 2.0412414523193154e-06 + t252 * (1.0 / sqrt(t241)) * 1.25e-09 +
-                   t252 * 5.103103630798288e-07 * t213 * pow(t242, (-1.25)) * t239 - 5e-09)) *
-                 1.2e+09;
+      (t28 * t53 * 28274333.882308144 * t254 * t266 +
+       t253 * 1.2e+09 *
+           ((-t137 * t53 * 0.023561944901923454 * x[2] * t66 +
+             t28 * 0.023561944901923454 * x[2] * t174 + t28 * 0.023561944901923454 * x[3] * t183 -
+             t137 * 0.023561944901923454 * t176 * x[3])));
+  jacobian[92] = t28 * t253 * 28274333.882308144 * t66;
+  jacobian[93] = t28 * t53 * t253 * 28274333.882308144;
+  jacobian[95] = ((-t234 * 2.0412414523193154e-06 * t259 * t255 +
+                   t262 * t265 * 2.0412414523193154e-06 * t233)) *
+                 t253 * 1.2e+09;
+  jacobian[99] =
+      ((t268 * t215 * 5.103103630798288e-07 * pow(t258, (-1.25)) * t255 -
+        t263 * pow(t264, (-1.25)) * t223 * 1.0206207261596577e-06 -
+        (1.0 / sqrt(t261)) * 1.25e-09 * ((-5.6e+07 + t267)) + t268 * (1.0 / sqrt(t257)) * 1.25e-09 +
+        t223 * t265 * 2.0412414523193154e-06 - t215 * 2.0412414523193154e-06 * t259 - 5e-09)) *
+      t253 * 1.2e+09;
 }
 
 namespace {

@@ -18,7 +18,7 @@ inline constexpr int kNumJoints = 2;
 inline constexpr int kNumAngles = 3;
 inline constexpr int kNumParams = 4;
 inline constexpr int kNumStates = 10;
-inline constexpr int kNumInputs = 6;
+inline constexpr int kNumInputs = 8;
 inline constexpr int kNumActuators = 2;
 /// Nominal [l_1 ... l_n, alpha_1 ... alpha_n] [m, rad].
 inline constexpr double kNominalParams[kNumParams] = {3.11, 1.295, 0.03490658503988659,

@@ -83,46 +83,45 @@ int InverseKinematics(const double* target, const double* params, double* q) {
   using std::pow;
   using std::sin;
   using std::sqrt;
-  const double t0 = (target[2] - 2.0);
-  const double t1 = (target[0] - 1.1);
+  const double t0 = (target[0] - 1.1);
+  const double t1 = (target[2] - 2.0);
   const double cos_elbow =
-      (-0.5) * ((-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1))) /
+      (((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) * 0.5 /
       (params[1] * params[0]);
   if (!(cos_elbow >= -1.0 && cos_elbow <= 1.0)) return 1;
   double branch[2][kNumJoints];
   {
     double* solution = branch[0];
-    const double t0 = (target[2] - 2.0);
-    const double t1 = (target[0] - 1.1);
-    const double t2 = (-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1));
+    const double t0 = (target[0] - 1.1);
+    const double t1 = (target[2] - 2.0);
+    const double t2 = ((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]));
     const double t3 = (1.0 / (params[0]));
     solution[0] =
-        (-atan2(sqrt((1.0 - (t2 * t2) * 0.25 / (params[0] * params[0] * params[1] * params[1]))) *
+        (-atan2(sqrt((-0.25 * (t2 * t2) / (params[0] * params[0] * params[1] * params[1]) + 1.0)) *
                     params[1],
-                (params[0] - t3 * 0.5 * t2)) +
-         atan2(t0, t1));
-    solution[1] = acos(t3 * (-0.5) * t2 / (params[1]));
+                (t2 * t3 * 0.5 + params[0])) +
+         atan2(t1, t0));
+    solution[1] = acos(t2 * t3 * 0.5 / (params[1]));
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
   }
   {
     double* solution = branch[1];
-    const double t0 = (target[2] - 2.0);
-    const double t1 = (target[0] - 1.1);
+    const double t0 = (target[0] - 1.1);
+    const double t1 = (target[2] - 2.0);
     solution[0] =
-        (-atan2(params[1] * sin(acos((-0.5) *
-                                     ((-(t0 * t0) + (params[0] * params[0]) +
-                                       (params[1] * params[1]) - (t1 * t1))) /
-                                     (params[1] * params[0])) *
-                                (-1.0)),
-                (params[0] + params[1] * cos(acos((-0.5) *
-                                                  ((-(t0 * t0) + (params[0] * params[0]) +
-                                                    (params[1] * params[1]) - (t1 * t1))) /
-                                                  (params[1] * params[0])) *
-                                             (-1.0)))) +
-         atan2(t0, t1));
+        (-atan2(
+             sin(acos(
+                     (((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) *
+                     0.5 / (params[1] * params[0])) *
+                 (-1.0)) *
+                 params[1],
+             (params[0] + params[1] * cos(acos((((t0 * t0) + (t1 * t1) - (params[0] * params[0]) -
+                                                 (params[1] * params[1]))) *
+                                               0.5 / (params[1] * params[0])) *
+                                          (-1.0)))) +
+         atan2(t1, t0));
     solution[1] =
-        acos((-0.5) *
-             ((-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1))) /
+        acos((((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) * 0.5 /
              (params[1] * params[0])) *
         (-1.0);
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
@@ -201,16 +200,16 @@ double LeverArm(int actuator, const double* q) {
       return lever;
     }
     case 1: {
-      const double t0 = cos(q[0]);
-      const double t1 = (q[0] + q[1]);
-      const double t2 = sin(t1);
-      const double t3 = (-0.389) * t2;
-      const double t4 = cos(t1);
+      const double t0 = (q[0] + q[1]);
+      const double t1 = sin(t0);
+      const double t2 = (-0.389) * t1;
+      const double t3 = cos(q[0]);
+      const double t4 = cos(t0);
       const double t5 = 0.159 * t4;
       const double t6 = sin(q[0]);
-      const double t7 = (t3 + t0 * 0.5249999999999999 + t5 + 0.365 * t6);
+      const double t7 = (t2 + t3 * 0.5249999999999999 + t5 + 0.365 * t6);
       const double t8 = (t7 * t7);
-      const double t9 = (0.159 * t2 - 0.365 * t0 + t6 * 0.5249999999999999 + 0.389 * t4);
+      const double t9 = (0.159 * t1 - 0.365 * t3 + t6 * 0.5249999999999999 + 0.389 * t4);
       const double t10 = (t9 * t9);
       const double t11 = (t8 + t10);
       const double t12 = (1.0 / sqrt(t11));
@@ -219,33 +218,32 @@ double LeverArm(int actuator, const double* q) {
       const double t15 = (1.0 / (t11));
       const double t16 = (-t14 * t15 * 0.25 + 0.567009);
       const double t17 = sqrt(t16);
-      const double t18 = (t17 * t7 * 2.0 + t12 * t13 * t9);
-      const double t19 = (t12 * t7 * t13 - t17 * 2.0 * t9);
-      const double t20 = atan2(t12 * 0.5 * t18, t12 * t19 * 0.5);
-      const double t21 = cos(t20);
-      const double t22 = sin(t20);
-      const double t23 = (-t0 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
-      const double t24 = (1.0 / ((((t19 * t19) * t15 + (t18 * t18) * t15))));
-      const double t25 = (-0.389 * t4 - 0.159 * t2);
-      const double t26 = (t3 + t5);
-      const double t27 = (t25 * t7 + t9 * t26);
-      const double t28 = pow(t11, (-1.5));
-      const double t29 = (1.0 / sqrt(t16));
-      const double t30 = (t27 * t13 * 2.0 * t15 - t27 * t14 / (t11 * t11));
-      const double t31 =
-          (t12 * t19 * t24 *
-               ((-t27 * 2.0 * t28 * t18 +
-                 t12 * ((t12 * t13 * 2.0 * t26 + t27 * t12 * 4.0 * t9 - t27 * t13 * 2.0 * t28 * t9 -
-                         t7 * t29 * t30 + t17 * t25 * 4.0)))) +
-           t12 *
-               ((t27 * t19 * 2.0 * t28 +
-                 t12 * ((-t25 * t12 * t13 * 2.0 - t9 * t29 * t30 + t17 * 4.0 * t26 +
-                         t27 * t7 * t13 * 2.0 * t28 - t27 * t12 * t7 * 4.0)))) *
-               t24 * t18);
-      const double t32 = (-0.853 * t21 + t0 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
-      const double lever = ((t23 * ((-0.4265 * t31 * t21 + 0.0705 * t31 * t22)) +
-                             ((0.4265 * t31 * t22 + 0.0705 * t31 * t21)) * t32)) *
-                           (1.0 / sqrt(((t32 * t32) + (t23 * t23))));
+      const double t18 = (t12 * t7 * t13 - t17 * 2.0 * t9);
+      const double t19 = (t17 * t7 * 2.0 + t12 * t13 * t9);
+      const double t20 = (1.0 / ((((t18 * t18) * t15 + (t19 * t19) * t15))));
+      const double t21 = (-0.389 * t4 - 0.159 * t1);
+      const double t22 = (t2 + t5);
+      const double t23 = (t21 * t7 + t9 * t22);
+      const double t24 = pow(t11, (-1.5));
+      const double t25 = (1.0 / sqrt(t16));
+      const double t26 = (t23 * t13 * 2.0 * t15 - t23 * t14 / (t11 * t11));
+      const double t27 =
+          (t12 * t18 * t20 *
+               ((t12 * ((-t17 * t21 * 4.0 - t23 * t12 * 4.0 * t9 - t12 * t13 * 2.0 * t22 +
+                         t23 * t13 * 2.0 * t24 * t9 + t7 * t25 * t26)) +
+                 t23 * 2.0 * t24 * t19)) +
+           ((-t23 * t18 * 2.0 * t24 +
+             t12 * ((t23 * t12 * t7 * 4.0 + t21 * t12 * t13 * 2.0 - t17 * 4.0 * t22 +
+                     t9 * t25 * t26 - t23 * t7 * t13 * 2.0 * t24)))) *
+               t12 * t20 * t19);
+      const double t28 = atan2(t12 * 0.5 * t19, t12 * t18 * 0.5);
+      const double t29 = cos(t28);
+      const double t30 = sin(t28);
+      const double t31 = (-0.853 * t29 + t3 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t30);
+      const double t32 = (-t3 * 0.15500000000000003 - 0.141 * t29 - 0.853 * t30 + 2.093 * t6);
+      const double lever = ((((-t27 * 0.0705 * t29 - t27 * 0.4265 * t30)) * t31 +
+                             t32 * ((t27 * 0.4265 * t29 - t27 * 0.0705 * t30)))) *
+                           (1.0 / sqrt(((t31 * t31) + (t32 * t32))));
       return lever;
     }
     default:
@@ -288,180 +286,191 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::pow;
   using std::sin;
   using std::sqrt;
-  const double t0 = cos(x[0]);
-  const double t1 = 3.11 * t0;
-  const double t2 = (x[0] + x[1]);
-  const double t3 = sin(t2);
-  const double t4 = t3 * (-0.25);
-  const double t5 = cos(t2);
-  const double t6 = 0.55 * t5;
-  const double t7 = (t1 + t4 + t6);
-  const double t8 = cos(u[5]);
-  const double t9 = sin(x[0]);
-  const double t10 = (-1.55 * t9 - 0.1 * t0);
-  const double t11 = sin(u[5]);
-  const double t12 = (0.389 * t5 + t9 * 0.5249999999999999 - 0.365 * t0 + t3 * 0.159);
-  const double t13 = 0.159 * t5;
-  const double t14 = t3 * (-0.389);
-  const double t15 = (0.365 * t9 + t13 + t14 + t0 * 0.5249999999999999);
-  const double t16 = (t15 * t15);
-  const double t17 = (t12 * t12);
-  const double t18 = (t16 + t17 - 0.38752);
-  const double t19 = (t16 + t17);
-  const double t20 = (1.0 / sqrt(t19));
-  const double t21 = (t18 * t18);
-  const double t22 = (1.0 / (t19));
-  const double t23 = (0.567009 - 0.25 * t21 * t22);
-  const double t24 = sqrt(t23);
-  const double t25 = (t12 * t18 * t20 + 2.0 * t15 * t24);
-  const double t26 = (-t12 * 2.0 * t24 + t18 * t15 * t20);
-  const double t27 = atan2(0.5 * t25 * t20, t26 * 0.5 * t20);
-  const double t28 = cos(t27);
-  const double t29 = sin(t27);
-  const double t30 = (-0.15500000000000003 * t0 - 0.141 * t28 + t9 * 2.093 - t29 * 0.853);
-  const double t31 = t9 * 0.15500000000000003;
-  const double t32 = 2.093 * t0;
-  const double t33 = (0.141 * t29 + t31 - 0.853 * t28 + t32);
-  const double t34 = ((t30 * t30) + (t33 * t33));
-  const double t35 = (1.0 / sqrt(t34));
-  const double t36 = sqrt(t34);
-  const double t37 = (-1.59 + t36);
-  const double t38 = (t36 - 2.9000000000000004);
-  const double t39 =
-      (sqrt(((t37 * t37) + 1e-06)) * 1e+08 + 0.031415926535897934 * x[7] - t36 * 2e+08 -
-       sqrt(((t38 * t38) + 1e-06)) * 1e+08 - 0.023561944901923454 * x[9] + 4.49e+08);
-  const double t40 = (-0.389) * t5;
-  const double t41 = t3 * (-0.159);
-  const double t42 = (t40 - t9 * 0.5249999999999999 + 0.365 * t0 + t41);
-  const double t43 = (t42 * t15 + t12 * t15);
-  const double t44 = pow(t19, (-1.5));
-  const double t45 = (1.0 / (t19 * t19));
-  const double t46 = (2.0 * t18 * t43 * t22 - t45 * t43 * t21);
-  const double t47 = (1.0 / sqrt(t23));
-  const double t48 = (1.0 / ((((t25 * t25) * t22 + (t26 * t26) * t22))));
-  const double t49 =
-      (((t26 * 2.0 * t43 * t44 - ((t42 * 2.0 * t18 * t20 - 4.0 * t15 * t24 + 4.0 * t15 * t43 * t20 +
-                                   t46 * t12 * t47 - 2.0 * t18 * t15 * t43 * t44)) *
-                                     t20)) *
-           t25 * t48 * t20 +
-       t26 *
-           ((((t42 * 4.0 * t24 - t46 * t47 * t15 - t12 * 2.0 * t18 * t43 * t44 +
-               t12 * 4.0 * t43 * t20 + 2.0 * t18 * t15 * t20)) *
-                 t20 -
-             2.0 * t43 * t25 * t44)) *
-           t48 * t20);
-  const double t50 =
-      (t30 * ((-0.4265 * t28 * t49 + 0.0705 * t29 * t49 + t31 + t32)) +
-       ((t29 * 0.4265 * t49 + 0.0705 * t28 * t49 - t9 * 2.093 + 0.15500000000000003 * t0)) * t33);
-  const double t51 = t3 * (-0.55);
-  const double t52 = (-0.25) * t5;
-  const double t53 = t9 * (-3.11);
-  const double t54 = (t51 + t52 + t53);
-  const double t55 = t3 * (-0.4011545671438309);
-  const double t56 = (-0.16343387866394005) * t5;
-  const double t57 = (t55 + t56 + t53);
-  const double t58 = t3 * (-0.16343387866394005);
-  const double t59 = 0.4011545671438309 * t5;
-  const double t60 = (t58 + t1 + t59);
-  const double t61 = (-t9 * 0.1 + 1.55 * t0);
-  const double t62 = (0.194 * t0 + 1.595 + t9 * 0.857);
-  const double t63 = (-0.194) * t9;
-  const double t64 = 0.857 * t0;
-  const double t65 = (t63 + t64 - 1.339);
-  const double t66 = (t62 * ((t63 + t64)) + ((-t9 * 0.857 - 0.194 * t0)) * t65);
-  const double t67 = ((t62 * t62) + (t65 * t65));
-  const double t68 = (1.0 / sqrt(t67));
-  const double t69 = sqrt(t67);
-  const double t70 = (-2.51 + t69);
-  const double t71 = (t69 - 1.4);
-  const double t72 = (t58 + t59);
-  const double t73 = (t55 + t56);
-  const double t74 = (t13 + t14);
-  const double t75 = (t40 + t41);
-  const double t76 = (t74 * t12 + t75 * t15);
-  const double t77 = (-t45 * t21 * t76 + 2.0 * t18 * t22 * t76);
-  const double t78 = (((((-t12 * t47 * t77 - 2.0 * t18 * t75 * t20 - 4.0 * t15 * t76 * t20 +
-                          2.0 * t18 * t15 * t44 * t76 + t74 * 4.0 * t24)) *
-                            t20 +
-                        t26 * 2.0 * t44 * t76)) *
-                          t25 * t48 * t20 -
-                      t26 *
-                          ((2.0 * t25 * t44 * t76 +
-                            ((-t74 * 2.0 * t18 * t20 - 4.0 * t75 * t24 - t12 * 4.0 * t76 * t20 +
-                              t12 * 2.0 * t18 * t44 * t76 + t47 * t15 * t77)) *
-                                t20)) *
-                          t48 * t20);
-  const double t79 = (t30 * ((-t78 * 0.4265 * t28 + 0.0705 * t29 * t78)) +
-                      ((t29 * t78 * 0.4265 + 0.0705 * t78 * t28)) * t33);
-  const double t80 = (t51 + t52);
-  const double t81 = (t4 + t6);
-  const double t82 = (-2.8e+07 + x[6]);
-  const double t83 = sqrt(((x[4] * x[4]) + 1e-04));
-  const double t84 = (x[4] + t83);
-  const double t85 = (x[6] - 2.5e+07);
-  const double t86 = (-x[4] + t83);
-  const double t87 = (x[6] - 2e+05);
-  const double t88 = (t87 * t87);
-  const double t89 = (x[7] - 2e+05);
-  const double t90 = (t89 * t89);
-  const double t91 = sqrt(((x[5] * x[5]) + 1e-04));
-  const double t92 = (-t91 + x[5]);
-  const double t93 = (-2.8e+07 + x[7]);
-  const double t94 = (t91 + x[5]);
-  const double t95 = (x[7] - 2.5e+07);
-  const double t96 = (x[8] - 2e+05);
+  const double t0 = sin(x[0]);
+  const double t1 = cos(x[0]);
+  const double t2 = (-t0 * 0.1 + 1.55 * t1);
+  const double t3 = cos(u[5]);
+  const double t4 = 3.11 * t1;
+  const double t5 = (x[0] + x[1]);
+  const double t6 = sin(t5);
+  const double t7 = t6 * (-0.25);
+  const double t8 = cos(t5);
+  const double t9 = 0.55 * t8;
+  const double t10 = (t4 + t7 + t9);
+  const double t11 = (0.389 * t8 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
+  const double t12 = 0.159 * t8;
+  const double t13 = t6 * (-0.389);
+  const double t14 = (0.365 * t0 + t12 + t13 + t1 * 0.5249999999999999);
+  const double t15 = (t14 * t14);
+  const double t16 = (t11 * t11);
+  const double t17 = (t15 + t16 - 0.38752);
+  const double t18 = (t15 + t16);
+  const double t19 = (1.0 / sqrt(t18));
+  const double t20 = (t17 * t17);
+  const double t21 = (1.0 / (t18));
+  const double t22 = (0.567009 - 0.25 * t20 * t21);
+  const double t23 = sqrt(t22);
+  const double t24 = (t11 * t17 * t19 + 2.0 * t14 * t23);
+  const double t25 = (-t11 * 2.0 * t23 + t17 * t14 * t19);
+  const double t26 = atan2(0.5 * t24 * t19, t25 * 0.5 * t19);
+  const double t27 = cos(t26);
+  const double t28 = sin(t26);
+  const double t29 = (-0.15500000000000003 * t1 - 0.141 * t27 + t0 * 2.093 - t28 * 0.853);
+  const double t30 = t0 * 0.15500000000000003;
+  const double t31 = 2.093 * t1;
+  const double t32 = (0.141 * t28 + t30 - 0.853 * t27 + t31);
+  const double t33 = ((t29 * t29) + (t32 * t32));
+  const double t34 = (1.0 / sqrt(t33));
+  const double t35 = sqrt(t33);
+  const double t36 = (-1.59 + t35);
+  const double t37 = ((t36 * t36) + 1e-06);
+  const double t38 = (t35 - 2.9000000000000004);
+  const double t39 = ((t38 * t38) + 1e-06);
+  const double t40 = (t12 + t13);
+  const double t41 = (-0.389) * t8;
+  const double t42 = t6 * (-0.159);
+  const double t43 = (t41 + t42);
+  const double t44 = (t40 * t11 + t43 * t14);
+  const double t45 = (1.0 / (t18 * t18));
+  const double t46 = (-2.0 * t17 * t21 * t44 + t45 * t20 * t44);
+  const double t47 = (1.0 / sqrt(t22));
+  const double t48 = pow(t18, (-1.5));
+  const double t49 = (1.0 / ((((t24 * t24) * t21 + (t25 * t25) * t21))));
+  const double t50 = (((-((-t11 * t46 * t47 - 2.0 * t17 * t14 * t48 * t44 + 2.0 * t17 * t43 * t19 +
+                           4.0 * t14 * t44 * t19 - t40 * 4.0 * t23)) *
+                            t19 +
+                        t25 * 2.0 * t48 * t44)) *
+                          t24 * t49 * t19 -
+                      t25 *
+                          ((-((-t11 * 2.0 * t17 * t48 * t44 + t46 * t47 * t14 +
+                               t40 * 2.0 * t17 * t19 + t11 * 4.0 * t44 * t19 + 4.0 * t43 * t23)) *
+                                t19 +
+                            2.0 * t24 * t48 * t44)) *
+                          t49 * t19);
+  const double t51 = (t29 * ((0.0705 * t50 * t28 - t50 * 0.4265 * t27)) +
+                      ((t50 * t28 * 0.4265 + 0.0705 * t50 * t27)) * t32);
+  const double t52 = (t41 - t0 * 0.5249999999999999 + 0.365 * t1 + t42);
+  const double t53 = (t52 * t14 + t11 * t14);
+  const double t54 = (-2.0 * t17 * t53 * t21 + t45 * t53 * t20);
+  const double t55 =
+      (((2.0 * t53 * t24 * t48 + ((-t47 * t54 * t14 - t52 * 4.0 * t23 - t11 * 4.0 * t53 * t19 +
+                                   t11 * 2.0 * t17 * t53 * t48 - 2.0 * t17 * t14 * t19)) *
+                                     t19)) *
+           t25 * t49 * t19 -
+       ((((2.0 * t17 * t14 * t53 * t48 + t11 * t47 * t54 - 4.0 * t14 * t53 * t19 + 4.0 * t14 * t23 -
+           t52 * 2.0 * t17 * t19)) *
+             t19 +
+         t25 * 2.0 * t53 * t48)) *
+           t24 * t49 * t19);
+  const double t56 =
+      (t29 * ((t30 + 0.4265 * t27 * t55 - 0.0705 * t28 * t55 + t31)) +
+       ((-t28 * 0.4265 * t55 - t0 * 2.093 + 0.15500000000000003 * t1 - 0.0705 * t27 * t55)) * t32);
+  const double t57 =
+      (-sqrt(t37) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + sqrt(t39) * 2e+08 +
+       ((t34 * 2e+06 * t51 * x[3] + t34 * 2e+06 * x[2] * t56)) *
+           ((2.0 + t38 * (1.0 / sqrt(t39)) - t36 * (1.0 / sqrt(t37)))) +
+       0.04712388980384691 * x[9] + 4e+08 * t35);
+  const double t58 = (0.194 * t1 + 1.595 + t0 * 0.857);
+  const double t59 = (-0.194) * t0;
+  const double t60 = 0.857 * t1;
+  const double t61 = (t59 + t60 - 1.339);
+  const double t62 = (t58 * ((t59 + t60)) + ((-t0 * 0.857 - 0.194 * t1)) * t61);
+  const double t63 = ((t58 * t58) + (t61 * t61));
+  const double t64 = (1.0 / sqrt(t63));
+  const double t65 = sqrt(t63);
+  const double t66 = (-2.51 + t65);
+  const double t67 = (1e-06 + (t66 * t66));
+  const double t68 = (t65 - 1.4);
+  const double t69 = (1e-06 + (t68 * t68));
+  const double t70 = (-1.55 * t0 - 0.1 * t1);
+  const double t71 = sin(u[5]);
+  const double t72 = t6 * (-0.4011545671438309);
+  const double t73 = (-0.16343387866394005) * t8;
+  const double t74 = t0 * (-3.11);
+  const double t75 = (t72 + t73 + t74);
+  const double t76 = t6 * (-0.16343387866394005);
+  const double t77 = 0.4011545671438309 * t8;
+  const double t78 = (t76 + t4 + t77);
+  const double t79 = t6 * (-0.55);
+  const double t80 = (-0.25) * t8;
+  const double t81 = (t79 + t80 + t74);
+  const double t82 = (t76 + t77);
+  const double t83 = (t72 + t73);
+  const double t84 = (t7 + t9);
+  const double t85 = (t79 + t80);
+  const double t86 = (-2.8e+07 + x[6]);
+  const double t87 = sqrt(((x[4] * x[4]) + 1e-06));
+  const double t88 = (x[4] + t87);
+  const double t89 = (x[6] - u[6]);
+  const double t90 = (x[6] - 2e+05);
+  const double t91 = (t90 * t90);
+  const double t92 = (-t87 + x[4]);
+  const double t93 = sqrt(((x[5] * x[5]) + 1e-06));
+  const double t94 = (t93 + x[5]);
+  const double t95 = (x[7] - u[7]);
+  const double t96 = (x[7] - 2e+05);
   const double t97 = (t96 * t96);
-  const double t98 = (-2.8e+07 + x[8]);
-  const double t99 = (x[8] - 2.5e+07);
-  const double t100 = (x[9] - 2e+05);
+  const double t98 = (t93 - x[5]);
+  const double t99 = (-2.8e+07 + x[7]);
+  const double t100 = (x[8] - 2e+05);
   const double t101 = (t100 * t100);
-  const double t102 = (-2.8e+07 + x[9]);
-  const double t103 = (x[9] - 2.5e+07);
+  const double t102 = (-x[8] + u[6]);
+  const double t103 = (-2.8e+07 + x[8]);
+  const double t104 = (x[9] - 2e+05);
+  const double t105 = (t104 * t104);
+  const double t106 = (-x[9] + u[7]);
+  const double t107 = (-2.8e+07 + x[9]);
   xdot[0] = x[2];
   xdot[1] = x[3];
-  xdot[2] =
-      ((-t7 * t8 * 17651.969999999998 - 2000.0 * x[2] - t10 * t11 * 25497.289999999997 +
-        t35 * t39 * t50 - t11 * t54 * 17651.969999999998 +
-        ((-t11 * t57 * 9.80665 - t60 * t8 * 9.80665)) * u[4] + u[2] -
-        t61 * t8 * 25497.289999999997 +
-        t66 * t68 *
-            ((-2e+08 * sqrt((1e-06 + (t70 * t70))) - x[8] * 0.03817035074111599 + 7.82e+08 +
-              2e+08 * sqrt((1e-06 + (t71 * t71))) - 4e+08 * t69 + 0.05089380098815465 * x[6])))) /
-      (((2600.0 * (t61 * t61) + 1800.0 * (t54 * t54) + (((t60 * t60) + (t57 * t57))) * u[4] +
-         (t7 * t7) * 1800.0 + 2600.0 * (t10 * t10) + 2900.0)));
-  xdot[3] =
-      ((((-t72 * t8 * 9.80665 - t11 * t73 * 9.80665)) * u[4] + t79 * t35 * t39 - 800.0 * x[3] -
-        t11 * 17651.969999999998 * t80 - t81 * t8 * 17651.969999999998 + u[3])) /
-      ((((t81 * t81) * 1800.0 + 600.0 + (((t73 * t73) + (t72 * t72))) * u[4] +
-         (t80 * t80) * 1800.0)));
+  xdot[2] = ((-t2 * 50994.579999999994 * t3 - t10 * t3 * 35303.939999999995 - x[2] * 4000.0 +
+              2.0 * u[2] - t34 * t57 * t56 +
+              t62 * t64 * 2.0 *
+                  ((-2e+08 * sqrt(t67) - x[8] * 0.03817035074111599 -
+                    ((-(1.0 / sqrt(t69)) * t68 + 2.0 + (1.0 / sqrt(t67)) * t66)) * t62 * t64 *
+                        2e+06 * x[2] +
+                    7.82e+08 + 2e+08 * sqrt(t69) - 4e+08 * t65 + 0.05089380098815465 * x[6])) -
+              t70 * 50994.579999999994 * t71 +
+              2.0 * ((-t71 * t75 * 9.80665 - t78 * t3 * 9.80665)) * u[4] -
+              t71 * t81 * 35303.939999999995)) *
+            0.5 /
+            (((2600.0 * (t2 * t2) + 1800.0 * (t81 * t81) + (((t78 * t78) + (t75 * t75))) * u[4] +
+               (t10 * t10) * 1800.0 + 2600.0 * (t70 * t70) + 2900.0)));
+  xdot[3] = ((-2.0 * ((-t82 * t3 * 9.80665 - t71 * t83 * 9.80665)) * u[4] +
+              t84 * t3 * 35303.939999999995 + t71 * t85 * 35303.939999999995 - 2.0 * u[3] +
+              1600.0 * x[3] + t34 * t51 * t57)) *
+            (-0.5) /
+            ((((t84 * t84) * 1800.0 + 600.0 + (((t83 * t83) + (t82 * t82))) * u[4] +
+               (t85 * t85) * 1800.0)));
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
-  xdot[6] = ((-3.3333333333333334e-09 * sqrt((1e+10 + (t82 * t82))) -
-              t84 * pow(((t85 * t85) + 4e+10), (-0.25)) * t85 * 2.721655269759087e-06 + 0.094 -
-              t86 * pow((4e+10 + t88), (-0.25)) * 2.721655269759087e-06 * t87 -
-              6.666666666666667e-09 * x[6] - t66 * t68 * 0.05089380098815465 * x[2] +
-              3.3333333333333334e-09 * sqrt((t88 + 1e+10)))) *
-            1.2e+09 / (((t69 * 0.05089380098815465 - 0.06725132138341651)));
-  xdot[7] = ((-t35 * 0.031415926535897934 * x[2] * t50 - x[7] * 5e-09 + 0.07050000000000001 -
-              t79 * t35 * 0.031415926535897934 * x[3] + sqrt((1e+10 + t90)) * 2.5e-09 +
-              t92 * 2.0412414523193154e-06 * t89 * pow((4e+10 + t90), (-0.25)) -
-              2.5e-09 * sqrt((1e+10 + (t93 * t93))) -
-              t94 * t95 * 2.0412414523193154e-06 * pow((4e+10 + (t95 * t95)), (-0.25)))) *
-            1.2e+09 / (((0.031415926535897934 * t36 - 0.04695132319207772)));
+  xdot[6] = 1.2e+09 *
+            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t86 * t86))) + 0.094 -
+              6.666666666666667e-09 * x[6] - t62 * t64 * 0.05089380098815465 * x[2] -
+              t88 * 2.721655269759087e-06 * pow((4e+10 + (t89 * t89)), (-0.25)) * t89 +
+              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) +
+              t92 * pow((4e+10 + t91), (-0.25)) * 2.721655269759087e-06 * t90)) /
+            (((t65 * 0.05089380098815465 - 0.06725132138341651)));
+  xdot[7] = 1.2e+09 *
+            ((-t94 * pow((4e+10 + (t95 * t95)), (-0.25)) * 2.0412414523193154e-06 * t95 -
+              t34 * 0.031415926535897934 * t51 * x[3] - x[7] * 5e-09 + 0.07050000000000001 +
+              sqrt((1e+10 + t97)) * 2.5e-09 -
+              t98 * 2.0412414523193154e-06 * t96 * pow((4e+10 + t97), (-0.25)) -
+              2.5e-09 * sqrt((1e+10 + (t99 * t99))) - t34 * 0.031415926535897934 * x[2] * t56)) /
+            (((0.031415926535897934 * t35 - 0.04695132319207772)));
   xdot[8] = 1.2e+09 *
-            ((t66 * t68 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
-              3.3333333333333334e-09 * sqrt((t97 + 1e+10)) -
-              pow((4e+10 + t97), (-0.25)) * t84 * 2.721655269759087e-06 * t96 -
-              3.3333333333333334e-09 * sqrt(((t98 * t98) + 1e+10)) -
-              t86 * pow((4e+10 + (t99 * t99)), (-0.25)) * 2.721655269759087e-06 * t99)) /
-            (((-t69 * 0.03817035074111599 + 0.09980758036020113)));
-  xdot[9] =
-      1.2e+09 *
-      ((sqrt((1e+10 + t101)) * 2.5e-09 + t35 * 0.023561944901923454 * x[2] * t50 - x[9] * 5e-09 +
-        0.07050000000000001 - t94 * 2.0412414523193154e-06 * pow((4e+10 + t101), (-0.25)) * t100 -
-        2.5e-09 * sqrt(((t102 * t102) + 1e+10)) + t79 * t35 * 0.023561944901923454 * x[3] +
-        t92 * pow(((t103 * t103) + 4e+10), (-0.25)) * t103 * 2.0412414523193154e-06)) /
-      (((0.07132964021557801 - 0.023561944901923454 * t36)));
+            ((t62 * t64 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
+              3.3333333333333334e-09 * sqrt((t101 + 1e+10)) -
+              t102 * t92 * 2.721655269759087e-06 * pow((4e+10 + (t102 * t102)), (-0.25)) -
+              pow((4e+10 + t101), (-0.25)) * t88 * 2.721655269759087e-06 * t100 -
+              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) /
+            (((-t65 * 0.03817035074111599 + 0.09980758036020113)));
+  xdot[9] = 1.2e+09 *
+            ((sqrt((1e+10 + t105)) * 2.5e-09 +
+              t106 * t98 * pow(((t106 * t106) + 4e+10), (-0.25)) * 2.0412414523193154e-06 -
+              x[9] * 5e-09 - t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
+              0.07050000000000001 - 2.5e-09 * sqrt(((t107 * t107) + 1e+10)) +
+              t34 * 0.023561944901923454 * t51 * x[3] + t34 * 0.023561944901923454 * x[2] * t56)) /
+            (((0.07132964021557801 - 0.023561944901923454 * t35)));
 }
 
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
@@ -472,488 +481,532 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   using std::sin;
   using std::sqrt;
   std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);
-  const double t0 = sin(u[5]);
-  const double t1 = (x[0] + x[1]);
-  const double t2 = sin(t1);
-  const double t3 = t2 * 0.25;
-  const double t4 = cos(x[0]);
-  const double t5 = (-3.11) * t4;
-  const double t6 = cos(t1);
-  const double t7 = (-0.55) * t6;
-  const double t8 = (t3 + t5 + t7);
-  const double t9 = sin(x[0]);
-  const double t10 = (t9 * 0.1 - 1.55 * t4);
-  const double t11 = (0.194 * t4 + 1.595 + t9 * 0.857);
-  const double t12 = (-0.194) * t9;
-  const double t13 = 0.857 * t4;
-  const double t14 = (t12 + t13 - 1.339);
-  const double t15 = ((t11 * t11) + (t14 * t14));
-  const double t16 = pow(t15, (-1.5));
-  const double t17 = (t12 + t13);
-  const double t18 = (-t9 * 0.857 - 0.194 * t4);
-  const double t19 = (t11 * t17 + t18 * t14);
-  const double t20 = (t19 * t19);
-  const double t21 = sqrt(t15);
-  const double t22 = (-2.51 + t21);
-  const double t23 = (1e-06 + (t22 * t22));
-  const double t24 = (t21 - 1.4);
-  const double t25 = (1e-06 + (t24 * t24));
-  const double t26 = (-2e+08 * sqrt(t23) - x[8] * 0.03817035074111599 + 7.82e+08 +
-                      2e+08 * sqrt(t25) - 4e+08 * t21 + 0.05089380098815465 * x[6]);
-  const double t27 = (1.0 / sqrt(t15));
-  const double t28 = ((t18 * t18) + (t17 * t17) + t14 * ((0.194 * t9 - t13)) + t18 * t11);
-  const double t29 = (0.389 * t6 + t9 * 0.5249999999999999 - 0.365 * t4 + t2 * 0.159);
-  const double t30 = 0.159 * t6;
-  const double t31 = t2 * (-0.389);
-  const double t32 = (0.365 * t9 + t30 + t31 + t4 * 0.5249999999999999);
-  const double t33 = (t32 * t32);
-  const double t34 = (t29 * t29);
-  const double t35 = (t33 + t34 - 0.38752);
-  const double t36 = (t33 + t34);
-  const double t37 = (1.0 / sqrt(t36));
-  const double t38 = (t35 * t35);
-  const double t39 = (1.0 / (t36));
-  const double t40 = (0.567009 - 0.25 * t38 * t39);
-  const double t41 = sqrt(t40);
-  const double t42 = (t29 * t35 * t37 + 2.0 * t32 * t41);
-  const double t43 = (-t29 * 2.0 * t41 + t35 * t32 * t37);
-  const double t44 = atan2(0.5 * t42 * t37, t43 * 0.5 * t37);
-  const double t45 = cos(t44);
-  const double t46 = sin(t44);
-  const double t47 = (-0.15500000000000003 * t4 - 0.141 * t45 + t9 * 2.093 - t46 * 0.853);
-  const double t48 = t9 * 0.15500000000000003;
-  const double t49 = 2.093 * t4;
-  const double t50 = (0.141 * t46 + t48 - 0.853 * t45 + t49);
-  const double t51 = ((t47 * t47) + (t50 * t50));
-  const double t52 = sqrt(t51);
-  const double t53 = (-1.59 + t52);
-  const double t54 = (1.0 / sqrt(t51));
-  const double t55 = ((t53 * t53) + 1e-06);
-  const double t56 = (1.0 / sqrt(t55));
-  const double t57 = (-0.389) * t6;
-  const double t58 = t2 * (-0.159);
-  const double t59 = (t57 - t9 * 0.5249999999999999 + 0.365 * t4 + t58);
-  const double t60 = (t59 * t32 + t29 * t32);
-  const double t61 = pow(t36, (-1.5));
-  const double t62 = (1.0 / (t36 * t36));
-  const double t63 = (2.0 * t35 * t60 * t39 - t62 * t60 * t38);
-  const double t64 = (1.0 / sqrt(t40));
-  const double t65 = (t59 * 2.0 * t35 * t37 - 4.0 * t32 * t41 + 4.0 * t32 * t60 * t37 +
-                      t63 * t29 * t64 - 2.0 * t35 * t32 * t60 * t61);
-  const double t66 = (t43 * 2.0 * t60 * t61 - t65 * t37);
-  const double t67 = (t42 * t42);
-  const double t68 = (t43 * t43);
-  const double t69 = (t67 * t39 + t68 * t39);
-  const double t70 = (1.0 / (t69));
-  const double t71 = (t59 * 4.0 * t41 - t63 * t64 * t32 - t29 * 2.0 * t35 * t60 * t61 +
-                      t29 * 4.0 * t60 * t37 + 2.0 * t35 * t32 * t37);
-  const double t72 = (t71 * t37 - 2.0 * t60 * t42 * t61);
-  const double t73 = (t66 * t42 * t70 * t37 + t43 * t72 * t70 * t37);
-  const double t74 = (-0.4265 * t45 * t73 + 0.0705 * t46 * t73 + t48 + t49);
-  const double t75 = t9 * (-2.093);
-  const double t76 = 0.15500000000000003 * t4;
-  const double t77 = (t46 * 0.4265 * t73 + 0.0705 * t45 * t73 + t75 + t76);
-  const double t78 = (t47 * t74 + t77 * t50);
-  const double t79 = (t52 - 2.9000000000000004);
-  const double t80 = ((t79 * t79) + 1e-06);
-  const double t81 = (1.0 / sqrt(t80));
-  const double t82 =
-      (t53 * t54 * t56 * 1e+08 * t78 - t54 * t79 * t81 * 1e+08 * t78 - t54 * 2e+08 * t78);
-  const double t83 = pow(t51, (-1.5));
-  const double t84 = (t78 * t78);
-  const double t85 = (sqrt(t55) * 1e+08 + 0.031415926535897934 * x[7] - t52 * 2e+08 -
-                      sqrt(t80) * 1e+08 - 0.023561944901923454 * x[9] + 4.49e+08);
-  const double t86 = t2 * (-0.4011545671438309);
-  const double t87 = (-0.16343387866394005) * t6;
-  const double t88 = t9 * (-3.11);
-  const double t89 = (t86 + t87 + t88);
-  const double t90 = cos(u[5]);
-  const double t91 = t2 * 0.16343387866394005;
-  const double t92 = (-0.4011545671438309) * t6;
-  const double t93 = (t5 + t91 + t92);
-  const double t94 =
-      (2.0 * t68 * t62 * t60 - t43 * t65 * t39 - t71 * t42 * t39 + 2.0 * t67 * t62 * t60);
-  const double t95 = (1.0 / (t69 * t69));
-  const double t96 = (-0.159) * t6;
-  const double t97 = t2 * 0.389;
-  const double t98 = (t96 - t4 * 0.5249999999999999 - 0.365 * t9 + t97);
-  const double t99 = (t98 * t32 + t33 + (t59 * t59) + t59 * t29);
-  const double t100 = (t60 * t60);
-  const double t101 = pow(t36, (-2.5));
-  const double t102 = (t63 * t63);
-  const double t103 = pow(t40, (-1.5));
-  const double t104 = (1.0 / (t36 * t36 * t36));
-  const double t105 = (-t35 * t100 * t62 * 8.0 - t62 * t99 * t38 + 2.0 * t35 * t99 * t39 +
-                       4.0 * t100 * t39 + 4.0 * t104 * t100 * t38);
-  const double t106 =
-      (t43 * t94 * 4.0 * t95 * t72 * t37 + t65 * 2.0 * t72 * t70 * t37 -
-       t43 *
-           ((8.0 * t99 * t42 * t61 + 8.0 * t60 * t71 * t61 +
-             ((-t29 * 24.0 * t35 * t100 * t101 - t59 * t35 * 8.0 * t37 - t98 * 16.0 * t41 -
-               32.0 * t32 * t60 * t37 + t63 * t59 * t64 * 8.0 + t102 * t103 * t32 +
-               4.0 * t64 * t105 * t32 + t29 * t35 * 8.0 * t99 * t61 + 16.0 * t35 * t32 * t60 * t61 -
-               t29 * 16.0 * t99 * t37 + t29 * 32.0 * t100 * t61)) *
-                 t37 -
-             24.0 * t100 * t101 * t42)) *
-           t70 * t37 +
-       t66 * t94 * 4.0 * t95 * t42 * t37 - t43 * 4.0 * t72 * t60 * t61 * t70 -
-       t66 * 4.0 * t60 * t42 * t61 * t70 + t66 * 2.0 * t71 * t70 * t37 -
-       ((-t43 * 8.0 * t99 * t61 - t65 * 8.0 * t60 * t61 + t43 * 24.0 * t100 * t101 +
-         ((t63 * t64 * 8.0 * t32 - t59 * 16.0 * t41 + t29 * t102 * t103 + t29 * 4.0 * t64 * t105 -
-           t59 * 16.0 * t35 * t60 * t61 + t59 * 32.0 * t60 * t37 - t35 * 8.0 * t99 * t32 * t61 +
-           16.0 * t99 * t32 * t37 - 32.0 * t100 * t32 * t61 + 24.0 * t35 * t100 * t101 * t32 +
-           t98 * t35 * 8.0 * t37)) *
-             t37)) *
-           t42 * t70 * t37);
-  const double t107 = (t73 * t73);
-  const double t108 = (((t46 * 0.106625 * t106 + 0.21325 * t45 * t107 + 0.017625 * t45 * t106 -
-                         t46 * t107 * 0.03525 - t49 - t48)) *
-                           t50 +
-                       (t77 * t77) + (t74 * t74) +
-                       t47 * ((t46 * 0.017625 * t106 + 0.21325 * t46 * t107 + t75 -
-                               0.106625 * t45 * t106 + t76 + t45 * t107 * 0.03525)));
-  const double t109 = (-1.55 * t9 - 0.1 * t4);
-  const double t110 = t2 * (-0.55);
-  const double t111 = (-0.25) * t6;
-  const double t112 = (t110 + t111 + t88);
-  const double t113 = (-t9 * 0.1 + 1.55 * t4);
-  const double t114 = t2 * (-0.16343387866394005);
-  const double t115 = 3.11 * t4;
-  const double t116 = 0.4011545671438309 * t6;
-  const double t117 = (t114 + t115 + t116);
-  const double t118 = t2 * (-0.25);
-  const double t119 = 0.55 * t6;
-  const double t120 = (t115 + t118 + t119);
-  const double t121 =
-      (2600.0 * (t113 * t113) + 1800.0 * (t112 * t112) + (((t117 * t117) + (t89 * t89))) * u[4] +
-       (t120 * t120) * 1800.0 + 2600.0 * (t109 * t109) + 2900.0);
-  const double t122 = (1.0 / (t121));
-  const double t123 =
-      (-t120 * t90 * 17651.969999999998 - 2000.0 * x[2] - t109 * t0 * 25497.289999999997 +
-       t54 * t85 * t78 - t0 * t112 * 17651.969999999998 +
-       ((-t0 * t89 * 9.80665 - t117 * t90 * 9.80665)) * u[4] + u[2] -
-       t113 * t90 * 25497.289999999997 + t19 * t27 * t26);
-  const double t124 = (1.0 / (t121 * t121));
-  const double t125 = (t86 + t87);
-  const double t126 = (t91 + t92);
-  const double t127 = (-t125 * t90 * 9.80665 - t0 * t126 * 9.80665);
-  const double t128 = u[4] * t127 * (-1.0);
-  const double t129 = (t30 + t31);
-  const double t130 = (t57 + t58);
-  const double t131 = (t129 * t29 + t130 * t32);
-  const double t132 = (-t62 * t38 * t131 + 2.0 * t35 * t39 * t131);
-  const double t133 = (-t29 * t64 * t132 - 2.0 * t35 * t130 * t37 - 4.0 * t32 * t131 * t37 +
-                       2.0 * t35 * t32 * t61 * t131 + t129 * 4.0 * t41);
-  const double t134 = (t133 * t37 + t43 * 2.0 * t61 * t131);
-  const double t135 = (-t129 * 2.0 * t35 * t37 - 4.0 * t130 * t41 - t29 * 4.0 * t131 * t37 +
-                       t29 * 2.0 * t35 * t61 * t131 + t64 * t32 * t132);
-  const double t136 = (2.0 * t42 * t61 * t131 + t135 * t37);
-  const double t137 = (t134 * t42 * t70 * t37 - t43 * t136 * t70 * t37);
-  const double t138 = (-t137 * 0.4265 * t45 + 0.0705 * t46 * t137);
-  const double t139 = (t46 * t137 * 0.4265 + 0.0705 * t137 * t45);
-  const double t140 = (t47 * t138 + t139 * t50);
-  const double t141 =
-      (-t140 * t54 * 2e+08 - t140 * t54 * t79 * t81 * 1e+08 + t53 * t140 * t54 * t56 * 1e+08);
-  const double t142 = (t110 + t111);
-  const double t143 = t90 * 17651.969999999998 * t142;
-  const double t144 = t139 * t77;
-  const double t145 = 0.21325 * t46 * t137 * t73;
-  const double t146 =
-      (2.0 * t68 * t62 * t131 + t43 * t133 * t39 + t135 * t42 * t39 + 2.0 * t67 * t62 * t131);
-  const double t147 = t29 * t130;
-  const double t148 = (t96 + t97);
-  const double t149 = t148 * t32;
-  const double t150 = (t59 * t130 + t129 * t32 + t147 + t149);
-  const double t151 = t35 * (-8.0) * t130 * t37;
-  const double t152 = (-16.0) * t148 * t41;
-  const double t153 = (2.0 * t150 * t35 * t39 + 4.0 * t104 * t60 * t38 * t131 +
-                       4.0 * t60 * t39 * t131 - t150 * t62 * t38 - t35 * t62 * 8.0 * t60 * t131);
+  const double t0 = sin(x[0]);
+  const double t1 = cos(x[0]);
+  const double t2 = (-t0 * 0.1 + 1.55 * t1);
+  const double t3 = cos(u[5]);
+  const double t4 = 3.11 * t1;
+  const double t5 = (x[0] + x[1]);
+  const double t6 = sin(t5);
+  const double t7 = t6 * (-0.25);
+  const double t8 = cos(t5);
+  const double t9 = 0.55 * t8;
+  const double t10 = (t4 + t7 + t9);
+  const double t11 = (0.389 * t8 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
+  const double t12 = 0.159 * t8;
+  const double t13 = t6 * (-0.389);
+  const double t14 = (0.365 * t0 + t12 + t13 + t1 * 0.5249999999999999);
+  const double t15 = (t14 * t14);
+  const double t16 = (t11 * t11);
+  const double t17 = (t15 + t16 - 0.38752);
+  const double t18 = (t15 + t16);
+  const double t19 = (1.0 / sqrt(t18));
+  const double t20 = (t17 * t17);
+  const double t21 = (1.0 / (t18));
+  const double t22 = (0.567009 - 0.25 * t20 * t21);
+  const double t23 = sqrt(t22);
+  const double t24 = (t11 * t17 * t19 + 2.0 * t14 * t23);
+  const double t25 = (-t11 * 2.0 * t23 + t17 * t14 * t19);
+  const double t26 = atan2(0.5 * t24 * t19, t25 * 0.5 * t19);
+  const double t27 = cos(t26);
+  const double t28 = sin(t26);
+  const double t29 = (-0.15500000000000003 * t1 - 0.141 * t27 + t0 * 2.093 - t28 * 0.853);
+  const double t30 = t0 * 0.15500000000000003;
+  const double t31 = 2.093 * t1;
+  const double t32 = (0.141 * t28 + t30 - 0.853 * t27 + t31);
+  const double t33 = ((t29 * t29) + (t32 * t32));
+  const double t34 = (1.0 / sqrt(t33));
+  const double t35 = sqrt(t33);
+  const double t36 = (-1.59 + t35);
+  const double t37 = (t36 * t36);
+  const double t38 = (t37 + 1e-06);
+  const double t39 = (t35 - 2.9000000000000004);
+  const double t40 = (t39 * t39);
+  const double t41 = (t40 + 1e-06);
+  const double t42 = (t12 + t13);
+  const double t43 = (-0.389) * t8;
+  const double t44 = t6 * (-0.159);
+  const double t45 = (t43 + t44);
+  const double t46 = (t42 * t11 + t45 * t14);
+  const double t47 = (1.0 / (t18 * t18));
+  const double t48 = (-2.0 * t17 * t21 * t46 + t47 * t20 * t46);
+  const double t49 = (1.0 / sqrt(t22));
+  const double t50 = pow(t18, (-1.5));
+  const double t51 = (-t11 * t48 * t49 - 2.0 * t17 * t14 * t50 * t46 + 2.0 * t17 * t45 * t19 +
+                      4.0 * t14 * t46 * t19 - t42 * 4.0 * t23);
+  const double t52 = (-t51 * t19 + t25 * 2.0 * t50 * t46);
+  const double t53 = (t24 * t24);
+  const double t54 = (t25 * t25);
+  const double t55 = (t53 * t21 + t54 * t21);
+  const double t56 = (1.0 / (t55));
+  const double t57 = (-t11 * 2.0 * t17 * t50 * t46 + t48 * t49 * t14 + t42 * 2.0 * t17 * t19 +
+                      t11 * 4.0 * t46 * t19 + 4.0 * t45 * t23);
+  const double t58 = (-t57 * t19 + 2.0 * t24 * t50 * t46);
+  const double t59 = (t52 * t24 * t56 * t19 - t25 * t58 * t56 * t19);
+  const double t60 = (0.0705 * t59 * t28 - t59 * 0.4265 * t27);
+  const double t61 = (t59 * t28 * 0.4265 + 0.0705 * t59 * t27);
+  const double t62 = (t29 * t60 + t61 * t32);
+  const double t63 = (t43 - t0 * 0.5249999999999999 + 0.365 * t1 + t44);
+  const double t64 = (t63 * t14 + t11 * t14);
+  const double t65 = (-2.0 * t17 * t64 * t21 + t47 * t64 * t20);
+  const double t66 = (-t49 * t65 * t14 - t63 * 4.0 * t23 - t11 * 4.0 * t64 * t19 +
+                      t11 * 2.0 * t17 * t64 * t50 - 2.0 * t17 * t14 * t19);
+  const double t67 = (2.0 * t64 * t24 * t50 + t66 * t19);
+  const double t68 = (2.0 * t17 * t14 * t64 * t50 + t11 * t49 * t65 - 4.0 * t14 * t64 * t19 +
+                      4.0 * t14 * t23 - t63 * 2.0 * t17 * t19);
+  const double t69 = (t68 * t19 + t25 * 2.0 * t64 * t50);
+  const double t70 = (t67 * t25 * t56 * t19 - t69 * t24 * t56 * t19);
+  const double t71 = (t30 + 0.4265 * t27 * t70 - 0.0705 * t28 * t70 + t31);
+  const double t72 = t0 * (-2.093);
+  const double t73 = 0.15500000000000003 * t1;
+  const double t74 = (-t28 * 0.4265 * t70 + t72 + t73 - 0.0705 * t27 * t70);
+  const double t75 = (t29 * t71 + t74 * t32);
+  const double t76 = (t34 * 2e+06 * t62 * x[3] + t34 * 2e+06 * x[2] * t75);
+  const double t77 = (1.0 / sqrt(t41));
+  const double t78 = (1.0 / sqrt(t38));
+  const double t79 = (2.0 + t39 * t77 - t36 * t78);
+  const double t80 = (-sqrt(t38) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] +
+                      sqrt(t41) * 2e+08 + t76 * t79 + 0.04712388980384691 * x[9] + 4e+08 * t35);
+  const double t81 = (0.194 * t1 + 1.595 + t0 * 0.857);
+  const double t82 = (-0.194) * t0;
+  const double t83 = 0.857 * t1;
+  const double t84 = (t82 + t83);
+  const double t85 = (-t0 * 0.857 - 0.194 * t1);
+  const double t86 = (t82 + t83 - 1.339);
+  const double t87 = (t81 * t84 + t85 * t86);
+  const double t88 = ((t81 * t81) + (t86 * t86));
+  const double t89 = (1.0 / sqrt(t88));
+  const double t90 = sqrt(t88);
+  const double t91 = (-2.51 + t90);
+  const double t92 = (t91 * t91);
+  const double t93 = (1e-06 + t92);
+  const double t94 = (t90 - 1.4);
+  const double t95 = (t94 * t94);
+  const double t96 = (1e-06 + t95);
+  const double t97 = (1.0 / sqrt(t96));
+  const double t98 = (1.0 / sqrt(t93));
+  const double t99 = (-t97 * t94 + 2.0 + t98 * t91);
+  const double t100 =
+      (-2e+08 * sqrt(t93) - x[8] * 0.03817035074111599 - t99 * t87 * t89 * 2e+06 * x[2] + 7.82e+08 +
+       2e+08 * sqrt(t96) - 4e+08 * t90 + 0.05089380098815465 * x[6]);
+  const double t101 = (-1.55 * t0 - 0.1 * t1);
+  const double t102 = sin(u[5]);
+  const double t103 = t6 * (-0.4011545671438309);
+  const double t104 = (-0.16343387866394005) * t8;
+  const double t105 = t0 * (-3.11);
+  const double t106 = (t103 + t104 + t105);
+  const double t107 = t6 * (-0.16343387866394005);
+  const double t108 = 0.4011545671438309 * t8;
+  const double t109 = (t107 + t4 + t108);
+  const double t110 = t6 * (-0.55);
+  const double t111 = (-0.25) * t8;
+  const double t112 = (t110 + t111 + t105);
+  const double t113 =
+      (-t2 * 50994.579999999994 * t3 - t10 * t3 * 35303.939999999995 - x[2] * 4000.0 + 2.0 * u[2] -
+       t34 * t80 * t75 + t87 * t89 * 2.0 * t100 - t101 * 50994.579999999994 * t102 +
+       2.0 * ((-t102 * t106 * 9.80665 - t109 * t3 * 9.80665)) * u[4] -
+       t102 * t112 * 35303.939999999995);
+  const double t114 =
+      (2600.0 * (t2 * t2) + 1800.0 * (t112 * t112) + (((t109 * t109) + (t106 * t106))) * u[4] +
+       (t10 * t10) * 1800.0 + 2600.0 * (t101 * t101) + 2900.0);
+  const double t115 = (1.0 / (t114 * t114));
+  const double t116 = (t0 * 0.1 - 1.55 * t1);
+  const double t117 = (-3.11) * t1;
+  const double t118 = t6 * 0.16343387866394005;
+  const double t119 = (-0.4011545671438309) * t8;
+  const double t120 = (t117 + t118 + t119);
+  const double t121 = t6 * 0.25;
+  const double t122 = (-0.55) * t8;
+  const double t123 = (t121 + t117 + t122);
+  const double t124 = (1.0 / (t114));
+  const double t125 = pow(t33, (-1.5));
+  const double t126 = (t75 * t75);
+  const double t127 = (t70 * t70);
+  const double t128 =
+      (2.0 * t54 * t47 * t64 + t25 * t68 * t21 + 2.0 * t53 * t47 * t64 + t66 * t24 * t21);
+  const double t129 = (1.0 / (t55 * t55));
+  const double t130 = (-0.159) * t8;
+  const double t131 = t6 * 0.389;
+  const double t132 = (t130 - t1 * 0.5249999999999999 - 0.365 * t0 + t131);
+  const double t133 = (t132 * t14 + t15 + (t63 * t63) + t63 * t11);
+  const double t134 = (t64 * t64);
+  const double t135 = pow(t18, (-2.5));
+  const double t136 = (1.0 / (t18 * t18 * t18));
+  const double t137 = (-4.0 * t136 * t134 * t20 + t17 * t134 * t47 * 8.0 - 2.0 * t17 * t133 * t21 +
+                       t47 * t133 * t20 - 4.0 * t134 * t21);
+  const double t138 = pow(t22, (-1.5));
+  const double t139 = (t65 * t65);
+  const double t140 =
+      (-t67 * t25 * t128 * 4.0 * t129 * t19 + t128 * t69 * 4.0 * t129 * t24 * t19 +
+       t67 * 2.0 * t68 * t56 * t19 +
+       ((t25 * 8.0 * t133 * t50 - t25 * 24.0 * t134 * t135 - 8.0 * t64 * t68 * t50 +
+         ((-24.0 * t17 * t134 * t135 * t14 + t11 * 4.0 * t49 * t137 + t63 * 16.0 * t17 * t64 * t50 -
+           16.0 * t133 * t14 * t19 + t63 * 16.0 * t23 + t17 * 8.0 * t133 * t14 * t50 -
+           t132 * t17 * 8.0 * t19 + 32.0 * t134 * t14 * t50 - t11 * t138 * t139 +
+           t49 * 8.0 * t65 * t14 - t63 * 32.0 * t64 * t19)) *
+             t19)) *
+           t24 * t56 * t19 +
+       t67 * t25 * 4.0 * t64 * t50 * t56 +
+       t25 * t56 *
+           ((t66 * 8.0 * t64 * t50 - 8.0 * t133 * t24 * t50 -
+             ((-t11 * 24.0 * t17 * t134 * t135 - t63 * t17 * 8.0 * t19 - t132 * 16.0 * t23 -
+               32.0 * t14 * t64 * t19 - 4.0 * t49 * t137 * t14 + t138 * t14 * t139 +
+               t11 * t17 * 8.0 * t133 * t50 + 16.0 * t17 * t14 * t64 * t50 -
+               t11 * 16.0 * t133 * t19 + t11 * 32.0 * t134 * t50 - t63 * t49 * 8.0 * t65)) *
+                 t19 +
+             24.0 * t134 * t135 * t24)) *
+           t19 -
+       t69 * 4.0 * t64 * t24 * t50 * t56 - t66 * t69 * 2.0 * t56 * t19);
+  const double t141 = (((-t28 * t127 * 0.03525 + t28 * 0.106625 * t140 + 0.017625 * t27 * t140 -
+                         t31 - t30 + 0.21325 * t27 * t127)) *
+                           t32 +
+                       (t71 * t71) +
+                       t29 * ((t27 * t127 * 0.03525 + t28 * 0.017625 * t140 + t72 + t73 +
+                               0.21325 * t28 * t127 - 0.106625 * t27 * t140)) +
+                       (t74 * t74));
+  const double t142 = pow(t88, (-1.5));
+  const double t143 = (t87 * t87);
+  const double t144 = ((t85 * t85) + (t84 * t84) + t86 * ((0.194 * t0 - t83)) + t85 * t81);
+  const double t145 = t71 * t60;
+  const double t146 = t61 * t74;
+  const double t147 = (-0.21325) * t59 * t27 * t70;
+  const double t148 = t59 * t28 * t70 * 0.03525;
+  const double t149 = t11 * t45;
+  const double t150 = (t130 + t131);
+  const double t151 = t150 * t14;
+  const double t152 = (t63 * t45 + t42 * t14 + t149 + t151);
+  const double t153 = (2.0 * t152 * t17 * t21 + 4.0 * t136 * t64 * t20 * t46 +
+                       4.0 * t64 * t21 * t46 - t152 * t47 * t20 - t17 * t47 * 8.0 * t64 * t46);
   const double t154 =
-      t43 *
-      ((-t135 * 4.0 * t60 * t61 + 4.0 * t71 * t61 * t131 + t150 * 8.0 * t42 * t61 +
-        ((t63 * t103 * t32 * t132 + t29 * t150 * t35 * 8.0 * t61 - t29 * 16.0 * t150 * t37 +
-          t29 * 32.0 * t60 * t61 * t131 - 16.0 * t32 * t131 * t37 + t35 * 8.0 * t32 * t61 * t131 -
-          t29 * 24.0 * t35 * t101 * t60 * t131 + t59 * 4.0 * t64 * t132 +
-          t129 * t35 * 8.0 * t60 * t61 + t151 + t63 * 4.0 * t130 * t64 + t152 -
-          t129 * 16.0 * t60 * t37 + t153 * 4.0 * t64 * t32)) *
-            t37 -
-        24.0 * t101 * t60 * t42 * t131)) *
-      (-1.0) * t70 * t37;
-  const double t155 = t148 * t35 * 8.0 * t37;
-  const double t156 = (-16.0) * t130 * t41;
-  const double t157 =
-      ((t43 * 24.0 * t101 * t60 * t131 - t43 * t150 * 8.0 * t61 + 4.0 * t133 * t60 * t61 +
-        ((t155 + t156 - t35 * t130 * 8.0 * t60 * t61 + t59 * 16.0 * t131 * t37 +
-          t63 * t29 * t103 * t132 + 4.0 * t64 * t32 * t132 + t63 * t129 * 4.0 * t64 +
-          t29 * t153 * 4.0 * t64 - 32.0 * t32 * t60 * t61 * t131 + 16.0 * t130 * t60 * t37 -
-          t59 * t35 * 8.0 * t61 * t131 + 16.0 * t150 * t32 * t37 +
-          24.0 * t35 * t101 * t32 * t60 * t131 - t150 * t35 * 8.0 * t32 * t61)) *
-            t37 -
-        t65 * 4.0 * t61 * t131)) *
-      (-1.0) * t42 * t70 * t37;
-  const double t158 = (t66 * t146 * 4.0 * t95 * t42 * t37 - t135 * t66 * 2.0 * t70 * t37 + t154 -
-                       t66 * 4.0 * t42 * t61 * t70 * t131 - t43 * 4.0 * t72 * t61 * t70 * t131 -
-                       2.0 * t133 * t72 * t70 * t37 + t157 + t43 * t146 * 4.0 * t95 * t72 * t37);
-  const double t159 = t137 * t45 * t73 * 0.03525;
-  const double t160 = t74 * t138;
-  const double t161 = t46 * t137 * t73 * (-0.03525);
-  const double t162 = 0.21325 * t137 * t45 * t73;
+      t25 *
+      ((((t48 * t138 * t65 * t14 + t11 * t152 * t17 * 8.0 * t50 - t11 * 16.0 * t152 * t19 +
+          t11 * 32.0 * t64 * t50 * t46 - 16.0 * t14 * t46 * t19 + t17 * 8.0 * t14 * t50 * t46 -
+          t11 * 24.0 * t17 * t135 * t64 * t46 + t42 * t17 * 8.0 * t64 * t50 -
+          t17 * t45 * 8.0 * t19 - 16.0 * t150 * t23 - t42 * 16.0 * t64 * t19 -
+          t63 * t48 * 4.0 * t49 - 4.0 * t45 * t49 * t65 + t153 * 4.0 * t49 * t14)) *
+            t19 +
+        4.0 * t57 * t64 * t50 + t152 * 8.0 * t24 * t50 - t66 * 4.0 * t50 * t46 -
+        24.0 * t135 * t64 * t24 * t46)) *
+      t56 * t19;
+  const double t155 =
+      ((t25 * 24.0 * t135 * t64 * t46 -
+        ((t48 * 4.0 * t49 * t14 + t42 * 4.0 * t49 * t65 - t11 * t153 * 4.0 * t49 +
+          t63 * t17 * 8.0 * t50 * t46 - 24.0 * t17 * t135 * t14 * t64 * t46 -
+          t150 * t17 * 8.0 * t19 + 32.0 * t14 * t64 * t50 * t46 - t11 * t48 * t138 * t65 -
+          16.0 * t45 * t64 * t19 + 16.0 * t45 * t23 - 16.0 * t152 * t14 * t19 +
+          t17 * t45 * 8.0 * t64 * t50 + t152 * t17 * 8.0 * t14 * t50 - t63 * 16.0 * t46 * t19)) *
+            t19 -
+        t25 * t152 * 8.0 * t50 - 4.0 * t64 * t51 * t50 + 4.0 * t68 * t50 * t46)) *
+      t24 * t56 * t19;
+  const double t156 =
+      (t52 * 4.0 * t64 * t24 * t50 * t56 + t66 * t52 * 2.0 * t56 * t19 -
+       2.0 * t58 * t68 * t56 * t19 + t154 + t155 + t25 * t128 * 4.0 * t58 * t129 * t19 -
+       t25 * 4.0 * t58 * t64 * t50 * t56 - t128 * t52 * 4.0 * t129 * t24 * t19);
+  const double t157 = t59 * t27 * t70 * (-0.03525);
+  const double t158 = (-0.21325) * t59 * t28 * t70;
+  const double t159 =
+      (t145 + t146 + ((t147 + t148 - 0.017625 * t27 * t156 - t28 * 0.106625 * t156)) * t32 +
+       t29 * ((t157 - t28 * 0.017625 * t156 + 0.106625 * t27 * t156 + t158)));
+  const double t160 = pow(t38, (-1.5));
+  const double t161 = pow(t41, (-1.5));
+  const double t162 = (t79 * ((t34 * t159 * 2e+06 * x[3] - t125 * 2e+06 * t62 * x[3] * t75 +
+                               t34 * 2e+06 * x[2] * t141 - t125 * 2e+06 * x[2] * t126)) -
+                       t36 * t34 * t78 * 2e+08 * t75 -
+                       t76 * ((-t34 * t77 * t75 + t34 * t78 * t75 - t34 * t37 * t160 * t75 +
+                               t34 * t40 * t161 * t75)) +
+                       t34 * 4e+08 * t75 + t34 * t39 * 2e+08 * t77 * t75);
   const double t163 =
-      (t144 + ((t145 - 0.106625 * t158 * t45 + t46 * t158 * 0.017625 + t159)) * t47 + t160 +
-       ((t161 + t162 + t158 * 0.017625 * t45 + t46 * 0.106625 * t158)) * t50);
-  const double t164 = (t3 + t7);
-  const double t165 = t0 * 17651.969999999998 * t164;
-  const double t166 = t140 * t83 * t85 * t78;
-  const double t167 = (2.0 * t134 * t71 * t70 * t37 + t154 - t43 * t136 * t94 * 4.0 * t95 * t37 -
-                       4.0 * t134 * t60 * t42 * t61 * t70 + t94 * 4.0 * t95 * t134 * t42 * t37 +
-                       t157 - t136 * t65 * 2.0 * t70 * t37 + t43 * t136 * 4.0 * t60 * t61 * t70);
-  const double t168 =
-      (t144 + t47 * ((t145 + t159 + t46 * 0.017625 * t167 - 0.106625 * t45 * t167)) + t160 +
-       t50 * ((t161 + t162 + t46 * 0.106625 * t167 + 0.017625 * t45 * t167)));
+      (t25 * t51 * t21 - 2.0 * t53 * t47 * t46 - 2.0 * t54 * t47 * t46 + t57 * t24 * t21);
+  const double t164 =
+      (-t67 * t25 * t163 * 4.0 * t129 * t19 + t154 + t69 * 4.0 * t24 * t50 * t56 * t46 + t155 -
+       t69 * 2.0 * t57 * t56 * t19 - t67 * t25 * 4.0 * t50 * t56 * t46 +
+       t163 * t69 * 4.0 * t129 * t24 * t19 + t67 * 2.0 * t51 * t56 * t19);
+  const double t165 =
+      (t145 + t29 * ((t157 + t158 + t164 * 0.106625 * t27 - t164 * t28 * 0.017625)) + t146 +
+       ((t147 + t148 - t164 * t28 * 0.106625 - t164 * 0.017625 * t27)) * t32);
+  const double t166 = (t110 + t111);
+  const double t167 = (t121 + t122);
+  const double t168 = (t103 + t104);
   const double t169 = (t118 + t119);
-  const double t170 = (t114 + t116);
-  const double t171 = ((t169 * t169) * 1800.0 + 600.0 + (((t125 * t125) + (t170 * t170))) * u[4] +
-                       (t142 * t142) * 1800.0);
-  const double t172 = (1.0 / (t171));
-  const double t173 =
-      ((((-t170 * t90 * 9.80665 - t0 * t125 * 9.80665)) * u[4] + t140 * t54 * t85 - 800.0 * x[3] -
-        t0 * 17651.969999999998 * t142 - t169 * t90 * 17651.969999999998 + u[3])) *
-      ((2.0 * ((t125 * t126 + t125 * t170)) * u[4] + 3600.0 * t164 * t142 + 3600.0 * t169 * t142)) *
-      (-1.0) / (t171 * t171);
-  const double t174 = (t140 * t140);
-  const double t175 = (t137 * t137);
-  const double t176 = ((t130 * t130) + (t129 * t129) + t147 + t149);
-  const double t177 = (t131 * t131);
-  const double t178 = (2.0 * t176 * t35 * t39 + 4.0 * t177 * t39 - t176 * t62 * t38 -
-                       t35 * t62 * t177 * 8.0 + 4.0 * t104 * t177 * t38);
-  const double t179 = (t132 * t132);
-  const double t180 =
-      (-4.0 * t134 * t42 * t61 * t70 * t131 + t146 * 4.0 * t95 * t134 * t42 * t37 -
-       t42 * t70 *
-           ((((t155 + t156 + t29 * 4.0 * t64 * t178 + 32.0 * t130 * t131 * t37 -
-               16.0 * t35 * t130 * t61 * t131 - 32.0 * t177 * t32 * t61 + t129 * t64 * 8.0 * t132 +
-               24.0 * t35 * t101 * t177 * t32 - t176 * t35 * 8.0 * t32 * t61 + t29 * t103 * t179 +
-               16.0 * t176 * t32 * t37)) *
-                 t37 +
-             t43 * 24.0 * t101 * t177 - t43 * t176 * 8.0 * t61 + t133 * 8.0 * t61 * t131)) *
-           t37 +
-       t43 * t136 * 4.0 * t61 * t70 * t131 - t43 * t146 * t136 * 4.0 * t95 * t37 -
-       t135 * 2.0 * t134 * t70 * t37 + t136 * 2.0 * t133 * t70 * t37 +
-       ((24.0 * t101 * t177 * t42 + t135 * 8.0 * t61 * t131 - t176 * 8.0 * t42 * t61 -
-         ((-t129 * 32.0 * t131 * t37 + t151 + t152 - t29 * 16.0 * t176 * t37 + t103 * t179 * t32 +
-           t129 * 16.0 * t35 * t61 * t131 + 4.0 * t64 * t32 * t178 + t130 * t64 * 8.0 * t132 +
-           t29 * t176 * t35 * 8.0 * t61 + t29 * 32.0 * t177 * t61 -
-           t29 * 24.0 * t35 * t101 * t177)) *
-             t37)) *
-           t43 * t70 * t37);
-  const double t181 = (t47 * ((t45 * t175 * 0.03525 - t180 * 0.106625 * t45 +
-                               t180 * t46 * 0.017625 + 0.21325 * t46 * t175)) +
-                       (t139 * t139) +
-                       ((t180 * 0.017625 * t45 - t46 * t175 * 0.03525 + t180 * t46 * 0.106625 +
-                         0.21325 * t45 * t175)) *
-                           t50 +
-                       (t138 * t138));
-  const double t182 = (-2.8e+07 + x[6]);
-  const double t183 = (1e+10 + (t182 * t182));
-  const double t184 = ((x[4] * x[4]) + 1e-04);
-  const double t185 = sqrt(t184);
-  const double t186 = (x[4] + t185);
-  const double t187 = (x[6] - 2.5e+07);
-  const double t188 = ((t187 * t187) + 4e+10);
-  const double t189 = pow(t188, (-0.25));
-  const double t190 = (-x[4] + t185);
-  const double t191 = (x[6] - 2e+05);
-  const double t192 = (t191 * t191);
-  const double t193 = (4e+10 + t192);
-  const double t194 = pow(t193, (-0.25));
-  const double t195 = (t192 + 1e+10);
-  const double t196 = (t21 * 0.05089380098815465 - 0.06725132138341651);
-  const double t197 = (1.0 / (t196));
-  const double t198 = (1.0 / sqrt(t184)) * x[4];
-  const double t199 = (1.0 + t198);
-  const double t200 = (t198 - 1.0);
-  const double t201 = 2.0 * x[6];
-  const double t202 = (-4e+05 + t201);
-  const double t203 = (x[7] - 2e+05);
-  const double t204 = (t203 * t203);
-  const double t205 = (1e+10 + t204);
-  const double t206 = ((x[5] * x[5]) + 1e-04);
-  const double t207 = sqrt(t206);
-  const double t208 = (-t207 + x[5]);
-  const double t209 = (4e+10 + t204);
-  const double t210 = pow(t209, (-0.25));
-  const double t211 = (-2.8e+07 + x[7]);
-  const double t212 = (1e+10 + (t211 * t211));
-  const double t213 = (t207 + x[5]);
-  const double t214 = (x[7] - 2.5e+07);
-  const double t215 = (4e+10 + (t214 * t214));
-  const double t216 = pow(t215, (-0.25));
-  const double t217 = (-t54 * 0.031415926535897934 * x[2] * t78 - x[7] * 5e-09 +
-                       0.07050000000000001 - t140 * t54 * 0.031415926535897934 * x[3] +
-                       sqrt(t205) * 2.5e-09 + t208 * 2.0412414523193154e-06 * t203 * t210 -
-                       2.5e-09 * sqrt(t212) - t213 * t214 * 2.0412414523193154e-06 * t216);
-  const double t218 = (0.031415926535897934 * t52 - 0.04695132319207772);
-  const double t219 = (1.0 / (t218 * t218));
-  const double t220 = (1.0 / (t218));
-  const double t221 = (1.0 / sqrt(t206)) * x[5];
-  const double t222 = (t221 + 1.0);
-  const double t223 = (t221 - 1.0);
-  const double t224 = 2.0 * x[7];
-  const double t225 = (-4e+05 + t224);
-  const double t226 = (-t21 * 0.03817035074111599 + 0.09980758036020113);
-  const double t227 = (x[8] - 2e+05);
-  const double t228 = (t227 * t227);
-  const double t229 = (t228 + 1e+10);
-  const double t230 = (4e+10 + t228);
-  const double t231 = pow(t230, (-0.25));
-  const double t232 = (-2.8e+07 + x[8]);
-  const double t233 = ((t232 * t232) + 1e+10);
-  const double t234 = (x[8] - 2.5e+07);
-  const double t235 = (4e+10 + (t234 * t234));
-  const double t236 = pow(t235, (-0.25));
-  const double t237 = (1.0 / (t226));
-  const double t238 = 2.0 * x[8];
-  const double t239 = (-4e+05 + t238);
-  const double t240 = (0.07132964021557801 - 0.023561944901923454 * t52);
-  const double t241 = (1.0 / (t240));
-  const double t242 = (1.0 / (t240 * t240));
-  const double t243 = (x[9] - 2e+05);
-  const double t244 = (t243 * t243);
-  const double t245 = (1e+10 + t244);
-  const double t246 = (4e+10 + t244);
-  const double t247 = pow(t246, (-0.25));
-  const double t248 = (-2.8e+07 + x[9]);
-  const double t249 = ((t248 * t248) + 1e+10);
-  const double t250 = (x[9] - 2.5e+07);
-  const double t251 = ((t250 * t250) + 4e+10);
-  const double t252 = pow(t251, (-0.25));
-  const double t253 =
-      (sqrt(t245) * 2.5e-09 + t54 * 0.023561944901923454 * x[2] * t78 - x[9] * 5e-09 +
-       0.07050000000000001 - t213 * 2.0412414523193154e-06 * t247 * t243 - 2.5e-09 * sqrt(t249) +
-       t140 * t54 * 0.023561944901923454 * x[3] + t208 * t252 * t250 * 2.0412414523193154e-06);
-  const double t254 = 2.0 * x[9];
-  const double t255 = (-4e+05 + t254);
+  const double t170 = (-t168 * t3 * 9.80665 - t102 * t169 * 9.80665);
+  const double t171 = (t62 * t62);
+  const double t172 = (t46 * t46);
+  const double t173 = ((t45 * t45) + (t42 * t42) + t149 + t151);
+  const double t174 = (t17 * t47 * t172 * 8.0 - 4.0 * t136 * t172 * t20 - 4.0 * t172 * t21 -
+                       2.0 * t173 * t17 * t21 + t173 * t47 * t20);
+  const double t175 = (t48 * t48);
+  const double t176 =
+      (t163 * t52 * 4.0 * t129 * t24 * t19 +
+       t25 *
+           ((-24.0 * t135 * t172 * t24 + t57 * 8.0 * t50 * t46 + t173 * 8.0 * t24 * t50 -
+             ((t11 * 24.0 * t17 * t135 * t172 + t17 * t45 * 8.0 * t19 + t174 * 4.0 * t49 * t14 +
+               t48 * t45 * t49 * 8.0 - t11 * 32.0 * t172 * t50 - t11 * t173 * t17 * 8.0 * t50 +
+               16.0 * t150 * t23 - t175 * t138 * t14 - t42 * 16.0 * t17 * t50 * t46 +
+               t11 * 16.0 * t173 * t19 + t42 * 32.0 * t46 * t19)) *
+                 t19)) *
+           t56 * t19 +
+       2.0 * t58 * t51 * t56 * t19 +
+       ((((t150 * t17 * 8.0 * t19 - 16.0 * t45 * t23 + 32.0 * t45 * t46 * t19 -
+           t11 * t174 * 4.0 * t49 - 16.0 * t17 * t45 * t50 * t46 - t42 * t48 * t49 * 8.0 -
+           32.0 * t172 * t14 * t50 + 24.0 * t17 * t135 * t172 * t14 - t173 * t17 * 8.0 * t14 * t50 +
+           16.0 * t173 * t14 * t19 + t11 * t175 * t138)) *
+             t19 +
+         t25 * 24.0 * t135 * t172 - t25 * t173 * 8.0 * t50 - 8.0 * t51 * t50 * t46)) *
+           t24 * t56 * t19 -
+       t25 * 4.0 * t58 * t50 * t56 * t46 - t25 * t163 * 4.0 * t58 * t129 * t19 -
+       t52 * 2.0 * t57 * t56 * t19 + t52 * 4.0 * t24 * t50 * t56 * t46);
+  const double t177 = (t59 * t59);
+  const double t178 = (t29 * ((0.106625 * t27 * t176 + t27 * t177 * 0.03525 -
+                               t28 * 0.017625 * t176 + 0.21325 * t28 * t177)) +
+                       (t61 * t61) +
+                       ((-t28 * 0.106625 * t176 - t28 * t177 * 0.03525 + 0.21325 * t27 * t177 -
+                         0.017625 * t27 * t176)) *
+                           t32 +
+                       (t60 * t60));
+  const double t179 =
+      (t76 * ((-t34 * t37 * t160 * t62 - t34 * t77 * t62 + t34 * t40 * t161 * t62 +
+               t34 * t78 * t62)) +
+       t36 * t34 * t78 * 2e+08 * t62 - t34 * t39 * 2e+08 * t77 * t62 - t34 * 4e+08 * t62 -
+       ((-t125 * t171 * 2e+06 * x[3] - t125 * 2e+06 * t62 * x[2] * t75 + t34 * 2e+06 * x[2] * t165 +
+         t34 * 2e+06 * x[3] * t178)) *
+           t79);
+  const double t180 = (1.0 / (t33));
+  const double t181 = (t7 + t9);
+  const double t182 = (t107 + t108);
+  const double t183 = ((t181 * t181) * 1800.0 + 600.0 + (((t168 * t168) + (t182 * t182))) * u[4] +
+                       (t166 * t166) * 1800.0);
+  const double t184 =
+      ((-2.0 * ((-t182 * t3 * 9.80665 - t102 * t168 * 9.80665)) * u[4] +
+        t181 * t3 * 35303.939999999995 + t102 * t166 * 35303.939999999995 - 2.0 * u[3] +
+        1600.0 * x[3] + t34 * t62 * t80)) *
+      0.5 *
+      ((2.0 * ((t168 * t169 + t168 * t182)) * u[4] + 3600.0 * t167 * t166 + 3600.0 * t181 * t166)) /
+      (t183 * t183);
+  const double t185 = t102 * t167 * 35303.939999999995;
+  const double t186 = (-2.0) * u[4] * t170;
+  const double t187 = t3 * t166 * 35303.939999999995;
+  const double t188 = (1.0 / (t183));
+  const double t189 = (t90 * 0.05089380098815465 - 0.06725132138341651);
+  const double t190 = (-2.8e+07 + x[6]);
+  const double t191 = (1e+10 + (t190 * t190));
+  const double t192 = ((x[4] * x[4]) + 1e-06);
+  const double t193 = sqrt(t192);
+  const double t194 = (x[4] + t193);
+  const double t195 = (x[6] - u[6]);
+  const double t196 = (t195 * t195);
+  const double t197 = (4e+10 + t196);
+  const double t198 = pow(t197, (-0.25));
+  const double t199 = (x[6] - 2e+05);
+  const double t200 = (t199 * t199);
+  const double t201 = (t200 + 1e+10);
+  const double t202 = (-t193 + x[4]);
+  const double t203 = (4e+10 + t200);
+  const double t204 = pow(t203, (-0.25));
+  const double t205 = (1.0 / (t189));
+  const double t206 = (1.0 / sqrt(t192)) * x[4];
+  const double t207 = (1.0 + t206);
+  const double t208 = (t206 - 1.0);
+  const double t209 = 2.0 * x[6];
+  const double t210 = (-4e+05 + t209);
+  const double t211 = ((x[5] * x[5]) + 1e-06);
+  const double t212 = sqrt(t211);
+  const double t213 = (t212 + x[5]);
+  const double t214 = (x[7] - u[7]);
+  const double t215 = (t214 * t214);
+  const double t216 = (4e+10 + t215);
+  const double t217 = pow(t216, (-0.25));
+  const double t218 = (x[7] - 2e+05);
+  const double t219 = (t218 * t218);
+  const double t220 = (1e+10 + t219);
+  const double t221 = (t212 - x[5]);
+  const double t222 = (4e+10 + t219);
+  const double t223 = pow(t222, (-0.25));
+  const double t224 = (-2.8e+07 + x[7]);
+  const double t225 = (1e+10 + (t224 * t224));
+  const double t226 =
+      (-t213 * t217 * 2.0412414523193154e-06 * t214 - t34 * 0.031415926535897934 * t62 * x[3] -
+       x[7] * 5e-09 + 0.07050000000000001 + sqrt(t220) * 2.5e-09 -
+       t221 * 2.0412414523193154e-06 * t218 * t223 - 2.5e-09 * sqrt(t225) -
+       t34 * 0.031415926535897934 * x[2] * t75);
+  const double t227 = (0.031415926535897934 * t35 - 0.04695132319207772);
+  const double t228 = (1.0 / (t227 * t227));
+  const double t229 = (1.0 / (t227));
+  const double t230 = (1.0 / sqrt(t211)) * x[5];
+  const double t231 = (t230 - 1.0);
+  const double t232 = (t230 + 1.0);
+  const double t233 = 2.0 * x[7];
+  const double t234 = (-4e+05 + t233);
+  const double t235 = (x[8] - 2e+05);
+  const double t236 = (t235 * t235);
+  const double t237 = (t236 + 1e+10);
+  const double t238 = (-x[8] + u[6]);
+  const double t239 = (t238 * t238);
+  const double t240 = (4e+10 + t239);
+  const double t241 = pow(t240, (-0.25));
+  const double t242 = (4e+10 + t236);
+  const double t243 = pow(t242, (-0.25));
+  const double t244 = (-2.8e+07 + x[8]);
+  const double t245 = ((t244 * t244) + 1e+10);
+  const double t246 = (-t90 * 0.03817035074111599 + 0.09980758036020113);
+  const double t247 = (1.0 / (t246));
+  const double t248 = 2.0 * x[8];
+  const double t249 = (-4e+05 + t248);
+  const double t250 = (x[9] - 2e+05);
+  const double t251 = (t250 * t250);
+  const double t252 = (1e+10 + t251);
+  const double t253 = (-x[9] + u[7]);
+  const double t254 = (t253 * t253);
+  const double t255 = (t254 + 4e+10);
+  const double t256 = pow(t255, (-0.25));
+  const double t257 = (4e+10 + t251);
+  const double t258 = pow(t257, (-0.25));
+  const double t259 = (-2.8e+07 + x[9]);
+  const double t260 = ((t259 * t259) + 1e+10);
+  const double t261 =
+      (sqrt(t252) * 2.5e-09 + t253 * t221 * t256 * 2.0412414523193154e-06 - x[9] * 5e-09 -
+       t213 * 2.0412414523193154e-06 * t258 * t250 + 0.07050000000000001 - 2.5e-09 * sqrt(t260) +
+       t34 * 0.023561944901923454 * t62 * x[3] + t34 * 0.023561944901923454 * x[2] * t75);
+  const double t262 = (0.07132964021557801 - 0.023561944901923454 * t35);
+  const double t263 = (1.0 / (t262 * t262));
+  const double t264 = (1.0 / (t262));
+  const double t265 = 2.0 * x[9];
+  const double t266 = (-4e+05 + t265);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[20] =
-      (((-t0 * t8 * 17651.969999999998 - t0 * t10 * 25497.289999999997 - t16 * t20 * t26 +
-         t27 * t28 * t26 + t82 * t54 * t78 - t83 * t84 * t85 +
-         u[4] * ((-t89 * t90 * 9.80665 - t0 * t93 * 9.80665)) + t54 * t108 * t85 +
-         t19 * t27 *
-             ((-t19 * 4e+08 * t27 - t19 * t27 * 2e+08 * (1.0 / sqrt(t23)) * t22 +
-               t19 * t27 * 2e+08 * (1.0 / sqrt(t25)) * t24)) -
-         t109 * t90 * 25497.289999999997 - t112 * t90 * 17651.969999999998)) *
-           t122 -
-       t123 * t124 *
-           ((t109 * 5200.0 * t10 + 3600.0 * t112 * t120 + 2.0 * ((t89 * t93 + t117 * t89)) * u[4] +
-             t113 * t109 * 5200.0 + 3600.0 * t8 * t112)));
-  jacobian[21] = (-((t128 - t54 * t141 * t78 + t143 - t54 * t163 * t85 + t165 + t166)) * t122 -
-                  t123 * t124 *
-                      ((3600.0 * t112 * t164 + ((t117 * t125 + t89 * t126)) * 2.0 * u[4] +
-                        3600.0 * t120 * t142)));
-  jacobian[22] = (-2000.0) * t122;
-  jacobian[26] = t19 * t27 * t122 * 0.05089380098815465;
-  jacobian[27] = t54 * 0.031415926535897934 * t122 * t78;
-  jacobian[28] = t19 * t27 * t122 * (-0.03817035074111599);
-  jacobian[29] = t54 * t122 * (-0.023561944901923454) * t78;
+      (-t113 * t115 *
+           ((t101 * 5200.0 * t116 + 3600.0 * t112 * t10 +
+             2.0 * ((t106 * t120 + t109 * t106)) * u[4] + t2 * t101 * 5200.0 +
+             3600.0 * t123 * t112)) *
+           0.5 +
+       t124 * 0.5 *
+           ((t125 * t80 * t126 - t101 * 50994.579999999994 * t3 - t102 * t123 * 35303.939999999995 -
+             t34 * t80 * t141 - 50994.579999999994 * t102 * t116 +
+             2.0 * u[4] * ((-t106 * t3 * 9.80665 - t102 * t120 * 9.80665)) -
+             t112 * t3 * 35303.939999999995 - 2.0 * t142 * t100 * t143 +
+             t87 * t89 * 2.0 *
+                 ((-t87 * t89 * 2e+06 *
+                       ((t87 * t89 * t98 + t87 * t89 * t95 * pow(t96, (-1.5)) - t87 * t89 * t97 -
+                         t87 * pow(t93, (-1.5)) * t89 * t92)) *
+                       x[2] -
+                   t87 * 4e+08 * t89 - t87 * t89 * 2e+08 * t98 * t91 +
+                   t87 * t89 * 2e+08 * t97 * t94 - t99 * t89 * 2e+06 * t144 * x[2] +
+                   t99 * 2e+06 * t142 * x[2] * t143)) +
+             t89 * 2.0 * t144 * t100 - t34 * t162 * t75)));
+  jacobian[21] = (t124 *
+                      ((-t34 * t80 * t165 - t187 - t185 + t125 * t62 * t80 * t75 +
+                        2.0 * u[4] * t170 + t34 * t179 * t75)) *
+                      0.5 -
+                  t113 * t115 *
+                      ((3600.0 * t112 * t167 + ((t109 * t168 + t106 * t169)) * 2.0 * u[4] +
+                        3600.0 * t10 * t166)) *
+                      0.5);
+  jacobian[22] = ((-t180 * 2e+06 * t79 * t126 - 4000.0 - t99 * 4e+06 * t143 / (t88))) * t124 * 0.5;
+  jacobian[23] = t180 * (-1e+06) * t124 * t79 * t62 * t75;
+  jacobian[26] = t87 * t89 * t124 * 0.05089380098815465;
+  jacobian[27] = t34 * 0.031415926535897934 * t124 * t75;
+  jacobian[28] = t87 * t89 * t124 * (-0.03817035074111599);
+  jacobian[29] = t34 * t124 * (-0.023561944901923454) * t75;
   jacobian[30] =
-      (-((t128 - t54 * t85 * t168 + t143 + t165 - t82 * t140 * t54 + t166)) * t172 + t173);
+      (t184 -
+       ((t185 + t34 * t159 * t80 + t186 + t187 + t34 * t162 * t62 - t125 * t62 * t80 * t75)) * 0.5 *
+           t188);
   jacobian[31] =
-      (((-t143 - t174 * t83 * t85 + u[4] * t127 + t54 * t181 * t85 - t165 + t140 * t54 * t141)) *
-           t172 +
-       t173);
-  jacobian[33] = (-800.0) * t172;
-  jacobian[37] = t140 * t54 * 0.031415926535897934 * t172;
-  jacobian[39] = t140 * t54 * (-0.023561944901923454) * t172;
+      (t184 - 0.5 * t188 *
+                  ((t185 + t186 + t187 - t34 * t62 * t179 + t34 * t80 * t178 - t125 * t171 * t80)));
+  jacobian[32] = t180 * (-1e+06) * t79 * t62 * t188 * t75;
+  jacobian[33] = ((1600.0 + t180 * t171 * 2e+06 * t79)) * t188 * (-0.5);
+  jacobian[37] = t34 * 0.031415926535897934 * t62 * t188;
+  jacobian[39] = t34 * (-0.023561944901923454) * t62 * t188;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
-      (-((-3.3333333333333334e-09 * sqrt(t183) - t186 * t189 * t187 * 2.721655269759087e-06 +
-          0.094 - t190 * t194 * 2.721655269759087e-06 * t191 - 6.666666666666667e-09 * x[6] -
-          t19 * t27 * 0.05089380098815465 * x[2] + 3.3333333333333334e-09 * sqrt(t195))) *
-           t19 * 61072561.185785584 * t27 / (t196 * t196) +
-       ((t16 * 0.05089380098815465 * x[2] * t20 - t27 * 0.05089380098815465 * t28 * x[2])) *
-           1.2e+09 * t197);
-  jacobian[62] = t19 * t27 * (-61072561.185785584) * t197;
+      (-t87 * 61072561.185785584 * t89 *
+           ((-3.3333333333333334e-09 * sqrt(t191) + 0.094 - 6.666666666666667e-09 * x[6] -
+             t87 * t89 * 0.05089380098815465 * x[2] - t194 * 2.721655269759087e-06 * t198 * t195 +
+             3.3333333333333334e-09 * sqrt(t201) + t202 * t204 * 2.721655269759087e-06 * t199)) /
+           (t189 * t189) +
+       ((t142 * 0.05089380098815465 * x[2] * t143 - t89 * 0.05089380098815465 * t144 * x[2])) *
+           1.2e+09 * t205);
+  jacobian[62] = t87 * t89 * (-61072561.185785584) * t205;
   jacobian[64] =
-      ((-t189 * t187 * 2.721655269759087e-06 * t199 - t200 * t194 * 2.721655269759087e-06 * t191)) *
-      1.2e+09 * t197;
-  jacobian[66] =
-      1.2e+09 *
-      ((-t190 * t194 * 2.721655269759087e-06 +
-        t202 * pow(t193, (-1.25)) * t190 * t191 * 6.804138174397718e-07 -
-        t186 * t189 * 2.721655269759087e-06 + t202 * 1.6666666666666667e-09 * (1.0 / sqrt(t195)) -
-        6.666666666666667e-09 - 1.6666666666666667e-09 * ((-5.6e+07 + t201)) * (1.0 / sqrt(t183)) +
-        pow(t188, (-1.25)) * t186 * t187 * ((-5e+07 + t201)) * 6.804138174397718e-07)) *
-      t197;
-  jacobian[70] =
-      (-t54 * t217 * 37699111.84307752 * t78 * t219 +
-       ((t83 * 0.031415926535897934 * t84 * x[2] + t140 * t83 * 0.031415926535897934 * x[3] * t78 -
-         t54 * 0.031415926535897934 * t108 * x[2] - t54 * 0.031415926535897934 * x[3] * t168)) *
-           t220 * 1.2e+09);
+      ((-2.721655269759087e-06 * t198 * t195 * t207 - t208 * t204 * 2.721655269759087e-06 * t199)) *
+      1.2e+09 * t205;
+  jacobian[66] = 1.2e+09 *
+                 ((-t194 * 2.721655269759087e-06 * t198 -
+                   t210 * pow(t203, (-1.25)) * t202 * t199 * 6.804138174397718e-07 +
+                   t210 * 1.6666666666666667e-09 * (1.0 / sqrt(t201)) - 6.666666666666667e-09 -
+                   1.6666666666666667e-09 * ((-5.6e+07 + t209)) * (1.0 / sqrt(t191)) +
+                   t202 * t204 * 2.721655269759087e-06 +
+                   pow(t197, (-1.25)) * 1.3608276348795436e-06 * t196 * t194)) *
+                 t205;
+  jacobian[70] = (-t34 * 37699111.84307752 * t226 * t228 * t75 +
+                  t229 * 1.2e+09 *
+                      ((-t34 * 0.031415926535897934 * t159 * x[3] +
+                        t125 * 0.031415926535897934 * t62 * x[3] * t75 +
+                        t125 * 0.031415926535897934 * x[2] * t126 -
+                        t34 * 0.031415926535897934 * x[2] * t141)));
   jacobian[71] =
-      (t220 * 1.2e+09 *
-           ((-t54 * 0.031415926535897934 * t181 * x[3] + t174 * t83 * 0.031415926535897934 * x[3] +
-             t140 * t83 * 0.031415926535897934 * x[2] * t78 -
-             t54 * 0.031415926535897934 * t163 * x[2])) -
-       t140 * t54 * t217 * 37699111.84307752 * t219);
-  jacobian[72] = t54 * (-37699111.84307752) * t220 * t78;
-  jacobian[73] = t140 * t54 * (-37699111.84307752) * t220;
-  jacobian[75] = t220 *
-                 ((-t222 * t214 * 2.0412414523193154e-06 * t216 -
-                   t223 * 2.0412414523193154e-06 * t203 * t210)) *
-                 1.2e+09;
-  jacobian[77] = t220 *
-                 ((t208 * 2.0412414523193154e-06 * t210 -
-                   t208 * t225 * 5.103103630798288e-07 * pow(t209, (-1.25)) * t203 -
-                   t213 * 2.0412414523193154e-06 * t216 + (1.0 / sqrt(t205)) * t225 * 1.25e-09 +
-                   5.103103630798288e-07 * t213 * pow(t215, (-1.25)) * ((-5e+07 + t224)) * t214 -
-                   (1.0 / sqrt(t212)) * 1.25e-09 * ((-5.6e+07 + t224)) - 5e-09)) *
-                 1.2e+09;
+      (t229 * 1.2e+09 *
+           ((t125 * 0.031415926535897934 * t62 * x[2] * t75 -
+             t34 * 0.031415926535897934 * x[2] * t165 - t34 * 0.031415926535897934 * x[3] * t178 +
+             t125 * 0.031415926535897934 * t171 * x[3])) -
+       t34 * 37699111.84307752 * t226 * t62 * t228);
+  jacobian[72] = t34 * (-37699111.84307752) * t229 * t75;
+  jacobian[73] = t34 * (-37699111.84307752) * t229 * t62;
+  jacobian[75] = t229 * 1.2e+09 *
+                 ((-2.0412414523193154e-06 * t231 * t218 * t223 -
+                   t232 * t217 * 2.0412414523193154e-06 * t214));
+  jacobian[77] = ((-t213 * t217 * 2.0412414523193154e-06 +
+                   t234 * 5.103103630798288e-07 * pow(t222, (-1.25)) * t221 * t218 -
+                   t221 * 2.0412414523193154e-06 * t223 + (1.0 / sqrt(t220)) * t234 * 1.25e-09 +
+                   pow(t216, (-1.25)) * t213 * t215 * 1.0206207261596577e-06 -
+                   (1.0 / sqrt(t225)) * 1.25e-09 * ((-5.6e+07 + t233)) - 5e-09)) *
+                 t229 * 1.2e+09;
   jacobian[80] =
-      (t19 * t27 * 45804420.889339186 *
-           ((t19 * t27 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
-             3.3333333333333334e-09 * sqrt(t229) - t231 * t186 * 2.721655269759087e-06 * t227 -
-             3.3333333333333334e-09 * sqrt(t233) - t190 * t236 * 2.721655269759087e-06 * t234)) /
-           (t226 * t226) +
-       1.2e+09 * t237 *
-           ((t27 * t28 * x[2] * 0.03817035074111599 - t16 * x[2] * 0.03817035074111599 * t20)));
-  jacobian[82] = t19 * t27 * 45804420.889339186 * t237;
+      (t87 * t89 * 45804420.889339186 *
+           ((t87 * t89 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
+             3.3333333333333334e-09 * sqrt(t237) - t238 * t202 * 2.721655269759087e-06 * t241 -
+             t243 * t194 * 2.721655269759087e-06 * t235 - 3.3333333333333334e-09 * sqrt(t245))) /
+           (t246 * t246) +
+       1.2e+09 * t247 *
+           ((t89 * t144 * x[2] * 0.03817035074111599 - t142 * x[2] * 0.03817035074111599 * t143)));
+  jacobian[82] = t87 * t89 * 45804420.889339186 * t247;
   jacobian[84] =
-      1.2e+09 * t237 *
-      ((-t231 * 2.721655269759087e-06 * t199 * t227 - t200 * t236 * 2.721655269759087e-06 * t234));
-  jacobian[88] = 1.2e+09 * t237 *
-                 ((-1.6666666666666667e-09 * (1.0 / sqrt(t233)) * ((-5.6e+07 + t238)) -
-                   t231 * t186 * 2.721655269759087e-06 +
-                   t239 * 1.6666666666666667e-09 * (1.0 / sqrt(t229)) - 6.666666666666667e-09 +
-                   pow(t235, (-1.25)) * t190 * ((-5e+07 + t238)) * t234 * 6.804138174397718e-07 +
-                   t239 * t186 * t227 * pow(t230, (-1.25)) * 6.804138174397718e-07 -
-                   t190 * t236 * 2.721655269759087e-06));
+      1.2e+09 * t247 *
+      ((-t243 * 2.721655269759087e-06 * t207 * t235 + t238 * t208 * 2.721655269759087e-06 * t241));
+  jacobian[88] =
+      1.2e+09 *
+      ((t202 * 2.721655269759087e-06 * t241 -
+        1.6666666666666667e-09 * (1.0 / sqrt(t245)) * ((-5.6e+07 + t248)) -
+        t243 * t194 * 2.721655269759087e-06 + t249 * 1.6666666666666667e-09 * (1.0 / sqrt(t237)) -
+        6.666666666666667e-09 - 1.3608276348795436e-06 * t202 * pow(t240, (-1.25)) * t239 +
+        t249 * t194 * t235 * pow(t242, (-1.25)) * 6.804138174397718e-07)) *
+      t247;
   jacobian[90] =
-      (t241 * 1.2e+09 *
-           ((-t83 * 0.023561944901923454 * t84 * x[2] + t54 * t108 * 0.023561944901923454 * x[2] -
-             t140 * t83 * 0.023561944901923454 * x[3] * t78 +
-             t54 * 0.023561944901923454 * x[3] * t168)) +
-       t54 * 28274333.882308144 * t242 * t78 * t253);
+      (t34 * 28274333.882308144 * t261 * t263 * t75 +
+       t264 * 1.2e+09 *
+           ((t34 * 0.023561944901923454 * x[2] * t141 - t125 * 0.023561944901923454 * x[2] * t126 -
+             t125 * 0.023561944901923454 * t62 * x[3] * t75 +
+             t34 * 0.023561944901923454 * t159 * x[3])));
   jacobian[91] =
-      (t241 * 1.2e+09 *
-           ((t54 * 0.023561944901923454 * t181 * x[3] - t174 * t83 * 0.023561944901923454 * x[3] -
-             t140 * t83 * 0.023561944901923454 * x[2] * t78 +
-             t54 * t163 * 0.023561944901923454 * x[2])) +
-       t140 * t54 * 28274333.882308144 * t242 * t253);
-  jacobian[92] = t54 * t241 * 28274333.882308144 * t78;
-  jacobian[93] = t140 * t54 * t241 * 28274333.882308144;
-  jacobian[95] = t241 *
-                 ((-t222 * 2.0412414523193154e-06 * t247 * t243 -
-                   t252 * t250 * t223 * 2.0412414523193154e-06)) *
-                 1.2e+09;
-  jacobian[99] = t241 *
-                 ((-(1.0 / sqrt(t249)) * 1.25e-09 * ((-5.6e+07 + t254)) -
-                   t213 * 2.0412414523193154e-06 * t247 -
-                   t208 * pow(t251, (-1.25)) * 5.103103630798288e-07 * ((-5e+07 + t254)) * t250 +
-                   t208 * t252 * 2.0412414523193154e-06 + t255 * (1.0 / sqrt(t245)) * 1.25e-09 +
-                   t255 * 5.103103630798288e-07 * t213 * pow(t246, (-1.25)) * t243 - 5e-09)) *
-                 1.2e+09;
+      (t34 * 28274333.882308144 * t261 * t263 * t62 +
+       t264 *
+           ((t34 * 0.023561944901923454 * x[2] * t165 + t34 * 0.023561944901923454 * x[3] * t178 -
+             t125 * 0.023561944901923454 * t62 * x[2] * t75 -
+             t125 * t171 * 0.023561944901923454 * x[3])) *
+           1.2e+09);
+  jacobian[92] = t34 * t264 * 28274333.882308144 * t75;
+  jacobian[93] = t34 * t264 * 28274333.882308144 * t62;
+  jacobian[95] = ((-t232 * 2.0412414523193154e-06 * t258 * t250 +
+                   t253 * t256 * 2.0412414523193154e-06 * t231)) *
+                 t264 * 1.2e+09;
+  jacobian[99] =
+      t264 * 1.2e+09 *
+      ((t266 * t213 * 5.103103630798288e-07 * pow(t257, (-1.25)) * t250 -
+        (1.0 / sqrt(t260)) * 1.25e-09 * ((-5.6e+07 + t265)) - t221 * t256 * 2.0412414523193154e-06 +
+        t254 * pow(t255, (-1.25)) * t221 * 1.0206207261596577e-06 +
+        t266 * (1.0 / sqrt(t252)) * 1.25e-09 - t213 * 2.0412414523193154e-06 * t258 - 5e-09));
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "runtime/app/describe_command.h"
+#include "runtime/app/plant_step_command.h"
 
 namespace {
 
@@ -60,11 +61,37 @@ int main(int argc, char** argv) {
   gen_cmd->add_option("--materials", gen_materials,
                       "Material folder (default: <description dir>/../materials)");
 
+  autoshovel::app::PlantStepOptions step;
+  CLI::App* plant_cmd = app.add_subcommand("plant", "Experiments on the simulated machine");
+  plant_cmd->require_subcommand(1);
+  CLI::App* step_cmd = plant_cmd->add_subcommand(
+      "step",
+      "Valve step (or chirp) on one actuator; CSV t,command,spool,pressure,joint_angle,"
+      "joint_rate for hydraulic identification");
+  step_cmd->add_option("--machine", step.machine, "Machine name or description file")->required();
+  step_cmd->add_option("--actuator", step.actuator, "Actuator name")->capture_default_str();
+  step_cmd->add_option("--amplitude", step.amplitude, "Valve duty of the step, in [-1, 1]")
+      ->capture_default_str();
+  step_cmd->add_flag("--chirp", step.chirp, "Linear frequency sweep instead of a step");
+  step_cmd->add_option("--f0", step.chirp_f0, "Chirp start frequency [Hz]")->capture_default_str();
+  step_cmd->add_option("--f1", step.chirp_f1, "Chirp end frequency [Hz]")->capture_default_str();
+  step_cmd->add_option("--start", step.step_time, "Time of the step [s]")->capture_default_str();
+  step_cmd->add_option("--duration", step.duration, "Length of the log [s]")->capture_default_str();
+  step_cmd->add_option("--rate", step.sample_rate, "Control and logging rate [Hz]")
+      ->capture_default_str();
+  step_cmd->add_flag("--noise", step.noise, "Add data-logger sensor noise");
+  step_cmd->add_option("--seed", step.seed, "Seed of the noise")->capture_default_str();
+  step_cmd->add_option("-o,--output", step.output, "CSV file (default: standard output)");
+
   CLI11_PARSE(app, argc, argv);
 
   if (*describe_cmd) {
     describe.models_dir = models_dir;
     return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
+  }
+  if (*step_cmd) {
+    step.models_dir = models_dir;
+    return autoshovel::app::RunPlantStep(step, std::cout, std::cerr);
   }
   if (*gen_cmd) {
     std::vector<std::string> arguments{"-o", gen_output};

@@ -11,7 +11,7 @@ ModelSizes SizesOf(const MachineDescription& machine) {
   sizes.num_angles = sizes.num_links + 1 + (machine.swing ? 1 : 0);
   sizes.num_params = 2 * sizes.num_links;
   sizes.num_states = 5 * sizes.num_joints;
-  sizes.num_inputs = 2 * sizes.num_joints + 2;
+  sizes.num_inputs = 3 * sizes.num_joints + 2;
   return sizes;
 }
 
@@ -93,6 +93,7 @@ std::vector<double> InterpretedModel::GravityTorques(const double* q, double pay
   for (int j = 0; j < J; ++j) x[j] = q[j];
   u[2 * J] = payload;
   u[2 * J + 1] = pitch;
+  for (int j = 0; j < J; ++j) u[2 * J + 2 + j] = machine_.hydraulics.pump_pressure;
   // At zero pressure the only hydraulic force left is the (smooth, tiny) end-stop spring,
   // removed explicitly below.
   PlantRhs(x.data(), u.data(), rest.data());

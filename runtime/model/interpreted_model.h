@@ -17,13 +17,14 @@
 //
 // Plant, per joint j with its one actuator (x = [q, q̇, x_s, p_A, p_B] each block of J entries;
 // u = [valve command after dead zone and delay (J), external torque (J), payload mass,
-// pitch of frame M]):
+// pitch of frame M, supply pressure p_P of each joint's valve section (J)]):
 //   ẋ_s = (u_j − x_s)/τ_s
 //   Q_A = K_v [pos(x_s) g(p_P − p_A) − pos(−x_s) g(p_A − p_T)]
 //   Q_B = K_v [pos(−x_s) g(p_P − p_B) − pos(x_s) g(p_B − p_T)]
 //   ṗ_A = β/V_A (Q_A − A_A ṡ + Q_makeup(p_A) − Q_relief(p_A)), V_A = V_0 + A_A s
 //   ṗ_B = β/V_B (Q_B + A_B ṡ + Q_makeup(p_B) − Q_relief(p_B)), V_B = V_0 + A_B (S − s)
-//   F = p_A A_A − p_B A_B + F_endstop(s);  generalized force F ∂L/∂q_i on every joint i
+//   F = p_A A_A − p_B A_B + F_endstop(s, ṡ) (spring and cushion damper past either end);
+//   generalized force F ∂L/∂q_i on every joint i
 //   M_jj(q) q̈_j = Σ F ∂L/∂q_j + Q_gravity,j(q) + τ_ext,j − b_j q̇_j
 // with s = L(q) − L_retracted the cylinder extension. M_jj is the diagonal of the chain's mass
 // matrix (inertia of everything distal to joint j about it); the off-diagonal coupling and
@@ -161,6 +162,12 @@ template <typename S>
 S SmoothPositive(const S& x, double width) {
   using std::sqrt;
   return (x + sqrt(x * x + width * width)) / 2.0;
+}
+
+template <typename S>
+S SmoothStep(const S& x, double width) {
+  using std::sqrt;
+  return (1.0 + x / sqrt(x * x + width * width)) / 2.0;
 }
 
 template <typename S>
@@ -347,10 +354,13 @@ void InterpretedModel::PlantRhs(const S* x, const double* u, S* xdot) const {
     }
   }
 
-  const double p_pump = hyd.pump_pressure, p_tank = hyd.tank_pressure;
+  const double p_tank = hyd.tank_pressure;
   for (int j = 0; j < J; ++j) {
     const Actuator& act = hyd.actuators[actuator_of_joint_[j]];
     const Valve& valve = act.valve;
+    // Supply behind this valve section (a pressure-compensated load-sensing system gives each
+    // section its own: load plus margin; see runtime/plant/plant.h).
+    const double p_pump = u[2 * J + 2 + j];
     S area_a(0.0), area_b(0.0), volume_a(0.0), volume_b(0.0), extension_rate(0.0);
     S end_force(0.0);
     const std::vector<S> lever = LeverArms(actuator_of_joint_[j], q);
@@ -367,8 +377,11 @@ void InterpretedModel::PlantRhs(const S* x, const double* u, S* xdot) const {
       volume_b = act.dead_volume + area_b * (act.stroke - s);
       for (int i = 0; i < J; ++i) extension_rate += lever[i] * qd[i];
       end_force = act.count * plant::kEndStopStiffness *
-                  (SmoothPositive(S(-s), plant::kEndStopSmoothing) -
-                   SmoothPositive(S(s - act.stroke), plant::kEndStopSmoothing));
+                      (SmoothPositive(S(-s), plant::kEndStopSmoothing) -
+                       SmoothPositive(S(s - act.stroke), plant::kEndStopSmoothing)) -
+                  act.count * plant::kEndStopDamping * extension_rate *
+                      (internal::SmoothStep(S(-s), plant::kEndStopSmoothing) +
+                       internal::SmoothStep(S(s - act.stroke), plant::kEndStopSmoothing));
     }
     const S open_a = SmoothPositive(xs[j], plant::kSpoolUnderlap);
     const S open_b = SmoothPositive(S(-xs[j]), plant::kSpoolUnderlap);

@@ -6,9 +6,11 @@
 namespace autoshovel::model::plant {
 
 inline constexpr double kGravity = 9.80665;  ///< [m/s²]
-/// Spool position at which the valve's underlap leakage equals a fully open path [-]: the
-/// smooth split pos(x) = (x + sqrt(x² + ε²))/2 keeps the Jacobian finite at x = 0.
-inline constexpr double kSpoolUnderlap = 0.01;
+/// Regularisation width of the spool opening [-]: the smooth split pos(x) = (x + sqrt(x² + ε²))/2
+/// keeps the Jacobian finite at x = 0 and leaves a centred spool an opening of ε/2 per path,
+/// an internal leakage of 0.05 % of rated flow per path (a boom valve: about 0.5 L/min at
+/// holding pressure, the order of a real spool valve's leakage).
+inline constexpr double kSpoolUnderlap = 1e-3;
 /// Pressure drop below which orifice flow turns laminar [Pa]: Q ∝ Δp/(Δp² + Δp_t²)^¼ is
 /// sign(Δp)·sqrt|Δp| above it and linear below (a two-regime orifice in the spirit of Ellman &
 /// Piché 1999, smooth so that CVODE's Newton iteration sees a finite Jacobian).
@@ -20,5 +22,9 @@ inline constexpr double kReliefFullFlowOverpressure = 1e6;
 /// Cylinder end-of-stroke stop stiffness per cylinder [N/m] and its smoothing length [m].
 inline constexpr double kEndStopStiffness = 2e8;
 inline constexpr double kEndStopSmoothing = 1e-3;
+/// End-of-stroke cushion damping per cylinder [N·s/m], acting only inside the stop (smooth
+/// step of the same width): about critical for a few tonnes reflected to the cylinder, so that
+/// an arm held against its stop does not ring (a real cylinder's cushion does the same).
+inline constexpr double kEndStopDamping = 2e6;
 
 }  // namespace autoshovel::model::plant

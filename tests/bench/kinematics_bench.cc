@@ -83,6 +83,7 @@ void PlantState(const Fixture& f, std::vector<double>& x, std::vector<double>& u
     x[4 * J + j] = 3e6;
     u[j] = 0.5;
   }
+  for (int j = 0; j < J; ++j) u[2 * J + 2 + j] = 2.5e7;  // supply pressures
 }
 
 void GeneratedPlantRhsAndJacobian(benchmark::State& state, const MachineFunctions* g) {

@@ -33,6 +33,9 @@ void RandomStateAndInput(const MachineUnderTest& m, std::mt19937_64& rng, std::v
   }
   u[2 * J] = std::uniform_real_distribution<double>(0.0, 6000.0)(rng);
   u[2 * J + 1] = 0.1 * unit(rng);
+  for (int j = 0; j < J; ++j) {
+    u[2 * J + 2 + j] = std::uniform_real_distribution<double>(5e6, 3.0e7)(rng);
+  }
 }
 
 TEST(GeneratedPlant, RightHandSideMatchesInterpreted) {
@@ -123,6 +126,7 @@ TEST(GeneratedPlant, ClosedValveHoldsTheArmAtStaticBalance) {
       const double force = -gravity[j] / lever;  // required cylinder force [N]
       x[3 * J + j] = (force + tank * area_b) / area_a;
     }
+    for (int j = 0; j < J; ++j) u[2 * J + 2 + j] = m.description->hydraulics.pump_pressure;
     g.plant_rhs(0.0, x.data(), u.data(), xdot.data());
     for (int j = 0; j < J; ++j) {
       // Unbalanced, gravity alone would give several rad/s²; the smooth end-stop spring leaves
@@ -147,6 +151,7 @@ TEST(GeneratedPlant, OpenValveFillsCapSideAndDrainsRodSide) {
       x[3 * J + j] = x[4 * J + j] = 8e6;
       u[j] = 0.8;
     }
+    for (int j = 0; j < J; ++j) u[2 * J + 2 + j] = m.description->hydraulics.pump_pressure;
     g.plant_rhs(0.0, x.data(), u.data(), xdot.data());
     for (int j = 0; j < J; ++j) {
       EXPECT_GT(xdot[3 * J + j], 0.0) << g.name << " joint " << j;

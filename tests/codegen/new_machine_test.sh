@@ -35,7 +35,7 @@ int main() {
     return 1;
   }
   if (std::abs(m->nominal_params[1] - 1.40) > 1e-15) { std::puts("wrong l2"); return 1; }
-  double x0[10] = {0.1, 0.3, 0, 0, 0, 0, 5e6, 5e6, 5e6, 5e6}, u[6] = {0, 0, 0, 0, 0, 0}, f[10];
+  double x0[10] = {0.1, 0.3, 0, 0, 0, 0, 5e6, 5e6, 5e6, 5e6}, u[8] = {0, 0, 0, 0, 0, 0, 2.5e7, 2.5e7}, f[10];
   m->plant_rhs(0.0, x0, u, f);
   for (double v : f) if (!std::isfinite(v)) { std::puts("plant rhs not finite"); return 1; }
   std::printf("ok: %s tip (%.6f, %.6f)\n", m->name, pose[0], pose[2]);

@@ -1,0 +1,94 @@
+// Exchange of material between the terrain and the bucket, and the relaxation of the terrain to
+// its angle of repose. Every operation moves volume from one place to another (cell ↔ bucket,
+// cell ↔ cell), so terrain volume + bucket volume is conserved to round-off.
+//
+// The bucket is its profile polygon (description `bucket.profile`, bucket frame, tip first, the
+// top of the back wall last) swept across its width in the vertical arm plane:
+// - capture: every terrain cell under the bucket whose surface lies above the bucket's lower
+//   outline loses the material above that outline to the bucket (the material inside the bucket
+//   and heaped on top of it moves with it; a height grid cannot hold an overhang);
+// - spill: the bucket holds what lies below its lower rim (the lower of tip and back-wall top)
+//   plus a heap whose size grows as the opening turns upwards, up to the rated heaped capacity
+//   (SAE J742); anything beyond pours over the lower rim onto the cells just outside it. The
+//   same rule empties the bucket when it is tilted to dump;
+// - repose: a neighbour pair steeper than the material's angle of repose exchanges material
+//   until it is not (a conservative relaxation of the classic sand-pile kind).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "runtime/model/description.h"
+#include "runtime/plant/world.h"
+
+namespace autoshovel::plant {
+
+/// The bucket at one instant. The arm plane is vertical through `plane_origin` (world xy) with
+/// horizontal axis along `plane_heading`; plane coordinates (s, z) map to the world point
+/// plane_origin + s·(cos h, sin h) at height z.
+struct BucketPlacement {
+  Eigen::Vector2d plane_origin = Eigen::Vector2d::Zero();
+  double plane_heading = 0;                         ///< [rad]
+  Eigen::Vector2d pivot = Eigen::Vector2d::Zero();  ///< bucket frame origin (s, z) [m]
+  double bucket_angle = 0;                          ///< φ_n of the bucket frame [rad]
+
+  /// A point of the bucket frame in plane coordinates.
+  Eigen::Vector2d ToPlane(const Eigen::Vector2d& p_bucket) const;
+  /// A plane point in world xy.
+  Eigen::Vector2d ToWorldXy(double s) const;
+};
+
+/// What the terrain touching the bucket looks like, for the resistance model.
+struct BucketContact {
+  bool in_contact = false;
+  double depth = 0;   ///< free surface above the tip, at the tip [m]
+  int material = -1;  ///< material index at the tip (or of the deepest cell)
+  Eigen::Vector2d tip = Eigen::Vector2d::Zero();  ///< plane coordinates [m]
+  Eigen::Vector2d rim = Eigen::Vector2d::Zero();  ///< top of the back wall, plane coordinates
+};
+
+struct ExchangeResult {
+  double captured_volume = 0;  ///< moved from terrain into the bucket this call [m³]
+  double spilled_volume = 0;   ///< poured from the bucket onto the terrain this call [m³]
+};
+
+class BucketTerrain {
+ public:
+  BucketTerrain(const model::Bucket& bucket, World& world);
+
+  /// Captures material under the bucket and pours out what it cannot hold.
+  ExchangeResult Exchange(const BucketPlacement& placement);
+  /// The contact seen at the bucket tip.
+  BucketContact Contact(const BucketPlacement& placement) const;
+  /// Volume the bucket holds in this orientation [m³] (struck part below the lower rim plus the
+  /// heap the opening's inclination supports).
+  double HoldableVolume(const BucketPlacement& placement) const;
+  /// Relaxes slopes steeper than the angle of repose in a square of half size `half_window`
+  /// around `center_xy`; at most `max_iterations` sweeps. Returns the volume moved [m³].
+  double RelaxToRepose(const Eigen::Vector2d& center_xy, double half_window,
+                       int max_iterations = 30);
+
+  double payload_volume() const { return payload_volume_; }
+  double payload_mass() const { return payload_mass_; }
+  /// Material index making up most of the payload, or -1 when empty.
+  int payload_material() const;
+  /// Empties the bucket into nothing (tests and scenario resets only: breaks conservation).
+  void ClearPayload();
+
+ private:
+  std::vector<Eigen::Vector2d> PlanePolygon(const BucketPlacement& placement) const;
+  /// Cells whose centre lies within the bucket's width and the s-range [s0, s1].
+  template <typename Visit>
+  void ForEachCellInStrip(const BucketPlacement& placement, double s0, double s1,
+                          Visit&& visit) const;
+  void Deposit(const BucketPlacement& placement, double s_from, double s_to, double volume);
+
+  const model::Bucket& bucket_;
+  World& world_;
+  double struck_area_ = 0;  ///< profile polygon area [m²]
+  double payload_volume_ = 0;
+  double payload_mass_ = 0;
+  std::vector<double> payload_by_material_;
+};
+
+}  // namespace autoshovel::plant

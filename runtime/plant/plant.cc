@@ -1,0 +1,625 @@
+#include "runtime/plant/plant.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "runtime/model/interpreted_model.h"
+#include "runtime/plant/earthmoving.h"
+
+namespace autoshovel::plant {
+
+namespace {
+
+/// Dead band of a pressure compensator [Pa].
+constexpr double kCompensatorBand = 2e5;
+
+struct Layout {
+  int joints = 0;
+  int arm = 0;  // 5J
+  int speed() const { return arm; }
+  int wheel() const { return arm + 1; }
+  int throttle() const { return arm + 2; }
+  int x() const { return arm + 3; }
+  int y() const { return arm + 4; }
+  int heading() const { return arm + 5; }
+  int articulation() const { return arm + 6; }
+  int travel_energy() const { return arm + 7; }
+  int hydraulic_energy() const { return arm + 8; }
+  int size() const { return arm + 9; }
+};
+
+// Link frame origins in M (n + 1, the last is the tip) and link angles, Eq. (2).
+void ArmGeometry(const model::MachineDescription& machine, const double* q,
+                 std::vector<Eigen::Vector2d>& origins, std::vector<double>& angles) {
+  const int n = static_cast<int>(machine.links.size());
+  origins.assign(n + 1, Eigen::Vector2d::Zero());
+  angles.assign(n, 0.0);
+  double phi = 0;
+  for (int k = 0; k < n; ++k) {
+    phi += q[k];
+    angles[k] = phi;
+    origins[k + 1] =
+        origins[k] + machine.links[k].length * Eigen::Vector2d(std::cos(phi), std::sin(phi));
+  }
+}
+
+}  // namespace
+
+// The ODE system of one machine: generated arm right-hand side plus drive, steering kinematics,
+// cutting resistance and energy quadratures, with the inputs held over a segment.
+class Plant::System : public OdeSystem {
+ public:
+  struct Held {
+    std::vector<double> spool_reference;  // per joint
+    double drive = 0, brake = 0, articulation_rate = 0;
+    double payload = 0;
+    std::vector<double> section_supply;  // per joint's valve section, after its compensator [Pa]
+    double pump_pressure = 0;            // load-sensing pump output [Pa]
+    ResistanceState resistance;          // magnitudes held over the segment
+    // A discrete event: a command reaching the machine, or the bucket entering or leaving
+    // the material. The other held inputs (payload, resistance magnitudes, compensated supply
+    // pressures) are samples of quantities that vary continuously with the state; they are
+    // updated at every tick without restarting the integrator's history.
+    bool IsEventAgainst(const Held& o) const {
+      return spool_reference != o.spool_reference || drive != o.drive || brake != o.brake ||
+             articulation_rate != o.articulation_rate ||
+             resistance.in_contact != o.resistance.in_contact ||
+             resistance.cut_side != o.resistance.cut_side;
+    }
+  };
+
+  System(const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+         const PlantOptions& options)
+      : machine_(machine), functions_(functions), options_(options) {
+    layout_.joints = functions.num_joints;
+    layout_.arm = functions.num_states;
+    held_.spool_reference.assign(layout_.joints, 0.0);
+    u_.assign(functions.num_inputs, 0.0);
+    arm_rhs_.assign(layout_.arm, 0.0);
+    arm_jacobian_.assign(static_cast<std::size_t>(layout_.arm) * layout_.arm, 0.0);
+    is_loader_ = machine.kind == model::MachineKind::kWheelLoader;
+  }
+
+  int size() const override { return layout_.size(); }
+  const Layout& layout() const { return layout_; }
+  Held& held() { return held_; }
+
+  struct Outputs {
+    Eigen::Vector2d tip_force = Eigen::Vector2d::Zero();  // on the bucket, base x–z [N]
+    DriveRates drive;
+    double hydraulic_power = 0;
+  };
+
+  // Inputs of the generated arm model at state y (external torques from the resistance).
+  Eigen::Vector2d FillArmInputs(const double* y) {
+    const int J = layout_.joints;
+    const int n = static_cast<int>(machine_.links.size());
+    for (int j = 0; j < J; ++j) {
+      u_[j] = held_.spool_reference[j];
+      u_[J + j] = 0.0;
+    }
+    u_[2 * J] = held_.payload;
+    u_[2 * J + 1] = 0.0;  // the yard floor is level: frame M is not pitched
+    for (int j = 0; j < J; ++j) u_[2 * J + 2 + j] = held_.section_supply[j];
+    const ResistanceState& R = held_.resistance;
+    if (!R.in_contact) return Eigen::Vector2d::Zero();
+    const double* q = y;
+    const double* qd = y + J;
+    ArmGeometry(machine_, q, origins_, angles_);
+    const Eigen::Vector2d tip = origins_[n];
+    Eigen::Vector2d tip_velocity(is_loader_ ? y[layout_.speed()] : 0.0, 0.0);
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector2d r = tip - origins_[j];
+      tip_velocity += Eigen::Vector2d(-r.y(), r.x()) * qd[j];
+    }
+    const double eps = options_.resistance_speed;
+    const double c = R.cut_side;
+    const double sign_s = c * tip_velocity.x() / std::hypot(tip_velocity.x(), eps);
+    const double sign_z = tip_velocity.y() / std::hypot(tip_velocity.y(), eps);
+    const Eigen::Vector2d force(
+        -sign_s * c * (sign_s > 0 ? R.cut : R.withdraw),
+        -sign_z * (sign_z > 0 ? R.lift : R.cut) - R.press * std::max(sign_s, 0.0));
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector2d r = tip - origins_[j];
+      u_[J + j] = Eigen::Vector2d(-r.y(), r.x()).dot(force);  // τ = Jᵀ F
+    }
+    return force;
+  }
+
+  Outputs Evaluate(const double* y, double* ydot) {
+    Outputs out;
+    out.tip_force = FillArmInputs(y);
+    functions_.plant_rhs(0.0, y, u_.data(), ydot);
+    EvaluateRest(y, out, ydot);
+    return out;
+  }
+
+  void EvaluateRest(const double* y, Outputs& out, double* ydot) {
+    const int J = layout_.joints;
+    // Hydraulic power: the pump's pressure times the flow it delivers into the chambers.
+    double flow = 0;
+    const double pump = held_.pump_pressure;
+    for (int j = 0; j < J; ++j) {
+      const model::Actuator& act = machine_.hydraulics.actuators[actuator_of_joint(j)];
+      const double xs = y[2 * J + j], pa = y[3 * J + j], pb = y[4 * J + j];
+      const double supply = held_.section_supply[j];
+      const double in_a = act.valve.flow_gain *
+                          model::internal::SmoothPositive(xs, model::plant::kSpoolUnderlap) *
+                          model::internal::OrificeRoot(supply - pa);
+      const double in_b = act.valve.flow_gain *
+                          model::internal::SmoothPositive(-xs, model::plant::kSpoolUnderlap) *
+                          model::internal::OrificeRoot(supply - pb);
+      flow += std::max(in_a, 0.0) + std::max(in_b, 0.0);
+    }
+    out.hydraulic_power = pump * flow / machine_.hydraulics.pump_efficiency;
+    ydot[layout_.hydraulic_energy()] = out.hydraulic_power;
+
+    for (int i = layout_.speed(); i <= layout_.travel_energy(); ++i) ydot[i] = 0.0;
+    if (!is_loader_) return;
+    DriveState drive_state{y[layout_.speed()], y[layout_.wheel()], y[layout_.throttle()]};
+    DriveInput input{held_.drive, held_.brake, held_.payload, out.tip_force.x(), out.tip_force.y()};
+    out.drive = EvaluateDrive(machine_, options_.drive, drive_state, input);
+    ydot[layout_.speed()] = out.drive.speed_dot;
+    ydot[layout_.wheel()] = out.drive.wheel_speed_dot;
+    ydot[layout_.throttle()] = out.drive.throttle_dot;
+    // Articulated steering kinematics (see plant.h).
+    const double v = y[layout_.speed()];
+    const double psi = y[layout_.heading()], gamma = y[layout_.articulation()];
+    const double lf = machine_.chassis.hinge_to_front_axle;
+    const double lr = machine_.chassis.hinge_to_rear_axle;
+    const double gamma_dot = held_.articulation_rate;
+    const double psi_dot = (v * std::sin(gamma) + lr * gamma_dot) / (lf * std::cos(gamma) + lr);
+    ydot[layout_.x()] = v * std::cos(psi) + lf * psi_dot * std::sin(psi);
+    ydot[layout_.y()] = v * std::sin(psi) - lf * psi_dot * std::cos(psi);
+    ydot[layout_.heading()] = psi_dot;
+    ydot[layout_.articulation()] = gamma_dot;
+    const double efficiency = machine_.electric_motor ? machine_.electric_motor->efficiency
+                                                      : machine_.diesel_engine->efficiency;
+    ydot[layout_.travel_energy()] = std::max(out.drive.wheel_power, 0.0) / efficiency;
+  }
+
+  void Rhs(double, const double* y, double* ydot) override { Evaluate(y, ydot); }
+
+  // ∂f/∂y: the generated Jacobian for the arm block at the held inputs, plus forward
+  // differences of what the generated code does not see: the resistance's dependence on the
+  // arm and vehicle speeds and positions (through the external torques), the drive, steering
+  // and energy rows. Those are a handful of cheap columns; the hydraulic block, where the
+  // stiffness is, stays exact.
+  void Jacobian(double, const double* y, double* jacobian) override {
+    const int n = layout_.size(), arm = layout_.arm, J = layout_.joints;
+    std::fill(jacobian, jacobian + static_cast<std::size_t>(n) * n, 0.0);
+    FillArmInputs(y);
+    functions_.plant_jacobian(0.0, y, u_.data(), arm_jacobian_.data());
+    for (int r = 0; r < arm; ++r) {
+      for (int c = 0; c < arm; ++c) jacobian[c * n + r] = arm_jacobian_[r * arm + c];
+    }
+    base_.resize(n);
+    probe_.resize(n);
+    work_.assign(y, y + n);
+    const std::vector<double> u_fixed = u_;
+    Residual(work_.data(), u_fixed, base_.data());
+    columns_.clear();
+    for (int j = 0; j < 2 * J; ++j) columns_.push_back(j);  // q, q̇
+    for (int c = layout_.speed(); c <= layout_.articulation(); ++c) columns_.push_back(c);
+    for (int c : columns_) {
+      const double h = 1e-7 * std::max(1.0, std::abs(y[c]));
+      work_[c] = y[c] + h;
+      Residual(work_.data(), u_fixed, probe_.data());
+      work_[c] = y[c];
+      for (int r = 0; r < n; ++r) jacobian[c * n + r] += (probe_[r] - base_[r]) / h;
+    }
+  }
+
+  int actuator_of_joint(int j) const { return actuator_of_joint_[j]; }
+  void set_actuator_of_joint(std::vector<int> map) { actuator_of_joint_ = std::move(map); }
+
+ private:
+  // The part of f the generated Jacobian does not cover: arm rows f(x, u(y)) − f(x, u_fixed),
+  // all other rows in full.
+  void Residual(const double* y, const std::vector<double>& u_fixed, double* r) {
+    Evaluate(y, r);
+    functions_.plant_rhs(0.0, y, u_fixed.data(), arm_rhs_.data());
+    for (int i = 0; i < layout_.arm; ++i) r[i] -= arm_rhs_[i];
+  }
+
+  const model::MachineDescription& machine_;
+  const generated::MachineFunctions& functions_;
+  const PlantOptions& options_;
+  Layout layout_;
+  Held held_;
+  bool is_loader_ = true;
+  std::vector<int> actuator_of_joint_;
+  std::vector<double> u_, arm_rhs_, arm_jacobian_, base_, probe_, work_;
+  std::vector<int> columns_;
+  std::vector<Eigen::Vector2d> origins_;
+  std::vector<double> angles_;
+};
+
+Plant::Plant(const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+             World& world, const MachineState& initial, const PlantOptions& options)
+    : machine_(machine), functions_(functions), world_(world), options_(options) {
+  if (machine.name != functions.name || machine.sha256 != functions.source_sha256) {
+    throw std::invalid_argument("Plant: generated code of '" + std::string(functions.name) +
+                                "' does not match description '" + machine.name +
+                                "' (regenerate: cmake --build build --target regen)");
+  }
+  system_ = std::make_unique<System>(machine, functions, options_);
+  const Layout& layout = system_->layout();
+  const int J = layout.joints;
+  std::vector<int> actuator_of_joint(J, -1);
+  for (int a = 0; a < functions.num_actuators; ++a) {
+    actuator_of_joint[functions.actuator_joint[a]] = a;
+  }
+  system_->set_actuator_of_joint(actuator_of_joint);
+  for (const model::Actuator& act : machine.hydraulics.actuators) {
+    valves_.emplace_back(act.valve.dead_zone, act.valve.transport_delay);
+  }
+  command_.valve.assign(machine.hydraulics.actuators.size(), 0.0);
+  // The margin of a load-sensing system equals the drop at which its valves are rated, so a
+  // fully open spool passes its rated flow.
+  for (const model::Actuator& act : machine.hydraulics.actuators) {
+    load_sensing_margin_ = std::max(load_sensing_margin_, act.valve.rated_pressure_drop);
+  }
+
+  if (options_.integrator.absolute_tolerance.size() != static_cast<std::size_t>(layout.size())) {
+    // Scales: 1e-7 rad, 1e-6 rad/s, 1e-6 spool, 10 Pa, 1e-6 m/s and m, 1 J.
+    std::vector<double>& atol = options_.integrator.absolute_tolerance;
+    atol.assign(layout.size(), 1e-6);
+    for (int j = 0; j < J; ++j) {
+      atol[j] = 1e-7;
+      atol[3 * J + j] = atol[4 * J + j] = 10.0;
+    }
+    atol[layout.heading()] = atol[layout.articulation()] = 1e-7;
+    atol[layout.travel_energy()] = atol[layout.hydraulic_energy()] = 1.0;
+  }
+  integrator_ = std::make_unique<OdeIntegrator>(*system_, options_.integrator);
+  bucket_terrain_ = std::make_unique<BucketTerrain>(machine.bucket, world_);
+
+  y_.assign(layout.size(), 0.0);
+  if (static_cast<int>(initial.q.size()) != J) {
+    throw std::invalid_argument("Plant: initial state has " + std::to_string(initial.q.size()) +
+                                " joints, machine '" + machine.name + "' has " + std::to_string(J));
+  }
+  // Start in static balance: each cylinder's rod side at a back pressure, its cap side at the
+  // pressure that holds the arm against gravity (or the other way round for a cylinder that
+  // must pull); motors at the back pressure on both ports.
+  const model::InterpretedModel reference(machine);
+  const std::vector<double> gravity = reference.GravityTorques(initial.q.data(), 0.0, 0.0);
+  const double tank = machine.hydraulics.tank_pressure;
+  const double back = tank + 1e6;
+  for (int j = 0; j < J; ++j) {
+    y_[j] = initial.q[j];
+    y_[3 * J + j] = y_[4 * J + j] = back;
+    const int a = actuator_of_joint[j];
+    const model::Actuator& act = machine.hydraulics.actuators[a];
+    if (act.kind != model::ActuatorKind::kCylinder) continue;
+    const double lever = functions.lever_arm(a, initial.q.data());
+    const double area_a = act.count * std::numbers::pi / 4 * act.bore * act.bore;
+    const double area_b =
+        act.count * std::numbers::pi / 4 * (act.bore * act.bore - act.rod * act.rod);
+    const double force = std::abs(lever) > 1e-6 ? -gravity[j] / lever : 0.0;
+    double p_a = (force + back * area_b) / area_a, p_b = back;
+    if (p_a < back) p_a = back, p_b = (back * area_a - force) / area_b;
+    y_[3 * J + j] = std::clamp(p_a, tank, act.relief_pressure);
+    y_[4 * J + j] = std::clamp(p_b, tank, act.relief_pressure);
+  }
+  y_[layout.x()] = initial.hinge_xy.x();
+  y_[layout.y()] = initial.hinge_xy.y();
+  y_[layout.heading()] = initial.heading;
+  y_[layout.articulation()] = initial.articulation;
+  state_.time = 0;
+  LoadSensing(system_->held().spool_reference, system_->held().section_supply,
+              system_->held().pump_pressure);
+  integrator_->Reset(0.0, y_.data());
+  dirty_ = false;
+  UpdateState();
+  UpdateResistance();
+}
+
+Plant::~Plant() = default;
+
+bool Plant::SetCommand(const core::ActuatorCommand& command, std::string* why) {
+  auto refuse = [&](const std::string& reason) {
+    ++counters_.refused_commands;
+    if (why) *why = reason;
+    return false;
+  };
+  if (command.valve.size() != valves_.size()) {
+    return refuse("expected " + std::to_string(valves_.size()) + " valve commands, got " +
+                  std::to_string(command.valve.size()));
+  }
+  for (std::size_t a = 0; a < command.valve.size(); ++a) {
+    const double u = command.valve[a];
+    if (!std::isfinite(u) || u < -1.0 || u > 1.0) {
+      return refuse("valve command of actuator '" + machine_.hydraulics.actuators[a].name +
+                    "' must be a finite number in [-1, 1], got " + std::to_string(u));
+    }
+  }
+  if (!std::isfinite(command.drive) || command.drive < -1.0 || command.drive > 1.0) {
+    return refuse("drive command must be in [-1, 1], got " + std::to_string(command.drive));
+  }
+  if (!std::isfinite(command.brake) || command.brake < 0.0 || command.brake > 1.0) {
+    return refuse("brake command must be in [0, 1], got " + std::to_string(command.brake));
+  }
+  if (!std::isfinite(command.articulation_rate)) {
+    return refuse("articulation rate must be finite");
+  }
+  command_ = command;
+  for (std::size_t a = 0; a < valves_.size(); ++a) valves_[a].Command(time(), command.valve[a]);
+  return true;
+}
+
+void Plant::SetPhase(const std::string& phase) { phase_ = phase; }
+
+Energy Plant::energy() const {
+  const Layout& layout = system_->layout();
+  return {y_[layout.travel_energy()], y_[layout.hydraulic_energy()]};
+}
+
+void Plant::SetTransportDelay(int actuator, double delay) {
+  valves_.at(actuator).set_transport_delay(delay);
+}
+
+void Plant::Advance(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw std::invalid_argument("Plant::Advance: dt must be > 0");
+  const Layout& layout = system_->layout();
+  const Energy before = energy();
+  double t = time();
+  const double t_end = t + dt;
+
+  System::Held held = system_->held();
+  held.drive = command_.drive;
+  held.brake = command_.brake;
+  // Steering cylinders stop at the articulation limit: the rate is cut so as to reach it exactly.
+  if (machine_.kind == model::MachineKind::kWheelLoader) {
+    const double limit = machine_.chassis.max_articulation;
+    const double rate_limit = machine_.chassis.max_articulation_rate;
+    double rate = std::clamp(command_.articulation_rate, -rate_limit, rate_limit);
+    const double gamma = y_[layout.articulation()];
+    if (gamma + rate * dt > limit) rate = std::max(0.0, (limit - gamma) / dt);
+    if (gamma + rate * dt < -limit) rate = std::min(0.0, (-limit - gamma) / dt);
+    held.articulation_rate = rate;
+  }
+  held.payload = bucket_terrain_->payload_mass();
+  held.resistance = resistance_;
+
+  while (t < t_end) {
+    double t_next = t_end;
+    for (const auto& valve : valves_) t_next = std::min(t_next, valve.NextSwitchAfter(t));
+    for (int a = 0; a < static_cast<int>(valves_.size()); ++a) {
+      held.spool_reference[functions_.actuator_joint[a]] = valves_[a].EffectiveAt(t);
+    }
+    LoadSensing(held.spool_reference, held.section_supply, held.pump_pressure);
+    const bool event = held.IsEventAgainst(system_->held()) || dirty_;
+    system_->held() = held;
+    if (event) {
+      integrator_->Reset(t, y_.data());
+      ++counters_.resets;
+      dirty_ = false;
+    }
+    integrator_->AdvanceTo(t_next, y_.data());
+    t = t_next;
+  }
+  for (auto& valve : valves_) valve.Prune(t_end);
+  state_.time = t_end;
+  ++counters_.ticks;
+  counters_.steps = integrator_->steps();
+  counters_.rhs_evaluations = integrator_->rhs_evaluations();
+  counters_.jacobian_evaluations = integrator_->jacobian_evaluations();
+
+  const Energy after = energy();
+  Energy& booked = phase_energy_[phase_];
+  booked.travel += after.travel - before.travel;
+  booked.hydraulic += after.hydraulic - before.hydraulic;
+
+  // Terrain exchange between ticks (a contact change resets the integrator at the next tick).
+  UpdateState();
+  const BucketPlacement placement = CurrentBucketPlacement();
+  const ExchangeResult exchange = bucket_terrain_->Exchange(placement);
+  terrain_unsettled_ |= exchange.captured_volume > 0 || exchange.spilled_volume > 0;
+  // Relax only where and when the bucket changed the terrain: elsewhere it stays at repose.
+  if (terrain_unsettled_ && t_end - last_relax_time_ >= options_.relax_period - 1e-12) {
+    const double moved = bucket_terrain_->RelaxToRepose(placement.ToWorldXy(placement.pivot.x()),
+                                                        options_.relax_half_window);
+    terrain_unsettled_ = moved > 0;
+    last_relax_time_ = t_end;
+  }
+  UpdateResistance();
+  state_.payload_mass = bucket_terrain_->payload_mass();
+  state_.payload_volume = bucket_terrain_->payload_volume();
+}
+
+void Plant::LoadSensing(const std::vector<double>& spool_reference,
+                        std::vector<double>& section_supply, double& pump_pressure) const {
+  // Pressure-compensated load sensing: each valve section's compensator keeps the drop across
+  // its spool at the margin, so it is supplied at (pressure of the chamber it feeds + margin);
+  // the pump follows the highest such demand, up to its maximum. A section whose demand exceeds
+  // the maximum gets no flow (its load check valve closes: supply = load). Held over a segment:
+  // a real pump and compensator respond in tens of milliseconds, a control tick is 10 ms.
+  const int J = static_cast<int>(spool_reference.size());
+  const model::Hydraulics& hyd = machine_.hydraulics;
+  section_supply.assign(J, 0.0);
+  pump_pressure = hyd.tank_pressure + load_sensing_margin_;  // standby
+  for (int j = 0; j < J; ++j) {
+    const double xs = y_[2 * J + j];
+    const double opening = spool_reference[j] != 0 ? spool_reference[j] : xs;
+    const double fed = opening >= 0 ? y_[3 * J + j] : y_[4 * J + j];
+    const double demand = fed + load_sensing_margin_;
+    double supply = demand <= hyd.pump_pressure ? demand : std::max(fed, hyd.tank_pressure);
+    // A compensator does not chase every pascal: within its dead band (kCompensatorBand) the
+    // previous supply is kept, which also spares the integrator a reset at every tick.
+    const std::vector<double>& previous = system_->held().section_supply;
+    if (static_cast<int>(previous.size()) == J &&
+        std::abs(previous[j] - supply) < kCompensatorBand) {
+      supply = previous[j];
+    }
+    section_supply[j] = supply;
+    if (std::abs(opening) > 0.01) pump_pressure = std::max(pump_pressure, section_supply[j]);
+  }
+  pump_pressure = std::min(pump_pressure, hyd.pump_pressure);
+}
+
+void Plant::UpdateState() {
+  const Layout& layout = system_->layout();
+  const int J = layout.joints;
+  state_.q.assign(y_.begin(), y_.begin() + J);
+  state_.qd.assign(y_.begin() + J, y_.begin() + 2 * J);
+  state_.spool.assign(y_.begin() + 2 * J, y_.begin() + 3 * J);
+  state_.pressure_a.assign(y_.begin() + 3 * J, y_.begin() + 4 * J);
+  state_.pressure_b.assign(y_.begin() + 4 * J, y_.begin() + 5 * J);
+  state_.hinge_xy = Eigen::Vector2d(y_[layout.x()], y_[layout.y()]);
+  state_.heading = y_[layout.heading()];
+  state_.articulation = y_[layout.articulation()];
+  state_.speed = y_[layout.speed()];
+  state_.wheel_speed = y_[layout.wheel()];
+  const double wheel_surface_speed = state_.wheel_speed * machine_.chassis.wheel_radius;
+  state_.wheel_slip = (wheel_surface_speed - state_.speed) /
+                      std::max({std::abs(state_.speed), std::abs(wheel_surface_speed), 0.1});
+  state_.payload_mass = bucket_terrain_->payload_mass();
+  state_.payload_volume = bucket_terrain_->payload_volume();
+}
+
+BucketPlacement Plant::CurrentBucketPlacement() const {
+  std::vector<Eigen::Vector2d> origins;
+  std::vector<double> angles;
+  ArmGeometry(machine_, state_.q.data(), origins, angles);
+  const int n = static_cast<int>(machine_.links.size());
+  BucketPlacement placement;
+  placement.plane_origin = state_.hinge_xy;
+  placement.plane_heading = state_.heading;
+  if (machine_.swing) placement.plane_heading += state_.q.back();
+  placement.pivot = machine_.arm_pivot + origins[n - 1];
+  placement.bucket_angle = angles[n - 1];
+  return placement;
+}
+
+Eigen::Vector3d Plant::TipInWorld() const {
+  const BucketPlacement placement = CurrentBucketPlacement();
+  const Eigen::Vector2d tip = placement.ToPlane(machine_.bucket.profile.front());
+  const Eigen::Vector2d xy = placement.ToWorldXy(tip.x());
+  return {xy.x(), xy.y(), tip.y()};
+}
+
+void Plant::UpdateResistance() {
+  const BucketPlacement placement = CurrentBucketPlacement();
+  const BucketContact contact = bucket_terrain_->Contact(placement);
+  ResistanceState next;
+  if (contact.in_contact) {
+    const model::Material& material = world_.materials.at(contact.material);
+    const double unit_weight = material.density * model::plant::kGravity;
+    // Which way the cutting edge points along the arm plane: from the bucket's interior (the
+    // middle of its opening) to the tip.
+    const Eigen::Vector2d middle = 0.5 * (contact.tip + contact.rim);
+    next.cut_side = contact.tip.x() >= middle.x() - 1e-9 ? 1.0 : -1.0;
+    // Rake angle: between the backward travel direction (−c along s) and the blade, here the
+    // bucket's opening from the cutting edge to the top of the back wall (material in the
+    // bucket acts as part of the tool once it has filled, so the opening, not the floor, is
+    // the blade).
+    const Eigen::Vector2d blade = contact.rim - contact.tip;
+    next.rake_angle = std::acos(std::clamp(-next.cut_side * blade.x() / blade.norm(), -1.0, 1.0));
+    // Blade height: the opening's rise above the edge; the material above it is surcharge.
+    const double blade_height = std::max(0.3, blade.y());
+    const double cut_depth = std::min(contact.depth, blade_height);
+    CuttingInput input;
+    input.width = machine_.bucket.width;
+    input.depth = cut_depth;
+    input.rake_angle = next.rake_angle;
+    input.density = material.density;
+    input.cohesion = material.cohesion;
+    input.adhesion = options_.adhesion_fraction * material.cohesion;
+    input.surcharge = unit_weight * std::max(0.0, contact.depth - blade_height);
+    input.friction_angle = material.friction_angle;
+    input.interface_angle = material.interface_friction_angle;
+    const CuttingResistance cutting = ComputeCuttingResistance(input);
+    next.cut = cutting.along;
+    next.press = cutting.across;
+    // Lifting: shear on the two side planes of the column (depth d, length of the opening)
+    // under at-rest pressure, plus cohesion on them.
+    const double d = contact.depth;
+    const double k0 = 1.0 - std::sin(material.friction_angle);
+    const double length = std::abs(blade.x()) + 0.1;
+    next.lift = 2.0 * length *
+                (0.5 * k0 * unit_weight * d * d * std::tan(material.friction_angle) +
+                 material.cohesion * d);
+    // Withdrawing: soil–steel friction under the weight of the column over the opening.
+    next.withdraw = std::tan(material.interface_friction_angle) * unit_weight * d * length *
+                    machine_.bucket.width;
+    next.in_contact = true;
+    next.depth = contact.depth;
+    next.material = contact.material;
+  }
+  resistance_ = next;
+}
+
+double Plant::ActuatorPressure(int actuator, bool cap_side) const {
+  const int joint = functions_.actuator_joint[actuator];
+  return cap_side ? state_.pressure_a[joint] : state_.pressure_b[joint];
+}
+
+double Plant::HydraulicPower() const {
+  std::vector<double> ydot(y_.size());
+  System::Outputs out = system_->Evaluate(y_.data(), ydot.data());
+  return out.hydraulic_power;
+}
+
+double Plant::TravelPower() const {
+  std::vector<double> ydot(y_.size());
+  system_->Evaluate(y_.data(), ydot.data());
+  return ydot[system_->layout().travel_energy()];
+}
+
+std::vector<OrientedBox> Plant::OwnBodies() const {
+  std::vector<OrientedBox> boxes;
+  const Eigen::Isometry3d T_world_base = state_.T_world_base();
+  auto add = [&](const std::string& name, const Eigen::Vector3d& center_base,
+                 const Eigen::Vector3d& half, double yaw_base,
+                 const Eigen::Isometry3d& T_world_body) {
+    OrientedBox box;
+    box.name = name;
+    box.center = T_world_body * center_base;
+    box.half_extents = half;
+    box.yaw = state_.heading + yaw_base;
+    box.semantic_class = core::SemanticClass::kOwnLoader;
+    box.reflectivity = 0.5;
+    boxes.push_back(box);
+  };
+  if (machine_.kind == model::MachineKind::kWheelLoader) {
+    const double lf = machine_.chassis.hinge_to_front_axle;
+    const double lr = machine_.chassis.hinge_to_rear_axle;
+    const double half_track = machine_.chassis.track_width / 2 + 0.3;
+    const double r = machine_.chassis.wheel_radius;
+    add("front_frame", {lf / 2 + 0.2, 0, r + 0.2}, {lf / 2 + 0.6, half_track, r + 0.2}, 0,
+        T_world_base);
+    add("rear_frame", {-lr / 2 - 0.8, 0, r + 0.6}, {lr / 2 + 1.2, half_track, r + 0.6},
+        -state_.articulation, state_.T_world_cab());
+  }
+  // Boom and bucket: boxes along the links in the arm plane (a box turned only about z stands for
+  // each short piece of an inclined link).
+  std::vector<Eigen::Vector2d> origins;
+  std::vector<double> angles;
+  ArmGeometry(machine_, state_.q.data(), origins, angles);
+  const double swing = machine_.swing ? state_.q.back() : 0.0;
+  Eigen::Isometry3d T_world_arm = T_world_base;
+  T_world_arm.rotate(Eigen::AngleAxisd(swing, Eigen::Vector3d::UnitZ()));
+  const int n = static_cast<int>(machine_.links.size());
+  for (int k = 0; k < n; ++k) {
+    const int pieces = std::max(1, static_cast<int>(std::ceil(machine_.links[k].length / 0.5)));
+    const bool is_bucket = k == n - 1;
+    const double half_width = is_bucket ? machine_.bucket.width / 2 : 0.4;
+    for (int p = 0; p < pieces; ++p) {
+      const double f = (p + 0.5) / pieces;
+      const Eigen::Vector2d c = machine_.arm_pivot + origins[k] + f * (origins[k + 1] - origins[k]);
+      const double piece = machine_.links[k].length / pieces;
+      const double dx = std::abs(std::cos(angles[k])) * piece / 2 + 0.15;
+      const double dz = std::abs(std::sin(angles[k])) * piece / 2 + 0.15;
+      add(machine_.links[k].name + "_" + std::to_string(p), {c.x(), 0, c.y()}, {dx, half_width, dz},
+          swing, T_world_arm);
+    }
+  }
+  return boxes;
+}
+
+}  // namespace autoshovel::plant

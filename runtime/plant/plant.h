@@ -1,0 +1,171 @@
+// The simulated machine: the generated hydraulic–mechanical arm model, the drive, the bucket–
+// terrain interaction and the energy counters, integrated by CVODE between control ticks.
+//
+// State y = [arm x (5J: q, q̇, spool, p_A, p_B, see interpreted_model.h) | v, ω, throttle,
+// x_hinge, y_hinge, ψ, γ, E_travel, E_hydraulic]. Per segment (between two discrete events) the
+// inputs are held: spool references (after dead zone and transport delay), drive command, brake,
+// articulation rate, payload mass and the magnitudes of the material's resistance. Inside the
+// segment the resistance follows the bucket tip velocity v = (v_s, v_z) in the arm plane, each
+// component through a smooth sign v/sqrt(v² + ε²), so that it acts like Coulomb friction that
+// never pushes the bucket backwards:
+//   F_s = −σ(c v_s)·c·(R_cut if cutting else R_withdraw)      c = ±1: the cutting edge's side
+//   F_z = −σ(v_z)·(R_lift if rising else R_cut) − R_press·max(σ(c v_s), 0)
+// R_cut and R_press are Reece's equation (earthmoving.h) for the cut ahead of the edge: the blade
+// height is the bucket's opening and the material above it a surcharge. Lifting through the
+// pile meets the shear on the two vertical planes bounding the column above the bucket (at-rest
+// pressure K₀ = 1 − sin φ, Jaky) plus cohesion; the weight of the material taken is the
+// payload. Withdrawing meets only soil–steel friction on the material's weight over the bucket.
+// The force acts on the arm through the tip Jacobian (τ = Jᵀ F) and on the chassis as a
+// longitudinal force and a vertical load.
+//
+// The hydraulics are pressure-compensated load sensing: each valve section is supplied at the
+// pressure of the chamber it feeds plus a margin (the valves' rated drop), so a spool passes
+// flow in proportion to its opening whatever the other loads; the pump runs at the highest such
+// demand, within its maximum. Section supplies are inputs of the generated model, held per
+// segment. Hydraulic energy is p_pump·ΣQ_in/η (compensator losses included).
+//
+// Events that reset the integrator: a valve command reaching its spool (exactly τ_d after it was
+// issued, see valve_command.h), any change of the held inputs at a control tick (command, payload,
+// contact). The terrain is changed between ticks only (bucket_terrain.h), never inside a segment.
+//
+// Articulated steering (loaders): the hinge moves so that neither axle slips sideways,
+//   ψ̇ = (v sin γ + l_r γ̇) / (l_f cos γ + l_r),  ḣ = v e_f − l_f ψ̇ n_f
+// with v the front axle speed, e_f/n_f the front frame's axis and normal, l_f/l_r the hinge-to-
+// axle distances (Corke & Ridley, "Steering kinematics for a center-articulated mobile robot",
+// IEEE T-RA 17(2), 2001). Excavators do not travel in this plant: the undercarriage stands still.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "generated/machine_functions.h"
+#include "runtime/core/actuator_command.h"
+#include "runtime/model/description.h"
+#include "runtime/plant/bucket_terrain.h"
+#include "runtime/plant/drive.h"
+#include "runtime/plant/machine_state.h"
+#include "runtime/plant/ode_integrator.h"
+#include "runtime/plant/valve_command.h"
+#include "runtime/plant/world.h"
+
+namespace autoshovel::plant {
+
+struct PlantOptions {
+  IntegratorOptions integrator{.relative_tolerance = 1e-6, .absolute_tolerance = {}};
+  DriveConstants drive;
+  /// How often the terrain relaxes to its angle of repose around the bucket [s].
+  double relax_period = 0.1;
+  double relax_half_window = 1.5;  ///< beyond the bucket pivot's foot [m]
+  /// Tip speed below which the cutting resistance fades (its smooth sign) [m/s].
+  double resistance_speed = 0.05;
+  /// Soil–steel adhesion as a fraction of cohesion (no material file gives it) [-].
+  double adhesion_fraction = 0.5;
+};
+
+/// Energy in J, cumulative.
+struct Energy {
+  double travel = 0;     ///< ∫ max(T_wheel ω, 0) dt / η_drive
+  double hydraulic = 0;  ///< ∫ p_supply Σ Q_in dt / η_pump
+  double total() const { return travel + hydraulic; }
+};
+
+/// The resistance the bucket meets, evaluated at the last tick (see the model above).
+struct ResistanceState {
+  bool in_contact = false;
+  double depth = 0;       ///< free surface above the cutting edge [m]
+  double rake_angle = 0;  ///< [rad]
+  double cut = 0;         ///< R_cut [N]
+  double press = 0;       ///< R_press [N]
+  double lift = 0;        ///< R_lift [N]
+  double withdraw = 0;    ///< R_withdraw [N]
+  double cut_side = 1;  ///< c: +1 when the edge points along +s (loader), −1 towards the machine
+  int material = -1;
+};
+
+/// Counts of what the plant refused or did.
+struct PlantCounters {
+  long refused_commands = 0;  ///< NaN, infinite or out-of-range commands (never integrated)
+  long ticks = 0;
+  long resets = 0;                ///< integrator re-initialisations (discrete events)
+  long steps = 0;                 ///< CVODE internal steps
+  long rhs_evaluations = 0;       ///< right-hand side evaluations by CVODE
+  long jacobian_evaluations = 0;  ///< Jacobian evaluations
+};
+
+class Plant {
+ public:
+  /// `functions` must be the generated code of `machine` (same name and hash). `world` is shared
+  /// with the sensors and changed by digging. `initial` gives pose and joint positions; spools,
+  /// pressures start in static balance, spools centred, at rest.
+  Plant(const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+        World& world, const MachineState& initial, const PlantOptions& options = {});
+  ~Plant();
+
+  /// Applies a command at the current time. A command with a NaN, an infinity or a value out of
+  /// range is refused whole (the previous one stays in force), counted, and false is returned
+  /// with the reason in `why` if given.
+  bool SetCommand(const core::ActuatorCommand& command, std::string* why = nullptr);
+
+  /// Advances the simulated clock by `dt` (one control tick).
+  void Advance(double dt);
+
+  /// Names the phase the following energy is booked to ("travel", "crowd", "scoop", …).
+  void SetPhase(const std::string& phase);
+  const std::map<std::string, Energy>& phase_energy() const { return phase_energy_; }
+  Energy energy() const;
+
+  const MachineState& state() const { return state_; }
+  double time() const { return state_.time; }
+  const ResistanceState& resistance() const { return resistance_; }
+  const PlantCounters& counters() const { return counters_; }
+  const BucketTerrain& bucket() const { return *bucket_terrain_; }
+  World& world() { return world_; }
+  const model::MachineDescription& machine() const { return machine_; }
+
+  /// Cap-side (A) and rod-side (B) pressure of an actuator [Pa]: the boom cylinder pressure that
+  /// the pressure-triggered baseline reads.
+  double ActuatorPressure(int actuator, bool cap_side = true) const;
+  /// Hydraulic power drawn now [W] and wheel power now [W] (for tests of the energy integral).
+  double HydraulicPower() const;
+  double TravelPower() const;
+  /// Where the bucket is now.
+  BucketPlacement CurrentBucketPlacement() const;
+  /// Bucket tip in the world [m].
+  Eigen::Vector3d TipInWorld() const;
+  /// Boxes approximating the machine's own body (chassis, boom, bucket) in the world, for the
+  /// simulated sensors (semantic class kOwnLoader).
+  std::vector<OrientedBox> OwnBodies() const;
+  /// Changes the transport delay of an actuator at run time (fault injection: delay drift).
+  void SetTransportDelay(int actuator, double delay);
+
+ private:
+  class System;
+  void UpdateState();
+  void UpdateResistance();
+  void LoadSensing(const std::vector<double>& spool_reference, std::vector<double>& section_supply,
+                   double& pump_pressure) const;
+
+  const model::MachineDescription& machine_;
+  const generated::MachineFunctions& functions_;
+  World& world_;
+  PlantOptions options_;
+  std::unique_ptr<System> system_;
+  std::unique_ptr<OdeIntegrator> integrator_;
+  std::unique_ptr<BucketTerrain> bucket_terrain_;
+  std::vector<DelayedValveCommand> valves_;  ///< per actuator
+  std::vector<double> y_;
+  MachineState state_;
+  ResistanceState resistance_;
+  PlantCounters counters_;
+  core::ActuatorCommand command_;
+  std::string phase_ = "idle";
+  std::map<std::string, Energy> phase_energy_;
+  double last_relax_time_ = 0;
+  double load_sensing_margin_ = 0;
+  bool terrain_unsettled_ = true;
+  bool dirty_ = true;
+};
+
+}  // namespace autoshovel::plant

@@ -1,0 +1,369 @@
+#include "runtime/sensors/raycast.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace autoshovel::sensors {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr float kNoSurface = -std::numeric_limits<float>::infinity();
+
+// A height rounded up to float, so that the pyramid never claims a cell lower than it is.
+float RoundUp(double h) {
+  float f = static_cast<float>(h);
+  if (static_cast<double>(f) < h) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+// Slab test in the frame of a box turned by yaw (cos c, sin s) about world z.
+bool SlabTest(const Eigen::Vector3d& center, const Eigen::Vector3d& half, double c, double s,
+              const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double max_range,
+              double& range, Eigen::Vector3d& normal) {
+  const Eigen::Vector3d v = origin - center;
+  const Eigen::Vector3d o(c * v.x() + s * v.y(), -s * v.x() + c * v.y(), v.z());
+  const Eigen::Vector3d d(c * direction.x() + s * direction.y(),
+                          -s * direction.x() + c * direction.y(), direction.z());
+  double t_near = -kInf, t_far = kInf;
+  int axis = -1;
+  double sign = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (std::abs(o[i]) > half[i]) return false;
+      continue;
+    }
+    const double inv = 1.0 / d[i];
+    double t1 = (-half[i] - o[i]) * inv;
+    double t2 = (half[i] - o[i]) * inv;
+    if (t1 > t2) std::swap(t1, t2);
+    if (t1 > t_near) {
+      t_near = t1;
+      axis = i;
+      sign = d[i] > 0 ? -1.0 : 1.0;  // entering through the face facing the ray
+    }
+    t_far = std::min(t_far, t2);
+  }
+  if (axis < 0 || t_near > t_far || t_near < 0 || t_near > max_range) return false;
+  range = t_near;
+  Eigen::Vector3d n_local = Eigen::Vector3d::Zero();
+  n_local[axis] = sign;
+  normal = Eigen::Vector3d(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y(),
+                           n_local.z());
+  return true;
+}
+
+// Restricts [t_lo, t_hi] to the t where p0 + d·t lies in [lo, hi].
+bool ClipSlab(double p0, double d, double lo, double hi, double& t_lo, double& t_hi) {
+  if (d == 0.0) return p0 >= lo && p0 <= hi;
+  double ta = (lo - p0) / d, tb = (hi - p0) / d;
+  if (ta > tb) std::swap(ta, tb);
+  t_lo = std::max(t_lo, ta);
+  t_hi = std::min(t_hi, tb);
+  return t_lo <= t_hi;
+}
+
+}  // namespace
+
+bool IntersectBox(const plant::OrientedBox& box, const Eigen::Vector3d& origin,
+                  const Eigen::Vector3d& direction, double max_range, double& range,
+                  Eigen::Vector3d& normal) {
+  return SlabTest(box.center, box.half_extents, std::cos(box.yaw), std::sin(box.yaw), origin,
+                  direction, max_range, range, normal);
+}
+
+RaycastScene::RaycastScene(const plant::World& world, std::vector<plant::OrientedBox> extra_boxes)
+    : world_(&world), extra_boxes_(std::move(extra_boxes)) {
+  Update();
+}
+
+void RaycastScene::Update() {
+  BuildPyramid();
+  UpdateBoxes();
+}
+
+void RaycastScene::SetExtraBoxes(std::vector<plant::OrientedBox> extra_boxes) {
+  extra_boxes_ = std::move(extra_boxes);
+  UpdateBoxes();
+}
+
+void RaycastScene::UpdateBoxes() {
+  boxes_ = world_->obstacles;
+  boxes_.insert(boxes_.end(), extra_boxes_.begin(), extra_boxes_.end());
+  prepared_.clear();
+  prepared_.reserve(boxes_.size());
+  for (const auto& b : boxes_) {
+    PreparedBox p;
+    p.center = b.center;
+    p.half = b.half_extents.cwiseAbs();
+    p.c = std::cos(b.yaw);
+    p.s = std::sin(b.yaw);
+    p.radius = p.half.norm();
+    prepared_.push_back(p);
+  }
+}
+
+float RaycastScene::PatchMax(int px, int py) const {
+  // Patch (px, py) spans the cell centres of cells px−1..px and py−1..py (clamped at the border,
+  // which extends the surface flat over the outer half cells).
+  const plant::Terrain& t = world_->terrain;
+  const int x0 = std::max(px - 1, 0), x1 = std::min(px, grid_nx_ - 1);
+  const int y0 = std::max(py - 1, 0), y1 = std::min(py, grid_ny_ - 1);
+  const double m = std::max(std::max(t.height(x0, y0), t.height(x1, y0)),
+                            std::max(t.height(x0, y1), t.height(x1, y1)));
+  return RoundUp(m);
+}
+
+void RaycastScene::BuildPyramid() {
+  const plant::Terrain& t = world_->terrain;
+  grid_nx_ = t.nx();
+  grid_ny_ = t.ny();
+  levels_.clear();
+  if (grid_nx_ <= 0 || grid_ny_ <= 0) return;
+  Level base;
+  base.nx = grid_nx_ + 1;
+  base.ny = grid_ny_ + 1;
+  base.max.resize(static_cast<std::size_t>(base.nx) * base.ny);
+  levels_.push_back(std::move(base));
+  while (levels_.back().nx > 1 || levels_.back().ny > 1) {
+    Level next;
+    next.nx = (levels_.back().nx + 1) / 2;
+    next.ny = (levels_.back().ny + 1) / 2;
+    next.max.resize(static_cast<std::size_t>(next.nx) * next.ny);
+    levels_.push_back(std::move(next));
+  }
+  RefreshLevels(0, 0, grid_nx_, grid_ny_);
+}
+
+void RaycastScene::RefreshLevels(int px0, int py0, int px1, int py1) {
+  Level& base = levels_[0];
+  for (int py = py0; py <= py1; ++py) {
+    for (int px = px0; px <= px1; ++px) base.max[py * base.nx + px] = PatchMax(px, py);
+  }
+  for (std::size_t l = 1; l < levels_.size(); ++l) {
+    const Level& child = levels_[l - 1];
+    Level& parent = levels_[l];
+    px0 >>= 1, py0 >>= 1, px1 >>= 1, py1 >>= 1;
+    for (int py = py0; py <= py1; ++py) {
+      for (int px = px0; px <= px1; ++px) {
+        float m = kNoSurface;
+        for (int cy = 2 * py; cy <= std::min(2 * py + 1, child.ny - 1); ++cy) {
+          for (int cx = 2 * px; cx <= std::min(2 * px + 1, child.nx - 1); ++cx) {
+            m = std::max(m, child.max[cy * child.nx + cx]);
+          }
+        }
+        parent.max[py * parent.nx + px] = m;
+      }
+    }
+  }
+}
+
+void RaycastScene::UpdateTerrain(int ix0, int iy0, int ix1, int iy1) {
+  const plant::Terrain& t = world_->terrain;
+  if (t.nx() != grid_nx_ || t.ny() != grid_ny_ || levels_.empty()) {
+    BuildPyramid();
+    return;
+  }
+  ix0 = std::clamp(ix0, 0, grid_nx_ - 1), ix1 = std::clamp(ix1, 0, grid_nx_ - 1);
+  iy0 = std::clamp(iy0, 0, grid_ny_ - 1), iy1 = std::clamp(iy1, 0, grid_ny_ - 1);
+  if (ix0 > ix1 || iy0 > iy1) return;
+  // Cell i is a corner of patches i and i + 1.
+  RefreshLevels(ix0, iy0, ix1 + 1, iy1 + 1);
+}
+
+double RaycastScene::max_terrain_height() const {
+  return levels_.empty() ? -kInf : static_cast<double>(levels_.back().max[0]);
+}
+
+bool RaycastScene::IntersectPatch(int px, int py, double u0, double v0, double z0, double du,
+                                  double dv, double dz, double t_in, double t_out, double& t_hit,
+                                  double& a_hit, double& b_hit) const {
+  const plant::Terrain& t = world_->terrain;
+  const int x0 = std::max(px - 1, 0), x1 = std::min(px, grid_nx_ - 1);
+  const int y0 = std::max(py - 1, 0), y1 = std::min(py, grid_ny_ - 1);
+  const double h00 = t.height(x0, y0), h10 = t.height(x1, y0);
+  const double h01 = t.height(x0, y1), h11 = t.height(x1, y1);
+  // z_s(a, b) = A + B a + C b + D a b with a, b the patch coordinates; along the ray, measured
+  // from the patch entry (s = t − t_in, which keeps the coefficients well conditioned):
+  // a = a0 + du s, b = b0 + dv s, z = zr + dz s; g(s) = z_s − z is quadratic in s.
+  const double A = h00, B = h10 - h00, C = h01 - h00, D = h00 - h10 - h01 + h11;
+  const double a0 = u0 + du * t_in - px, b0 = v0 + dv * t_in - py, zr = z0 + dz * t_in;
+  const double len = t_out - t_in;
+  const double c0 = A + B * a0 + C * b0 + D * a0 * b0 - zr;
+  double s;
+  if (c0 >= 0) {
+    s = 0;  // at or below the surface on entry: the crossing is on the patch edge
+  } else {
+    const double c1 = B * du + C * dv + D * (a0 * dv + b0 * du) - dz;
+    const double c2 = D * du * dv;
+    s = kInf;
+    if (c2 == 0.0) {
+      if (c1 > 0) s = -c0 / c1;
+    } else {
+      const double disc = c1 * c1 - 4 * c2 * c0;
+      if (disc < 0) return false;
+      // Numerically stable roots (Numerical Recipes §5.6).
+      const double q = -0.5 * (c1 + std::copysign(std::sqrt(disc), c1));
+      const double r1 = q / c2;
+      const double r2 = q != 0.0 ? c0 / q : kInf;
+      constexpr double kSlack = -1e-12;  // a root a rounding error before the entry
+      for (const double r : {r1, r2}) {
+        if (r >= kSlack && r < s) s = r;
+      }
+      s = std::max(s, 0.0);
+    }
+    if (!(s <= len)) return false;
+  }
+  t_hit = t_in + s;
+  a_hit = std::clamp(a0 + du * s, 0.0, 1.0);
+  b_hit = std::clamp(b0 + dv * s, 0.0, 1.0);
+  return true;
+}
+
+void RaycastScene::FillTerrainHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                  double t_hit, int px, int py, double a, double b,
+                                  RayHit& hit) const {
+  const plant::Terrain& t = world_->terrain;
+  const double h = t.resolution();
+  const int x0 = std::max(px - 1, 0), x1 = std::min(px, grid_nx_ - 1);
+  const int y0 = std::max(py - 1, 0), y1 = std::min(py, grid_ny_ - 1);
+  const double h00 = t.height(x0, y0), h10 = t.height(x1, y0);
+  const double h01 = t.height(x0, y1), h11 = t.height(x1, y1);
+  const double B = h10 - h00, C = h01 - h00, D = h00 - h10 - h01 + h11;
+  // Border patches span half a cell; their clamped corners make B or C zero there, so the
+  // gradient below is right with the full cell width.
+  const double gx = (B + D * b) / h, gy = (C + D * a) / h;
+  hit.hit = true;
+  hit.range = t_hit;
+  hit.point = origin + t_hit * direction;
+  hit.normal = Eigen::Vector3d(-gx, -gy, 1.0).normalized();
+  hit.box = -1;
+  const auto& g = t.geometry();
+  hit.cell_x =
+      std::clamp(static_cast<int>(std::floor((hit.point.x() - g.origin.x()) / h)), 0, grid_nx_ - 1);
+  hit.cell_y =
+      std::clamp(static_cast<int>(std::floor((hit.point.y() - g.origin.y()) / h)), 0, grid_ny_ - 1);
+  const bool pile = t.depth(hit.cell_x, hit.cell_y) > kPileDepthThreshold;
+  hit.semantic_class = pile ? core::SemanticClass::kPile : core::SemanticClass::kGround;
+  hit.reflectivity = world_->ground_reflectivity;
+  const int m = t.material(hit.cell_x, hit.cell_y);
+  if (pile && m >= 0 && m < static_cast<int>(world_->materials.size())) {
+    hit.reflectivity = world_->materials[m].reflectivity;
+  }
+}
+
+bool RaycastScene::TraverseTerrain(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                   double max_range, RayHit& hit) const {
+  if (levels_.empty() || !origin.allFinite() || !direction.allFinite()) return false;
+  const auto& g = world_->terrain.geometry();
+  const double h = g.resolution;
+  // Patch coordinates: u = (x − x_origin)/h + 1/2, so patch p spans u ∈ [p, p + 1) and cell i's
+  // centre lies at u = i + 1. The grid's rectangle is u ∈ [1/2, nx + 1/2].
+  const double u0 = (origin.x() - g.origin.x()) / h + 0.5;
+  const double v0 = (origin.y() - g.origin.y()) / h + 0.5;
+  const double z0 = origin.z();
+  const double du = direction.x() / h, dv = direction.y() / h, dz = direction.z();
+  double t_lo = 0, t_hi = max_range;
+  if (!ClipSlab(u0, du, 0.5, grid_nx_ + 0.5, t_lo, t_hi)) return false;
+  if (!ClipSlab(v0, dv, 0.5, grid_ny_ + 0.5, t_lo, t_hi)) return false;
+  if (!ClipSlab(z0, dz, -kInf, max_terrain_height(), t_lo, t_hi)) return false;
+
+  const int sx = du > 0 ? 1 : -1, sy = dv > 0 ? 1 : -1;
+  const double inv_du = du != 0.0 ? 1.0 / du : kInf;
+  const double inv_dv = dv != 0.0 ? 1.0 / dv : kInf;
+  const int top = static_cast<int>(levels_.size()) - 1;
+  int level = top, cx = 0, cy = 0;
+  double t = t_lo;
+  // Each iteration either descends a level (at most `top` times in a row) or steps to the next
+  // cell along the ray, so the loop ends.
+  for (;;) {
+    const Level& lev = levels_[level];
+    const double size = static_cast<double>(1 << level);  // cell edge in patches
+    double tx = kInf, ty = kInf;
+    if (du > 0) tx = ((cx + 1) * size - u0) * inv_du;
+    if (du < 0) tx = (cx * size - u0) * inv_du;
+    if (dv > 0) ty = ((cy + 1) * size - v0) * inv_dv;
+    if (dv < 0) ty = (cy * size - v0) * inv_dv;
+    const double t_exit = std::max(t, std::min(std::min(tx, ty), t_hi));
+    const float cell_max = lev.max[cy * lev.nx + cx];
+    const double z_low = z0 + dz * (dz < 0 ? t_exit : t);  // the ray's lowest point in the cell
+    if (!(z_low > cell_max)) {
+      if (level > 0) {
+        --level;
+        const Level& child = levels_[level];
+        const double child_size = size * 0.5;
+        // The child of (cx, cy) holding the ray at t: compare with the parent's midlines (no
+        // division, and a point on a boundary stays inside the parent).
+        const double uc = u0 + du * t, vc = v0 + dv * t;
+        cx = std::min(2 * cx + (uc >= (2 * cx + 1) * child_size ? 1 : 0), child.nx - 1);
+        cy = std::min(2 * cy + (vc >= (2 * cy + 1) * child_size ? 1 : 0), child.ny - 1);
+        continue;
+      }
+      double t_hit, a, b;
+      if (IntersectPatch(cx, cy, u0, v0, z0, du, dv, dz, t, t_exit, t_hit, a, b)) {
+        FillTerrainHit(origin, direction, t_hit, cx, cy, a, b, hit);
+        return true;
+      }
+    }
+    if (t_exit >= t_hi) return false;
+    const int ocx = cx, ocy = cy;
+    if (tx <= ty) {
+      cx += sx;
+    } else {
+      cy += sy;
+    }
+    if (cx < 0 || cy < 0 || cx >= lev.nx || cy >= lev.ny) return false;  // left the grid
+    t = t_exit;
+    if (level < top && ((cx >> 1) != (ocx >> 1) || (cy >> 1) != (ocy >> 1))) {
+      ++level;
+      cx >>= 1;
+      cy >>= 1;
+    }
+  }
+}
+
+RayHit RaycastScene::CastTerrain(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                 double max_range) const {
+  RayHit hit;
+  TraverseTerrain(origin, direction, max_range, hit);
+  return hit;
+}
+
+RayHit RaycastScene::CastBoxes(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                               double max_range) const {
+  RayHit hit;
+  if (!origin.allFinite() || !direction.allFinite()) return hit;
+  double best = max_range;
+  for (std::size_t i = 0; i < prepared_.size(); ++i) {
+    const PreparedBox& p = prepared_[i];
+    // Bounding-sphere reject: the ray passes farther from the centre than the half diagonal.
+    const Eigen::Vector3d v = p.center - origin;
+    const double along = v.dot(direction);
+    if (along + p.radius < 0 || v.squaredNorm() - along * along > p.radius * p.radius) continue;
+    double range;
+    Eigen::Vector3d normal;
+    if (SlabTest(p.center, p.half, p.c, p.s, origin, direction, best, range, normal)) {
+      best = range;
+      hit.hit = true;
+      hit.range = range;
+      hit.normal = normal;
+      hit.box = static_cast<int>(i);
+    }
+  }
+  if (hit.hit) {
+    hit.point = origin + hit.range * direction;
+    hit.semantic_class = boxes_[hit.box].semantic_class;
+    hit.reflectivity = boxes_[hit.box].reflectivity;
+  }
+  return hit;
+}
+
+RayHit RaycastScene::Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                          double max_range) const {
+  RayHit box = CastBoxes(origin, direction, max_range);
+  RayHit terrain;
+  if (TraverseTerrain(origin, direction, box.hit ? box.range : max_range, terrain)) return terrain;
+  return box;
+}
+
+}  // namespace autoshovel::sensors

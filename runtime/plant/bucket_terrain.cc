@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace autoshovel::plant {
 
@@ -83,6 +84,14 @@ std::vector<Eigen::Vector2d> BucketTerrain::PlanePolygon(const BucketPlacement& 
 template <typename Visit>
 void BucketTerrain::ForEachCellInStrip(const BucketPlacement& placement, double s0, double s1,
                                        Visit&& visit) const {
+  ForEachCellInStrip(placement, s0, s1, -std::numeric_limits<double>::infinity(),
+                     world_.terrain.heights(), std::forward<Visit>(visit));
+}
+
+template <typename Visit>
+void BucketTerrain::ForEachCellInStrip(const BucketPlacement& placement, double s0, double s1,
+                                       double min_height, const std::vector<double>& heights,
+                                       Visit&& visit) const {
   const Terrain& terrain = world_.terrain;
   const Eigen::Vector2d axis(std::cos(placement.plane_heading), std::sin(placement.plane_heading));
   const Eigen::Vector2d lateral(-axis.y(), axis.x());
@@ -107,6 +116,7 @@ void BucketTerrain::ForEachCellInStrip(const BucketPlacement& placement, double 
       std::min(g.ny - 1, static_cast<int>(std::floor((hi.y() - g.origin.y()) / g.resolution)));
   for (int iy = iy0; iy <= iy1; ++iy) {
     for (int ix = ix0; ix <= ix1; ++ix) {
+      if (heights[terrain.Index(ix, iy)] <= min_height) continue;
       const Eigen::Vector2d d = terrain.CellCenter(ix, iy) - placement.plane_origin;
       const double s = d.dot(axis), l = d.dot(lateral);
       if (std::abs(l) > half_width || s < s0 || s > s1) continue;
@@ -138,7 +148,12 @@ ExchangeResult BucketTerrain::Exchange(const BucketPlacement& placement) {
   for (const auto& p : polygon) s_min = std::min(s_min, p.x()), s_max = std::max(s_max, p.x());
   const double cell_area = terrain.cell_area();
 
-  ForEachCellInStrip(placement, s_min, s_max, [&](int ix, int iy, double s) {
+  // Only cells whose surface rises above the bucket's lowest point can meet it: test the height
+  // first (one load), the geometry after. Most cells under a bucket are below it.
+  double z_min = std::numeric_limits<double>::infinity();
+  for (const auto& p : polygon) z_min = std::min(z_min, p.y());
+  const std::vector<double>& heights = terrain.heights();
+  ForEachCellInStrip(placement, s_min, s_max, z_min, heights, [&](int ix, int iy, double s) {
     double z_low = 0;
     if (!LowerOutline(polygon, s, z_low)) return;
     const double h = terrain.height(ix, iy);
@@ -155,7 +170,12 @@ ExchangeResult BucketTerrain::Exchange(const BucketPlacement& placement) {
     terrain.SetHeight(ix, iy, new_height);
   });
 
-  const double holdable = HoldableVolume(placement);
+  // Inside the pile the material around the lip holds what the bucket carries in place: it
+  // can take up to its heaped capacity and pushes the rest ahead. In the open it holds what
+  // its attitude allows (HoldableVolume), which is why it must be curled before it leaves.
+  const double holdable = Contact(placement).in_contact
+                              ? std::max(bucket_.rated_capacity, HoldableVolume(placement))
+                              : HoldableVolume(placement);
   if (payload_volume_ > holdable) {
     // Pour over the lower rim, onto the strip just outside it.
     const Eigen::Vector2d& tip = polygon.front();

@@ -7,10 +7,12 @@
 // - capture: every terrain cell under the bucket whose surface lies above the bucket's lower
 //   outline loses the material above that outline to the bucket (the material inside the bucket
 //   and heaped on top of it moves with it; a height grid cannot hold an overhang);
-// - spill: the bucket holds what lies below its lower rim (the lower of tip and back-wall top)
-//   plus a heap whose size grows as the opening turns upwards, up to the rated heaped capacity
-//   (SAE J742); anything beyond pours over the lower rim onto the cells just outside it. The
-//   same rule empties the bucket when it is tilted to dump;
+// - spill: in the open, the bucket holds what lies below its lower rim (the lower of tip and
+//   back-wall top) plus a heap whose size grows as the opening turns upwards, up to the rated
+//   heaped capacity (SAE J742); anything beyond pours over the lower rim onto the cells just
+//   outside it. The same rule empties the bucket when it is tilted to dump. While the lip is
+//   in the pile, the surrounding material retains the load up to the heaped capacity and the
+//   excess is pushed ahead of the lip;
 // - repose: a neighbour pair steeper than the material's angle of repose exchanges material
 //   until it is not (a conservative relaxation of the classic sand-pile kind).
 #pragma once
@@ -81,6 +83,10 @@ class BucketTerrain {
   template <typename Visit>
   void ForEachCellInStrip(const BucketPlacement& placement, double s0, double s1,
                           Visit&& visit) const;
+  /// The same, skipping cells whose surface is at or below `min_height`.
+  template <typename Visit>
+  void ForEachCellInStrip(const BucketPlacement& placement, double s0, double s1, double min_height,
+                          const std::vector<double>& heights, Visit&& visit) const;
   void Deposit(const BucketPlacement& placement, double s_from, double s_to, double volume);
 
   const model::Bucket& bucket_;

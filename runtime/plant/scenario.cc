@@ -708,18 +708,6 @@ std::string ResolveScenario(const std::string& name_or_path, const std::string& 
   throw std::runtime_error(message);
 }
 
-const char* ToString(Lighting lighting) {
-  switch (lighting) {
-    case Lighting::kBright:
-      return "bright";
-    case Lighting::kDim:
-      return "dim";
-    case Lighting::kNormal:
-      break;
-  }
-  return "normal";
-}
-
 const char* ToString(PileShape shape) {
   switch (shape) {
     case PileShape::kIrregular:

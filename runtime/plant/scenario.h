@@ -19,8 +19,6 @@
 
 namespace autoshovel::plant {
 
-enum class Lighting { kNormal, kBright, kDim };
-
 enum class PileShape {
   kCone,         ///< a regular cone
   kIrregular,    ///< a cone with seeded lobes, bumps and dents
@@ -99,7 +97,6 @@ std::vector<std::string> FindScenarios(const std::string& models_dir);
 /// std::runtime_error listing the known scenarios when nothing matches.
 std::string ResolveScenario(const std::string& name_or_path, const std::string& models_dir);
 
-const char* ToString(Lighting lighting);
 const char* ToString(PileShape shape);
 
 /// Whether the footprint (xy rectangle) of `box` contains world point `xy`.

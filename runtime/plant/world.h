@@ -5,7 +5,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "runtime/core/semantic_class.h"
@@ -13,6 +15,14 @@
 #include "runtime/plant/terrain.h"
 
 namespace autoshovel::plant {
+
+/// Lighting of the yard, for the simulated camera (wheel-loader seed §7.2: normal, bright, dim).
+enum class Lighting { kNormal, kBright, kDim };
+
+/// "normal", "bright", "dim".
+const char* ToString(Lighting lighting);
+/// Inverse of ToString; nullopt for anything else.
+std::optional<Lighting> ParseLighting(std::string_view name);
 
 /// A box standing on or above the ground, turned about the vertical axis.
 struct OrientedBox {

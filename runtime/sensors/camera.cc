@@ -81,25 +81,6 @@ Rgb Sky(const Eigen::Vector3d& d) {
 
 }  // namespace
 
-const char* ToString(Lighting lighting) {
-  switch (lighting) {
-    case Lighting::kNormal:
-      return "normal";
-    case Lighting::kBright:
-      return "bright";
-    case Lighting::kDim:
-      return "dim";
-  }
-  return "normal";
-}
-
-std::optional<Lighting> ParseLighting(std::string_view name) {
-  for (Lighting l : {Lighting::kNormal, Lighting::kBright, Lighting::kDim}) {
-    if (name == ToString(l)) return l;
-  }
-  return std::nullopt;
-}
-
 Eigen::Matrix3d BodyFromOptical() {
   Eigen::Matrix3d R;
   // Columns: the optical x (right), y (down), z (forward) axes in the body frame.

@@ -45,12 +45,10 @@
 
 namespace autoshovel::sensors {
 
-enum class Lighting { kNormal, kBright, kDim };
-
-/// "normal", "bright", "dim".
-const char* ToString(Lighting lighting);
-/// Inverse of ToString; nullopt for anything else.
-std::optional<Lighting> ParseLighting(std::string_view name);
+// The yard's lighting is part of the world (plant/world.h), shared with the scenario files.
+using plant::Lighting;
+using plant::ParseLighting;
+using plant::ToString;
 
 struct CameraOptions {
   Lighting lighting = Lighting::kNormal;

@@ -10,7 +10,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "max reach" <<<"$out" || fail "describe $machine: no reach"
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
-for level in "" describe gen; do
+for level in "" describe gen plant "plant step"; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -27,4 +27,19 @@ grep -qE "broken.yaml:[0-9]+:[0-9]+: chassis.track_width: must be > 0 m, got -2.
   || fail "unexpected message: $(cat "$tmp/err")"
 [ ! -e "$tmp/out" ] || fail "output written for a malformed description"
 "$autoshovel" --models "$source_dir/models" describe no_such_machine 2>/dev/null && fail "unknown machine accepted"
+# plant step: a CSV with the documented columns; the same seed gives the same bytes.
+"$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --actuator boom \
+  --amplitude 0.6 --duration 1.5 --noise --seed 7 -o "$tmp/step.csv" || fail "plant step"
+grep -q "^t,command,spool,pressure,joint_angle,joint_rate$" "$tmp/step.csv" || fail "step header"
+[ "$(grep -cv '^[#t]' "$tmp/step.csv")" -eq 151 ] || fail "expected 151 samples"
+"$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --actuator boom \
+  --amplitude 0.6 --duration 1.5 --noise --seed 7 >"$tmp/step2.csv" || fail "plant step to stdout"
+cmp -s "$tmp/step.csv" "$tmp/step2.csv" || fail "plant step is not deterministic"
+"$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --actuator stick \
+  2>"$tmp/err" >/dev/null && fail "unknown actuator accepted"
+grep -q "has no actuator 'stick'; it has: boom_cylinders (joint boom)" "$tmp/err" \
+  || fail "unexpected message: $(cat "$tmp/err")"
+"$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --amplitude 1.5 \
+  2>"$tmp/err" >/dev/null && fail "amplitude 1.5 accepted"
+grep -q "amplitude must be in \[-1, 1\]" "$tmp/err" || fail "unexpected message: $(cat "$tmp/err")"
 echo "cli ok"

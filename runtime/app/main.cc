@@ -11,6 +11,7 @@
 
 #include "runtime/app/describe_command.h"
 #include "runtime/app/plant_step_command.h"
+#include "runtime/app/scenario_command.h"
 
 namespace {
 
@@ -83,11 +84,24 @@ int main(int argc, char** argv) {
   step_cmd->add_option("--seed", step.seed, "Seed of the noise")->capture_default_str();
   step_cmd->add_option("-o,--output", step.output, "CSV file (default: standard output)");
 
+  autoshovel::app::ScenarioOptions scenario;
+  CLI::App* scenario_cmd = app.add_subcommand(
+      "scenario", "Load a yard scenario, list its piles and obstacles, draw its top view");
+  scenario_cmd->add_option("scenario", scenario.scenario, "Scenario name or .yaml path")
+      ->required();
+  scenario_cmd->add_option("-o,--png", scenario.png, "Write the top view to this PNG");
+  scenario_cmd->add_option("--mpp", scenario.metres_per_pixel, "Top view metres per pixel")
+      ->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
 
   if (*describe_cmd) {
     describe.models_dir = models_dir;
     return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
+  }
+  if (*scenario_cmd) {
+    scenario.models_dir = models_dir;
+    return autoshovel::app::RunScenario(scenario, std::cout, std::cerr);
   }
   if (*step_cmd) {
     step.models_dir = models_dir;

@@ -10,7 +10,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "max reach" <<<"$out" || fail "describe $machine: no reach"
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
-for level in "" describe gen plant "plant step"; do
+for level in "" describe gen plant "plant step" scenario; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -42,4 +42,12 @@ grep -q "has no actuator 'stick'; it has: boom_cylinders (joint boom)" "$tmp/err
 "$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --amplitude 1.5 \
   2>"$tmp/err" >/dev/null && fail "amplitude 1.5 accepted"
 grep -q "amplitude must be in \[-1, 1\]" "$tmp/err" || fail "unexpected message: $(cat "$tmp/err")"
+# scenario: lists the yard, draws the top view, suggests the nearest name for a typo.
+"$autoshovel" --models "$source_dir/models" scenario cone_pile -o "$tmp/cone.png" >"$tmp/out" \
+  || fail "scenario cone_pile"
+grep -q "gravel_cone .*cone .*big_gravel" "$tmp/out" || fail "scenario listing: $(cat "$tmp/out")"
+[ -s "$tmp/cone.png" ] || fail "no top view written"
+"$autoshovel" --models "$source_dir/models" scenario cone_pil 2>"$tmp/err" >/dev/null \
+  && fail "unknown scenario accepted"
+grep -q "did you mean 'cone_pile'" "$tmp/err" || fail "unexpected message: $(cat "$tmp/err")"
 echo "cli ok"

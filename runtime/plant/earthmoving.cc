@@ -56,10 +56,37 @@ ReeceFactors ComputeReeceFactors(double rake_angle, double friction_angle,
   return factors;
 }
 
+namespace {
+constexpr double kTableStepDeg = 0.5;
+constexpr double kTableMinDeg = 10.0, kTableMaxDeg = 90.0;
+}  // namespace
+
+ReeceTable::ReeceTable(double friction_angle, double interface_friction_angle)
+    : friction_angle_(friction_angle), interface_friction_angle_(interface_friction_angle) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  for (double a = kTableMinDeg; a <= kTableMaxDeg + 1e-9; a += kTableStepDeg) {
+    entries_.push_back(ComputeReeceFactors(a * kDeg, friction_angle, interface_friction_angle));
+  }
+}
+
+ReeceFactors ReeceTable::At(double rake_angle) const {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  const double f =
+      (std::clamp(rake_angle / kDeg, kTableMinDeg, kTableMaxDeg) - kTableMinDeg) / kTableStepDeg;
+  const std::size_t i = std::min(static_cast<std::size_t>(f), entries_.size() - 2);
+  const double t = f - static_cast<double>(i);
+  const ReeceFactors &a = entries_[i], &b = entries_[i + 1];
+  auto mix = [t](double x, double y) { return (1 - t) * x + t * y; };
+  return {mix(a.n_gamma, b.n_gamma), mix(a.n_c, b.n_c), mix(a.n_q, b.n_q), mix(a.n_a, b.n_a),
+          mix(a.failure_angle, b.failure_angle)};
+}
+
 CuttingResistance ComputeCuttingResistance(const CuttingInput& in) {
   CuttingResistance out;
   if (!(in.depth > 0) || !(in.width > 0)) return out;
-  const ReeceFactors n = ComputeReeceFactors(in.rake_angle, in.friction_angle, in.interface_angle);
+  const ReeceFactors n = in.table != nullptr ? in.table->At(in.rake_angle)
+                                             : ComputeReeceFactors(in.rake_angle, in.friction_angle,
+                                                                   in.interface_angle);
   const double unit_weight = in.density * model::plant::kGravity;
   const double d = in.depth;
   out.total = in.width * (unit_weight * d * d * n.n_gamma + in.cohesion * d * n.n_c +

@@ -37,6 +37,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,7 @@
 #include "runtime/model/description.h"
 #include "runtime/plant/bucket_terrain.h"
 #include "runtime/plant/drive.h"
+#include "runtime/plant/earthmoving.h"
 #include "runtime/plant/machine_state.h"
 #include "runtime/plant/ode_integrator.h"
 #include "runtime/plant/valve_command.h"
@@ -169,6 +171,7 @@ class Plant {
   std::map<std::string, Energy> phase_energy_;
   double last_relax_time_ = 0;
   double load_sensing_margin_ = 0;
+  std::vector<std::optional<ReeceTable>> reece_tables_;  ///< per material, built on first contact
   bool terrain_unsettled_ = true;
   bool dirty_ = true;
 };

@@ -29,6 +29,17 @@ TEST(Earthmoving, VerticalSmoothBladeIsRankinePassive) {
   }
 }
 
+TEST(Earthmoving, TabulatedFactorsMatchTheSearch) {
+  const ReeceTable table(36 * kDeg, 28 * kDeg);
+  for (double a = 10.0; a <= 90.0; a += 0.37) {
+    const ReeceFactors direct = ComputeReeceFactors(a * kDeg, 36 * kDeg, 28 * kDeg);
+    const ReeceFactors looked_up = table.At(a * kDeg);
+    EXPECT_NEAR(looked_up.n_gamma, direct.n_gamma, 1e-3 * direct.n_gamma) << a;
+    EXPECT_NEAR(looked_up.n_c, direct.n_c, 1e-3 * direct.n_c) << a;
+    EXPECT_NEAR(looked_up.n_q, direct.n_q, 1e-3 * direct.n_q) << a;
+  }
+}
+
 TEST(Earthmoving, ResistanceGrowsWithDepthSquaredAndCohesion) {
   CuttingInput in;
   in.width = 3;

@@ -1,0 +1,220 @@
+#include "runtime/perception/semantic_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "runtime/core/semantic_class.h"
+#include "runtime/perception/ground_plane.h"
+
+namespace autoshovel::perception {
+
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr int kBlock = 4;  // pixels per side of an occlusion-buffer block
+
+// Semantic class → the three confidences of Eq. (11). The own machine is neither: its pixels
+// carry no information about the cell behind them (and its returns were removed from the map).
+struct Confidences {
+  float ground, pile, obstacle;
+  float hard;  // the part of `obstacle` that is a machine, a person or a wall
+};
+
+Confidences Collapse(const ClassProbabilities& p, int pixel) {
+  const std::size_t plane = static_cast<std::size_t>(p.width) * p.height;
+  auto at = [&](core::SemanticClass c) { return p.planes[static_cast<int>(c) * plane + pixel]; };
+  using core::SemanticClass;
+  const float ground = at(SemanticClass::kGround), pile = at(SemanticClass::kPile);
+  const float hard =
+      at(SemanticClass::kOtherLoader) + at(SemanticClass::kPerson) + at(SemanticClass::kWall);
+  const float obstacle = hard + at(SemanticClass::kOther);
+  const float sum = ground + pile + obstacle;
+  if (!(sum > 1e-6f)) return {kNaN, kNaN, kNaN, kNaN};
+  return {ground / sum, pile / sum, obstacle / sum, hard / sum};
+}
+
+// Standard normal CDF.
+double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+}  // namespace
+
+ClassProbabilities FromLabels(const std::vector<std::uint8_t>& labels, int width, int height) {
+  ClassProbabilities p;
+  p.width = width;
+  p.height = height;
+  const std::size_t plane = static_cast<std::size_t>(width) * height;
+  p.planes.assign(core::kNumSemanticClasses * plane, 0.0f);
+  for (std::size_t i = 0; i < plane && i < labels.size(); ++i) {
+    p.planes[std::min<int>(labels[i], core::kNumSemanticClasses - 1) * plane + i] = 1.0f;
+  }
+  return p;
+}
+
+SemanticMap::SemanticMap(ElevationMap& map, const SemanticMapConfig& config)
+    : map_(map), config_(config) {
+  GridMap& g = map_.map();
+  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
+                            "height_ground_confidence", "class"}) {
+    if (!g.Exists(layer)) g.Add(layer, kNaN);
+  }
+  if (!g.Exists("semantic_frames")) g.Add("semantic_frames", 0.0f);
+}
+
+long SemanticMap::Project(const ClassProbabilities& probabilities, const model::Camera& camera,
+                          const Eigen::Isometry3d& T_world_camera) {
+  GridMap& g = map_.map();
+  const int w = probabilities.width, h = probabilities.height;
+  if (w <= 0 || h <= 0 ||
+      probabilities.planes.size() != static_cast<std::size_t>(core::kNumSemanticClasses) * w * h) {
+    return 0;
+  }
+  // The image may be smaller than the camera's (a network run at reduced resolution).
+  const double sx = static_cast<double>(w) / camera.width_px;
+  const double sy = static_cast<double>(h) / camera.height_px;
+  // World → optical: optical x = −body y, optical y = −body z, optical z = body x.
+  const Eigen::Isometry3d T_camera_world = T_world_camera.inverse();
+  const Eigen::Matrix<float, 3, 3> R = T_camera_world.linear().cast<float>();
+  const Eigen::Vector3f t = T_camera_world.translation().cast<float>();
+  const Eigen::MatrixXf& elevation = g["elevation"];
+  const int nx = g.size().x(), ny = g.size().y();
+
+  // Pass 1: where each cell lands and how far it is; the nearest depth per pixel block.
+  const int bw = (w + kBlock - 1) / kBlock, bh = (h + kBlock - 1) / kBlock;
+  std::vector<float> nearest(static_cast<std::size_t>(bw) * bh,
+                             std::numeric_limits<float>::infinity());
+  struct Hit {
+    int cell, pixel;
+    float depth;
+  };
+  std::vector<Hit> hits;
+  hits.reserve(static_cast<std::size_t>(nx) * ny / 4);
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      const float z = elevation(ix, iy);
+      if (std::isnan(z)) continue;
+      const Eigen::Vector2d xy = g.PositionOf(Index(ix, iy));
+      const Eigen::Vector3f p_body =
+          R * Eigen::Vector3f(static_cast<float>(xy.x()), static_cast<float>(xy.y()), z) + t;
+      if (!(p_body.x() > 0.3f)) continue;  // behind or at the lens
+      const double u = (camera.fx * (-p_body.y()) / p_body.x() + camera.cx) * sx;
+      const double v = (camera.fy * (-p_body.z()) / p_body.x() + camera.cy) * sy;
+      if (!(u >= 0 && v >= 0 && u < w && v < h)) continue;
+      const int pixel = static_cast<int>(v) * w + static_cast<int>(u);
+      const float depth = p_body.x();
+      const int block = (static_cast<int>(v) / kBlock) * bw + static_cast<int>(u) / kBlock;
+      nearest[block] = std::min(nearest[block], depth);
+      hits.push_back({iy * nx + ix, pixel, depth});
+    }
+  }
+  // Pass 2: cells not hidden behind nearer ones take the pixel's confidences.
+  Eigen::MatrixXf& ground = g["ground_confidence"];
+  Eigen::MatrixXf& pile = g["pile_confidence"];
+  Eigen::MatrixXf& obstacle = g["obstacle_confidence"];
+  Eigen::MatrixXf& frames = g["semantic_frames"];
+  long updated = 0;
+  for (const Hit& hit : hits) {
+    const int pu = hit.pixel % w, pv = hit.pixel / w;
+    const float near = nearest[(pv / kBlock) * bw + pu / kBlock];
+    if (hit.depth > near + config_.occlusion_tolerance + 0.03f * near) continue;
+    // The cell covers a few pixels: the confidences are their mean, except that a machine,
+    // person or wall anywhere in the cell's image footprint counts in full, so that a cell on
+    // such an obstacle's silhouette is an obstacle (the seed's safety rule of Eq. 11 applied to
+    // the whole footprint). "Other" (debris, and the sky above a pile's crest) is averaged.
+    const int radius = std::clamp(
+        static_cast<int>(camera.fx * sx * 0.5 * map_.map().resolution() / hit.depth), 1, 4);
+    Confidences c{0, 0, 0, 0};
+    float hard_max = 0;
+    int samples = 0;
+    for (int dv = -radius; dv <= radius; ++dv) {
+      for (int du = -radius; du <= radius; ++du) {
+        const int u = pu + du, v = pv + dv;
+        if (u < 0 || v < 0 || u >= w || v >= h) continue;
+        const Confidences p = Collapse(probabilities, v * w + u);
+        if (std::isnan(p.ground)) continue;
+        c.ground += p.ground, c.pile += p.pile, c.obstacle += p.obstacle;
+        hard_max = std::max(hard_max, p.hard);
+        ++samples;
+      }
+    }
+    if (samples == 0) continue;
+    c.ground /= samples, c.pile /= samples, c.obstacle /= samples;
+    c.obstacle = std::max(c.obstacle, hard_max);
+    const int ix = hit.cell % nx, iy = hit.cell / nx;
+    float& n = frames(ix, iy);
+    n += 1;
+    const float weight = std::max(1.0f / n, static_cast<float>(config_.min_frame_weight));
+    auto blend = [&](float& layer, float value) {
+      layer = std::isnan(layer) || n == 1 ? value : (1 - weight) * layer + weight * value;
+    };
+    blend(ground(ix, iy), c.ground);
+    blend(pile(ix, iy), c.pile);
+    blend(obstacle(ix, iy), c.obstacle);
+    ++updated;
+  }
+  return updated;
+}
+
+bool SemanticMap::Fuse() {
+  GridMap& g = map_.map();
+  const Eigen::MatrixXf& elevation = g["elevation"];
+  const Eigen::MatrixXf& variance = g["variance"];
+  const int nx = g.size().x(), ny = g.size().y();
+  std::vector<Eigen::Vector3d> low;
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      const float z = elevation(ix, iy);
+      if (std::isnan(z) || z > config_.ground_z0) continue;
+      const Eigen::Vector2d xy = g.PositionOf(Index(ix, iy));
+      low.emplace_back(xy.x(), xy.y(), z);
+    }
+  }
+  const GroundPlane plane =
+      FitGroundPlane(low, config_.ransac_threshold, config_.ransac_iterations);
+  if (!plane.ok) return false;
+  plane_ = plane.coefficients;
+  ground_variance_ = plane.variance;
+  const double sigma_z = std::sqrt(plane.variance);
+
+  Eigen::MatrixXf& p1_layer = g["height_ground_confidence"];
+  Eigen::MatrixXf& cls = g["class"];
+  const Eigen::MatrixXf& ground = g["ground_confidence"];
+  const Eigen::MatrixXf& pile = g["pile_confidence"];
+  const Eigen::MatrixXf& obstacle = g["obstacle_confidence"];
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      const float h = elevation(ix, iy);
+      if (std::isnan(h)) {
+        p1_layer(ix, iy) = cls(ix, iy) = kNaN;
+        continue;
+      }
+      const Eigen::Vector2d xy = g.PositionOf(Index(ix, iy));
+      const double z_ground = plane_.x() * xy.x() + plane_.y() * xy.y() + plane_.z();
+      const double sigma_m = std::sqrt(std::max<double>(variance(ix, iy), 1e-8));
+      const float p1 = static_cast<float>(Phi((z_ground + sigma_z - h) / sigma_m));  // Eq. (10)
+      const float p2 = 1.0f - p1;
+      p1_layer(ix, iy) = p1;
+      // Eq. (11); a cell no image has seen is classified by its height alone.
+      const float g1 = std::isnan(ground(ix, iy)) ? 0.0f : ground(ix, iy);
+      const float g2 = std::isnan(pile(ix, iy)) ? 0.0f : pile(ix, iy);
+      const float g3 = std::isnan(obstacle(ix, iy)) ? 0.0f : obstacle(ix, iy);
+      CellClass c = CellClass::kGround;
+      if (g3 > std::max(g1, g2)) {
+        c = CellClass::kObstacle;
+      } else if (p1 + g1 < p2 + g2) {
+        c = CellClass::kPile;
+      }
+      cls(ix, iy) = static_cast<float>(c);
+    }
+  }
+  return true;
+}
+
+CellClass SemanticOnlyClass(float ground, float pile, float obstacle) {
+  if (obstacle > std::max(ground, pile)) return CellClass::kObstacle;
+  return pile > ground ? CellClass::kPile : CellClass::kGround;
+}
+
+CellClass HeightOnlyClass(float p1) { return p1 < 0.5f ? CellClass::kPile : CellClass::kGround; }
+
+}  // namespace autoshovel::perception

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "runtime/app/describe_command.h"
+#include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
 
@@ -93,11 +94,27 @@ int main(int argc, char** argv) {
   scenario_cmd->add_option("--mpp", scenario.metres_per_pixel, "Top view metres per pixel")
       ->capture_default_str();
 
+  autoshovel::app::MapOptions map;
+  CLI::App* map_cmd = app.add_subcommand(
+      "map",
+      "Build the semantic elevation map from a scenario's start pose (simulated LiDARs and "
+      "camera) and draw its six layers");
+  map_cmd->add_option("scenario", map.scenario, "Scenario name or .yaml path")->required();
+  map_cmd->add_option("-o,--png", map.png, "Six-layer picture")->capture_default_str();
+  map_cmd->add_option("--lighting", map.lighting, "normal, bright or dim (default: scenario's)");
+  map_cmd->add_option("--frames", map.frames, "LiDAR frames per sensor")->capture_default_str();
+  map_cmd->add_option("--advance", map.advance, "Start this far ahead of the start pose [m]")
+      ->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
 
   if (*describe_cmd) {
     describe.models_dir = models_dir;
     return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
+  }
+  if (*map_cmd) {
+    map.models_dir = models_dir;
+    return autoshovel::app::RunMap(map, std::cout, std::cerr);
   }
   if (*scenario_cmd) {
     scenario.models_dir = models_dir;

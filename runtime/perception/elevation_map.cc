@@ -248,6 +248,10 @@ long ElevationMap::FillHoles() {
       }
       const Index& from = source[labels.at<int>(iy, ix)];
       elevation(ix, iy) = elevation(from.x(), from.y());
+      for (const std::string& layer : fill_also_) {
+        Eigen::MatrixXf& values = map_[layer];
+        values(ix, iy) = values(from.x(), from.y());
+      }
       filled(ix, iy) = 1;
       ++count;
     }

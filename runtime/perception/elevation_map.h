@@ -72,8 +72,11 @@ class ElevationMap {
                         double pose_stamp, const MachineFootprint* footprint = nullptr);
 
   /// Eq. (9): every unobserved cell within `max_fill_distance` of an observed one takes the
-  /// height of its nearest observed cell and is flagged "filled". Returns the cells filled.
+  /// height of its nearest observed cell (and the values of the layers registered with
+  /// FillAlso, e.g. the semantic confidences) and is flagged "filled". Returns the cells filled.
   long FillHoles();
+  /// Layers that hole filling copies from the nearest observed cell along with the height.
+  void FillAlso(const std::string& layer) { fill_also_.push_back(layer); }
 
   /// Keeps the machine near the middle of the map (cells that leave are forgotten).
   void FollowTo(const Eigen::Vector2d& center_xy) { map_.Move(center_xy); }
@@ -92,6 +95,7 @@ class ElevationMap {
   // Per-frame scratch, sized to the map: the frame's own fused estimate per cell.
   Eigen::MatrixXf frame_height_, frame_variance_;
   std::vector<int> touched_;
+  std::vector<std::string> fill_also_;
 };
 
 }  // namespace autoshovel::perception

@@ -71,7 +71,8 @@ std::vector<ExtractedPile> ExtractPiles(GridMap& map, const Eigen::Vector3d& pla
   }
   piles.erase(std::remove_if(piles.begin(), piles.end(),
                              [&](const ExtractedPile& p) {
-                               return static_cast<int>(p.cells.size()) < config.min_cells;
+                               return static_cast<int>(p.cells.size()) < config.min_cells ||
+                                      p.peak_height < config.min_peak_height;
                              }),
               piles.end());
   std::sort(piles.begin(), piles.end(),

@@ -27,6 +27,10 @@ struct ExtractedPile {
 
 struct PileExtractionConfig {
   int min_cells = 6;  ///< smaller components are noise, not piles
+  /// Components whose highest cell stands lower than this above the ground are not piles:
+  /// where no image has seen the ground, Eq. (11) falls back on the height alone, and far
+  /// cells (σp² = α_d d² is large there) a few centimetres up come out as pile by a hair [m].
+  double min_peak_height = 0.15;
 };
 
 /// Adds the layer "pile_elevation" (the height of pile cells, NaN elsewhere) and returns the

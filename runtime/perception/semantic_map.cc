@@ -59,6 +59,11 @@ SemanticMap::SemanticMap(ElevationMap& map, const SemanticMapConfig& config)
     if (!g.Exists(layer)) g.Add(layer, kNaN);
   }
   if (!g.Exists("semantic_frames")) g.Add("semantic_frames", 0.0f);
+  // A hole takes its nearest observed cell's class evidence with its height (Eq. 9's
+  // continuity assumption): a hole behind a person is not pile by its height alone.
+  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence"}) {
+    map_.FillAlso(layer);
+  }
 }
 
 long SemanticMap::Project(const ClassProbabilities& probabilities, const model::Camera& camera,

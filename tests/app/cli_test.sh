@@ -10,7 +10,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "max reach" <<<"$out" || fail "describe $machine: no reach"
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
-for level in "" describe gen plant "plant step" scenario; do
+for level in "" describe gen plant "plant step" scenario map; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -50,4 +50,12 @@ grep -q "gravel_cone .*cone .*big_gravel" "$tmp/out" || fail "scenario listing: 
 "$autoshovel" --models "$source_dir/models" scenario cone_pil 2>"$tmp/err" >/dev/null \
   && fail "unknown scenario accepted"
 grep -q "did you mean 'cone_pile'" "$tmp/err" || fail "unexpected message: $(cat "$tmp/err")"
+# map: the six-layer picture of the semantic elevation map from a scenario's start pose.
+"$autoshovel" --models "$source_dir/models" map cone_pile --advance 4 --frames 2 \
+  -o "$tmp/map.png" >"$tmp/out" || fail "map cone_pile: $(cat "$tmp/out")"
+grep -q "pile at" "$tmp/out" || fail "map found no pile: $(cat "$tmp/out")"
+[ -s "$tmp/map.png" ] || fail "no map picture written"
+"$autoshovel" --models "$source_dir/models" map cone_pile --lighting dusk 2>"$tmp/err" \
+  >/dev/null && fail "lighting dusk accepted"
+grep -q "lighting must be normal, bright or dim" "$tmp/err" || fail "unexpected: $(cat "$tmp/err")"
 echo "cli ok"

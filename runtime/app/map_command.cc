@@ -1,0 +1,130 @@
+#include "runtime/app/map_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "generated/registry.h"
+#include "runtime/core/diagnostics.h"
+#include "runtime/model/description.h"
+#include "runtime/perception/elevation_map.h"
+#include "runtime/perception/map_render.h"
+#include "runtime/perception/pile_extraction.h"
+#include "runtime/perception/semantic_map.h"
+#include "runtime/plant/plant.h"
+#include "runtime/plant/scenario.h"
+#include "runtime/sensors/camera.h"
+#include "runtime/sensors/lidar.h"
+#include "runtime/sensors/raycast.h"
+#include "runtime/sensors/sensor_pose.h"
+
+namespace autoshovel::app {
+
+int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
+  try {
+    plant::Scenario scenario =
+        plant::LoadScenario(plant::ResolveScenario(options.scenario, options.models_dir));
+    const model::MachineDescription machine = model::LoadMachineDescription(
+        model::ResolveMachineDescription(scenario.machine, options.models_dir));
+    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+    if (functions == nullptr) {
+      err << "autoshovel map: machine '" << machine.name << "' has no generated code\n";
+      return 2;
+    }
+    plant::Lighting lighting = scenario.lighting;
+    if (!options.lighting.empty()) {
+      const auto parsed = plant::ParseLighting(options.lighting);
+      if (!parsed) {
+        err << "autoshovel map: --lighting must be normal, bright or dim, got '" << options.lighting
+            << "'\n";
+        return 2;
+      }
+      lighting = *parsed;
+    }
+    plant::MachineState start;
+    start.heading = scenario.start.heading;
+    start.hinge_xy =
+        Eigen::Vector2d(scenario.start.x, scenario.start.y) +
+        options.advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
+    start.q.assign(machine.num_joints(), 0.0);
+    // Bucket lowered and level, as when approaching a pile.
+    for (std::size_t j = 0; j < machine.num_links(); ++j) {
+      start.q[j] = machine.links[j].joint_min +
+                   0.1 * (machine.links[j].joint_max - machine.links[j].joint_min);
+    }
+    plant::Plant plant(machine, *functions, scenario.world, start);
+    sensors::RaycastScene scene(scenario.world, plant.OwnBodies());
+    sensors::Rng rng(scenario.seed);
+
+    const auto t0 = std::chrono::steady_clock::now();
+    const plant::MachineState& s = plant.state();
+    perception::MachineFootprint footprint;
+    footprint.hinge_xy = s.hinge_xy;
+    footprint.heading_front = s.heading;
+    footprint.articulation = s.articulation;
+    footprint.front_length = (plant.TipInWorld().head<2>() - s.hinge_xy).norm() + 0.3;
+    footprint.rear_length = machine.chassis.hinge_to_rear_axle + 2.5;
+    footprint.half_width = machine.bucket.width / 2 + 0.3;
+    footprint.max_height = 4.5;
+    perception::ElevationMap map({}, s.hinge_xy);
+    long points = 0, dropped = 0;
+    for (const model::Lidar& lidar : machine.sensors.lidars) {
+      const Eigen::Isometry3d T = sensors::SensorInWorld(s, lidar.pose);
+      for (int k = 0; k < options.frames; ++k) {
+        const perception::MapUpdateStats stats = map.Update(
+            sensors::SimulateLidarFrame(lidar, scene, T, 0.1 * k, rng), T, 0.1 * k, &footprint);
+        points += stats.fused;
+        dropped += stats.on_machine;
+      }
+    }
+    perception::SemanticMap semantic(map);
+    const Eigen::Isometry3d T_camera = sensors::SensorInWorld(s, machine.sensors.camera.pose);
+    sensors::CameraOptions camera_options;
+    camera_options.lighting = lighting;
+    const sensors::CameraFrame image = sensors::SimulateCameraFrame(
+        machine.sensors.camera, scene, T_camera, 0.0, camera_options, rng);
+    // Until a segmentation network is given, the simulator's own labels stand in for it.
+    semantic.Project(perception::FromLabels(image.labels, image.width, image.height),
+                     machine.sensors.camera, T_camera);
+    const long filled = map.FillHoles();
+    if (!semantic.Fuse()) {
+      err << "autoshovel map: too few ground cells to fit the ground plane\n";
+      return 1;
+    }
+    const std::vector<perception::ExtractedPile> piles =
+        perception::ExtractPiles(map.map(), semantic.ground_plane());
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    perception::WriteSemanticMapPng(map.map(), piles, options.png);
+
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "%s, %s light: %ld returns fused (%ld on the machine dropped), %ld holes "
+                  "filled, ground z = %.3f x + %.3f y + %.3f (sigma %.3f m), %.2f s\n",
+                  scenario.name.c_str(), plant::ToString(lighting), points, dropped, filled,
+                  semantic.ground_plane().x(), semantic.ground_plane().y(),
+                  semantic.ground_plane().z(), std::sqrt(semantic.ground_variance()), seconds);
+    out << line << "semantics: simulator labels (no segmentation network given)\n";
+    for (const perception::ExtractedPile& pile : piles) {
+      int front = 0;
+      for (const auto& b : pile.boundary) front += b.front;
+      std::snprintf(line, sizeof line,
+                    "  pile at (%.1f, %.1f): %zu cells, %.1f m3 seen, peak %.2f m, boundary %zu "
+                    "cells (%d front)\n",
+                    pile.centroid.x(), pile.centroid.y(), pile.cells.size(), pile.volume,
+                    pile.peak_height, pile.boundary.size(), front);
+      out << line;
+    }
+    out << "six layers: " << options.png << "\n";
+    return 0;
+  } catch (const core::InputError& e) {
+    err << e.what();
+    return 2;
+  } catch (const std::exception& e) {
+    err << "autoshovel map: " << e.what() << "\n";
+    return 2;
+  }
+}
+
+}  // namespace autoshovel::app

@@ -177,13 +177,18 @@ TEST(SemanticMap, FusionBeatsHeightOnlyOnTheThinLowPile) {
 
 // Parked loaders, fences, walls and people are never pile, whatever the lighting.
 TEST(SemanticMap, ObstaclesAreNeverPile) {
-  for (const plant::Lighting lighting : {plant::Lighting::kNormal, plant::Lighting::kDim}) {
-    Scene scene("pile_behind_loader", 0.0);
-    ElevationMap map({}, scene.plant->state().hinge_xy);
-    SemanticMap semantic(map);
-    scene.Build(map, semantic, nullptr, lighting);
-    const Scores s = Evaluate(scene, map.map());
-    EXPECT_EQ(s.obstacle_as_pile, 0) << plant::ToString(lighting);
+  const std::pair<const char*, double> yards[] = {{"pile_behind_loader", 0.0},
+                                                  {"mixing_station", 12.0}};
+  for (const auto& [name, advance] : yards) {
+    for (const plant::Lighting lighting : {plant::Lighting::kNormal, plant::Lighting::kDim}) {
+      Scene scene(name, advance);
+      ElevationMap map({}, scene.plant->state().hinge_xy);
+      SemanticMap semantic(map);
+      scene.Build(map, semantic, nullptr, lighting);
+      const Scores s = Evaluate(scene, map.map());
+      EXPECT_GT(s.cells, 300) << name;
+      EXPECT_EQ(s.obstacle_as_pile, 0) << name << ", " << plant::ToString(lighting);
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "identification/calibration/calibrate_arm_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
@@ -106,11 +107,36 @@ int main(int argc, char** argv) {
   map_cmd->add_option("--advance", map.advance, "Start this far ahead of the start pose [m]")
       ->capture_default_str();
 
+  autoshovel::identification::CalibrateArmOptions calibrate_arm;
+  CLI::App* calibrate_cmd = app.add_subcommand("calibrate", "Calibrate a machine from data");
+  calibrate_cmd->require_subcommand(1);
+  CLI::App* arm_cmd = calibrate_cmd->add_subcommand(
+      "arm", "Arm kinematic calibration (l_k, alpha_k) from IMU angles and tip displacements");
+  arm_cmd->add_option("data", calibrate_arm.data, "Measurement CSV (see --help of the format)");
+  arm_cmd->add_option("--machine", calibrate_arm.machine, "Machine name or description")
+      ->required();
+  arm_cmd
+      ->add_option("--initial", calibrate_arm.initial,
+                   "Start: lengths [m] then offsets [deg] (default: the description's)")
+      ->delimiter(',');
+  arm_cmd->add_option("-o,--overlay", calibrate_arm.overlay, "Overlay to write");
+  arm_cmd->add_option("--simulate", calibrate_arm.simulate,
+                      "Write a simulated measurement file (7 poses, seed's noise) and stop");
+  arm_cmd->add_option("--seed", calibrate_arm.seed, "Seed of --simulate")->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
 
   if (*describe_cmd) {
     describe.models_dir = models_dir;
     return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
+  }
+  if (*arm_cmd) {
+    calibrate_arm.models_dir = models_dir;
+    if (calibrate_arm.data.empty() && calibrate_arm.simulate.empty()) {
+      std::cerr << "autoshovel calibrate arm: give a measurement CSV (or --simulate FILE)\n";
+      return 2;
+    }
+    return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
   }
   if (*map_cmd) {
     map.models_dir = models_dir;

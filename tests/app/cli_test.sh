@@ -10,7 +10,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "max reach" <<<"$out" || fail "describe $machine: no reach"
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
-for level in "" describe gen plant "plant step" scenario map; do
+for level in "" describe gen plant "plant step" scenario map calibrate "calibrate arm"; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -58,4 +58,20 @@ grep -q "pile at" "$tmp/out" || fail "map found no pile: $(cat "$tmp/out")"
 "$autoshovel" --models "$source_dir/models" map cone_pile --lighting dusk 2>"$tmp/err" \
   >/dev/null && fail "lighting dusk accepted"
 grep -q "lighting must be normal, bright or dim" "$tmp/err" || fail "unexpected: $(cat "$tmp/err")"
+# calibrate arm: simulate a measurement file, calibrate, get an overlay; bad files are located.
+"$autoshovel" --models "$source_dir/models" calibrate arm --machine xcmg_968ev \
+  --simulate "$tmp/arm.csv" >/dev/null || fail "calibrate arm --simulate"
+"$autoshovel" --models "$source_dir/models" calibrate arm "$tmp/arm.csv" --machine xcmg_968ev \
+  --initial 1,1,0,0 -o "$tmp/arm.yaml" >"$tmp/out" || fail "calibrate arm: $(cat "$tmp/out")"
+grep -q "l_1 (boom" "$tmp/out" || fail "calibration table: $(cat "$tmp/out")"
+grep -q "^    - name: bucket" "$tmp/arm.yaml" || fail "overlay: $(cat "$tmp/arm.yaml")"
+sed '4s/^\([^,]*\),[^,]*,/\1,abc,/' "$tmp/arm.csv" >"$tmp/bad_arm.csv"
+"$autoshovel" --models "$source_dir/models" calibrate arm "$tmp/bad_arm.csv" \
+  --machine xcmg_968ev -o "$tmp/bad.yaml" 2>"$tmp/err" >/dev/null && fail "bad csv accepted"
+grep -q "bad_arm.csv:4:2: theta_boom_deg: expected a finite number, got 'abc'" "$tmp/err" \
+  || fail "unexpected: $(cat "$tmp/err")"
+[ ! -e "$tmp/bad.yaml" ] || fail "overlay written for a bad file"
+head -4 "$tmp/arm.csv" >"$tmp/two.csv"
+"$autoshovel" --models "$source_dir/models" calibrate arm "$tmp/two.csv" --machine xcmg_968ev \
+  2>"$tmp/err" >/dev/null && fail "two poses accepted"
 echo "cli ok"

@@ -35,7 +35,9 @@ int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& er
   bool invalid = false;
   for (const auto& path : descriptions) {
     try {
-      machines.push_back(model::LoadMachineDescription(path, {request.materials_dir}));
+      model::LoadOptions options;
+      options.materials_dir = request.materials_dir;
+      machines.push_back(model::LoadMachineDescription(path, options));
     } catch (const core::InputError& e) {
       for (const auto& d : e.diagnostics()) err << d.ToString() << '\n';
       invalid = true;

@@ -27,8 +27,10 @@ double Deg(double radians) { return radians * 180.0 / std::numbers::pi; }
 int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream& err) {
   model::MachineDescription m;
   try {
+    model::LoadOptions load;
+    load.overlays = options.overlays;
     m = model::LoadMachineDescription(
-        model::ResolveMachineDescription(options.machine, options.models_dir));
+        model::ResolveMachineDescription(options.machine, options.models_dir), load);
   } catch (const core::InputError& e) {
     for (const auto& d : e.diagnostics()) err << d.ToString() << '\n';
     return 1;

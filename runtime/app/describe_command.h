@@ -3,6 +3,7 @@
 
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace autoshovel::app {
 
@@ -10,6 +11,7 @@ struct DescribeOptions {
   std::string machine;  ///< name or path
   std::string models_dir;
   bool show_estimated = false;
+  std::vector<std::string> overlays;  ///< identified values applied on top
 };
 
 /// Prints the summary; returns a process exit code (diagnostics on `err`).

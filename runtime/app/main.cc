@@ -51,6 +51,8 @@ int main(int argc, char** argv) {
       ->required();
   describe_cmd->add_flag("--estimated", describe.show_estimated,
                          "List the values marked as estimated");
+  describe_cmd->add_option("--overlay", describe.overlays,
+                           "Apply identified values (calibrate/identify output), in order");
 
   std::vector<std::string> gen_descriptions;
   std::string gen_output = "generated", gen_materials;

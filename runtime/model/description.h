@@ -208,6 +208,7 @@ struct MachineDescription {
   std::string sha256;                  ///< of the file's bytes
   std::string notes;                   ///< provenance, free text
   std::vector<std::string> estimated;  ///< key paths whose values are estimates
+  std::vector<std::string> overlays;   ///< overlay files applied on top, in order
 
   Chassis chassis;
   std::optional<ElectricMotor> electric_motor;
@@ -238,6 +239,12 @@ struct MachineDescription {
 struct LoadOptions {
   /// Where material files are found. Empty: `<description dir>/../materials`.
   std::string materials_dir;
+  /// Overlays applied in order on top of the description before it is validated: files
+  /// written by identification (`autoshovel calibrate arm` …) holding identified values. An
+  /// overlay names its machine and the SHA-256 of the description it was identified against;
+  /// both must match. Schema: `machine`, `base_sha256`, `arm.links[]{name, length,
+  /// imu_offset_deg}` (each value optional).
+  std::vector<std::string> overlays;
 };
 
 /// Loads and validates a machine description. Throws core::InputError listing every problem

@@ -641,6 +641,56 @@ std::vector<Material> LoadMaterials(const std::string& directory) {
   return materials;
 }
 
+namespace {
+
+// Identified values on top of a description (LoadOptions::overlays).
+void ApplyOverlay(MachineDescription& m, const std::string& path, core::DiagnosticSink& sink) {
+  const core::YamlFile file(path, sink);
+  if (!file.ok()) return;
+  MapReader root = MapReader::Root(file, nullptr);
+  const std::string machine = root.String("machine");
+  if (!machine.empty() && machine != m.name) {
+    root.Error("machine", "this overlay is for '" + machine + "', the description is '" + m.name +
+                              "' (" + m.source_file + ")");
+  }
+  if (root.Has("base_sha256")) {
+    const std::string sha = root.String("base_sha256");
+    if (!sha.empty() && sha != m.sha256) {
+      root.Error("base_sha256", "identified against another version of " + m.source_file +
+                                    " (its SHA-256 is now " + m.sha256 +
+                                    "): identify again, or delete this line to apply anyway");
+    }
+  }
+  if (std::optional<MapReader> arm = root.OptionalMap("arm")) {
+    for (MapReader& link : arm->MapList("links", false)) {
+      const std::string name = link.String("name");
+      const int k = m.LinkIndex(name);
+      if (k < 0) {
+        std::vector<std::string> names;
+        for (const Link& l : m.links) names.push_back(l.name);
+        std::string message = "no link '" + name + "' in " + m.name;
+        if (const std::string near = core::NearestWord(name, names); !near.empty()) {
+          message += "; did you mean '" + near + "'?";
+        }
+        link.Error("name", message);
+        continue;
+      }
+      if (link.Has("length")) {
+        m.links[k].length = link.Number("length", NumberRule::Positive("m"));
+      }
+      if (link.Has("imu_offset_deg")) {
+        m.links[k].imu_offset = link.AngleDeg("imu_offset_deg", NumberRule::Open(-180, 180, "deg"));
+      }
+      link.Finish();
+    }
+    arm->Finish();
+  }
+  root.Finish();
+  m.overlays.push_back(path);
+}
+
+}  // namespace
+
 MachineDescription LoadMachineDescription(const std::string& path, const LoadOptions& options) {
   core::DiagnosticSink sink;
   MachineDescription m;
@@ -703,6 +753,9 @@ MachineDescription LoadMachineDescription(const std::string& path, const LoadOpt
   m.bucket = ReadBucket(root.Map("bucket"), file, sink);
   m.sensors = ReadSensors(root.Map("sensors"));
   root.Finish();
+  if (sink.empty()) {
+    for (const std::string& overlay : options.overlays) ApplyOverlay(m, overlay, sink);
+  }
 
   const std::string materials_dir =
       options.materials_dir.empty()

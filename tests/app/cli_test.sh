@@ -71,6 +71,8 @@ sed '4s/^\([^,]*\),[^,]*,/\1,abc,/' "$tmp/arm.csv" >"$tmp/bad_arm.csv"
 grep -q "bad_arm.csv:4:2: theta_boom_deg: expected a finite number, got 'abc'" "$tmp/err" \
   || fail "unexpected: $(cat "$tmp/err")"
 [ ! -e "$tmp/bad.yaml" ] || fail "overlay written for a bad file"
+"$autoshovel" --models "$source_dir/models" describe xcmg_968ev --overlay "$tmp/arm.yaml" \
+  >/dev/null || fail "describe with the calibration overlay"
 head -4 "$tmp/arm.csv" >"$tmp/two.csv"
 "$autoshovel" --models "$source_dir/models" calibrate arm "$tmp/two.csv" --machine xcmg_968ev \
   2>"$tmp/err" >/dev/null && fail "two poses accepted"

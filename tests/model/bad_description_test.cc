@@ -18,6 +18,12 @@ namespace fs = std::filesystem;
 const fs::path kBad = fs::path(AUTOSHOVEL_SOURCE_DIR) / "tests" / "data" / "bad";
 const std::string kMaterials = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models/materials";
 
+LoadOptions MaterialsOnly() {
+  LoadOptions options;
+  options.materials_dir = kMaterials;
+  return options;
+}
+
 std::vector<fs::path> Fixtures() {
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(kBad)) {
@@ -42,7 +48,7 @@ TEST(BadDescriptions, EachIsRefusedWithOneLineAtTheExpectedLocation) {
     const std::string location = expected.substr(0, second_colon);
     const std::string text = expected.substr(second_colon + 2);
     try {
-      LoadMachineDescription(fixture.string(), {kMaterials});
+      LoadMachineDescription(fixture.string(), MaterialsOnly());
       ADD_FAILURE() << fixture << " was accepted; " << defect;
     } catch (const core::InputError& e) {
       ASSERT_EQ(e.diagnostics().size(), 1u) << fixture << ":\n" << e.what();

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <numbers>
 
 #include "runtime/model/machine_summary.h"
@@ -69,6 +70,60 @@ TEST(MachineSummary, LoaderFiguresAreThoseOfItsClass) {
     EXPECT_GT(a.lever_min, 0.02) << a.name;
   }
   EXPECT_GT(s.lift_capacity_at_carry, m.bucket.rated_load);
+}
+
+// Identified values flow in through overlays, checked against the description they belong to.
+TEST(Overlay, ReplacesIdentifiedValuesAndRefusesForeignOnes) {
+  const std::string path = ResolveMachineDescription("xcmg_968ev", kModels);
+  const MachineDescription base = LoadMachineDescription(path);
+  const std::string dir = ::testing::TempDir();
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  LoadOptions options;
+  options.overlays = {write("good.yaml", "machine: xcmg_968ev\nbase_sha256: " + base.sha256 +
+                                             "\narm:\n  links:\n    - name: boom\n"
+                                             "      length: 3.1234\n"
+                                             "      imu_offset_deg: 1.5\n")};
+  const MachineDescription calibrated = LoadMachineDescription(path, options);
+  EXPECT_DOUBLE_EQ(calibrated.links[0].length, 3.1234);
+  EXPECT_NEAR(calibrated.links[0].imu_offset, 1.5 * std::numbers::pi / 180, 1e-15);
+  EXPECT_DOUBLE_EQ(calibrated.links[1].length, base.links[1].length);  // untouched
+  EXPECT_EQ(calibrated.sha256, base.sha256);  // still the same description underneath
+  ASSERT_EQ(calibrated.overlays.size(), 1u);
+
+  auto error_of = [&](const std::string& file) {
+    LoadOptions bad;
+    bad.overlays = {file};
+    try {
+      LoadMachineDescription(path, bad);
+    } catch (const core::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string foreign = error_of(write("foreign.yaml", "machine: sdlg_l955he\n"));
+  EXPECT_NE(foreign.find("foreign.yaml:1:10: machine: this overlay is for 'sdlg_l955he'"),
+            std::string::npos)
+      << foreign;
+  const std::string stale =
+      error_of(write("stale.yaml", "machine: xcmg_968ev\nbase_sha256: 0123\n"));
+  EXPECT_NE(stale.find("stale.yaml:2:14: base_sha256: identified against another version"),
+            std::string::npos)
+      << stale;
+  const std::string typo =
+      error_of(write("typo.yaml", "machine: xcmg_968ev\narm:\n  links:\n    - name: bom\n"));
+  EXPECT_NE(typo.find("typo.yaml:4:13: arm.links[0].name: no link 'bom' in xcmg_968ev; did you "
+                      "mean 'boom'?"),
+            std::string::npos)
+      << typo;
+  const std::string negative =
+      error_of(write("negative.yaml",
+                     "machine: xcmg_968ev\narm:\n  links:\n    - name: boom\n      length: -1\n"));
+  EXPECT_NE(negative.find("negative.yaml:5:15: arm.links[0].length: must be > 0 m"),
+            std::string::npos)
+      << negative;
 }
 
 }  // namespace

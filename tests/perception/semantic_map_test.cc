@@ -12,6 +12,7 @@
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/map_render.h"
 #include "runtime/perception/pile_extraction.h"
+#include "runtime/perception/segmentation.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/sensors/camera.h"
@@ -47,7 +48,7 @@ struct Scene {
   }
 
   /// The semantic map after `frames` LiDAR frames and one camera frame, semantics given.
-  void Build(ElevationMap& map, SemanticMap& semantic, const ClassProbabilities* semantics,
+  void Build(ElevationMap& map, SemanticMap& semantic, const Segmenter* segmenter,
              plant::Lighting lighting, int frames = 5) {
     const plant::MachineState& s = plant->state();
     MachineFootprint footprint;  // what the encoder, localisation and Eq. (2) would give
@@ -70,8 +71,16 @@ struct Scene {
     options.lighting = lighting;
     const sensors::CameraFrame frame =
         sensors::SimulateCameraFrame(machine.sensors.camera, *raycast, T_camera, 0.0, options, rng);
-    const ClassProbabilities truth = FromLabels(frame.labels, frame.width, frame.height);
-    semantic.Project(semantics ? *semantics : truth, machine.sensors.camera, T_camera);
+    ClassProbabilities probabilities;
+    if (segmenter != nullptr) {  // the shipped network on the rendered image
+      SegmentationResult result = segmenter->Run(frame);
+      probabilities.width = result.width;
+      probabilities.height = result.height;
+      probabilities.planes = std::move(result.probabilities);
+    } else {  // the simulator's labels: perfect semantics
+      probabilities = FromLabels(frame.labels, frame.width, frame.height);
+    }
+    semantic.Project(probabilities, machine.sensors.camera, T_camera);
     ASSERT_TRUE(semantic.Fuse());
   }
 
@@ -189,6 +198,42 @@ TEST(SemanticMap, ObstaclesAreNeverPile) {
       EXPECT_GT(s.cells, 300) << name;
       EXPECT_EQ(s.obstacle_as_pile, 0) << name << ", " << plant::ToString(lighting);
     }
+  }
+}
+
+// Seed Fig. 8: in dim light the segmentation errs; fusing it with the height corrects it. With
+// the shipped network on dim images, the fused classification beats semantics alone.
+TEST(SemanticMap, WithTheNetworkFusionBeatsSemanticsOnlyInDimLight) {
+  const Segmenter segmenter(kModels + "/segmentation/yard_segmenter.onnx");
+  for (const char* name : {"cone_pile", "irregular_pile"}) {
+    Scene scene(name, 3.0);
+    ElevationMap map({}, scene.plant->state().hinge_xy);
+    SemanticMap semantic(map);
+    scene.Build(map, semantic, &segmenter, plant::Lighting::kDim);
+    const Scores s = Evaluate(scene, map.map());
+    std::printf("%s, dim, network: pile IoU fused %.3f, semantic only %.3f, height only %.3f\n",
+                name, s.fused, s.semantic_only, s.height_only);
+    EXPECT_GT(s.fused, s.semantic_only) << name;
+    EXPECT_GE(s.fused, 0.85) << name;
+    EXPECT_EQ(s.obstacle_as_pile, 0) << name;
+  }
+}
+
+// With the shipped network in normal light. The goal is IoU ≥ 0.9; measured: cone
+// 0.824, irregular 0.916, low 0.896. The guard below holds today's level so that a regression
+// shows; raising it to 0.9 is open work (the perception issue's note says so).
+TEST(SemanticMap, WithTheNetworkPileCellsMatchTheSimulatorInNormalLight) {
+  const Segmenter segmenter(kModels + "/segmentation/yard_segmenter.onnx");
+  for (const char* name : {"cone_pile", "irregular_pile", "low_pile"}) {
+    Scene scene(name, 3.0);
+    ElevationMap map({}, scene.plant->state().hinge_xy);
+    SemanticMap semantic(map);
+    scene.Build(map, semantic, &segmenter, plant::Lighting::kNormal);
+    const Scores s = Evaluate(scene, map.map());
+    std::printf("%s, normal, network: pile IoU fused %.3f, semantic only %.3f, height only %.3f\n",
+                name, s.fused, s.semantic_only, s.height_only);
+    EXPECT_GE(s.fused, 0.8) << name;
+    EXPECT_GE(s.fused, s.semantic_only) << name;
   }
 }
 

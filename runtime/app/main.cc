@@ -108,6 +108,10 @@ int main(int argc, char** argv) {
   map_cmd->add_option("--frames", map.frames, "LiDAR frames per sensor")->capture_default_str();
   map_cmd->add_option("--advance", map.advance, "Start this far ahead of the start pose [m]")
       ->capture_default_str();
+  map_cmd->add_option("--segmenter", map.segmenter,
+                      "ONNX segmentation network (default: models/segmentation/yard_segmenter)");
+  map_cmd->add_flag("--truth", map.truth_labels,
+                    "Use the simulator's per-pixel labels instead of the network");
 
   autoshovel::identification::CalibrateArmOptions calibrate_arm;
   CLI::App* calibrate_cmd = app.add_subcommand("calibrate", "Calibrate a machine from data");

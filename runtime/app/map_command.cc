@@ -11,6 +11,7 @@
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/map_render.h"
 #include "runtime/perception/pile_extraction.h"
+#include "runtime/perception/segmentation.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/scenario.h"
@@ -84,9 +85,22 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     camera_options.lighting = lighting;
     const sensors::CameraFrame image = sensors::SimulateCameraFrame(
         machine.sensors.camera, scene, T_camera, 0.0, camera_options, rng);
-    // Until a segmentation network is given, the simulator's own labels stand in for it.
-    semantic.Project(perception::FromLabels(image.labels, image.width, image.height),
-                     machine.sensors.camera, T_camera);
+    std::string semantics_source = "simulator labels (--truth)";
+    perception::ClassProbabilities probabilities;
+    if (options.truth_labels) {
+      probabilities = perception::FromLabels(image.labels, image.width, image.height);
+    } else {
+      const std::string model = options.segmenter.empty()
+                                    ? options.models_dir + "/segmentation/yard_segmenter.onnx"
+                                    : options.segmenter;
+      const perception::Segmenter segmenter(model);
+      perception::SegmentationResult result = segmenter.Run(image);
+      probabilities.width = result.width;
+      probabilities.height = result.height;
+      probabilities.planes = std::move(result.probabilities);
+      semantics_source = "network " + model;
+    }
+    semantic.Project(probabilities, machine.sensors.camera, T_camera);
     const long filled = map.FillHoles();
     if (!semantic.Fuse()) {
       err << "autoshovel map: too few ground cells to fit the ground plane\n";
@@ -105,7 +119,7 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
                   scenario.name.c_str(), plant::ToString(lighting), points, dropped, filled,
                   semantic.ground_plane().x(), semantic.ground_plane().y(),
                   semantic.ground_plane().z(), std::sqrt(semantic.ground_variance()), seconds);
-    out << line << "semantics: simulator labels (no segmentation network given)\n";
+    out << line << "semantics: " << semantics_source << "\n";
     for (const perception::ExtractedPile& pile : piles) {
       int front = 0;
       for (const auto& b : pile.boundary) front += b.front;

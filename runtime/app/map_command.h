@@ -15,6 +15,9 @@ struct MapOptions {
   std::string lighting;  ///< overrides the scenario's: normal | bright | dim
   int frames = 5;        ///< LiDAR frames per sensor
   double advance = 0.0;  ///< drive the start pose this far ahead first [m]
+  /// ONNX segmentation network; empty: models/segmentation/yard_segmenter.onnx.
+  std::string segmenter;
+  bool truth_labels = false;  ///< use the simulator's labels instead of the network
 };
 
 int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err);

@@ -60,14 +60,9 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
 
     const auto t0 = std::chrono::steady_clock::now();
     const plant::MachineState& s = plant.state();
-    perception::MachineFootprint footprint;
-    footprint.hinge_xy = s.hinge_xy;
-    footprint.heading_front = s.heading;
-    footprint.articulation = s.articulation;
-    footprint.front_length = (plant.TipInWorld().head<2>() - s.hinge_xy).norm() + 0.3;
-    footprint.rear_length = machine.chassis.hinge_to_rear_axle + 2.5;
-    footprint.half_width = machine.bucket.width / 2 + 0.3;
-    footprint.max_height = 4.5;
+    const perception::MachineFootprint footprint =
+        perception::LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation,
+                                    (plant.TipInWorld().head<2>() - s.hinge_xy).norm());
     perception::ElevationMap map({}, s.hinge_xy);
     long points = 0, dropped = 0;
     for (const model::Lidar& lidar : machine.sensors.lidars) {

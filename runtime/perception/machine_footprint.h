@@ -5,7 +5,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+
+#include "runtime/model/description.h"
 
 namespace autoshovel::perception {
 
@@ -32,5 +35,23 @@ struct MachineFootprint {
            inside(heading_front - articulation, -rear_length, 0.0);
   }
 };
+
+/// The footprint of a wheel loader from its description, the localisation pose, the encoder's
+/// articulation and the tip's horizontal reach from the hinge (Eq. 2 on the IMU angles). The
+/// margins cover what the description does not draw: 0.3 m beyond the tip and the sides, the
+/// body 2.5 m behind the rear axle (counterweight), 4.5 m of height (cab, raised boom).
+inline MachineFootprint LoaderFootprint(const model::MachineDescription& machine,
+                                        const Eigen::Vector2d& hinge_xy, double heading_front,
+                                        double articulation, double tip_reach) {
+  MachineFootprint f;
+  f.hinge_xy = hinge_xy;
+  f.heading_front = heading_front;
+  f.articulation = articulation;
+  f.front_length = tip_reach + 0.3;
+  f.rear_length = machine.chassis.hinge_to_rear_axle + 2.5;
+  f.half_width = std::max(machine.bucket.width, machine.chassis.track_width) / 2 + 0.3;
+  f.max_height = 4.5;
+  return f;
+}
 
 }  // namespace autoshovel::perception

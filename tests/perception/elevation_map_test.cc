@@ -130,15 +130,8 @@ struct YardFixture {
   }
   MachineFootprint Footprint() const {
     const plant::MachineState& s = plant->state();
-    MachineFootprint f;
-    f.hinge_xy = s.hinge_xy;
-    f.heading_front = s.heading;
-    f.articulation = s.articulation;
-    f.front_length = (plant->TipInWorld().head<2>() - s.hinge_xy).norm() + 0.3;
-    f.rear_length = machine.chassis.hinge_to_rear_axle + 2.5;
-    f.half_width = machine.bucket.width / 2 + 0.3;
-    f.max_height = 4.5;
-    return f;
+    return LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation,
+                           (plant->TipInWorld().head<2>() - s.hinge_xy).norm());
   }
   /// RMS of map minus truth over observed cells whose centre lies within `radius` of `center`.
   double Rms(const ElevationMap& map, const Eigen::Vector2d& center, double radius,

@@ -51,14 +51,9 @@ struct Scene {
   void Build(ElevationMap& map, SemanticMap& semantic, const Segmenter* segmenter,
              plant::Lighting lighting, int frames = 5) {
     const plant::MachineState& s = plant->state();
-    MachineFootprint footprint;  // what the encoder, localisation and Eq. (2) would give
-    footprint.hinge_xy = s.hinge_xy;
-    footprint.heading_front = s.heading;
-    footprint.articulation = s.articulation;
-    footprint.front_length = (plant->TipInWorld().head<2>() - s.hinge_xy).norm() + 0.3;
-    footprint.rear_length = machine.chassis.hinge_to_rear_axle + 2.5;
-    footprint.half_width = machine.bucket.width / 2 + 0.3;
-    footprint.max_height = 4.5;
+    const MachineFootprint footprint =
+        LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation,
+                        (plant->TipInWorld().head<2>() - s.hinge_xy).norm());
     for (const model::Lidar& lidar : machine.sensors.lidars) {
       const Eigen::Isometry3d T = sensors::SensorInWorld(s, lidar.pose);
       for (int k = 0; k < frames; ++k) {

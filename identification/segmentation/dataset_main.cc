@@ -91,46 +91,32 @@ int Run(int argc, char** argv) {
   fs::create_directories(out / "labels");
 
   std::vector<std::string> lines(static_cast<std::size_t>(count));
-  std::atomic<std::int64_t> next{0}, done{0};
-  std::mutex error_mutex;
-  std::string error;
-  auto worker = [&] {
-    for (std::int64_t k = next++; k < count; k = next++) {
-      try {
-        const std::int64_t index = first + k;
-        const identification::YardView v = sampler.Render(
-            static_cast<std::uint64_t>(seed), static_cast<std::uint64_t>(index), lighting);
-        char id[16];
-        std::snprintf(id, sizeof id, "%06lld", static_cast<long long>(index));
-        const cv::Mat bgr(v.frame.height, v.frame.width, CV_8UC3,
-                          const_cast<std::uint8_t*>(v.frame.bgr.data()));
-        const cv::Mat labels(v.frame.height, v.frame.width, CV_8UC1,
-                             const_cast<std::uint8_t*>(v.frame.labels.data()));
-        if (!cv::imwrite((out / "images" / (std::string(id) + ".png")).string(), bgr) ||
-            !cv::imwrite((out / "labels" / (std::string(id) + ".png")).string(), labels)) {
-          throw std::runtime_error("cannot write PNG files under " + out.string());
-        }
-        const std::string split = args.has("split") ? args.String("split", "")
-                                  : (val_every > 0 && index % val_every == val_every - 1) ? "val"
-                                                                                          : "train";
-        lines[static_cast<std::size_t>(k)] = CsvLine(id, split, v);
-        const std::int64_t n = ++done;
-        if (n % 100 == 0 || n == count) {
-          std::fprintf(stderr, "\r%lld / %lld views", static_cast<long long>(n),
-                       static_cast<long long>(count));
-        }
-      } catch (const std::exception& e) {
-        const std::lock_guard<std::mutex> lock(error_mutex);
-        if (error.empty()) error = e.what();
-        next = count;
-      }
+  std::atomic<std::int64_t> done{0};
+  identification::ParallelFor(count, jobs, [&](std::int64_t k) {
+    const std::int64_t index = first + k;
+    const identification::YardView v = sampler.Render(static_cast<std::uint64_t>(seed),
+                                                      static_cast<std::uint64_t>(index), lighting);
+    char id[16];
+    std::snprintf(id, sizeof id, "%06lld", static_cast<long long>(index));
+    const cv::Mat bgr(v.frame.height, v.frame.width, CV_8UC3,
+                      const_cast<std::uint8_t*>(v.frame.bgr.data()));
+    const cv::Mat labels(v.frame.height, v.frame.width, CV_8UC1,
+                         const_cast<std::uint8_t*>(v.frame.labels.data()));
+    if (!cv::imwrite((out / "images" / (std::string(id) + ".png")).string(), bgr) ||
+        !cv::imwrite((out / "labels" / (std::string(id) + ".png")).string(), labels)) {
+      throw std::runtime_error("cannot write PNG files under " + out.string());
     }
-  };
-  std::vector<std::thread> threads;
-  for (std::int64_t j = 0; j < jobs; ++j) threads.emplace_back(worker);
-  for (std::thread& t : threads) t.join();
+    const std::string split = args.has("split") ? args.String("split", "")
+                              : (val_every > 0 && index % val_every == val_every - 1) ? "val"
+                                                                                      : "train";
+    lines[static_cast<std::size_t>(k)] = CsvLine(id, split, v);
+    const std::int64_t n = ++done;
+    if (n % 100 == 0 || n == count) {
+      std::fprintf(stderr, "\r%lld / %lld views", static_cast<long long>(n),
+                   static_cast<long long>(count));
+    }
+  });
   std::fprintf(stderr, "\n");
-  if (!error.empty()) throw std::runtime_error(error);
 
   // Appends when the set is made in pieces (--first > 0), so one split file lists them all.
   const fs::path split_file = out / "split.csv";

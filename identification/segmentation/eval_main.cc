@@ -64,29 +64,14 @@ std::vector<Sample> Render(const identification::ToolArgs& args, std::string& wh
   what = std::to_string(count) + " views rendered from seed " + std::to_string(seed) + " (first " +
          std::to_string(first) + ")";
   std::vector<Sample> samples(static_cast<std::size_t>(count));
-  std::atomic<std::int64_t> next{0};
-  std::mutex error_mutex;
-  std::string error;
-  auto worker = [&] {
-    for (std::int64_t k = next++; k < count; k = next++) {
-      try {
-        identification::YardView v =
-            sampler.Render(static_cast<std::uint64_t>(seed), static_cast<std::uint64_t>(first + k));
-        Sample& s = samples[static_cast<std::size_t>(k)];
-        s.id = std::to_string(first + k);
-        s.lighting = v.lighting;
-        s.frame = std::move(v.frame);
-      } catch (const std::exception& e) {
-        const std::lock_guard<std::mutex> lock(error_mutex);
-        if (error.empty()) error = e.what();
-        next = count;
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (std::int64_t j = 0; j < jobs; ++j) threads.emplace_back(worker);
-  for (std::thread& t : threads) t.join();
-  if (!error.empty()) throw std::runtime_error(error);
+  identification::ParallelFor(count, jobs, [&](std::int64_t k) {
+    identification::YardView v =
+        sampler.Render(static_cast<std::uint64_t>(seed), static_cast<std::uint64_t>(first + k));
+    Sample& s = samples[static_cast<std::size_t>(k)];
+    s.id = std::to_string(first + k);
+    s.lighting = v.lighting;
+    s.frame = std::move(v.frame);
+  });
   return samples;
 }
 

@@ -2,13 +2,16 @@
 // these tools take a handful of options).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace autoshovel::identification {
@@ -66,6 +69,30 @@ class ToolArgs {
   std::map<std::string, std::string> values_;
   bool help_ = false;
 };
+
+/// Runs body(k) for k in [0, count) on `jobs` threads, each taking the next index. The first
+/// exception stops the others from taking more and is rethrown (as std::runtime_error) here.
+template <typename Body>
+void ParallelFor(std::int64_t count, std::int64_t jobs, Body&& body) {
+  std::atomic<std::int64_t> next{0};
+  std::mutex error_mutex;
+  std::string error;
+  auto worker = [&] {
+    for (std::int64_t k = next++; k < count; k = next++) {
+      try {
+        body(k);
+      } catch (const std::exception& e) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (error.empty()) error = e.what();
+        next = count;
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (std::int64_t j = 0; j < jobs; ++j) threads.emplace_back(worker);
+  for (std::thread& t : threads) t.join();
+  if (!error.empty()) throw std::runtime_error(error);
+}
 
 /// A tool's main: runs `run`, turning an escaped exception into "<tool>: <what>" and exit 1.
 inline int RunTool(const char* tool, int (*run)(int, char**), int argc, char** argv) {

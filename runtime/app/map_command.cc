@@ -14,6 +14,7 @@
 #include "runtime/perception/segmentation.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/sensors/camera.h"
 #include "runtime/sensors/lidar.h"
@@ -48,11 +49,15 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     start.hinge_xy =
         Eigen::Vector2d(scenario.start.x, scenario.start.y) +
         options.advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
+    // Bucket on the floor, as when approaching a pile (other arms: low in their range).
     start.q.assign(machine.num_joints(), 0.0);
-    // Bucket lowered and level, as when approaching a pile.
-    for (std::size_t j = 0; j < machine.num_links(); ++j) {
-      start.q[j] = machine.links[j].joint_min +
-                   0.1 * (machine.links[j].joint_max - machine.links[j].joint_min);
+    if (machine.num_links() == 2) {
+      start.q = plant::BucketOnFloor(machine);
+    } else {
+      for (std::size_t j = 0; j < machine.num_links(); ++j) {
+        start.q[j] = machine.links[j].joint_min +
+                     0.1 * (machine.links[j].joint_max - machine.links[j].joint_min);
+      }
     }
     plant::Plant plant(machine, *functions, scenario.world, start);
     sensors::RaycastScene scene(scenario.world, plant.OwnBodies());

@@ -9,6 +9,7 @@
 #include "generated/registry.h"
 #include "runtime/model/description.h"
 #include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
 
 namespace {
 
@@ -64,7 +65,7 @@ void CrowdScoopCycle(benchmark::State& state, const std::string& material) {
     plant::World world = fixture.world;
     plant::MachineState start;
     start.hinge_xy = Eigen::Vector2d(toe - 4.1, 0.0);  // the tip 1 m before the toe
-    start.q = {-0.5233, 0.2126};                       // bucket flat on the floor
+    start.q = plant::BucketOnFloor(fixture.machine);
     state.ResumeTiming();
     const double cpu0 = CpuSeconds();
     plant::Plant plant(fixture.machine, functions, world, start);

@@ -10,6 +10,7 @@
 #include "runtime/model/description.h"
 #include "runtime/plant/machine_state.h"
 #include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/sensors/lidar.h"
 #include "runtime/sensors/raycast.h"
@@ -115,7 +116,7 @@ struct YardFixture {
     plant::MachineState start;
     start.hinge_xy = Eigen::Vector2d(scenario.start.x + start_offset, scenario.start.y);
     start.heading = scenario.start.heading;
-    start.q = {-0.5233, 0.2126};
+    start.q = plant::BucketOnFloor(machine);
     plant = std::make_unique<plant::Plant>(machine, *generated::FindMachine(machine.name),
                                            scenario.world, start);
     scene = std::make_unique<sensors::RaycastScene>(scenario.world, plant->OwnBodies());

@@ -8,6 +8,7 @@
 #include "runtime/perception/pile_extraction.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/sensors/camera.h"
 #include "runtime/sensors/lidar.h"
@@ -34,7 +35,7 @@ struct Frames {
     plant::MachineState state;
     state.hinge_xy = Eigen::Vector2d(scenario.start.x, scenario.start.y);
     state.heading = scenario.start.heading;
-    state.q = {-0.5233, 0.2126};
+    state.q = plant::BucketOnFloor(machine);
     plant::Plant plant(machine, *generated::FindMachine(machine.name), scenario.world, state);
     sensors::RaycastScene scene(scenario.world, plant.OwnBodies());
     sensors::Rng rng(1);

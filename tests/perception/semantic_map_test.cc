@@ -14,6 +14,7 @@
 #include "runtime/perception/pile_extraction.h"
 #include "runtime/perception/segmentation.h"
 #include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/sensors/camera.h"
 #include "runtime/sensors/lidar.h"
@@ -41,7 +42,7 @@ struct Scene {
     start.heading = scenario.start.heading;
     start.hinge_xy = Eigen::Vector2d(scenario.start.x, scenario.start.y) +
                      advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
-    start.q = {-0.5233, 0.2126};
+    start.q = plant::BucketOnFloor(machine);
     plant = std::make_unique<plant::Plant>(machine, *generated::FindMachine(machine.name),
                                            scenario.world, start);
     raycast = std::make_unique<sensors::RaycastScene>(scenario.world, plant->OwnBodies());

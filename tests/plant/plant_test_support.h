@@ -9,6 +9,7 @@
 #include "generated/registry.h"
 #include "runtime/model/description.h"
 #include "runtime/plant/machine_state.h"
+#include "runtime/plant/poses.h"
 #include "runtime/plant/world.h"
 
 namespace autoshovel::plant::testing {
@@ -63,12 +64,14 @@ inline void AddCone(World& world, const Eigen::Vector2d& center, double height,
   }
 }
 
-/// Boom and bucket joints that put the xcmg_968ev bucket flat on the floor, tip 5 cm up.
-inline constexpr double kBoomOnFloor = -0.5233, kBucketOnFloor = 0.2126;
-
-/// A loader at `x` facing +x, by default with its bucket flat on the floor.
+/// A loader at `x` facing +x with its bucket flat on the floor (`boom` and `bucket` NaN) or at
+/// the given joint positions.
 inline MachineState LoaderAt(const model::MachineDescription& machine, double x,
-                             double boom = kBoomOnFloor, double bucket = kBucketOnFloor) {
+                             double boom = std::nan(""), double bucket = std::nan("")) {
+  if (std::isnan(boom)) {
+    const std::vector<double> q = BucketOnFloor(machine);
+    boom = q[0], bucket = q[1];
+  }
   MachineState state;
   state.hinge_xy = Eigen::Vector2d(x, 0.0);
   state.q.assign(machine.num_joints(), 0.0);

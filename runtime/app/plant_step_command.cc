@@ -108,6 +108,9 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
     const double dt = 1.0 / options.sample_rate;
     const long samples = std::lround(options.duration * options.sample_rate);
     csv << std::setprecision(9);
+    // The true joint (not the noisy column) tells when the arm first moves after the step.
+    const double q_start = plant.state().q[joint];
+    double motion_time = -1;
     for (long i = 0; i <= samples; ++i) {
       const double t = plant.time();
       double u = 0;
@@ -133,7 +136,19 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
           << s.pressure_a[joint] + noise * 1e5 * gauss(rng) << ','
           << s.q[joint] + noise * 0.05 * std::numbers::pi / 180 * gauss(rng) << ','
           << s.qd[joint] + noise * 0.2 * std::numbers::pi / 180 * gauss(rng) << '\n';
+      if (motion_time < 0 && t >= options.step_time &&
+          std::abs(s.q[joint] - q_start) > 0.1 * std::numbers::pi / 180) {
+        motion_time = t - options.step_time;
+      }
       if (i < samples) plant.Advance(dt);
+    }
+    // On standard error so that the CSV on standard output stays clean.
+    if (!options.chirp) {
+      if (motion_time >= 0) {
+        err << "command to motion (0.1 deg): " << motion_time << " s\n";
+      } else {
+        err << "the joint did not move 0.1 deg within the log\n";
+      }
     }
     return 0;
   } catch (const core::InputError& e) {

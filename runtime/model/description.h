@@ -242,8 +242,10 @@ struct LoadOptions {
   /// Overlays applied in order on top of the description before it is validated: files
   /// written by identification (`autoshovel calibrate arm` …) holding identified values. An
   /// overlay names its machine and the SHA-256 of the description it was identified against;
-  /// both must match. Schema: `machine`, `base_sha256`, `arm.links[]{name, length,
-  /// imu_offset_deg}` (each value optional).
+  /// both must match. Schema (every value optional, units as in the description):
+  /// `machine`, `base_sha256`, `arm.links[]{name, length, imu_offset_deg}`,
+  /// `hydraulics.actuators[]{name, dead_zone, transport_delay, spool_time_constant,
+  /// rated_flow_lpm}`, `sensors.camera.pose{xyz, rpy_deg}`, `sensors.lidars[]{name, pose}`.
   std::vector<std::string> overlays;
 };
 

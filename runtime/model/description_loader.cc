@@ -643,6 +643,20 @@ std::vector<Material> LoadMaterials(const std::string& directory) {
 
 namespace {
 
+// Index of `name` among `names`, or -1 after a located error suggesting the nearest name.
+int FindOverlayTarget(MapReader& item, const std::string& name,
+                      const std::vector<std::string>& names, const std::string& what,
+                      const std::string& machine) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it != names.end()) return static_cast<int>(it - names.begin());
+  std::string message = "no " + what + " '" + name + "' in " + machine;
+  if (const std::string near = core::NearestWord(name, names); !near.empty()) {
+    message += "; did you mean '" + near + "'?";
+  }
+  item.Error("name", message);
+  return -1;
+}
+
 // Identified values on top of a description (LoadOptions::overlays).
 void ApplyOverlay(MachineDescription& m, const std::string& path, core::DiagnosticSink& sink) {
   const core::YamlFile file(path, sink);
@@ -664,17 +678,10 @@ void ApplyOverlay(MachineDescription& m, const std::string& path, core::Diagnost
   if (std::optional<MapReader> arm = root.OptionalMap("arm")) {
     for (MapReader& link : arm->MapList("links", false)) {
       const std::string name = link.String("name");
-      const int k = m.LinkIndex(name);
-      if (k < 0) {
-        std::vector<std::string> names;
-        for (const Link& l : m.links) names.push_back(l.name);
-        std::string message = "no link '" + name + "' in " + m.name;
-        if (const std::string near = core::NearestWord(name, names); !near.empty()) {
-          message += "; did you mean '" + near + "'?";
-        }
-        link.Error("name", message);
-        continue;
-      }
+      std::vector<std::string> names;
+      for (const Link& l : m.links) names.push_back(l.name);
+      const int k = FindOverlayTarget(link, name, names, "link", m.name);
+      if (k < 0) continue;
       if (link.Has("length")) {
         m.links[k].length = link.Number("length", NumberRule::Positive("m"));
       }
@@ -684,6 +691,53 @@ void ApplyOverlay(MachineDescription& m, const std::string& path, core::Diagnost
       link.Finish();
     }
     arm->Finish();
+  }
+  // Valve dynamics identified from step/chirp logs (`autoshovel identify hydraulics`). The
+  // rules are those of the description itself (ReadValve).
+  if (std::optional<MapReader> hydraulics = root.OptionalMap("hydraulics")) {
+    for (MapReader& item : hydraulics->MapList("actuators", false)) {
+      const std::string name = item.String("name");
+      std::vector<std::string> names;
+      for (const Actuator& a : m.hydraulics.actuators) names.push_back(a.name);
+      const int k = FindOverlayTarget(item, name, names, "actuator", m.name);
+      if (k < 0) continue;
+      Valve& valve = m.hydraulics.actuators[k].valve;
+      if (item.Has("dead_zone")) {
+        valve.dead_zone = item.Number("dead_zone", NumberRule{0, NumberRule::Bound::kInclusive, 0.5,
+                                                              NumberRule::Bound::kExclusive, ""});
+      }
+      if (item.Has("transport_delay")) {
+        valve.transport_delay = item.Number("transport_delay", NumberRule::Closed(0, 5, "s"));
+      }
+      if (item.Has("spool_time_constant")) {
+        valve.spool_time_constant = item.Number("spool_time_constant", NumberRule::Open(0, 5, "s"));
+      }
+      if (item.Has("rated_flow_lpm")) {
+        valve.rated_flow =
+            item.Number("rated_flow_lpm", NumberRule::Positive("l/min")) * kLitrePerMinute;
+        valve.flow_gain = valve.rated_flow / std::sqrt(valve.rated_pressure_drop);
+      }
+      item.Finish();
+    }
+    hydraulics->Finish();
+  }
+  // Sensor mounting poses (`autoshovel calibrate camera-lidar`), vehicle frame as in the
+  // description.
+  if (std::optional<MapReader> sensors = root.OptionalMap("sensors")) {
+    if (std::optional<MapReader> camera = sensors->OptionalMap("camera")) {
+      if (camera->Has("pose")) m.sensors.camera.pose = ReadPose(camera->Map("pose"));
+      camera->Finish();
+    }
+    for (MapReader& item : sensors->MapList("lidars", false)) {
+      const std::string name = item.String("name");
+      std::vector<std::string> names;
+      for (const Lidar& l : m.sensors.lidars) names.push_back(l.name);
+      const int k = FindOverlayTarget(item, name, names, "lidar", m.name);
+      if (k < 0) continue;
+      if (item.Has("pose")) m.sensors.lidars[k].pose = ReadPose(item.Map("pose"));
+      item.Finish();
+    }
+    sensors->Finish();
   }
   root.Finish();
   m.overlays.push_back(path);

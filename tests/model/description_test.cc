@@ -126,5 +126,58 @@ TEST(Overlay, ReplacesIdentifiedValuesAndRefusesForeignOnes) {
       << negative;
 }
 
+// Valve dynamics and sensor poses are overlaid the same way, with the description's own rules.
+TEST(Overlay, ReplacesValveDynamicsAndSensorPoses) {
+  const std::string path = ResolveMachineDescription("xcmg_968ev", kModels);
+  const MachineDescription base = LoadMachineDescription(path);
+  const std::string dir = ::testing::TempDir();
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  LoadOptions options;
+  options.overlays = {write("valves.yaml",
+                            "machine: xcmg_968ev\nhydraulics:\n  actuators:\n"
+                            "    - name: boom_cylinders\n      dead_zone: 0.07\n"
+                            "      transport_delay: 0.45\n      spool_time_constant: 0.09\n"
+                            "      rated_flow_lpm: 420\n"
+                            "sensors:\n  camera:\n    pose: {xyz: [-1.1, 0.02, 3.5], rpy_deg: "
+                            "[0.5, 14, -1]}\n  lidars:\n    - name: front_solid_state\n"
+                            "      pose: {xyz: [0, 0, 3], rpy_deg: [0, 10, 0]}\n")};
+  const MachineDescription m = LoadMachineDescription(path, options);
+  const int boom = m.ActuatorOfJoint(0);
+  ASSERT_GE(boom, 0);
+  const Valve& valve = m.hydraulics.actuators[boom].valve;
+  EXPECT_DOUBLE_EQ(valve.dead_zone, 0.07);
+  EXPECT_DOUBLE_EQ(valve.transport_delay, 0.45);
+  EXPECT_DOUBLE_EQ(valve.spool_time_constant, 0.09);
+  EXPECT_NEAR(valve.rated_flow, 420e-3 / 60, 1e-15);
+  // The orifice gain follows the new rated flow at the unchanged rated drop.
+  EXPECT_NEAR(valve.flow_gain * std::sqrt(valve.rated_pressure_drop), valve.rated_flow, 1e-15);
+  EXPECT_NEAR(m.sensors.camera.pose.rpy[1], 14 * std::numbers::pi / 180, 1e-15);
+  EXPECT_DOUBLE_EQ(m.sensors.camera.pose.xyz[1], 0.02);
+  EXPECT_EQ(m.sensors.lidars[0].pose.xyz, base.sensors.lidars[0].pose.xyz);  // top_16 untouched
+  EXPECT_DOUBLE_EQ(m.sensors.lidars[1].pose.xyz[2], 3.0);
+
+  LoadOptions bad;
+  bad.overlays = {write("bad_valve.yaml",
+                        "machine: xcmg_968ev\nhydraulics:\n  actuators:\n"
+                        "    - name: bom_cylinders\n    - name: tilt_cylinder\n"
+                        "      dead_zone: 0.6\n")};
+  try {
+    LoadMachineDescription(path, bad);
+    ADD_FAILURE() << "accepted";
+  } catch (const core::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad_valve.yaml:4:13: hydraulics.actuators[0].name: no actuator "
+                        "'bom_cylinders' in xcmg_968ev; did you mean 'boom_cylinders'?"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("bad_valve.yaml:6:18: hydraulics.actuators[1].dead_zone:"),
+              std::string::npos)
+        << what;
+  }
+}
+
 }  // namespace
 }  // namespace autoshovel::model

@@ -30,8 +30,24 @@ Confidences Collapse(const ClassProbabilities& p, int pixel) {
       at(SemanticClass::kOtherLoader) + at(SemanticClass::kPerson) + at(SemanticClass::kWall);
   const float obstacle = hard + at(SemanticClass::kOther);
   const float sum = ground + pile + obstacle;
-  if (!(sum > 1e-6f)) return {kNaN, kNaN, kNaN, kNaN};
+  // A pixel that is mostly the own machine says nothing about the cell: renormalising its
+  // small remainder would turn a network's 1 % doubt into a confident class.
+  if (!(sum > 0.5f)) return {kNaN, kNaN, kNaN, kNaN};
   return {ground / sum, pile / sum, obstacle / sum, hard / sum};
+}
+
+// Whether a pixel block within one block of the pixel rectangle [u0, u1] × [v0, v1] holds a
+// surface nearer than `depth_limit`.
+bool BesideOccludingContour(const std::vector<float>& nearest, int bw, int bh, int u0, int u1,
+                            int v0, int v1, float depth_limit) {
+  const int bu0 = std::max(0, u0 / kBlock - 1), bu1 = std::min(bw - 1, u1 / kBlock + 1);
+  const int bv0 = std::max(0, v0 / kBlock - 1), bv1 = std::min(bh - 1, v1 / kBlock + 1);
+  for (int bv = bv0; bv <= bv1; ++bv) {
+    for (int bu = bu0; bu <= bu1; ++bu) {
+      if (nearest[bv * bw + bu] < depth_limit) return true;
+    }
+  }
+  return false;
 }
 
 // Standard normal CDF.
@@ -91,6 +107,14 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
   struct Hit {
     int cell, pixel;
     float depth;
+    std::int16_t v_min, v_max;  // image rows the cell's surface covers
+  };
+  const Eigen::Vector3d camera_world = T_world_camera.translation();
+  auto project_v = [&](const Eigen::Vector3f& p_world, float& v) {
+    const Eigen::Vector3f p_body = R * p_world + t;
+    if (!(p_body.x() > 0.3f)) return false;
+    v = static_cast<float>((camera.fy * (-p_body.z()) / p_body.x() + camera.cy) * sy);
+    return true;
   };
   std::vector<Hit> hits;
   hits.reserve(static_cast<std::size_t>(nx) * ny / 4);
@@ -109,7 +133,30 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
       const float depth = p_body.x();
       const int block = (static_cast<int>(v) / kBlock) * bw + static_cast<int>(u) / kBlock;
       nearest[block] = std::min(nearest[block], depth);
-      hits.push_back({iy * nx + ix, pixel, depth});
+      // The rows the cell covers: its near and far edges along the viewing direction, at the
+      // heights halfway to the neighbouring cells, projected. A pile face towards the camera
+      // covers many rows, more than a square of the cell's width would.
+      Eigen::Vector2d e = xy - camera_world.head<2>();
+      e /= std::max(e.norm(), 1e-6);
+      float v_edge[2] = {static_cast<float>(v), static_cast<float>(v)};
+      for (int side = 0; side < 2; ++side) {
+        const double sign = side == 0 ? -1.0 : 1.0;
+        const Eigen::Vector2d edge = xy + sign * 0.5 * g.resolution() * e;
+        Index neighbour;
+        float z_edge = z;
+        if (g.IndexOf(xy + sign * g.resolution() * e, neighbour) &&
+            !std::isnan(elevation(neighbour.x(), neighbour.y()))) {
+          z_edge = 0.5f * (z + elevation(neighbour.x(), neighbour.y()));
+        }
+        project_v(
+            Eigen::Vector3f(static_cast<float>(edge.x()), static_cast<float>(edge.y()), z_edge),
+            v_edge[side]);
+      }
+      const auto row = [&](float vv) {
+        return static_cast<std::int16_t>(std::clamp(static_cast<int>(vv), 0, h - 1));
+      };
+      hits.push_back({iy * nx + ix, pixel, depth, row(std::min(v_edge[0], v_edge[1])),
+                      row(std::max(v_edge[0], v_edge[1]))});
     }
   }
   // Pass 2: cells not hidden behind nearer ones take the pixel's confidences.
@@ -128,12 +175,25 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
     // the whole footprint). "Other" (debris, and the sky above a pile's crest) is averaged.
     const int radius = std::clamp(
         static_cast<int>(camera.fx * sx * 0.5 * map_.map().resolution() / hit.depth), 1, 4);
+    // Rows: the square of the cell's width, widened to the rows its surface covers (at most
+    // four either way). (A footprint of the covered rows alone, thinner for grazing ground
+    // cells, averaged too few pixels: the thin low pile lost 0.04 of IoU with the network.)
+    const int v_lo = std::max<int>(std::min<int>(hit.v_min, pv - radius), pv - 4);
+    const int v_hi = std::min<int>(std::max<int>(hit.v_max, pv + radius), pv + 4);
+    // Beside an occluding contour (a much nearer surface within a block of the footprint) the
+    // pixels mix the occluder and what lies behind it, and a network's labels blur across the
+    // edge: the cell takes no evidence from this frame rather than the occluder's class.
+    if (BesideOccludingContour(nearest, bw, bh, pu - radius, pu + radius, v_lo, v_hi,
+                               static_cast<float>(config_.contour_depth_ratio) * hit.depth -
+                                   static_cast<float>(config_.occlusion_tolerance))) {
+      continue;
+    }
     Confidences c{0, 0, 0, 0};
     float hard_max = 0;
     int samples = 0;
-    for (int dv = -radius; dv <= radius; ++dv) {
+    for (int v = v_lo; v <= v_hi; ++v) {
       for (int du = -radius; du <= radius; ++du) {
-        const int u = pu + du, v = pv + dv;
+        const int u = pu + du;
         if (u < 0 || v < 0 || u >= w || v >= h) continue;
         const Confidences p = Collapse(probabilities, v * w + u);
         if (std::isnan(p.ground)) continue;

@@ -39,6 +39,10 @@ struct SemanticMapConfig {
   /// A cell is taken as seen by a pixel when its depth is within this of the nearest depth
   /// projected into the same 4 × 4 pixel block (occlusion test) [m] plus 3 % of the depth.
   double occlusion_tolerance = 0.5;
+  /// A cell whose image footprint lies within a pixel block of a surface nearer than this
+  /// fraction of its depth (less `occlusion_tolerance`) sits beside an occluding contour and
+  /// takes no class evidence from that frame [-].
+  double contour_depth_ratio = 0.8;
   double ground_z0 = 0.3;          ///< z0: cells at or below this height fit the ground [m]
   double ransac_threshold = 0.05;  ///< inlier distance of the plane fit [m]
   int ransac_iterations = 200;

@@ -103,18 +103,22 @@ struct Scene {
 
 struct Scores {
   double fused = 0, semantic_only = 0, height_only = 0;  // pile IoU
+  double fused_all = 0;  // fused pile IoU over every classified cell, seen by an image or not
   int cells = 0, obstacle_as_pile = 0;
 };
 
 // Pile IoU over the cells with a height that an image has seen.
 Scores Evaluate(const Scene& scene, const GridMap& g) {
-  long inter[3] = {}, uni[3] = {};
+  long inter[3] = {}, uni[3] = {}, inter_all = 0, uni_all = 0;
   Scores s;
   for (GridMapIterator it(g); !it.done(); ++it) {
-    if (std::isnan(g.at("class", *it)) || g.at("semantic_frames", *it) == 0) continue;
+    if (std::isnan(g.at("class", *it))) continue;
     const Eigen::Vector2d xy = g.PositionOf(*it);
     const bool truth = scene.Truth(xy) == CellClass::kPile;
     const CellClass fused = static_cast<CellClass>(static_cast<int>(g.at("class", *it)));
+    inter_all += fused == CellClass::kPile && truth;
+    uni_all += fused == CellClass::kPile || truth;
+    if (g.at("semantic_frames", *it) == 0) continue;
     const CellClass predicted[3] = {
         fused,
         SemanticOnlyClass(g.at("ground_confidence", *it), g.at("pile_confidence", *it),
@@ -137,6 +141,7 @@ Scores Evaluate(const Scene& scene, const GridMap& g) {
   }
   auto iou = [&](int k) { return uni[k] ? static_cast<double>(inter[k]) / uni[k] : 1.0; };
   s.fused = iou(0), s.semantic_only = iou(1), s.height_only = iou(2);
+  s.fused_all = uni_all ? static_cast<double>(inter_all) / uni_all : 1.0;
   return s;
 }
 
@@ -215,21 +220,40 @@ TEST(SemanticMap, WithTheNetworkFusionBeatsSemanticsOnlyInDimLight) {
   }
 }
 
-// With the shipped network in normal light. The goal is IoU ≥ 0.9; measured: cone
-// 0.824, irregular 0.916, low 0.896. The guard below holds today's level so that a regression
-// shows; raising it to 0.9 is open work (the perception issue's note says so).
+// With the shipped network in normal light: the goal is pile IoU ≥ 0.9. The map is
+// built as the loader builds it, from the camera frames of its approach (the last 3 m, a frame
+// per metre; at the seed's 7 Hz the real map gets about five per metre), so that the network's
+// errors in any one view are outvoted. A single view is held to a lower guard.
+// The thin low pile falls short (measured 0.876): 0.45 m of sand is within the height noise of
+// α_d = 0.05 at that range (p1 ≈ 0.4–0.5 on its top), so the network's boundary errors of a
+// cell or so decide, and one 0.3 m ring of a 6 m × 4 m pile is a quarter of its cells. With
+// perfect semantics it reaches 0.927. Its guard holds today's level.
 TEST(SemanticMap, WithTheNetworkPileCellsMatchTheSimulatorInNormalLight) {
   const Segmenter segmenter(kModels + "/segmentation/yard_segmenter.onnx");
-  for (const char* name : {"cone_pile", "irregular_pile", "low_pile"}) {
-    Scene scene(name, 3.0);
-    ElevationMap map({}, scene.plant->state().hinge_xy);
+  for (const auto& [name, goal] : {std::pair<const char*, double>{"cone_pile", 0.9},
+                                   {"irregular_pile", 0.9},
+                                   {"low_pile", 0.86}}) {
+    std::vector<std::unique_ptr<Scene>> approach;
+    for (const double advance : {0.0, 1.0, 2.0, 3.0}) {
+      approach.push_back(std::make_unique<Scene>(name, advance));
+    }
+    const Scene& last = *approach.back();
+    ElevationMap single_map({}, last.plant->state().hinge_xy);
+    SemanticMap single(single_map);
+    approach.back()->Build(single_map, single, &segmenter, plant::Lighting::kNormal);
+    const Scores one = Evaluate(last, single_map.map());
+
+    ElevationMap map({}, last.plant->state().hinge_xy);
     SemanticMap semantic(map);
-    scene.Build(map, semantic, &segmenter, plant::Lighting::kNormal);
-    const Scores s = Evaluate(scene, map.map());
-    std::printf("%s, normal, network: pile IoU fused %.3f, semantic only %.3f, height only %.3f\n",
-                name, s.fused, s.semantic_only, s.height_only);
-    EXPECT_GE(s.fused, 0.8) << name;
+    for (auto& scene : approach) scene->Build(map, semantic, &segmenter, plant::Lighting::kNormal);
+    const Scores s = Evaluate(last, map.map());
+    std::printf(
+        "%s, normal, network, approach: pile IoU fused %.3f, semantic only %.3f, height "
+        "only %.3f over %d cells (all classified cells: fused %.3f); one view: fused %.3f\n",
+        name, s.fused, s.semantic_only, s.height_only, s.cells, s.fused_all, one.fused);
+    EXPECT_GE(s.fused, goal) << name;
     EXPECT_GE(s.fused, s.semantic_only) << name;
+    EXPECT_GE(one.fused, 0.83) << name;
   }
 }
 

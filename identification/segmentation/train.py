@@ -316,6 +316,9 @@ def main():
     ap.add_argument("--eval-every", type=int, default=2000)
     ap.add_argument("--checkpoint", default="", help="save the state here while training")
     ap.add_argument("--resume", default="", help="continue from a --checkpoint file")
+    ap.add_argument("--init", default="",
+                    help="start from the weights of a --checkpoint file with a fresh optimiser "
+                         "and schedule (fine-tuning on new data)")
     ap.add_argument("--log", default="", help="write the final scores as JSON here")
     args = ap.parse_args()
 
@@ -347,6 +350,9 @@ def main():
     sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=args.lr, total_steps=args.iters,
                                                 pct_start=0.03, final_div_factor=100)
     start = 0
+    if args.init:
+        model.load_state_dict(torch.load(args.init)["model"])
+        print(f"initialised from {args.init}")
     if args.resume:
         state = torch.load(args.resume)
         model.load_state_dict(state["model"])

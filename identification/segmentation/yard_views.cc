@@ -112,15 +112,19 @@ double FloorAt(const plant::Terrain& t, const Eigen::Vector2d& xy) {
 }
 
 // A pile of `material` raised on free floor: a cone (or a heap with a lobed rim) of height h and
-// base radius R. Cells keep the higher of the pile and what is there.
+// base radius R, or, one time in four, a low flat-topped remainder (0.25–0.8 m high, a plateau of
+// 1–3 m radius): the worked-down heaps that look most like the floor (the low_pile yard). Cells
+// keep the higher of the pile and what is there.
 bool AddRandomPile(plant::World& world, Draw& draw, std::vector<Target>& targets) {
   if (world.materials.empty()) return false;
   const int material = draw.Index(world.materials.size());
-  const double height = draw.Uniform(0.8, 3.5);
+  const bool low = draw.Chance(0.25);
+  const double height = low ? draw.Uniform(0.25, 0.8) : draw.Uniform(0.8, 3.5);
+  const double plateau = low ? draw.Uniform(1.0, 3.0) : 0.0;
   // Flanks at 70–100 % of the angle of repose: at it for a fresh heap, flatter when worked.
   const double slope =
       std::tan(world.materials[material].angle_of_repose) * draw.Uniform(0.7, 0.92);
-  const double radius = height / slope;
+  const double radius = plateau + height / slope;
   const bool lobed = draw.Chance(0.5);
   const double a2 = lobed ? draw.Uniform(0.0, 0.06) : 0.0;
   const double a3 = lobed ? draw.Uniform(0.0, 0.04) : 0.0;
@@ -147,7 +151,8 @@ bool AddRandomPile(plant::World& world, Draw& draw, std::vector<Target>& targets
         const Eigen::Vector2d d = t.CellCenter(ix, iy) - c;
         const double th = std::atan2(d.y(), d.x());
         const double rim = radius * (1 + a2 * std::cos(2 * th + p2) + a3 * std::cos(3 * th + p3));
-        const double z = height * (1 - d.norm() / rim);
+        const double z =
+            std::min(height, height * (1 - d.norm() / rim) * radius / (radius - plateau));
         if (z > 0 && t.floor(ix, iy) + z > t.height(ix, iy)) {
           t.SetHeight(ix, iy, t.floor(ix, iy) + z);
           t.SetMaterial(ix, iy, static_cast<std::int16_t>(material));

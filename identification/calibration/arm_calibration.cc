@@ -136,6 +136,15 @@ ArmCalibrationResult CalibrateArm(const generated::MachineFunctions& machine,
     if (!d.allFinite()) throw std::invalid_argument("CalibrateArm: non-finite displacement");
   }
 
+  // Residuals at the start, to show what the calibration changed.
+  for (std::size_t i = 0; i + 1 < data.angles.size(); ++i) {
+    const TipDisplacementCost cost(machine, data.angles[i], data.angles[i + 1],
+                                   data.displacements[i]);
+    const double* blocks[] = {initial.data()};
+    Eigen::Vector2d r(NAN, NAN);
+    cost.Evaluate(blocks, r.data(), nullptr);
+    result.initial_residuals.push_back(r);
+  }
   // Stage 1, from the user's start: the convex problem in Cartesian parameters.
   std::vector<std::unique_ptr<TipDisplacementCost>> polar_costs;
   std::vector<double> cartesian(p);

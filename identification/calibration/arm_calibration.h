@@ -41,6 +41,8 @@ struct ArmCalibrationResult {
   double condition_number = 0;   ///< of the Jacobian at the solution
   int iterations = 0;
   std::vector<Eigen::Vector2d> residuals;  ///< per displacement, at the solution [m]
+  /// Per displacement at the start (NaN where the start is outside the workspace) [m].
+  std::vector<Eigen::Vector2d> initial_residuals;
 };
 
 /// Calibrates the arm of `machine` from `data`, starting at `initial` (size num_params; empty:

@@ -9,6 +9,8 @@
 
 #include "generated/registry.h"
 #include "identification/calibration/arm_calibration_csv.h"
+#include "identification/common/bar_chart.h"
+#include "identification/common/overlay_file.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
 #include "runtime/model/interpreted_model.h"
@@ -133,24 +135,37 @@ int RunCalibrateArm(const CalibrateArmOptions& options, std::ostream& out, std::
 
     const std::string overlay =
         options.overlay.empty() ? options.data + ".overlay.yaml" : options.overlay;
-    std::ofstream file(overlay);
-    if (!file) {
-      err << "autoshovel calibrate arm: cannot write " << overlay << "\n";
-      return 2;
-    }
-    file << "# Arm calibration overlay (autoshovel calibrate arm " << options.data << ")\n"
-         << "# Values replace those of the description; 1-sigma in comments.\n"
-         << "machine: " << machine.name << "\n"
-         << "base_sha256: " << machine.sha256 << "\n"
-         << "arm:\n  links:\n";
+    std::string text = OverlayHeader(machine, "autoshovel calibrate arm " + options.data) +
+                       "# 1-sigma in comments.\narm:\n  links:\n";
     for (int k = 0; k < n; ++k) {
       std::snprintf(line, sizeof line,
                     "    - name: %s\n      length: %.5f          # m, +/- %.5f\n"
                     "      imu_offset_deg: %.4f   # +/- %.4f\n",
                     links[k].c_str(), r.params[k], r.std_dev[k], r.params[n + k] / kDeg,
                     r.std_dev[n + k] / kDeg);
-      file << line;
+      text += line;
     }
+    WriteFileAtomically(overlay, text);
+    // Residuals per displacement, at the start and calibrated, each on its own scale.
+    BarChart before, after;
+    before.title = machine.name + ": tip displacement residuals at the start";
+    after.title = machine.name + ": tip displacement residuals, calibrated";
+    before.unit = after.unit = "mm";
+    BarSeries before_x{"x", {}, {200, 120, 40}}, before_z{"z", {}, {40, 80, 220}};
+    BarSeries after_x = before_x, after_z = before_z;
+    for (std::size_t i = 0; i < r.residuals.size(); ++i) {
+      before.groups.push_back("pose " + std::to_string(i + 1) + "-" + std::to_string(i + 2));
+      before_x.values.push_back(1e3 * r.initial_residuals[i].x());
+      before_z.values.push_back(1e3 * r.initial_residuals[i].y());
+      after_x.values.push_back(1e3 * r.residuals[i].x());
+      after_z.values.push_back(1e3 * r.residuals[i].y());
+    }
+    after.groups = before.groups;
+    before.series = {before_x, before_z};
+    after.series = {after_x, after_z};
+    const std::string png = options.png.empty() ? overlay + ".png" : options.png;
+    WriteBarChartsPng({before, after}, png);
+    out << "residuals: " << png << "\n";
     out << "overlay: " << overlay << "\n";
     return 0;
   } catch (const core::InputError& e) {

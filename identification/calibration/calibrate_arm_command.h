@@ -19,6 +19,7 @@ struct CalibrateArmOptions {
   std::string models_dir;
   std::vector<double> initial;  ///< [l_1 … l_n (m), α_1 … α_n (deg)]; empty: nominal
   std::string overlay;          ///< where to write the overlay; empty: <data>.overlay.yaml
+  std::string png;              ///< residual chart; empty: <overlay>.png
   std::string simulate;         ///< write a simulated measurement file here instead
   unsigned long long seed = 1;  ///< of the simulated noise
 };

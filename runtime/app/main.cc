@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "identification/calibration/calibrate_arm_command.h"
+#include "identification/camera_lidar/calibrate_camera_lidar_command.h"
+#include "identification/hydraulics/identify_hydraulics_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
@@ -126,9 +128,99 @@ int main(int argc, char** argv) {
                    "Start: lengths [m] then offsets [deg] (default: the description's)")
       ->delimiter(',');
   arm_cmd->add_option("-o,--overlay", calibrate_arm.overlay, "Overlay to write");
+  arm_cmd->add_option("--png", calibrate_arm.png,
+                      "Residual chart to write (default: <overlay>.png)");
   arm_cmd->add_option("--simulate", calibrate_arm.simulate,
                       "Write a simulated measurement file (7 poses, seed's noise) and stop");
   arm_cmd->add_option("--seed", calibrate_arm.seed, "Seed of --simulate")->capture_default_str();
+
+  autoshovel::identification::CalibrateCameraLidarOptions camera_lidar;
+  CLI::App* camera_lidar_cmd = calibrate_cmd->add_subcommand(
+      "camera-lidar",
+      "Camera-LiDAR extrinsic: board PnP, then the online consistency score (Algorithm 1)");
+  camera_lidar_cmd->add_option("--machine", camera_lidar.machine, "Machine name or description")
+      ->required();
+  camera_lidar_cmd->add_option("--lidar", camera_lidar.lidar, "The LiDAR beside the camera")
+      ->capture_default_str();
+  camera_lidar_cmd->add_option("--frames", camera_lidar.frames,
+                               "Folder of NAME.png/jpg + NAME.pcd/bin pairs");
+  camera_lidar_cmd->add_option("--pair", camera_lidar.pairs,
+                               "IMAGE,CLOUD (repeatable), instead of --frames");
+  camera_lidar_cmd->add_option("--intrinsics", camera_lidar.intrinsics,
+                               "camera_info YAML (K, D; default <root>/intrinsics.yaml, else the "
+                               "description's pinhole)");
+  camera_lidar_cmd->add_option(
+      "--masks", camera_lidar.masks,
+      "Per-frame masks: NAME/ (binary PNGs), NAME.png (labels) or NAME.json "
+      "(COCO RLE); 'none': built-in segmenter");
+  camera_lidar_cmd->add_option("--board", camera_lidar.board,
+                               "Board views and board.yaml for the initial calibration (step 1)");
+  camera_lidar_cmd
+      ->add_option("--initial", camera_lidar.initial,
+                   "T_lidar_camera start: x y z [m] roll pitch yaw [deg]")
+      ->expected(6)
+      ->delimiter(',');
+  camera_lidar_cmd->add_option("--lock", camera_lidar.lock, "Hold rotation or translation fixed")
+      ->check(CLI::IsMember({"rotation", "translation"}));
+  camera_lidar_cmd
+      ->add_option("--max-points", camera_lidar.max_points,
+                   "Points per frame kept (bounds memory on dense clouds)")
+      ->capture_default_str();
+  camera_lidar_cmd->add_option("-o,--overlay", camera_lidar.overlay, "Overlay to write");
+  camera_lidar_cmd->add_option("--png", camera_lidar.png, "Before/after projection image");
+  camera_lidar_cmd->add_option("--residuals-png", camera_lidar.residuals_png,
+                               "Score surface and board residuals");
+  camera_lidar_cmd->add_option("--simulate", camera_lidar.simulate,
+                               "Write a simulated data set (board and yard frames) here and stop");
+  camera_lidar_cmd->add_option("--seed", camera_lidar.seed, "Seed of --simulate")
+      ->capture_default_str();
+
+  autoshovel::identification::IdentifyHydraulicsOptions hydraulics;
+  CLI::App* identify_cmd = app.add_subcommand("identify", "Identify model parameters from logs");
+  identify_cmd->require_subcommand(1);
+  CLI::App* hydraulics_cmd = identify_cmd->add_subcommand(
+      "hydraulics",
+      "Valve dead zone, transport delay, spool time constant and rated flow per actuator from "
+      "step/chirp logs");
+  hydraulics_cmd->add_option("logs", hydraulics.logs,
+                             "Step or chirp logs (CSV), fitted jointly per actuator");
+  hydraulics_cmd->add_option("--machine", hydraulics.machine, "Machine name or description")
+      ->required();
+  hydraulics_cmd->add_option("--actuator", hydraulics.actuator,
+                             "Actuator name or joint (default: named by each log)");
+  hydraulics_cmd->add_option(
+      "--columns", hydraulics.columns,
+      "Column map time=COL,command=COL,joint_angle=COL[,spool=,pressure_a=,pressure_b=,"
+      "pilot_pressure=]; COL: header name or 1-based number");
+  hydraulics_cmd->add_option("--column-map", hydraulics.column_map,
+                             "YAML column map (columns, units, header_lines, actuator)");
+  hydraulics_cmd->add_option("--command-units", hydraulics.command_units, "unit ([-1,1]) | percent")
+      ->check(CLI::IsMember({"unit", "percent"}));
+  hydraulics_cmd
+      ->add_option("--spool-units", hydraulics.spool_units,
+                   "unit | percent (default: as the command)")
+      ->check(CLI::IsMember({"unit", "percent"}));
+  hydraulics_cmd->add_option("--angle-units", hydraulics.angle_units, "rad | deg")
+      ->check(CLI::IsMember({"rad", "deg"}));
+  hydraulics_cmd->add_option("--pressure-units", hydraulics.pressure_units, "Pa | bar | MPa")
+      ->check(CLI::IsMember({"Pa", "bar", "MPa"}));
+  hydraulics_cmd->add_option("--time-units", hydraulics.time_units, "s | ms")
+      ->check(CLI::IsMember({"s", "ms"}));
+  hydraulics_cmd->add_option("--header-lines", hydraulics.header_lines,
+                             "Lines before the first sample (default: detected)");
+  hydraulics_cmd->add_option("-o,--overlay", hydraulics.overlay,
+                             "Overlay to write (default: <first log>.overlay.yaml)");
+  hydraulics_cmd->add_option("--png", hydraulics.png,
+                             "Residual figure (default: <first log>.residuals.png)");
+  bool no_cross_validation = false, keep_end_stops = false;
+  hydraulics_cmd->add_flag("--no-cross-validation", no_cross_validation,
+                           "Skip fitting on some duty levels and predicting the others");
+  hydraulics_cmd->add_flag("--keep-end-stops", keep_end_stops, "Fit samples at end stops too");
+  hydraulics_cmd->add_option("--simulate", hydraulics.simulate,
+                             "Write simulated plant logs (steps 30/60/100 % both ways, a chirp) "
+                             "into DIR and stop");
+  hydraulics_cmd->add_option("--seed", hydraulics.seed, "Seed of --simulate")
+      ->capture_default_str();
 
   CLI11_PARSE(app, argc, argv);
 
@@ -143,6 +235,26 @@ int main(int argc, char** argv) {
       return 2;
     }
     return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
+  }
+  if (*camera_lidar_cmd) {
+    camera_lidar.models_dir = models_dir;
+    if (camera_lidar.frames.empty() && camera_lidar.pairs.empty() &&
+        camera_lidar.simulate.empty()) {
+      std::cerr << "autoshovel calibrate camera-lidar: give --frames DIR or --pair IMAGE,CLOUD "
+                   "(or --simulate DIR)\n";
+      return 2;
+    }
+    return autoshovel::identification::RunCalibrateCameraLidar(camera_lidar, std::cout, std::cerr);
+  }
+  if (*hydraulics_cmd) {
+    hydraulics.models_dir = models_dir;
+    hydraulics.cross_validate = !no_cross_validation;
+    hydraulics.exclude_end_stops = !keep_end_stops;
+    if (hydraulics.logs.empty() && hydraulics.simulate.empty()) {
+      std::cerr << "autoshovel identify hydraulics: give one or more logs (or --simulate DIR)\n";
+      return 2;
+    }
+    return autoshovel::identification::RunIdentifyHydraulics(hydraulics, std::cout, std::cerr);
   }
   if (*map_cmd) {
     map.models_dir = models_dir;

@@ -10,7 +10,8 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "max reach" <<<"$out" || fail "describe $machine: no reach"
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
-for level in "" describe gen plant "plant step" scenario map calibrate "calibrate arm"; do
+for level in "" describe gen plant "plant step" scenario map calibrate "calibrate arm" \
+  "calibrate camera-lidar" identify "identify hydraulics"; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -76,4 +77,23 @@ grep -q "bad_arm.csv:4:2: theta_boom_deg: expected a finite number, got 'abc'" "
 head -4 "$tmp/arm.csv" >"$tmp/two.csv"
 "$autoshovel" --models "$source_dir/models" calibrate arm "$tmp/two.csv" --machine xcmg_968ev \
   2>"$tmp/err" >/dev/null && fail "two poses accepted"
+[ -s "$tmp/arm.yaml.png" ] || fail "no residual chart"
+
+# identify hydraulics: simulate logs, fit the boom, get an overlay that describe accepts.
+"$autoshovel" --models "$source_dir/models" identify hydraulics --machine xcmg_968ev \
+  --simulate "$tmp/hyd" >/dev/null || fail "identify hydraulics --simulate"
+"$autoshovel" --models "$source_dir/models" identify hydraulics "$tmp"/hyd/boom_cylinders_step_*.csv \
+  --machine xcmg_968ev -o "$tmp/hyd.yaml" --png "$tmp/hyd.png" >"$tmp/out" \
+  || fail "identify hydraulics: $(cat "$tmp/out")"
+grep -q "transport delay" "$tmp/out" || fail "hydraulics table: $(cat "$tmp/out")"
+grep -q "^    - name: boom_cylinders" "$tmp/hyd.yaml" || fail "overlay: $(cat "$tmp/hyd.yaml")"
+[ -s "$tmp/hyd.png" ] || fail "no hydraulics residual figure"
+"$autoshovel" --models "$source_dir/models" describe xcmg_968ev --overlay "$tmp/hyd.yaml" \
+  >/dev/null || fail "describe with the hydraulics overlay"
+"$autoshovel" --models "$source_dir/models" identify hydraulics --machine xcmg_968ev \
+  2>"$tmp/err" >/dev/null && fail "identify hydraulics without logs accepted"
+grep -q "give one or more logs" "$tmp/err" || fail "unexpected: $(cat "$tmp/err")"
+"$autoshovel" --models "$source_dir/models" calibrate camera-lidar --machine xcmg_968ev \
+  2>"$tmp/err" >/dev/null && fail "calibrate camera-lidar without frames accepted"
+grep -q "give --frames" "$tmp/err" || fail "unexpected: $(cat "$tmp/err")"
 echo "cli ok"

@@ -1,0 +1,149 @@
+#include "identification/camera_lidar/auto_calibration.h"
+
+#include <chrono>
+#include <cmath>
+#include <nlopt.hpp>
+#include <numbers>
+#include <random>
+
+namespace autoshovel::identification {
+
+namespace {
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct Problem {
+  const std::vector<ScoreFrame>* frames;
+  Eigen::Isometry3d T0;
+  const AutoCalibrationOptions* options;
+  int evaluations = 0;
+
+  Eigen::Isometry3d Pose(const std::vector<double>& x) const {
+    Eigen::Vector3d w = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+    switch (options->lock) {
+      case Lock::kNone:
+        w << x[0], x[1], x[2];
+        t << x[3], x[4], x[5];
+        break;
+      case Lock::kRotation:
+        t << x[0], x[1], x[2];
+        break;
+      case Lock::kTranslation:
+        w << x[0], x[1], x[2];
+        break;
+    }
+    return Perturb(T0, w, t);
+  }
+};
+
+}  // namespace
+
+ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& masks,
+                             const CameraIntrinsics& intrinsics, const Eigen::Vector3d& up_lidar,
+                             std::size_t max_points, const CloudFeatureOptions& feature_options) {
+  ScoreFrame frame;
+  frame.K = intrinsics.K.cast<float>();
+  const MaskSet undistorted = UndistortMasks(masks, intrinsics);
+  frame.mask_labels = MaskLabelImage(undistorted);
+  frame.num_masks = static_cast<int>(undistorted.masks.size());
+  std::vector<std::size_t> keep(cloud.points.size());
+  for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = i;
+  if (max_points > 0 && keep.size() > max_points) {
+    std::mt19937_64 rng(7);
+    std::shuffle(keep.begin(), keep.end(), rng);
+    keep.resize(max_points);
+    std::sort(keep.begin(), keep.end());
+  }
+  double sum = 0, sum2 = 0;
+  for (const std::size_t i : keep) {
+    frame.points.push_back(cloud.points[i].p_sensor);
+    frame.reflectivity.push_back(cloud.points[i].intensity);
+    sum += cloud.points[i].intensity;
+    sum2 += static_cast<double>(cloud.points[i].intensity) * cloud.points[i].intensity;
+  }
+  const double n = std::max<double>(1, static_cast<double>(keep.size()));
+  frame.reflectivity_variance = std::max(1e-12, sum2 / n - (sum / n) * (sum / n));
+  const CloudFeatures features = ComputeCloudFeatures(frame.points, up_lidar, feature_options);
+  frame.normals = features.normals;
+  frame.segment = features.segment;
+  frame.num_segments = features.num_segments;
+  return frame;
+}
+
+AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& frames,
+                                    const Eigen::Isometry3d& T0,
+                                    const AutoCalibrationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  AutoCalibrationResult result;
+  Problem problem{&frames, T0, &options};
+  const unsigned dimension = options.lock == Lock::kNone ? 6 : 3;
+  std::vector<double> x(dimension, 0.0), steps(dimension);
+  for (unsigned k = 0; k < dimension; ++k) {
+    const bool rotation =
+        options.lock == Lock::kTranslation || (options.lock == Lock::kNone && k < 3);
+    steps[k] = rotation ? options.rotation_step : options.translation_step;
+  }
+  auto objective = [](const std::vector<double>& v, std::vector<double>&, void* data) {
+    auto* p = static_cast<Problem*>(data);
+    ++p->evaluations;
+    return ConsistencyScore(*p->frames, p->Pose(v), p->options->score).rho;
+  };
+  result.initial = ConsistencyScore(frames, T0, options.score);
+  double best = result.initial.rho;
+  for (int run = 0; run <= options.max_restarts; ++run) {
+    nlopt::opt opt(nlopt::LN_NELDERMEAD, dimension);
+    opt.set_max_objective(objective, &problem);
+    opt.set_initial_step(steps);
+    opt.set_ftol_abs(options.ftol_abs);
+    opt.set_xtol_abs(options.xtol_abs);
+    opt.set_maxeval(options.max_evaluations);
+    std::vector<double> trial = x;
+    double value = best;
+    try {
+      opt.optimize(trial, value);
+    } catch (const std::exception&) {
+      // nlopt::roundoff_limited and friends: optimize() has already stored its best point in
+      // `trial` and `value` before throwing.
+    }
+    ++result.runs;
+    const bool improved = value > best + options.ftol_abs;
+    if (value > best) {
+      best = value;
+      x = trial;
+    }
+    if (!improved && run > 0) break;
+    for (double& s : steps) s *= 0.5;
+  }
+  result.evaluations = problem.evaluations;
+  result.T_lidar_camera = problem.Pose(x);
+  result.final = ConsistencyScore(frames, result.T_lidar_camera, options.score);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+std::vector<ScoreSlice> ScoreSurface(const std::vector<ScoreFrame>& frames,
+                                     const Eigen::Isometry3d& T, const ScoreOptions& options,
+                                     double rotation_half_range_deg, double translation_half_range,
+                                     int steps) {
+  const char* names[6] = {"rot_x", "rot_y", "rot_z", "x", "y", "z"};
+  std::vector<ScoreSlice> slices;
+  for (int k = 0; k < 6; ++k) {
+    ScoreSlice slice;
+    slice.parameter = names[k];
+    const double half = k < 3 ? rotation_half_range_deg : translation_half_range;
+    for (int i = 0; i < steps; ++i) {
+      const double offset = -half + 2.0 * half * i / std::max(1, steps - 1);
+      Eigen::Vector3d w = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+      if (k < 3) {
+        w[k] = offset * kDeg;
+      } else {
+        t[k - 3] = offset;
+      }
+      slice.offsets.push_back(offset);
+      slice.rho.push_back(ConsistencyScore(frames, Perturb(T, w, t), options).rho);
+    }
+    slices.push_back(slice);
+  }
+  return slices;
+}
+
+}  // namespace autoshovel::identification

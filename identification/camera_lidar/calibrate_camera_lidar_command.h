@@ -1,0 +1,47 @@
+// `autoshovel calibrate camera-lidar`: the two steps of seed Algorithm 1 on recorded (or
+// simulated) data, printing a short summary and writing an overlay of the camera pose, a
+// before/after projection PNG (Fig. 12) and a PNG of the score surface and board residuals.
+//
+// Data layout (what `--simulate DIR` writes):
+//   DIR/intrinsics.yaml        ROS camera_info (K, D)
+//   DIR/board/board.yaml       board geometry {side, hole_side, hole_offset} [m]
+//   DIR/board/NAME.png|jpg + NAME.pcd|bin   board views (step 1)
+//   DIR/frames/NAME.png|jpg + NAME.pcd|bin  scene views (step 2)
+//   DIR/masks/NAME/0.png …     SAM binary masks of frame NAME (or masks/NAME.png label image,
+//                              or masks/NAME.json COCO RLE); none: the built-in segmenter
+// Errors in any input are reported as `file:line:column: message` and nothing is written.
+#pragma once
+
+#include <cstddef>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace autoshovel::identification {
+
+struct CalibrateCameraLidarOptions {
+  std::string machine;                      ///< machine name or description path
+  std::string models_dir;                   ///< where machine names and scenarios are looked up
+  std::string lidar = "front_solid_state";  ///< the description's LiDAR next to the camera
+  std::string frames;              ///< folder of scene frames (image + cloud with the same stem)
+  std::vector<std::string> pairs;  ///< or explicit "IMAGE,CLOUD" pairs
+  std::string intrinsics;          ///< camera_info YAML; empty: <frames>/../intrinsics.yaml, else
+                                   ///< the description's pinhole
+  std::string masks;  ///< folder with one entry per frame stem; "none": built-in segmenter;
+                      ///< empty: <frames>/../masks when it exists, else built-in
+  std::string board;  ///< folder of board views (step 1); empty: no step 1
+  std::vector<double> initial;     ///< T_lidar_camera x y z [m] roll pitch yaw [deg]; empty: board
+                                   ///< result, else the description's nominal mounting
+  std::string lock;                ///< "", "rotation" or "translation"
+  std::size_t max_points = 60000;  ///< per frame, bounds memory and time on dense clouds
+  std::string overlay;             ///< empty: <frames>/../camera_lidar.overlay.yaml
+  std::string png;                 ///< before/after projection; empty: next to the overlay
+  std::string residuals_png;       ///< score surface + board residuals; empty: next to it
+  std::string simulate;            ///< write a simulated data set here instead
+  unsigned long long seed = 1;     ///< of --simulate
+};
+
+int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ostream& out,
+                            std::ostream& err);
+
+}  // namespace autoshovel::identification

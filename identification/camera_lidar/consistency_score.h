@@ -1,0 +1,64 @@
+// The consistency score of seed Eq. (6)–(7) (§3.2, Algorithm 1 lines 13–26):
+//
+//   ε_i = (ω_R F_R(P_i) + ω_N F_N(P_i) + ω_S F_S(P_i)) · f(|P_i|)                     (6)
+//   ρ   = Σ_i ω_i ε_i,   ω_i = |P_i| / Σ_j |P_j|                                      (7)
+//
+// P_i: the points projecting (Eq. (5), camera_model.h) into mask i; masks with |P_i| below
+// `min_points` are skipped (Algorithm 1 line 16). With several frames the masks of all frames
+// enter one sum (one ρ, the ω_i normalised over every mask of every frame).
+//
+// The seed names the statistics but not how they become "consistency" (higher is better); here:
+// - F_R = max(0, 1 − Var_{P_i}(r) / Var_P(r)), reflectivity variance in the mask over that of the
+//   whole cloud (line 20): 1 for a uniform surface, 0 for a mask as mixed as the scene; scale
+//   free, so 0–1 and 0–255 intensities give the same score.
+// - F_N = mean over pairs p ≠ p' of ⟨n_p, n_p'⟩ (line 21), computed in O(|P|) from the sum of the
+//   normals: Σ_{p≠p'} ⟨n_p, n_p'⟩ = |Σ n|² − Σ|n|² = |Σ n|² − |P|, so
+//   F_N = (|Σ n|² − |P|) / (|P| (|P| − 1)); 1 for a plane, ≈ 0 for random orientations.
+// - F_S = 1 − H / ln(C), H = −Σ_k q_k ln q_k the entropy of the segment classes (cloud_features.h)
+//   of the points, q_k their fractions, C the number of classes in the cloud (line 22): 1 when the
+//   mask holds one object of the cloud.
+// - f(n) = n / (n + n0), n0 = `size_scale`: a small set looks consistent by chance (three points
+//   have tiny variance), a large one pays for every stray point across the mask's edge; f
+//   discounts the former and saturates for the latter, so neither dominates.
+// Weights ω_R, ω_N, ω_S = 0.20, 0.30, 0.50 (seed Table 1).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace autoshovel::identification {
+
+struct ScoreOptions {
+  double weight_reflectivity = 0.20;  ///< ω_R, Table 1
+  double weight_normal = 0.30;        ///< ω_N, Table 1
+  double weight_segmentation = 0.50;  ///< ω_S, Table 1
+  int min_points = 10;                ///< Algorithm 1 line 16 threshold [-]
+  double size_scale = 30;             ///< n0 of f(n) [-]
+};
+
+/// One frame prepared for scoring: masks undistorted into a label image, points with attributes.
+struct ScoreFrame {
+  Eigen::Matrix3f K = Eigen::Matrix3f::Identity();  ///< pinhole of the undistorted image [px]
+  cv::Mat mask_labels;  ///< CV_32S, 0 outside every mask, k + 1 in mask k (MaskLabelImage)
+  int num_masks = 0;
+  std::vector<Eigen::Vector3f> points;   ///< LiDAR frame [m]
+  std::vector<float> reflectivity;       ///< as read (any scale)
+  std::vector<Eigen::Vector3f> normals;  ///< unit, LiDAR frame
+  std::vector<int> segment;              ///< class per point, in [0, num_segments)
+  int num_segments = 2;
+  double reflectivity_variance = 1;  ///< over the whole cloud
+};
+
+struct ScoreBreakdown {
+  double rho = 0;      ///< Eq. (7)
+  int masks_used = 0;  ///< with |P_i| ≥ min_points
+  long points_in_masks = 0;
+  double reflectivity = 0, normal = 0, segmentation = 0;  ///< ω_i-weighted means of F_R, F_N, F_S
+};
+
+ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
+                                const Eigen::Isometry3d& T_lidar_camera,
+                                const ScoreOptions& options = {});
+
+}  // namespace autoshovel::identification

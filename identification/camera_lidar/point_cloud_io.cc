@@ -1,0 +1,359 @@
+// The PCL translation unit of point cloud input and output (pcl::io).
+#include "identification/camera_lidar/point_cloud_io.h"
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <vector>
+
+#include "runtime/core/diagnostics.h"
+
+namespace autoshovel::identification {
+
+namespace {
+
+[[noreturn]] void Fail(const std::string& file, int line, const std::string& key,
+                       const std::string& message) {
+  core::DiagnosticSink sink;
+  sink.Add({file, line, line > 0 ? 1 : 0}, key, message);
+  sink.ThrowIfAny();
+  throw std::logic_error("unreachable");
+}
+
+std::vector<std::string> Split(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+bool ParseLong(const std::string& word, long& value) {
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtol(word.c_str(), &end, 10);
+  return errno == 0 && end != word.c_str() && *end == '\0';
+}
+
+bool ParseDouble(const std::string& word, double& value) {
+  char* end = nullptr;
+  value = std::strtod(word.c_str(), &end);
+  return end != word.c_str() && *end == '\0';
+}
+
+void Reduce(std::vector<sensors::LidarPoint>& points, std::size_t max_points) {
+  if (max_points == 0 || points.size() <= max_points) return;
+  std::mt19937_64 rng(0x5eed);
+  for (std::size_t i = 0; i < max_points; ++i) {  // partial Fisher–Yates, then keep order
+    std::uniform_int_distribution<std::size_t> pick(i, points.size() - 1);
+    std::swap(points[i], points[pick(rng)]);
+  }
+  points.resize(max_points);
+}
+
+// Checks the PCD header line by line (pcl::io reports problems on the console only) and the
+// size of the data that follows.
+void CheckPcd(const std::string& path, bool& has_intensity) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) Fail(path, 0, "", "cannot open the point cloud");
+  std::vector<std::string> fields;
+  std::vector<long> sizes, counts;
+  std::vector<std::string> types;
+  long width = -1, height = -1, points = -1;
+  std::string data;
+  int line_no = 0, fields_line = 0, data_line = 0;
+  std::string line;
+  const char* const keys[] = {"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
+                              "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+  int next_key = 0;
+  while (data.empty() && std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> w = Split(line);
+    if (w.empty()) continue;
+    const std::string& key = w[0];
+    int index = -1;
+    for (int k = 0; k < 10; ++k) {
+      if (key == keys[k]) index = k;
+    }
+    if (index < 0) Fail(path, line_no, "", "unknown PCD header entry '" + key + "'");
+    if (index < next_key) {
+      Fail(path, line_no, key,
+           "out of order (PCD v0.7 order: VERSION FIELDS SIZE TYPE COUNT "
+           "WIDTH HEIGHT VIEWPOINT POINTS DATA)");
+    }
+    next_key = index + 1;
+    const std::size_t n = w.size() - 1;
+    auto check_count = [&](std::size_t expected) {
+      if (n != expected) {
+        std::string names;
+        for (const auto& f : fields) names += (names.empty() ? "" : " ") + f;
+        Fail(path, line_no, key,
+             "has " + std::to_string(n) + " values for " + std::to_string(expected) + " FIELDS (" +
+                 names + ")");
+      }
+    };
+    auto positive = [&](long& value, bool allow_zero) {
+      if (n != 1 || !ParseLong(w[1], value) || value < (allow_zero ? 0 : 1)) {
+        Fail(path, line_no, key,
+             std::string("expected one integer ") + (allow_zero ? ">= 0" : "> 0") + ", got '" +
+                 (n ? line.substr(line.find(w[1])) : "") + "'");
+      }
+    };
+    if (key == "FIELDS") {
+      fields.assign(w.begin() + 1, w.end());
+      fields_line = line_no;
+      if (fields.empty()) Fail(path, line_no, key, "no field names");
+    } else if (key == "SIZE" || key == "COUNT") {
+      check_count(fields.size());
+      auto& out = key == "SIZE" ? sizes : counts;
+      for (std::size_t i = 1; i <= n; ++i) {
+        long v = 0;
+        if (!ParseLong(w[i], v) || v < 1 || (key == "SIZE" && v != 1 && v != 2 && v != 4 && v != 8))
+          Fail(path, line_no, key,
+               "value " + std::to_string(i) + " '" + w[i] + "' is not " +
+                   (key == "SIZE" ? "1, 2, 4 or 8" : "> 0"));
+        out.push_back(v);
+      }
+    } else if (key == "TYPE") {
+      check_count(fields.size());
+      for (std::size_t i = 1; i <= n; ++i) {
+        if (w[i] != "F" && w[i] != "I" && w[i] != "U")
+          Fail(path, line_no, key,
+               "value " + std::to_string(i) + " '" + w[i] + "' is not F, I or U");
+      }
+      types.assign(w.begin() + 1, w.end());
+    } else if (key == "WIDTH") {
+      positive(width, true);
+    } else if (key == "HEIGHT") {
+      positive(height, false);
+    } else if (key == "POINTS") {
+      positive(points, true);
+    } else if (key == "VIEWPOINT") {
+      if (n != 7)
+        Fail(path, line_no, key,
+             "expected 7 numbers (tx ty tz qw qx qy qz), got " + std::to_string(n));
+      for (std::size_t i = 1; i <= n; ++i) {
+        double v = 0;
+        if (!ParseDouble(w[i], v) || !std::isfinite(v))
+          Fail(path, line_no, key,
+               "value " + std::to_string(i) + " '" + w[i] + "' is not a finite number");
+      }
+    } else if (key == "DATA") {
+      if (n != 1 || (w[1] != "ascii" && w[1] != "binary" && w[1] != "binary_compressed"))
+        Fail(path, line_no, key, "expected ascii, binary or binary_compressed");
+      data = w[1];
+      data_line = line_no;
+    }
+  }
+  if (data.empty()) Fail(path, line_no, "", "truncated header: no DATA line");
+  if (fields.empty()) Fail(path, data_line, "FIELDS", "missing");
+  if (sizes.empty() || types.empty())
+    Fail(path, data_line, sizes.empty() ? "SIZE" : "TYPE", "missing");
+  if (counts.empty()) counts.assign(fields.size(), 1);
+  if (width < 0) Fail(path, data_line, "WIDTH", "missing");
+  if (height < 0) height = 1;
+  if (points < 0) points = width * height;
+  if (points != width * height) {
+    Fail(path, data_line, "POINTS",
+         std::to_string(points) + " != WIDTH x HEIGHT = " + std::to_string(width * height));
+  }
+  bool x = false, y = false, z = false;
+  has_intensity = false;
+  long values = 0, point_bytes = 0;
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    x = x || fields[i] == "x";
+    y = y || fields[i] == "y";
+    z = z || fields[i] == "z";
+    has_intensity = has_intensity || fields[i] == "intensity";
+    values += counts[i];
+    point_bytes += counts[i] * sizes[i];
+  }
+  if (!x || !y || !z) Fail(path, fields_line, "FIELDS", "needs x, y and z");
+  std::string names;
+  for (const auto& f : fields) names += (names.empty() ? "" : " ") + f;
+  if (data == "ascii") {
+    long seen = 0;
+    while (std::getline(in, line)) {
+      ++line_no;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      const std::vector<std::string> w = Split(line);
+      if (w.empty()) continue;
+      if (seen == points)
+        Fail(path, line_no, "", "more points than POINTS " + std::to_string(points));
+      if (static_cast<long>(w.size()) != values) {
+        Fail(path, line_no, "",
+             "expected " + std::to_string(values) + " values (" + names + "), got " +
+                 std::to_string(w.size()));
+      }
+      for (std::size_t i = 0; i < w.size(); ++i) {
+        double v = 0;
+        if (!ParseDouble(w[i], v) && w[i] != "nan" && w[i] != "NaN")
+          Fail(path, line_no, "",
+               "value " + std::to_string(i + 1) + " '" + w[i] + "' is not a number");
+      }
+      ++seen;
+    }
+    if (seen < points) {
+      Fail(path, line_no + 1, "",
+           "truncated: the header promises " + std::to_string(points) + " points, " +
+               std::to_string(seen) + " follow");
+    }
+    return;
+  }
+  const std::streamoff start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const long remaining = static_cast<long>(in.tellg() - start);
+  if (data == "binary") {
+    if (remaining < points * point_bytes) {
+      Fail(path, data_line, "DATA",
+           "truncated: the header promises " + std::to_string(points) + " points (" +
+               std::to_string(points * point_bytes) + " bytes), " + std::to_string(remaining) +
+               " follow");
+    }
+    return;
+  }
+  std::uint32_t sizes_lzf[2] = {0, 0};
+  in.seekg(start);
+  if (remaining < 8 || !in.read(reinterpret_cast<char*>(sizes_lzf), 8)) {
+    Fail(path, data_line, "DATA", "truncated: no compressed block sizes after the header");
+  }
+  if (sizes_lzf[1] != static_cast<std::uint32_t>(points * point_bytes)) {
+    Fail(path, data_line, "DATA",
+         "the compressed block unpacks to " + std::to_string(sizes_lzf[1]) +
+             " bytes, the header promises " + std::to_string(points) + " points (" +
+             std::to_string(points * point_bytes) + " bytes)");
+  }
+  if (remaining - 8 < static_cast<long>(sizes_lzf[0])) {
+    Fail(path, data_line, "DATA",
+         "truncated: the compressed block has " + std::to_string(sizes_lzf[0]) + " bytes, " +
+             std::to_string(remaining - 8) + " follow");
+  }
+}
+
+sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points) {
+  bool has_intensity = false;
+  CheckPcd(path, has_intensity);
+  pcl::PCLPointCloud2 blob;
+  pcl::PCDReader reader;
+  if (reader.read(path, blob) < 0) Fail(path, 0, "", "pcl::io could not decode the data");
+  sensors::PointCloud cloud;
+  cloud.sensor = std::filesystem::path(path).stem().string();
+  if (has_intensity) {
+    pcl::PointCloud<pcl::PointXYZI> points;
+    pcl::fromPCLPointCloud2(blob, points);
+    cloud.points.reserve(points.size());
+    for (const auto& p : points) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      sensors::LidarPoint q;
+      q.p_sensor = Eigen::Vector3f(p.x, p.y, p.z);
+      q.intensity = std::isfinite(p.intensity) ? p.intensity : 0.0f;
+      cloud.points.push_back(q);
+    }
+  } else {
+    pcl::PointCloud<pcl::PointXYZ> points;
+    pcl::fromPCLPointCloud2(blob, points);
+    for (const auto& p : points) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      sensors::LidarPoint q;
+      q.p_sensor = Eigen::Vector3f(p.x, p.y, p.z);
+      cloud.points.push_back(q);
+    }
+  }
+  Reduce(cloud.points, max_points);
+  return cloud;
+}
+
+sensors::PointCloud ReadKittiBin(const std::string& path, std::size_t max_points) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) Fail(path, 0, "", "cannot open the point cloud");
+  in.seekg(0, std::ios::end);
+  const long bytes = static_cast<long>(in.tellg());
+  in.seekg(0);
+  if (bytes % 16 != 0) {
+    Fail(path, 0, "",
+         "size " + std::to_string(bytes) +
+             " bytes is not a multiple of 16 (float32 x, y, z, intensity per point)");
+  }
+  sensors::PointCloud cloud;
+  cloud.sensor = std::filesystem::path(path).stem().string();
+  std::mt19937_64 rng(0x5eed);
+  long seen = 0;
+  float v[4];
+  while (in.read(reinterpret_cast<char*>(v), sizeof v)) {
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
+    sensors::LidarPoint q;
+    q.p_sensor = Eigen::Vector3f(v[0], v[1], v[2]);
+    q.intensity = std::isfinite(v[3]) ? v[3] : 0.0f;
+    ++seen;
+    if (max_points == 0 || cloud.points.size() < max_points) {
+      cloud.points.push_back(q);
+    } else {  // reservoir sampling (Vitter's algorithm R): memory stays at max_points
+      std::uniform_int_distribution<long> pick(0, seen - 1);
+      const long j = pick(rng);
+      if (j < static_cast<long>(max_points)) cloud.points[j] = q;
+    }
+  }
+  return cloud;
+}
+
+}  // namespace
+
+sensors::PointCloud ReadPointCloud(const std::string& path, std::size_t max_points) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".pcd") return ReadPcd(path, max_points);
+  if (ext == ".bin") return ReadKittiBin(path, max_points);
+  Fail(path, 0, "", "unknown point cloud format '" + ext + "' (expected .pcd or .bin)");
+}
+
+void WritePcd(const std::string& path, const sensors::PointCloud& cloud, PcdEncoding encoding) {
+  pcl::PointCloud<pcl::PointXYZI> points;
+  points.reserve(cloud.points.size());
+  for (const auto& p : cloud.points) {
+    pcl::PointXYZI q;
+    q.x = p.p_sensor.x();
+    q.y = p.p_sensor.y();
+    q.z = p.p_sensor.z();
+    q.intensity = p.intensity;
+    points.push_back(q);
+  }
+  points.width = static_cast<std::uint32_t>(points.size());
+  points.height = 1;
+  pcl::PCDWriter writer;
+  int rc = 0;
+  if (points.empty()) {  // PCL refuses to write an empty cloud; write the header by hand
+    std::ofstream out(path);
+    out << "VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+           "WIDTH 0\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n";
+    rc = out ? 0 : -1;
+  } else if (encoding == PcdEncoding::kAscii) {
+    rc = writer.writeASCII(path, points, 7);
+  } else if (encoding == PcdEncoding::kBinary) {
+    rc = writer.writeBinary(path, points);
+  } else {
+    rc = writer.writeBinaryCompressed(path, points);
+  }
+  if (rc != 0) throw std::runtime_error("cannot write " + path);
+}
+
+void WriteKittiBin(const std::string& path, const sensors::PointCloud& cloud) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  for (const auto& p : cloud.points) {
+    const float v[4] = {p.p_sensor.x(), p.p_sensor.y(), p.p_sensor.z(), p.intensity};
+    out.write(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace autoshovel::identification

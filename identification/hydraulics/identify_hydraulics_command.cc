@@ -1,0 +1,267 @@
+#include "identification/hydraulics/identify_hydraulics_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "generated/registry.h"
+#include "identification/common/overlay_file.h"
+#include "identification/hydraulics/hydraulic_identification.h"
+#include "identification/hydraulics/log_reader.h"
+#include "identification/hydraulics/plant_logs.h"
+#include "identification/hydraulics/residual_plot.h"
+#include "runtime/core/diagnostics.h"
+#include "runtime/model/description.h"
+
+namespace autoshovel::identification {
+
+namespace {
+
+constexpr double kLpm = 1e-3 / 60;  // m³/s per l/min
+constexpr double kMs = 1e-3;
+
+std::string Sidecar(const std::string& log) {
+  std::filesystem::path path(log);
+  return (path.parent_path() / (path.stem().string() + ".columns.yaml")).string();
+}
+
+LogFormat FormatFor(const std::string& log, const IdentifyHydraulicsOptions& options) {
+  const std::string sidecar = Sidecar(log);
+  if (std::filesystem::exists(sidecar)) return ReadLogFormatYaml(sidecar);
+  LogFormat format;
+  if (!options.column_map.empty()) format = ReadLogFormatYaml(options.column_map);
+  if (!options.columns.empty()) format = ParseColumnsSpec(options.columns, format);
+  if (!options.command_units.empty()) {
+    format.command_units = format.spool_units = ParseCommandUnits(options.command_units);
+  }
+  if (!options.spool_units.empty()) format.spool_units = ParseCommandUnits(options.spool_units);
+  if (!options.angle_units.empty()) format.angle_units = ParseAngleUnits(options.angle_units);
+  if (!options.pressure_units.empty()) {
+    format.pressure_units = ParsePressureUnits(options.pressure_units);
+  }
+  if (!options.time_units.empty()) format.time_units = ParseTimeUnits(options.time_units);
+  if (options.header_lines >= 0) format.header_lines = options.header_lines;
+  if (!options.actuator.empty()) format.actuator = options.actuator;
+  return format;
+}
+
+[[noreturn]] void FailFile(const std::string& file, const std::string& message) {
+  core::DiagnosticSink sink;
+  sink.Add({file, 0, 0}, "", message);
+  sink.ThrowIfAny();
+  throw std::logic_error("unreachable");
+}
+
+std::string ActuatorList(const model::MachineDescription& machine) {
+  std::string list;
+  for (const auto& act : machine.hydraulics.actuators) {
+    list += (list.empty() ? "" : ", ") + act.name + " (joint " + act.joint + ")";
+  }
+  return list;
+}
+
+// "0.0812 ± 0.0011" columns of the table.
+void PrintTable(const ActuatorIdentification& r, std::ostream& out) {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "%s: %zu files, %zu samples (%zu at end stops left out), spool feedback %s\n",
+                r.actuator.c_str(), r.files.size(), r.samples, r.excluded,
+                r.has_spool ? "used" : "not logged");
+  out << line;
+  out << "  parameter                 description   identified     1-sigma     95 % interval\n";
+  struct Row {
+    const char* name;
+    double nominal, value, sigma, scale;
+    const char* format;
+  };
+  const Row rows[] = {
+      {"dead zone [%]", r.nominal.dead_zone, r.params.dead_zone, r.std_dev.dead_zone, 100, "%9.2f"},
+      {"transport delay [ms]", r.nominal.transport_delay, r.params.transport_delay,
+       r.std_dev.transport_delay, 1 / kMs, "%9.1f"},
+      {"spool time const. [ms]", r.nominal.spool_time_constant, r.params.spool_time_constant,
+       r.std_dev.spool_time_constant, 1 / kMs, "%9.1f"},
+      {"rated flow [l/min]", r.nominal.rated_flow, r.params.rated_flow, r.std_dev.rated_flow,
+       1 / kLpm, "%9.1f"},
+  };
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Row& row = rows[i];
+    char cells[5][40];
+    std::snprintf(cells[0], sizeof cells[0], row.format, row.nominal * row.scale);
+    std::snprintf(cells[1], sizeof cells[1], row.format, row.value * row.scale);
+    std::snprintf(cells[2], sizeof cells[2], row.format, row.sigma * row.scale);
+    std::snprintf(cells[3], sizeof cells[3], row.format,
+                  (row.value - 1.96 * row.sigma) * row.scale);
+    std::snprintf(cells[4], sizeof cells[4], row.format,
+                  (row.value + 1.96 * row.sigma) * row.scale);
+    std::snprintf(line, sizeof line, "  %-24s %s    %s   %s   [%s, %s]%s\n", row.name, cells[0],
+                  cells[1], cells[2], cells[3], cells[4], r.at_bound[i] ? "  (at its bound)" : "");
+    out << line;
+  }
+  std::snprintf(
+      line, sizeof line, "  residual RMS: joint angle %.3f deg%s; %d iterations, %.2f s\n",
+      r.angle_sigma * 180 / std::numbers::pi,
+      r.has_spool ? (", spool " + std::to_string(r.spool_sigma * 100).substr(0, 5) + " %").c_str()
+                  : "",
+      r.iterations, r.seconds);
+  out << line;
+  if (r.cross_validation.empty()) {
+    out << "  cross-validation: needs logs at two or more duty levels\n";
+    return;
+  }
+  out << "  cross-validation (fit on the other duty levels, predict this one):\n"
+      << "    held out  files  dead zone  delay    tau_s    flow       angle RMS        "
+         "spool RMS\n";
+  for (const CrossValidationFold& fold : r.cross_validation) {
+    std::snprintf(
+        line, sizeof line,
+        "    %5.0f %%   %5zu  %7.2f %%  %5.0f ms %5.1f ms %6.1f l/min  %.3f deg "
+        "(%.1f %%)  %s\n",
+        fold.level * 100, fold.files.size(), fold.params.dead_zone * 100,
+        fold.params.transport_delay / kMs, fold.params.spool_time_constant / kMs,
+        fold.params.rated_flow / kLpm, fold.angle_rms * 180 / std::numbers::pi,
+        100 * fold.angle_rms / std::max(fold.angle_range, 1e-9),
+        r.has_spool ? (std::to_string(fold.spool_rms * 100).substr(0, 4) + " %").c_str() : "-");
+    out << line;
+  }
+}
+
+std::string OverlayText(const model::MachineDescription& machine,
+                        const std::vector<ActuatorIdentification>& results,
+                        const std::string& command_line) {
+  std::ostringstream text;
+  text << OverlayHeader(machine, command_line) << "hydraulics:\n  actuators:\n";
+  char line[200];
+  for (const ActuatorIdentification& r : results) {
+    text << "    - name: " << r.actuator << "\n";
+    std::snprintf(line, sizeof line,
+                  "      dead_zone: %.4f            # fraction of full command, +/- %.4f\n",
+                  r.params.dead_zone, r.std_dev.dead_zone);
+    text << line;
+    std::snprintf(line, sizeof line, "      transport_delay: %.4f      # s, +/- %.4f\n",
+                  r.params.transport_delay, r.std_dev.transport_delay);
+    text << line;
+    std::snprintf(line, sizeof line, "      spool_time_constant: %.4f  # s, +/- %.4f\n",
+                  r.params.spool_time_constant, r.std_dev.spool_time_constant);
+    text << line;
+    std::snprintf(line, sizeof line, "      rated_flow_lpm: %.1f         # l/min, +/- %.1f\n",
+                  r.params.rated_flow / kLpm, r.std_dev.rated_flow / kLpm);
+    text << line;
+  }
+  return text.str();
+}
+
+}  // namespace
+
+int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream& out,
+                          std::ostream& err) {
+  const char* kName = "autoshovel identify hydraulics";
+  try {
+    const model::MachineDescription machine = model::LoadMachineDescription(
+        model::ResolveMachineDescription(options.machine, options.models_dir));
+    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+    if (functions == nullptr) {
+      err << kName << ": machine '" << machine.name
+          << "' has no generated code: run `autoshovel gen " << machine.source_file
+          << "` and rebuild\n";
+      return 2;
+    }
+    if (!options.actuator.empty() && FindActuator(machine, options.actuator) < 0) {
+      err << kName << ": machine '" << machine.name << "' has no actuator '" << options.actuator
+          << "'; it has: " << ActuatorList(machine) << "\n";
+      return 2;
+    }
+
+    if (!options.simulate.empty()) {
+      std::vector<int> actuators;
+      if (!options.actuator.empty()) {
+        actuators.push_back(FindActuator(machine, options.actuator));
+      } else {
+        for (std::size_t a = 0; a < machine.hydraulics.actuators.size(); ++a) {
+          actuators.push_back(static_cast<int>(a));
+        }
+      }
+      std::vector<std::string> paths;
+      for (int a : actuators) {
+        for (const std::string& p :
+             WriteSimulatedCampaign(machine, *functions, a, options.simulate, options.seed)) {
+          paths.push_back(p);
+        }
+      }
+      out << "simulated " << paths.size() << " plant logs of " << machine.name << " in "
+          << options.simulate << " (steps at 30, 60, 100 % both ways, a 60 % chirp; seed "
+          << options.seed << "):\n";
+      for (const std::string& p : paths) out << "  " << p << "\n";
+      out << "try: autoshovel identify hydraulics " << options.simulate << "/*.csv --machine "
+          << machine.name << "\n";
+      return 0;
+    }
+
+    if (options.logs.empty()) {
+      err << kName << ": give one or more logs (or --simulate DIR)\n";
+      return 2;
+    }
+    // Read everything first.
+    std::vector<HydraulicLog> logs;
+    for (const std::string& path : options.logs) {
+      logs.push_back(ReadHydraulicLog(path, FormatFor(path, options)));
+    }
+    std::map<int, std::vector<HydraulicLog>> by_actuator;
+    for (HydraulicLog& log : logs) {
+      if (log.actuator.empty()) {
+        FailFile(log.file, "the log does not name its actuator: give --actuator (" +
+                               ActuatorList(machine) + ")");
+      }
+      const int a = FindActuator(machine, log.actuator);
+      if (a < 0) {
+        FailFile(log.file, "no actuator '" + log.actuator + "' on " + machine.name + " (it has " +
+                               ActuatorList(machine) + ")");
+      }
+      by_actuator[a].push_back(std::move(log));
+    }
+    HydraulicIdentificationOptions fit_options;
+    fit_options.cross_validate = options.cross_validate;
+    fit_options.exclude_end_stops = options.exclude_end_stops;
+    std::vector<ActuatorIdentification> results;
+    for (const auto& [a, group] : by_actuator) {
+      results.push_back(IdentifyActuator(machine, *functions, a, group, fit_options));
+    }
+
+    out << "hydraulic identification of " << machine.name << " from " << options.logs.size()
+        << " log" << (options.logs.size() == 1 ? "" : "s") << "\n";
+    for (const ActuatorIdentification& r : results) PrintTable(r, out);
+
+    std::string command_line = kName;
+    // Name a few logs; a campaign of many would make the comment unreadable.
+    for (std::size_t i = 0; i < options.logs.size() && i < 3; ++i) {
+      command_line += " " + options.logs[i];
+    }
+    if (options.logs.size() > 3) {
+      command_line += " … (" + std::to_string(options.logs.size()) + " logs)";
+    }
+    command_line += " --machine " + machine.name;
+    const std::string overlay =
+        options.overlay.empty() ? options.logs.front() + ".overlay.yaml" : options.overlay;
+    const std::string png =
+        options.png.empty() ? options.logs.front() + ".residuals.png" : options.png;
+    WriteResidualPlot(results, png);
+    WriteFileAtomically(overlay, OverlayText(machine, results, command_line));
+    out << "overlay: " << overlay << "\nresiduals: " << png << "\n";
+    return 0;
+  } catch (const core::InputError& e) {
+    err << e.what() << "\n" << kName << ": nothing written\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    err << kName << ": " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    err << kName << ": " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace autoshovel::identification

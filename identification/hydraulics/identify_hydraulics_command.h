@@ -1,0 +1,43 @@
+// `autoshovel identify hydraulics LOG.csv... --machine M`: hydraulic delay identification
+// (hydraulic_identification.h) from valve step and chirp logs, printed as a table with
+// cross-validation by duty level, written as an overlay of the machine description
+// (`hydraulics.actuators[]` dead_zone, transport_delay, spool_time_constant, rated_flow_lpm)
+// and as a PNG of the fits and residuals. `--simulate DIR` writes plant logs to try it on.
+//
+// How each log is read (log_reader.h): a log `X.csv` with a `X.columns.yaml` beside it is read
+// with that column map alone; the others with `--column-map` (if given) overridden by
+// `--columns`, the unit options, `--header-lines` and `--actuator`. Every log is read and every
+// actuator fitted before anything is written: a bad file leaves no overlay and no figure.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace autoshovel::identification {
+
+struct IdentifyHydraulicsOptions {
+  std::vector<std::string> logs;  ///< step / chirp logs, fitted jointly per actuator
+  std::string machine;
+  std::string models_dir;
+  std::string actuator;        ///< name or joint; empty: named by each log (map or header)
+  std::string columns;         ///< `time=t_s,command=cmd_pct,...`
+  std::string column_map;      ///< YAML column map (log_reader.h)
+  std::string command_units;   ///< unit | percent; empty: the map's, else unit
+  std::string spool_units;     ///< unit | percent; empty: as the command
+  std::string angle_units;     ///< rad | deg; empty: the map's, else rad
+  std::string pressure_units;  ///< Pa | bar | MPa; empty: the map's, else Pa
+  std::string time_units;      ///< s | ms; empty: the map's, else s
+  int header_lines = -1;       ///< lines before the samples; -1: detected
+  std::string overlay;         ///< empty: <first log>.overlay.yaml
+  std::string png;             ///< empty: <first log>.residuals.png
+  bool cross_validate = true;
+  bool exclude_end_stops = true;
+  std::string simulate;         ///< write simulated logs into this folder instead
+  unsigned long long seed = 1;  ///< of the simulated noise
+};
+
+int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream& out,
+                          std::ostream& err);
+
+}  // namespace autoshovel::identification

@@ -1,0 +1,16 @@
+// The residual figure of hydraulic identification: per file, measured and fitted joint angle
+// (and spool, if logged) against time, and the angle residual. OpenCV stays in residual_plot.cc.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "identification/hydraulics/hydraulic_identification.h"
+
+namespace autoshovel::identification {
+
+/// Writes the PNG to `path` (through a temporary file, renamed once complete). Throws
+/// std::runtime_error naming the path when it cannot be written.
+void WriteResidualPlot(const std::vector<ActuatorIdentification>& results, const std::string& path);
+
+}  // namespace autoshovel::identification

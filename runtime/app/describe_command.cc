@@ -52,6 +52,7 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
   } else {
     out << "  generated     up to date (generated/" << m.name << "/)\n";
   }
+  for (const std::string& overlay : m.overlays) out << "  overlay       " << overlay << '\n';
   out << "  estimated     " << m.estimated.size() << " values"
       << (options.show_estimated ? ":" : " (--estimated lists them)") << '\n';
   if (options.show_estimated) {
@@ -108,6 +109,25 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
         << Fixed((a.retracted_length + a.stroke - high) * 1000, 0) << " mm; lever "
         << Fixed(a.lever_min, 3) << " .. " << Fixed(a.lever_max, 3) << " m/rad; delay "
         << Fixed(a.transport_delay, 2) << " s\n";
+  }
+  out << "\nValves (`autoshovel identify hydraulics` identifies these)\n";
+  for (const model::Actuator& a : m.hydraulics.actuators) {
+    out << "  " << std::left << std::setw(17) << a.name << std::right << " dead zone "
+        << Fixed(100 * a.valve.dead_zone, 1) << " %, delay " << Fixed(a.valve.transport_delay, 3)
+        << " s, spool lag " << Fixed(a.valve.spool_time_constant, 3) << " s, rated flow "
+        << Fixed(a.valve.rated_flow * 60e3, 0) << " l/min\n";
+  }
+  const auto pose_text = [](const model::Pose3& pose) {
+    return "xyz " + Fixed(pose.xyz.x(), 3) + " " + Fixed(pose.xyz.y(), 3) + " " +
+           Fixed(pose.xyz.z(), 3) + " m, rpy " + Fixed(Deg(pose.rpy.x()), 2) + " " +
+           Fixed(Deg(pose.rpy.y()), 2) + " " + Fixed(Deg(pose.rpy.z()), 2) + " deg";
+  };
+  out << "\nSensor poses in the base frame (`autoshovel calibrate camera-lidar` calibrates the "
+         "camera)\n";
+  out << "  camera            " << pose_text(m.sensors.camera.pose) << '\n';
+  for (const model::Lidar& lidar : m.sensors.lidars) {
+    out << "  " << std::left << std::setw(17) << lidar.name << std::right << " "
+        << pose_text(lidar.pose) << '\n';
   }
   out << "\nCarry pose (" << s.carry_pose_definition << "):";
   for (double q : s.carry_pose) out << ' ' << Fixed(Deg(q), 1);

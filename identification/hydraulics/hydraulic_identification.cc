@@ -215,6 +215,15 @@ FitState StartingPoint(const std::vector<PreparedFile>& files, const ActuatorKin
   const double taus[] = {0.02, 0.04, 0.08, 0.16, 0.32};
   const double zones[] = {0.0, 0.04, 0.08, 0.12, 0.2, 0.3};
   std::vector<std::vector<double>> flow(files.size());
+  // Lever-weighted means of the modelled flow integral and of the length over a segment.
+  const auto weighted_means = [&](std::size_t f, std::size_t begin, std::size_t end) {
+    double w = 0, mx = 0, my = 0;
+    for (std::size_t j = begin; j < end; ++j) {
+      const double wj = 1.0 / (files[f].lever[j] * files[f].lever[j]);
+      w += wj, mx += wj * flow[f][j], my += wj * files[f].length[j];
+    }
+    return std::pair<double, double>{mx / w, my / w};
+  };
   for (double delay = options.lower.transport_delay; delay <= options.upper.transport_delay;
        delay += options.delay_scan_step) {
     for (double tau : taus) {
@@ -232,12 +241,7 @@ FitState StartingPoint(const std::vector<PreparedFile>& files, const ActuatorKin
             flow[f][j] = r.positive[j] * inv_extend + r.negative[j] * inv_retract;
           }
           for (const auto& [begin, end] : files[f].segments) {
-            double w = 0, mx = 0, my = 0;
-            for (std::size_t j = begin; j < end; ++j) {
-              const double wj = 1.0 / (files[f].lever[j] * files[f].lever[j]);
-              w += wj, mx += wj * flow[f][j], my += wj * files[f].length[j];
-            }
-            mx /= w, my /= w;
+            const auto [mx, my] = weighted_means(f, begin, end);
             for (std::size_t j = begin; j < end; ++j) {
               const double wj = 1.0 / (files[f].lever[j] * files[f].lever[j]);
               const double x = flow[f][j] - mx, y = files[f].length[j] - my;
@@ -261,12 +265,7 @@ FitState StartingPoint(const std::vector<PreparedFile>& files, const ActuatorKin
           best.start.assign(files.size(), {});
           for (std::size_t f = 0; f < files.size(); ++f) {
             for (const auto& [begin, end] : files[f].segments) {
-              double w = 0, mx = 0, my = 0;
-              for (std::size_t j = begin; j < end; ++j) {
-                const double wj = 1.0 / (files[f].lever[j] * files[f].lever[j]);
-                w += wj, mx += wj * flow[f][j], my += wj * files[f].length[j];
-              }
-              mx /= w, my /= w;
+              const auto [mx, my] = weighted_means(f, begin, end);
               best.start[f].push_back(kinematics.Angle(my - q * mx + q * flow[f][begin]));
             }
           }

@@ -16,24 +16,13 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180;
 
-plant::World EmptyYard(const model::MachineDescription& machine) {
-  plant::World world;
-  plant::GridGeometry geometry;
-  geometry.resolution = 0.1;
-  geometry.nx = geometry.ny = 200;
-  geometry.origin = Eigen::Vector2d(-10, -10);
-  world.terrain = plant::Terrain(geometry, 0.0);
-  world.materials = machine.materials;
-  return world;
-}
-
 }  // namespace
 
 HydraulicLog SimulatePlantLog(const model::MachineDescription& machine,
                               const generated::MachineFunctions& functions, int actuator,
                               const std::function<double(double)>& command, double duration,
                               const PlantLogOptions& options) {
-  plant::World world = EmptyYard(machine);
+  plant::World world = plant::EmptyYard(machine);
   plant::MachineState initial;
   initial.q.assign(machine.num_joints(), 0.0);
   for (std::size_t j = 0; j < machine.num_links(); ++j) {

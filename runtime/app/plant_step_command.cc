@@ -74,13 +74,7 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
     }
 
     // A 20 m × 20 m empty yard: the experiment needs no material.
-    plant::World world;
-    plant::GridGeometry geometry;
-    geometry.resolution = 0.1;
-    geometry.nx = geometry.ny = 200;
-    geometry.origin = Eigen::Vector2d(-10, -10);
-    world.terrain = plant::Terrain(geometry, 0.0);
-    world.materials = machine.materials;
+    plant::World world = plant::EmptyYard(machine);
     plant::Plant plant(machine, *functions, world, StartState(machine));
 
     std::ofstream file;

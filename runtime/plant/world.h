@@ -41,4 +41,9 @@ struct World {
   double ground_reflectivity = 0.2;  ///< of the bare floor
 };
 
+/// A bare level floor of `size` × `size` metres centred on the world origin, at 0.1 m
+/// resolution, with the machine's materials: for experiments that need no material (valve
+/// steps, identification logs).
+World EmptyYard(const model::MachineDescription& machine, double size = 20.0);
+
 }  // namespace autoshovel::plant

@@ -45,6 +45,13 @@ ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& ma
   const MaskSet undistorted = UndistortMasks(masks, intrinsics);
   frame.mask_labels = MaskLabelImage(undistorted);
   frame.num_masks = static_cast<int>(undistorted.masks.size());
+  frame.mask_area.assign(frame.num_masks, 0.0);
+  for (int v = 0; v < frame.mask_labels.rows; ++v) {
+    for (int u = 0; u < frame.mask_labels.cols; ++u) {
+      const int label = frame.mask_labels.at<int>(v, u);
+      if (label > 0) frame.mask_area[label - 1] += 1;
+    }
+  }
   std::vector<std::size_t> keep(cloud.points.size());
   for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = i;
   if (max_points > 0 && keep.size() > max_points) {

@@ -11,6 +11,7 @@
 #include <pcl/segmentation/conditional_euclidean_clustering.h>
 #include <pcl/segmentation/sac_segmentation.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 namespace autoshovel::identification {
@@ -58,14 +59,54 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
   pcl::ModelCoefficients plane;
   sac.segment(ground, plane);
   std::vector<char> is_ground(n, 0);
-  for (const int i : ground.indices) is_ground[i] = 1;
-  features.ground_points = static_cast<int>(ground.indices.size());
-
-  // The rest: conditional Euclidean clustering (region growing that cuts at creases).
+  features.ground_points = 0;
+  if (plane.values.size() == 4) {
+    Eigen::Vector3f normal(plane.values[0], plane.values[1], plane.values[2]);
+    float offset = plane.values[3];
+    const float norm = normal.norm();
+    normal /= norm;
+    offset /= norm;
+    if (normal.dot(up_lidar.cast<float>()) < 0) {
+      normal = -normal;
+      offset = -offset;
+    }
+    // Least-squares refits on ever closer inliers: RANSAC's inliers (±ground_threshold) include
+    // the feet of piles and walls, which lift and tilt its least-squares plane by centimetres.
+    for (const double band : {0.5 * options.ground_threshold, 2 * options.ground_class_threshold}) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+      double count = 0;
+      for (const auto& p : points) {
+        if (std::abs(normal.dot(p) + offset) >= band) continue;
+        const Eigen::Vector3d q = p.cast<double>();
+        sum += q;
+        outer += q * q.transpose();
+        ++count;
+      }
+      if (count < 3) break;
+      const Eigen::Vector3d mean = sum / count;
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / count -
+                                                               mean * mean.transpose());
+      Eigen::Vector3d refit = eig.eigenvectors().col(0);
+      if (refit.dot(up_lidar) < 0) refit = -refit;
+      normal = refit.cast<float>();
+      offset = static_cast<float>(-refit.dot(mean));
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const float height = normal.dot(points[i]) + offset;
+      if (std::abs(height) < options.ground_class_threshold) {
+        is_ground[i] = 1;
+        ++features.ground_points;
+      } else if (height < options.object_min_height) {
+        is_ground[i] = 2;  // the ambiguous band: a pile's foot, a wall's base, noise: no class
+      }
+    }
+  }
+  // The rest: Euclidean clustering, cut at creases too when cluster_normal_angle < π.
   pcl::PointCloud<pcl::PointNormal>::Ptr rest(new pcl::PointCloud<pcl::PointNormal>);
   std::vector<int> rest_index;
   for (std::size_t i = 0; i < n; ++i) {
-    if (is_ground[i]) continue;
+    if (is_ground[i] != 0) continue;
     pcl::PointNormal q;
     q.x = points[i].x();
     q.y = points[i].y();
@@ -84,7 +125,7 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
     clustering.setInputCloud(rest);
     clustering.setConditionFunction([cos_max](const pcl::PointNormal& a, const pcl::PointNormal& b,
                                               float) {
-      return a.normal_x * b.normal_x + a.normal_y * b.normal_y + a.normal_z * b.normal_z > cos_max;
+      return a.normal_x * b.normal_x + a.normal_y * b.normal_y + a.normal_z * b.normal_z >= cos_max;
     });
     clustering.setClusterTolerance(static_cast<float>(options.cluster_tolerance));
     clustering.setMinClusterSize(options.min_cluster_points);
@@ -96,11 +137,13 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
       ++next;
     }
   }
-  const int unclustered = next;
-  for (std::size_t j = 0; j < rest_index.size(); ++j) {
-    features.segment[rest_index[j]] = label[j] >= 0 ? label[j] : unclustered;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (is_ground[i] == 2) features.segment[i] = -1;
   }
-  features.num_segments = unclustered + 1;
+  for (std::size_t j = 0; j < rest_index.size(); ++j) {
+    features.segment[rest_index[j]] = label[j];  // −1: unclustered
+  }
+  features.num_segments = next;
   return features;
 }
 

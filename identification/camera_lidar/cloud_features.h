@@ -20,17 +20,19 @@
 namespace autoshovel::identification {
 
 struct CloudFeatureOptions {
-  int normal_neighbours = 12;         ///< k of the normal PCA [-]
-  double ground_threshold = 0.08;     ///< RANSAC inlier distance of the ground [m]
-  double ground_max_tilt = 0.35;      ///< ground normal within this of `up` [rad]
-  double cluster_tolerance = 0.3;     ///< neighbour radius of the clustering [m]
-  double cluster_normal_angle = 0.5;  ///< [rad]
-  int min_cluster_points = 20;        ///< smaller clusters are "unclustered" [-]
+  int normal_neighbours = 12;             ///< k of the normal PCA [-]
+  double ground_threshold = 0.08;         ///< RANSAC inlier distance of the ground [m]
+  double ground_class_threshold = 0.015;  ///< |height| below: class ground [m]
+  double object_min_height = 0.15;        ///< between the two: no class [m]
+  double ground_max_tilt = 0.35;          ///< ground normal within this of `up` [rad]
+  double cluster_tolerance = 0.3;         ///< neighbour radius of the clustering [m]
+  double cluster_normal_angle = 3.1416;   ///< ≥ π: plain Euclidean clustering [rad]
+  int min_cluster_points = 20;            ///< smaller clusters are "unclustered" [-]
 };
 
 struct CloudFeatures {
   std::vector<Eigen::Vector3f> normals;  ///< unit, towards the sensor
-  std::vector<int> segment;              ///< 0 ground, 1..n clusters, num_segments−1 unclustered
+  std::vector<int> segment;              ///< 0 ground, 1..n−1 clusters, −1 no class
   int num_segments = 0;
   int ground_points = 0;
 };

@@ -16,11 +16,25 @@
 //   F_N = (|Σ n|² − |P|) / (|P| (|P| − 1)); 1 for a plane, ≈ 0 for random orientations.
 // - F_S = 1 − H / ln(C), H = −Σ_k q_k ln q_k the entropy of the segment classes (cloud_features.h)
 //   of the points, q_k their fractions, C the number of classes in the cloud (line 22): 1 when the
-//   mask holds one object of the cloud.
+//   mask holds one object of the cloud. Points without a class (−1: a pile's foot, small
+//   clusters) enter no histogram; a mask with none classified has F_S = 1.
+//   `segmentation_entropy = false` uses the purity Σ_k q_k² instead (the prose's "weighted sum of
+//   the number of points within each category"): linear in a small impurity where the entropy's
+//   slope is infinite; measured no better on the simulated frames, so off.
 // - f(n) = n / (n + n0), n0 = `size_scale`: a small set looks consistent by chance (three points
 //   have tiny variance), a large one pays for every stray point across the mask's edge; f
 //   discounts the former and saturates for the latter, so neither dominates.
 // Weights ω_R, ω_N, ω_S = 0.20, 0.30, 0.50 (seed Table 1).
+//
+// Options left open by the seed, measured on simulated frames and off by default
+// (docs/camera_lidar_calibration.md, "Limits"):
+// - `zbuffer_block` r > 0: a point is hidden from the camera when a point within r px is nearer
+//   by more than `zbuffer_margin` + `zbuffer_relative`·depth (LiDAR and camera are 11 cm
+//   apart). It removes the background points next to every occluding edge but keeps the
+//   foreground's, so edges penalise shifts one way only: it *biased* z and pitch (+2.5 cm).
+// - `min_density_fraction` α, `count_skipped`: a mask is skipped below α·area·(points/pixel) too
+//   (the sky collects wall-top spill-over and scores it as consistent), and the points of skipped
+//   masks stay in Σ_j |P_j| (Eq. (7) read over all masks), so dropping points costs.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -35,6 +49,12 @@ struct ScoreOptions {
   double weight_segmentation = 0.50;  ///< ω_S, Table 1
   int min_points = 10;                ///< Algorithm 1 line 16 threshold [-]
   double size_scale = 30;             ///< n0 of f(n) [-]
+  bool segmentation_entropy = true;   ///< F_S = 1 − H/ln C (Algorithm 1), else Σ_k q_k²
+  double min_density_fraction = 0;    ///< α: skip below α · mask area · points per pixel
+  bool count_skipped = false;         ///< skipped masks' points stay in Σ_j |P_j|
+  int zbuffer_block = 0;              ///< occlusion test radius [px]; 0 off
+  double zbuffer_margin = 0.3;        ///< nearer by more than this (+ relative): hidden [m]
+  double zbuffer_relative = 0.05;     ///< of the hidden point's neighbour's depth [-]
 };
 
 /// One frame prepared for scoring: masks undistorted into a label image, points with attributes.
@@ -42,6 +62,7 @@ struct ScoreFrame {
   Eigen::Matrix3f K = Eigen::Matrix3f::Identity();  ///< pinhole of the undistorted image [px]
   cv::Mat mask_labels;  ///< CV_32S, 0 outside every mask, k + 1 in mask k (MaskLabelImage)
   int num_masks = 0;
+  std::vector<double> mask_area;         ///< pixels of each mask in mask_labels
   std::vector<Eigen::Vector3f> points;   ///< LiDAR frame [m]
   std::vector<float> reflectivity;       ///< as read (any scale)
   std::vector<Eigen::Vector3f> normals;  ///< unit, LiDAR frame
@@ -50,11 +71,19 @@ struct ScoreFrame {
   double reflectivity_variance = 1;  ///< over the whole cloud
 };
 
+/// One mask's terms (frame index, mask index within the frame).
+struct MaskScore {
+  int frame = 0, mask = 0;
+  long n = 0;
+  double f_r = 0, f_n = 0, f_s = 0, epsilon = 0;
+};
+
 struct ScoreBreakdown {
   double rho = 0;      ///< Eq. (7)
   int masks_used = 0;  ///< with |P_i| ≥ min_points
   long points_in_masks = 0;
   double reflectivity = 0, normal = 0, segmentation = 0;  ///< ω_i-weighted means of F_R, F_N, F_S
+  std::vector<MaskScore> masks;                           ///< the masks used
 };
 
 ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,

@@ -28,25 +28,27 @@ struct SimulatedData {
   std::vector<ScoreFrame> frames;
 };
 
+SimulatedData Simulate(double range_noise) {
+  SimulatedData s;
+  const std::string models = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
+  s.machine = model::LoadMachineDescription(model::ResolveMachineDescription("xcmg_968ev", models));
+  for (const auto& l : s.machine.sensors.lidars) {
+    if (l.name == "front_solid_state") s.lidar = l;
+  }
+  if (range_noise >= 0) s.lidar.range_noise = range_noise;
+  const Eigen::Isometry3d T_base_lidar = sensors::PoseToIsometry(s.lidar.pose);
+  s.T_lidar_camera =
+      T_base_lidar.inverse() * sensors::PoseToIsometry(s.machine.sensors.camera.pose);
+  s.up_lidar = T_base_lidar.linear().transpose() * Eigen::Vector3d::UnitZ();
+  const CameraIntrinsics intrinsics = IntrinsicsFromDescription(s.machine.sensors.camera);
+  for (const YardFrame& f : SimulateYardFrames(s.machine, s.lidar, s.T_lidar_camera, models)) {
+    s.frames.push_back(PrepareScoreFrame(f.cloud, f.masks, intrinsics, s.up_lidar, 40000));
+  }
+  return s;
+}
+
 const SimulatedData& GetSimulatedData() {
-  static const SimulatedData setup = [] {
-    SimulatedData s;
-    const std::string models = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
-    s.machine =
-        model::LoadMachineDescription(model::ResolveMachineDescription("xcmg_968ev", models));
-    for (const auto& l : s.machine.sensors.lidars) {
-      if (l.name == "front_solid_state") s.lidar = l;
-    }
-    const Eigen::Isometry3d T_base_lidar = sensors::PoseToIsometry(s.lidar.pose);
-    s.T_lidar_camera =
-        T_base_lidar.inverse() * sensors::PoseToIsometry(s.machine.sensors.camera.pose);
-    s.up_lidar = T_base_lidar.linear().transpose() * Eigen::Vector3d::UnitZ();
-    const CameraIntrinsics intrinsics = IntrinsicsFromDescription(s.machine.sensors.camera);
-    for (const YardFrame& f : SimulateYardFrames(s.machine, s.lidar, s.T_lidar_camera, models)) {
-      s.frames.push_back(PrepareScoreFrame(f.cloud, f.masks, intrinsics, s.up_lidar, 40000));
-    }
-    return s;
-  }();
+  static const SimulatedData setup = Simulate(-1);  // the description's range noise
   return setup;
 }
 
@@ -110,6 +112,25 @@ TEST(AutoCalibration, TruthScoresHigherThanPerturbations) {
   }
 }
 
+// The score's bias (docs, "Limits"): on noise-free frames ρ at the truth must not be exceeded
+// 2 cm or 0.2° away along any axis.
+TEST(AutoCalibration, NoiseFreeTruthIsTheMaximumAlongEveryAxis) {
+  const SimulatedData s = Simulate(0.0);
+  const double truth = ConsistencyScore(s.frames, s.T_lidar_camera).rho;
+  for (int k = 0; k < 6; ++k) {
+    for (const double sign : {-1.0, 1.0}) {
+      Eigen::Vector3d w = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+      if (k < 3) {
+        w[k] = sign * 0.2 * kDeg;
+      } else {
+        t[k - 3] = sign * 0.02;
+      }
+      EXPECT_GE(truth, ConsistencyScore(s.frames, Perturb(s.T_lidar_camera, w, t)).rho)
+          << "axis " << k << " sign " << sign;
+    }
+  }
+}
+
 void ExpectRecovered(const Eigen::Vector3d& w, const Eigen::Vector3d& t, Lock lock,
                      double max_rotation, double max_translation) {
   const SimulatedData& s = GetSimulatedData();
@@ -129,20 +150,20 @@ void ExpectRecovered(const Eigen::Vector3d& w, const Eigen::Vector3d& t, Lock lo
   EXPECT_GE(r.final.rho, r.initial.rho);
 }
 
-// Issue 5 asks for 0.3° and 2 cm. The rotation meets it; the translation does NOT: along the
-// LiDAR's boresight (x) the score is nearly flat (±10 cm changes ρ by < 0.5 %, see the slices
-// printed above) and its maximum lies several centimetres off the truth (ρ at the solution
-// exceeds ρ at the truth), so Nelder–Mead ends 5–10 cm away. The bound below records what the
-// method achieves today (docs/camera_lidar_calibration.md, "Limits"), not the issue's target.
+// Issue 5 asks for 0.3° and 2 cm. The rotation meets it; the translation does NOT: every axis
+// alone now peaks at the truth (test above), but along a coupled direction (z up with a pitch
+// that keeps far structure in place, x back) ρ still rises by ≈ 0.1–0.2 % over 3–4 cm, so
+// Nelder–Mead ends 3–4 cm away (ρ there exceeds ρ at the truth). The bound below records what
+// the method achieves today (docs/camera_lidar_calibration.md, "Limits"), not the issue's 2 cm.
 TEST(AutoCalibration, TwoDegreesFiveCentimetresRotationBackWithinSpec) {
   const Eigen::Vector3d axis = Eigen::Vector3d(1, -2, 1.5).normalized();
   const Eigen::Vector3d shift = Eigen::Vector3d(-1, 1, 0.5).normalized();
-  ExpectRecovered(2 * kDeg * axis, 0.05 * shift, Lock::kNone, 0.3 * kDeg, 0.10);
+  ExpectRecovered(2 * kDeg * axis, 0.05 * shift, Lock::kNone, 0.3 * kDeg, 0.06);
 }
 
 TEST(AutoCalibration, ThreeDegreesPerAxisBackWithinHalfADegree) {
   ExpectRecovered(Eigen::Vector3d(3, -3, 3) * kDeg, Eigen::Vector3d::Zero(), Lock::kNone,
-                  0.5 * kDeg, 0.15);
+                  0.5 * kDeg, 0.06);
 }
 
 TEST(AutoCalibration, ThreeDegreesPerAxisTranslationLocked) {

@@ -16,6 +16,7 @@
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
+#include "runtime/planning/select_command.h"
 
 namespace {
 
@@ -222,6 +223,33 @@ int main(int argc, char** argv) {
   hydraulics_cmd->add_option("--seed", hydraulics.seed, "Seed of --simulate")
       ->capture_default_str();
 
+  autoshovel::planning::SelectOptions select;
+  CLI::App* select_cmd = app.add_subcommand(
+      "select", "Shovel point selection (Algorithm 2) on a yard: ranked candidates and a PNG");
+  select_cmd->add_option("scenario", select.scenario, "Scenario name or path")->required();
+  select_cmd->add_option("--png", select.png, "Candidates drawn on the map")->capture_default_str();
+  select_cmd->add_flag("--truth-map", select.truth_map,
+                       "Rasterise the simulator's yard instead of perceiving it");
+  select_cmd->add_flag("--truth", select.truth_labels,
+                       "Perceive with the simulator's labels instead of the network");
+  select_cmd->add_option("--segmenter", select.segmenter, "ONNX segmentation network");
+  select_cmd->add_option("--frames", select.frames, "LiDAR frames per sensor")
+      ->capture_default_str();
+  select_cmd->add_option("--advance", select.advance, "Drive the start pose this far ahead [m]")
+      ->capture_default_str();
+  select_cmd->add_option("--spacing", select.spacing, "Candidate spacing along the front [m]")
+      ->capture_default_str();
+  select_cmd
+      ->add_option("--angles", select.entry_angles_deg,
+                   "Entry headings relative to the face normal [deg]")
+      ->delimiter(',');
+  select_cmd->add_option("--safety-distance", select.safety_distance, "d_res [m]")
+      ->capture_default_str();
+  select_cmd->add_option("--top", select.top, "Candidates listed and drawn")->capture_default_str();
+  select_cmd->add_option("--pile", select.pile, "Only this pile (index, largest first)");
+  bool no_baseline = false;
+  select_cmd->add_flag("--no-baseline", no_baseline, "Skip the Chen et al. (2024) ranking");
+
   CLI11_PARSE(app, argc, argv);
 
   if (*describe_cmd) {
@@ -235,6 +263,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
+  }
+  if (*select_cmd) {
+    select.models_dir = models_dir;
+    select.baseline = !no_baseline;
+    return autoshovel::planning::RunSelect(select, std::cout, std::cerr);
   }
   if (*camera_lidar_cmd) {
     camera_lidar.models_dir = models_dir;

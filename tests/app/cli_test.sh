@@ -11,7 +11,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
 for level in "" describe gen plant "plant step" scenario map calibrate "calibrate arm" \
-  "calibrate camera-lidar" identify "identify hydraulics"; do
+  "calibrate camera-lidar" identify "identify hydraulics" select; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -96,4 +96,10 @@ grep -q "give one or more logs" "$tmp/err" || fail "unexpected: $(cat "$tmp/err"
 "$autoshovel" --models "$source_dir/models" calibrate camera-lidar --machine xcmg_968ev \
   2>"$tmp/err" >/dev/null && fail "calibrate camera-lidar without frames accepted"
 grep -q "give --frames" "$tmp/err" || fail "unexpected: $(cat "$tmp/err")"
+# select: candidates on the simulator's cone, a PNG.
+"$autoshovel" --models "$source_dir/models" select cone_pile --truth-map --png "$tmp/sel.png" \
+  >"$tmp/out" || fail "select: $(cat "$tmp/out")"
+[ -s "$tmp/sel.png" ] || fail "select wrote no PNG"
+"$autoshovel" --models "$source_dir/models" select no_such_yard 2>"$tmp/err" >/dev/null \
+  && fail "select accepted an unknown scenario"
 echo "cli ok"

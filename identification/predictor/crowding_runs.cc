@@ -1,0 +1,280 @@
+#include "identification/predictor/crowding_runs.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <random>
+#include <thread>
+
+#include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
+#include "runtime/plant/scenario_builder.h"
+
+namespace autoshovel::predictor {
+
+namespace {
+
+// Roughness of irregular piles as a fraction of their height, and their flank slope as a
+// fraction of the angle of repose's tangent (the scenario reader's defaults, scenario.cc).
+constexpr double kIrregularRoughness = 0.12;
+constexpr double kIrregularSlopeFraction = 0.8;
+
+int MaterialIndexOf(const model::MachineDescription& machine, const std::string& name) {
+  for (std::size_t i = 0; i < machine.materials.size(); ++i) {
+    if (machine.materials[i].name == name) return static_cast<int>(i);
+  }
+  throw std::invalid_argument("crowding run: machine '" + machine.name + "' knows no material '" +
+                              name + "'");
+}
+
+// h1..h6 (penetration_predictor.h): the surface k·Δl ahead of the tip along the heading, mean of
+// five points across the bucket width.
+std::array<double, prediction::kNumHeights> SampleHeights(const plant::Terrain& terrain,
+                                                          const Eigen::Vector3d& tip,
+                                                          double heading, double width) {
+  const Eigen::Vector2d forward(std::cos(heading), std::sin(heading));
+  const Eigen::Vector2d left(-forward.y(), forward.x());
+  std::array<double, prediction::kNumHeights> h{};
+  for (int k = 0; k < prediction::kNumHeights; ++k) {
+    double sum = 0;
+    for (int j = -2; j <= 2; ++j) {
+      const Eigen::Vector2d p =
+          tip.head<2>() + (k + 1) * prediction::kHeightSpacing * forward + j * 0.2 * width * left;
+      sum += terrain.HeightAt(p.x(), p.y());
+    }
+    h[k] = sum / 5;
+  }
+  return h;
+}
+
+prediction::HeightGrid Crop(const plant::Terrain& terrain, const Eigen::Vector2d& lo,
+                            const Eigen::Vector2d& hi) {
+  int ix0 = 0, iy0 = 0, ix1 = 0, iy1 = 0;
+  const double r = terrain.resolution();
+  const Eigen::Vector2d o = terrain.geometry().origin;
+  ix0 = std::clamp(static_cast<int>(std::floor((lo.x() - o.x()) / r)), 0, terrain.nx() - 1);
+  iy0 = std::clamp(static_cast<int>(std::floor((lo.y() - o.y()) / r)), 0, terrain.ny() - 1);
+  ix1 = std::clamp(static_cast<int>(std::floor((hi.x() - o.x()) / r)), 0, terrain.nx() - 1);
+  iy1 = std::clamp(static_cast<int>(std::floor((hi.y() - o.y()) / r)), 0, terrain.ny() - 1);
+  prediction::HeightGrid grid;
+  grid.resolution = r;
+  grid.origin = o + r * Eigen::Vector2d(ix0, iy0);
+  grid.nx = ix1 - ix0 + 1;
+  grid.ny = iy1 - iy0 + 1;
+  grid.height.reserve(static_cast<std::size_t>(grid.nx) * grid.ny);
+  for (int iy = iy0; iy <= iy1; ++iy) {
+    for (int ix = ix0; ix <= ix1; ++ix) grid.height.push_back(terrain.height(ix, iy));
+  }
+  return grid;
+}
+
+}  // namespace
+
+CrowdingRunSpec DrawSpec(const model::MachineDescription& machine,
+                         const CrowdingRunOptions& options, std::uint64_t seed, int index) {
+  std::seed_seq sequence{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                         static_cast<std::uint32_t>(index), 0x5eedu};
+  std::mt19937_64 rng(sequence);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  CrowdingRunSpec spec;
+  spec.index = index;
+  spec.seed = rng();
+  static const char* kShapes[] = {"cone", "irregular", "low"};
+  spec.shape = kShapes[static_cast<int>(unit(rng) * 3) % 3];
+  spec.material = machine.materials
+                      .at(static_cast<std::size_t>(unit(rng) * machine.materials.size()) %
+                          machine.materials.size())
+                      .name;
+  spec.height = spec.shape == "low" ? 0.5 + 0.5 * unit(rng) : 1.5 + 2.0 * unit(rng);
+  spec.approach_speed = options.min_speed + (options.max_speed - options.min_speed) * unit(rng);
+  spec.trigger_volume = machine.bucket.rated_capacity *
+                        (options.min_trigger_fraction +
+                         (options.max_trigger_fraction - options.min_trigger_fraction) * unit(rng));
+  return spec;
+}
+
+CrowdingRun RunCrowding(const model::MachineDescription& machine,
+                        const generated::MachineFunctions& functions,
+                        const CrowdingRunOptions& options, const CrowdingRunSpec& spec) {
+  CrowdingRun run;
+  run.spec = spec;
+  std::mt19937_64 rng(spec.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+
+  // The loader at the origin facing +x, bucket on the floor; the pile's toe ahead of the tip
+  // far enough to reach v0 (about 0.7 m/s² of acceleration) plus a metre.
+  const std::vector<double> q0 = plant::BucketOnFloor(machine);
+  const double tip_x = prediction::TipInBase(machine, q0[0], q0[1]).x();
+  const double toe = tip_x + 1.0 + spec.approach_speed * spec.approach_speed / (2 * 0.7);
+  const int m = MaterialIndexOf(machine, spec.material);
+  const double tan_repose = std::tan(machine.materials[m].angle_of_repose);
+
+  plant::Pile pile;
+  pile.name = "pile";
+  pile.material = spec.material;
+  pile.material_index = m;
+  pile.height = spec.height;
+  pile.yaw = (unit(rng) - 0.5) * 0.6;
+  double reach = 0, half_span = 0;  // toe to far end along x, half extent along y
+  if (spec.shape == "low") {
+    pile.shape = plant::PileShape::kLow;
+    pile.slope = tan_repose;
+    const double flanks = 2 * spec.height / tan_repose;
+    pile.length = std::max(flanks, 4.0) + 4.0 * unit(rng);
+    pile.width = std::max(flanks, 4.0) + 4.0 * unit(rng);
+    reach = pile.length, half_span = 0.5 * std::hypot(pile.length, pile.width);
+  } else {
+    pile.shape = spec.shape == "cone" ? plant::PileShape::kCone : plant::PileShape::kIrregular;
+    pile.slope = spec.shape == "cone" ? tan_repose : kIrregularSlopeFraction * tan_repose;
+    pile.base_radius = spec.height / pile.slope;
+    if (pile.shape == plant::PileShape::kIrregular) {
+      pile.roughness = kIrregularRoughness * spec.height;
+      pile.seed = rng();
+    }
+    reach = 2 * pile.base_radius, half_span = pile.base_radius;
+  }
+  pile.center = Eigen::Vector2d(toe + 0.5 * reach, (unit(rng) - 0.5) * 1.0);
+
+  plant::World world;
+  plant::GridGeometry geometry;
+  geometry.resolution = options.map_resolution;
+  const double x_min = -1.0, x_max = toe + reach + 1.5;
+  const double y_half = std::max(half_span + 1.5, 0.5 * machine.bucket.width + 2.0);
+  geometry.origin = Eigen::Vector2d(x_min, -y_half);
+  geometry.nx = static_cast<int>(std::ceil((x_max - x_min) / geometry.resolution));
+  geometry.ny = static_cast<int>(std::ceil(2 * y_half / geometry.resolution));
+  world.terrain = plant::Terrain(geometry, 0.0);
+  world.materials = machine.materials;
+  std::vector<plant::Pile> piles = {pile};
+  plant::BuildTerrain(world, piles, {});
+  const plant::Terrain before = world.terrain;
+
+  plant::MachineState start;
+  start.q.assign(machine.num_joints(), 0.0);
+  start.q[0] = q0[0], start.q[1] = q0[1];
+  plant::Plant loader(machine, functions, world, start);
+
+  core::ActuatorCommand command;
+  command.valve.assign(machine.hydraulics.actuators.size(), 0.0);
+  const int boom_valve = machine.ActuatorOfJoint(0), tilt_valve = machine.ActuatorOfJoint(1);
+  double integral = 0;
+  const double kp = 1.0, ki = 0.5;
+  bool contact = false, triggered = false, curled = false, arm_moving = false;
+  double contact_time = 0, trigger_time = 0;
+  Eigen::Vector2d contact_hinge = Eigen::Vector2d::Zero();
+  const double heading = 0;
+  const double rack_back = machine.links[1].joint_max - options.rack_back_margin;
+  double boom_target = 0, max_travel = 0;
+  long tick = 0;
+  while (true) {
+    const plant::MachineState& s = loader.state();
+    const double t = loader.time();
+    if (!contact && loader.resistance().in_contact) {
+      contact = true;
+      contact_time = t;
+      contact_hinge = s.hinge_xy;
+    }
+    if (!contact && t > 30) {
+      run.failure = "no contact with the pile within 30 s";
+      return run;
+    }
+    if (contact && !triggered) {
+      run.past_path.push_back(loader.TipInWorld());
+      if (tick % options.decision_every == 0) {
+        const prediction::HeightGrid map =
+            Crop(before, run.past_path.front().head<2>() - Eigen::Vector2d(1, 3),
+                 run.past_path.back().head<2>() + Eigen::Vector2d(1, 3));
+        const double v1 = prediction::Eq19Volume(map, run.past_path, machine.bucket.width).volume;
+        const bool stalled = s.speed < options.stall_speed && t - contact_time > 0.3;
+        if (v1 >= spec.trigger_volume || stalled || t - contact_time > options.max_crowd_time) {
+          triggered = true;
+          trigger_time = t;
+          const Eigen::Vector3d tip = run.past_path.back();
+          run.features.speed = s.speed;
+          run.features.shoveled_volume = v1;
+          run.features.material = spec.material;
+          run.features.heights = SampleHeights(world.terrain, tip, heading, machine.bucket.width);
+          run.at_trigger.hinge_xy = s.hinge_xy;
+          run.at_trigger.heading = s.heading;
+          run.at_trigger.speed = s.speed;
+          run.at_trigger.q = {s.q[0], s.q[1]};
+          run.contact_to_trigger = (s.hinge_xy - contact_hinge).x();
+          run.payload_at_trigger = loader.bucket().payload_volume();
+          run.plan = prediction::ScoopPlanFromMachine(machine, functions, s.q, 1.0, 1.0,
+                                                      std::max(rack_back - s.q[1], 0.0),
+                                                      options.boom_lift);
+          boom_target = s.q[0] + options.boom_lift;
+        }
+      }
+    }
+    if (triggered) {
+      max_travel = std::max(max_travel, (s.hinge_xy - run.at_trigger.hinge_xy).x());
+      if (!curled && s.q[1] >= rack_back) curled = true;
+      if (!arm_moving && s.q[1] > run.at_trigger.q[1] + 0.02) arm_moving = true;
+      command.valve[tilt_valve] = curled ? 0.0 : 1.0;
+      command.valve[boom_valve] = curled && s.q[0] < boom_target ? 1.0 : 0.0;
+      const bool lifted = curled && s.q[0] >= boom_target;
+      if ((lifted && std::abs(s.speed) < 0.02) || t - trigger_time > options.max_scoop_time) break;
+    }
+    if (!triggered || !arm_moving) {
+      const double error = spec.approach_speed - s.speed;
+      const double u = kp * error + integral;
+      if (u < 1.0 && u > 0.0) integral += ki * error * options.tick;  // no wind-up
+      command.drive = std::clamp(u, 0.0, 1.0);
+      command.brake = 0;
+    } else {
+      // Scoop: the crowd goes on through the hydraulic delay (Fig. 21 (a)–(b)); once the bucket
+      // moves the drive is released (the machine runs on into the pile on its momentum while the
+      // bucket curls) and the brake is applied once the bucket is racked back.
+      command.drive = 0;
+      command.brake = curled ? 1.0 : 0.0;
+    }
+    std::string why;
+    if (!loader.SetCommand(command, &why)) {
+      run.failure = "command refused: " + why;
+      return run;
+    }
+    loader.Advance(options.tick);
+    ++tick;
+  }
+  run.penetration = max_travel;
+  run.payload = loader.bucket().payload_volume();
+  run.simulated_time = loader.time();
+  run.map =
+      Crop(before, run.past_path.front().head<2>() - Eigen::Vector2d(1, options.map_margin + 1.5),
+           run.past_path.back().head<2>() +
+               Eigen::Vector2d(max_travel + 4 + options.map_margin, options.map_margin + 1.5));
+  run.ok = true;
+  return run;
+}
+
+std::vector<CrowdingRun> RunCrowdingBatch(
+    const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+    const CrowdingRunOptions& options, std::uint64_t seed, int first, int count, int threads,
+    const std::function<void(const CrowdingRun&, int done)>& progress) {
+  std::vector<CrowdingRun> runs(static_cast<std::size_t>(count));
+  std::atomic<int> next{0};
+  std::mutex mutex;
+  int done = 0;
+  auto worker = [&] {
+    for (int i = next++; i < count; i = next++) {
+      const CrowdingRunSpec spec = DrawSpec(machine, options, seed, first + i);
+      try {
+        runs[i] = RunCrowding(machine, functions, options, spec);
+      } catch (const std::exception& e) {
+        runs[i].spec = spec;
+        runs[i].failure = e.what();
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      ++done;
+      if (progress) progress(runs[i], done);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 0; k < std::max(threads, 1); ++k) pool.emplace_back(worker);
+  for (std::thread& t : pool) t.join();
+  return runs;
+}
+
+}  // namespace autoshovel::predictor

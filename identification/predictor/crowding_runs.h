@@ -1,0 +1,90 @@
+// Plant crowding runs for the penetration predictor (wheel-loader seed §6.1, §7.4.1: the seed
+// trains on 991 real loads; we generate them in the simulated yard).
+//
+// One run: a randomised pile (shape cone / irregular / low, height, material, lateral offset and
+// yaw) in front of a loader standing with its bucket flat on the floor, a randomised approach
+// speed v0 ∈ [0.5, 2] m/s and a randomised trigger volume. The loader accelerates to v0 (a PI
+// speed loop on the drive command, saturating at full drive once the pile slows it: the
+// crowding phase), keeps the bucket on the floor from first contact on, and at the 20 Hz state
+// machine rate computes V1 (Eq. 19) from the pre-contact height map and the tip path. The scoop
+// is triggered when V1 reaches the run's trigger volume, when the machine all but stalls
+// (< 0.1 m/s) or 8 s after contact. At the trigger the sample is taken (v, V1, material,
+// h1..h6 on the current surface); then the "Just in & out" scoop runs: the tilt valve fully
+// open until the bucket is racked back, the drive held meanwhile; then drive off, brake on and
+// the boom lifted. The target is the machine's forward travel from the trigger until it stops;
+// the final payload (plant ground truth) checks the volume prediction.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "generated/machine_functions.h"
+#include "runtime/model/description.h"
+#include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/volume_estimation.h"
+
+namespace autoshovel::predictor {
+
+struct CrowdingRunOptions {
+  double tick = 0.01;      ///< plant/control step [s] (100 Hz low-level control)
+  int decision_every = 5;  ///< ticks between trigger checks (20 Hz state machine)
+  double min_speed = 0.5;  ///< v0 range [m/s]
+  double max_speed = 2.0;
+  double min_trigger_fraction = 0.02;  ///< trigger V1 as a fraction of the rated capacity [-]
+  double max_trigger_fraction = 0.4;
+  double stall_speed = 0.1;       ///< trigger when slower than this after contact [m/s]
+  double max_crowd_time = 8.0;    ///< trigger at the latest this long after contact [s]
+  double max_scoop_time = 10.0;   ///< the run ends at the latest this long after the trigger [s]
+  double rack_back_margin = 0.1;  ///< curl until the bucket joint is this far below its max [rad]
+  double boom_lift = 0.35;        ///< boom joint travel of the lift [rad]
+  double map_resolution = 0.05;   ///< of the yard grid [m]
+  double map_margin = 2.0;        ///< kept around the tip path in the stored map [m]
+};
+
+/// The randomised inputs of one run, drawn from its seed.
+struct CrowdingRunSpec {
+  int index = 0;
+  std::uint64_t seed = 0;
+  std::string shape;          ///< cone | irregular | low
+  std::string material;       ///< material name
+  double height = 0;          ///< pile peak [m]
+  double approach_speed = 0;  ///< v0 [m/s]
+  double trigger_volume = 0;  ///< V1 at which the scoop is triggered [m³]
+};
+
+struct CrowdingRun {
+  CrowdingRunSpec spec;
+  bool ok = false;                           ///< contact made and the scoop completed
+  std::string failure;                       ///< why not
+  prediction::PenetrationFeatures features;  ///< at the trigger
+  double penetration = 0;                    ///< travel from trigger to stop [m] (the target)
+  double contact_to_trigger = 0;             ///< travel from first contact to the trigger [m]
+  double payload = 0;             ///< bucket volume at the end of the run [m³] (plant truth)
+  double payload_at_trigger = 0;  ///< [m³]
+  prediction::HeightGrid map;     ///< pre-contact heights around the path (cropped)
+  std::vector<Eigen::Vector3d> past_path;  ///< tip path from first contact to the trigger
+  prediction::MachineAtTrigger at_trigger;
+  prediction::ScoopPlan plan;
+  double simulated_time = 0;  ///< [s]
+};
+
+/// Draws the spec of run `index` from `seed` (deterministic).
+CrowdingRunSpec DrawSpec(const model::MachineDescription& machine,
+                         const CrowdingRunOptions& options, std::uint64_t seed, int index);
+
+/// Runs one crowding run in its own yard (thread-safe: nothing shared is written).
+CrowdingRun RunCrowding(const model::MachineDescription& machine,
+                        const generated::MachineFunctions& functions,
+                        const CrowdingRunOptions& options, const CrowdingRunSpec& spec);
+
+/// Runs `count` runs with indices first..first+count−1 on `threads` std::threads; `progress` (if
+/// given) is called from the workers, serialised, after each run.
+std::vector<CrowdingRun> RunCrowdingBatch(
+    const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+    const CrowdingRunOptions& options, std::uint64_t seed, int first, int count, int threads,
+    const std::function<void(const CrowdingRun&, int done)>& progress = {});
+
+}  // namespace autoshovel::predictor

@@ -1,0 +1,83 @@
+#include "identification/predictor/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace autoshovel::predictor {
+
+PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& predictor,
+                                      const model::MachineDescription& machine,
+                                      const std::vector<const CrowdingRun*>& runs,
+                                      double capacity) {
+  PredictorEvaluation e;
+  double volume_error = 0, capped_error = 0, oracle_error = 0;
+  for (const CrowdingRun* run : runs) {
+    if (!run->ok) continue;
+    ++e.samples;
+    e.mean_penetration += run->penetration;
+    const prediction::PenetrationPrediction p = predictor.Predict(run->features);
+    if (!p.ok) {
+      ++e.refused;
+      continue;
+    }
+    const double error = std::abs(p.penetration - run->penetration);
+    e.within_010 += error <= 0.10;
+    e.within_015 += error <= 0.15;
+    e.within_020 += error <= 0.20;
+    e.mse += error * error;
+    if (run->payload < 0.2) continue;
+    const double v1 = run->features.shoveled_volume;
+    const double v2 = prediction::PredictFutureVolume(machine, run->map, run->past_path,
+                                                      run->at_trigger, p.penetration, run->plan)
+                          .total();
+    const double v2_oracle =
+        prediction::PredictFutureVolume(machine, run->map, run->past_path, run->at_trigger,
+                                        run->penetration, run->plan)
+            .total();
+    const double predicted = v1 + v2;
+    ++e.capped_samples;
+    capped_error += std::abs(std::min(predicted, capacity) - run->payload) / run->payload;
+    if (run->payload >= 0.95 * capacity) {
+      ++e.full_runs;
+      continue;
+    }
+    ++e.volume_samples;
+    e.mean_payload += run->payload;
+    e.mean_predicted_volume += predicted;
+    volume_error += std::abs(predicted - run->payload) / run->payload;
+    oracle_error += std::abs(v1 + v2_oracle - run->payload) / run->payload;
+  }
+  if (e.samples > 0) {
+    e.within_010 /= e.samples, e.within_015 /= e.samples, e.within_020 /= e.samples;
+    e.mse /= std::max(e.samples - e.refused, 1);
+    e.mean_penetration /= e.samples;
+  }
+  if (e.volume_samples > 0) {
+    e.volume_accuracy = 1 - volume_error / e.volume_samples;
+    e.oracle_volume_accuracy = 1 - oracle_error / e.volume_samples;
+    e.mean_payload /= e.volume_samples;
+    e.mean_predicted_volume /= e.volume_samples;
+  }
+  if (e.capped_samples > 0) e.volume_accuracy_capped = 1 - capped_error / e.capped_samples;
+  return e;
+}
+
+std::string FormatEvaluation(const PredictorEvaluation& e) {
+  char text[1024];
+  std::snprintf(
+      text, sizeof text,
+      "samples %d (refused %d), mean penetration %.3f m\n"
+      "  |error| <= 0.10 m: %.1f %%   <= 0.15 m: %.1f %%   <= 0.20 m: %.1f %%   "
+      "MSE %.4f m^2\n"
+      "  volume accuracy 1 - mean|V^-V|/V: %.1f %% over %d runs not full (V2 along the true "
+      "penetration: %.1f %%; mean payload %.2f m^3, mean prediction %.2f m^3); all %d "
+      "runs, V^ capped at the capacity: %.1f %% (%d full)",
+      e.samples, e.refused, e.mean_penetration, 100 * e.within_010, 100 * e.within_015,
+      100 * e.within_020, e.mse, 100 * e.volume_accuracy, e.volume_samples,
+      100 * e.oracle_volume_accuracy, e.mean_payload, e.mean_predicted_volume, e.capped_samples,
+      100 * e.volume_accuracy_capped, e.full_runs);
+  return text;
+}
+
+}  // namespace autoshovel::predictor

@@ -1,0 +1,606 @@
+// Shovel point selection: wheel-loader seed §5, Algorithm 2 and Eq. (12)–(18). The readings of
+// what the seed leaves open are listed in shovel_point_selection.h and argued where they are
+// implemented below.
+#include "runtime/planning/shovel_point_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+
+#include "runtime/perception/semantic_map.h"
+
+namespace autoshovel::planning {
+
+using perception::CellClass;
+using perception::GridMap;
+using perception::Index;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Eigen::Vector2d Direction(double heading) { return {std::cos(heading), std::sin(heading)}; }
+
+bool IsClass(const GridMap& map, const Index& i, CellClass c) {
+  return map.at("class", i) == static_cast<float>(c);
+}
+
+double GroundZ(const Eigen::Vector3d& plane, const Eigen::Vector2d& xy) {
+  return plane.x() * xy.x() + plane.y() * xy.y() + plane.z();
+}
+
+// Visits every cell whose centre lies in the rectangle ahead of `entry` along `heading`:
+// along ∈ [−ε/2, length], |λ| ≤ width/2 (λ left of the centre line). f(index, along, λ).
+template <typename F>
+void ForEachCellAhead(const GridMap& map, const Eigen::Vector2d& entry, double heading,
+                      double width, double length, F&& f) {
+  const Eigen::Vector2d u = Direction(heading), v(-u.y(), u.x());
+  const double back = map.resolution() / 2;
+  Eigen::Vector2d lo = entry, hi = entry;
+  for (const double a : {-back, length}) {
+    for (const double l : {-width / 2, width / 2}) {
+      const Eigen::Vector2d corner = entry + a * u + l * v;
+      lo = lo.cwiseMin(corner);
+      hi = hi.cwiseMax(corner);
+    }
+  }
+  const double r = map.resolution();
+  const Eigen::Vector2d origin = map.position() - map.length() / 2;
+  const int x0 = std::max(0, static_cast<int>(std::floor((lo.x() - origin.x()) / r)));
+  const int y0 = std::max(0, static_cast<int>(std::floor((lo.y() - origin.y()) / r)));
+  const int x1 =
+      std::min(map.size().x() - 1, static_cast<int>(std::floor((hi.x() - origin.x()) / r)));
+  const int y1 =
+      std::min(map.size().y() - 1, static_cast<int>(std::floor((hi.y() - origin.y()) / r)));
+  for (int iy = y0; iy <= y1; ++iy) {
+    for (int ix = x0; ix <= x1; ++ix) {
+      const Index index(ix, iy);
+      const Eigen::Vector2d d = map.PositionOf(index) - entry;
+      const double along = d.dot(u), lateral = d.dot(v);
+      if (along < -back || along > length || std::abs(lateral) > width / 2) continue;
+      f(index, along, lateral);
+    }
+  }
+}
+
+// Bilinear interpolation of a cell-centred field at a world point (clamped at the border).
+double Interpolate(const GridMap& map, const Eigen::MatrixXf& field, const Eigen::Vector2d& xy) {
+  const double r = map.resolution();
+  const Eigen::Vector2d origin = map.position() - map.length() / 2;
+  const double fx = std::clamp((xy.x() - origin.x()) / r - 0.5, 0.0, map.size().x() - 1.0);
+  const double fy = std::clamp((xy.y() - origin.y()) / r - 0.5, 0.0, map.size().y() - 1.0);
+  const int ix = std::min(static_cast<int>(fx), map.size().x() - 2 < 0 ? 0 : map.size().x() - 2);
+  const int iy = std::min(static_cast<int>(fy), map.size().y() - 2 < 0 ? 0 : map.size().y() - 2);
+  const int jx = std::min(ix + 1, map.size().x() - 1), jy = std::min(iy + 1, map.size().y() - 1);
+  const double tx = fx - ix, ty = fy - iy;
+  const double a = field(ix, iy), b = field(jx, iy), c = field(ix, jy), d = field(jx, jy);
+  if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(c) || !std::isfinite(d)) {
+    return std::min({a, b, c, d});  // +inf (no obstacle anywhere) stays +inf
+  }
+  return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d);
+}
+
+// Squared 1-D distance transform of f (Felzenszwalb & Huttenlocher 2012), in cells².
+void DistanceTransform1d(std::vector<double>& f) {
+  const int n = static_cast<int>(f.size());
+  std::vector<double> d(n), z(n + 1);
+  std::vector<int> v(n);
+  int k = 0;
+  v[0] = 0;
+  z[0] = -kInf;
+  z[1] = kInf;
+  for (int q = 1; q < n; ++q) {
+    if (!std::isfinite(f[q])) continue;
+    if (!std::isfinite(f[v[k]])) {  // no finite parabola yet: this one starts the envelope
+      v[k] = q;
+      continue;
+    }
+    double s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * q - 2.0 * v[k]);
+    while (s <= z[k]) {
+      --k;
+      s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * q - 2.0 * v[k]);
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = kInf;
+  }
+  if (!std::isfinite(f[v[0]])) return;  // all infinite
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[k + 1] < q) ++k;
+    d[q] = (q - v[k]) * (q - v[k]) + f[v[k]];
+  }
+  f = d;
+}
+
+// The pile height above ground of every cell (0 where not pile or unknown).
+Eigen::MatrixXf PileHeightField(const GridMap& map, const Eigen::Vector3d& plane) {
+  Eigen::MatrixXf h = Eigen::MatrixXf::Zero(map.size().x(), map.size().y());
+  for (perception::GridMapIterator it(map); !it.done(); ++it) {
+    h((*it).x(), (*it).y()) = static_cast<float>(PileHeightAboveGround(map, plane, *it));
+  }
+  return h;
+}
+
+// True if a tyre contact or the chassis' centre line stands on pile higher than the limit
+// anywhere along the path. The bucket is excepted: it is meant to meet the pile.
+bool DrivesOverPile(const GridMap& map, const Eigen::MatrixXf& pile_height,
+                    const std::vector<PathSample>& samples, const LoaderGeometry& loader,
+                    double limit) {
+  const double half_track = loader.track_width / 2;
+  for (const PathSample& p : samples) {
+    const double gamma = loader.ArticulationFor(p.curvature);
+    const Eigen::Vector2d u_front = Direction(p.heading);
+    const Eigen::Vector2d hinge = p.xy - loader.hinge_to_front_axle * u_front;
+    const Eigen::Vector2d u_rear = Direction(p.heading - gamma);
+    const Eigen::Vector2d n_front(-u_front.y(), u_front.x()), n_rear(-u_rear.y(), u_rear.x());
+    const Eigen::Vector2d rear_axle = hinge - loader.hinge_to_rear_axle * u_rear;
+    auto high = [&](const Eigen::Vector2d& xy) {
+      Index i;
+      return map.IndexOf(xy, i) && pile_height(i.x(), i.y()) > limit;
+    };
+    if (high(hinge)) return true;
+    for (const double side : {-half_track, 0.0, half_track}) {
+      for (const double fore : {-loader.wheel_radius, 0.0, loader.wheel_radius}) {
+        if (high(p.xy + fore * u_front + side * n_front)) return true;
+        if (high(rear_axle + fore * u_rear + side * n_rear)) return true;
+      }
+    }
+  }
+  return false;
+}
+
+// The inward normal of the pile at a front point: from the ground cells around it towards the
+// pile cells around it (means within `radius`). Falls back on the direction to the centroid.
+double InwardNormal(const GridMap& map, const Eigen::Vector2d& xy, double radius,
+                    const Eigen::Vector2d& centroid) {
+  Eigen::Vector2d pile_sum = Eigen::Vector2d::Zero(), ground_sum = Eigen::Vector2d::Zero();
+  int pile_n = 0, ground_n = 0;
+  const int reach = static_cast<int>(std::ceil(radius / map.resolution()));
+  Index c;
+  if (map.IndexOf(xy, c)) {
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const Index i(c.x() + dx, c.y() + dy);
+        if (!map.IsValid(i)) continue;
+        const Eigen::Vector2d p = map.PositionOf(i);
+        if ((p - xy).norm() > radius) continue;
+        if (IsClass(map, i, CellClass::kPile)) pile_sum += p, ++pile_n;
+        if (IsClass(map, i, CellClass::kGround)) ground_sum += p, ++ground_n;
+      }
+    }
+  }
+  Eigen::Vector2d n = centroid - xy;
+  if (pile_n > 0 && ground_n > 0) {
+    const Eigen::Vector2d d = pile_sum / pile_n - ground_sum / ground_n;
+    if (d.norm() > 1e-9) n = d;
+  }
+  return std::atan2(n.y(), n.x());
+}
+
+}  // namespace
+
+// --- LoaderGeometry ---
+
+double LoaderGeometry::MaxCurvature() const {
+  return std::sin(max_articulation) /
+         (hinge_to_front_axle * std::cos(max_articulation) + hinge_to_rear_axle);
+}
+
+double LoaderGeometry::ArticulationFor(double curvature) const {
+  // κ (l_f cos γ + l_r) = sin γ  ⇔  A sin(γ − φ) = κ l_r with A = √(1 + κ² l_f²), φ = atan(κ l_f).
+  const double lf = hinge_to_front_axle, lr = hinge_to_rear_axle;
+  const double a = std::sqrt(1 + curvature * curvature * lf * lf);
+  const double phi = std::atan(curvature * lf);
+  return phi + std::asin(std::clamp(curvature * lr / a, -1.0, 1.0));
+}
+
+double LoaderGeometry::HalfWidth() const {
+  // Tyres stand out about a third of their radius beyond the track on each side.
+  return std::max(bucket_width, track_width + 0.66 * wheel_radius) / 2 + body_margin;
+}
+
+LoaderGeometry LoaderGeometryFrom(const model::MachineDescription& machine,
+                                  const generated::MachineFunctions& functions) {
+  if (machine.links.size() != 2 || machine.bucket.profile.size() < 2 || functions.num_links != 2 ||
+      functions.num_angles != 3) {
+    throw std::invalid_argument("LoaderGeometryFrom: " + machine.name +
+                                " is not a two-link wheel loader with a bucket profile");
+  }
+  LoaderGeometry g;
+  g.hinge_to_front_axle = machine.chassis.hinge_to_front_axle;
+  g.hinge_to_rear_axle = machine.chassis.hinge_to_rear_axle;
+  g.max_articulation = machine.chassis.max_articulation;
+  g.track_width = machine.chassis.track_width;
+  g.wheel_radius = machine.chassis.wheel_radius;
+  g.bucket_width = machine.bucket.width;
+  g.rated_capacity = machine.bucket.rated_capacity;
+  // Bucket level on the floor, as when approaching a pile (the plant's BucketOnFloor: the floor
+  // edge of the profile horizontal, the tip 5 cm up), then Eq. (2) through the generated code.
+  const Eigen::Vector2d floor = machine.bucket.profile[1] - machine.bucket.profile[0];
+  const double phi_bucket =
+      std::remainder(std::numbers::pi - std::atan2(floor.y(), floor.x()), 2 * std::numbers::pi);
+  const double l1 = machine.links[0].length, l2 = machine.links[1].length;
+  const double sin_boom = (0.05 - machine.arm_pivot.y() - l2 * std::sin(phi_bucket)) / l1;
+  if (std::abs(sin_boom) > 1) {
+    throw std::invalid_argument("LoaderGeometryFrom: " + machine.name + " cannot reach the floor");
+  }
+  const double boom = std::asin(sin_boom);
+  // IMU angles (Eq. 1 with the nominal offsets α_k, level chassis): θ_k = φ_k − α_k.
+  const double* params = functions.nominal_params;  // l1, l2, α1, α2
+  const double angles[3] = {0.0, boom - params[2], phi_bucket - params[3]};
+  double pose[4];
+  functions.forward_kinematics(angles, params, pose);
+  g.tip_reach = pose[0];
+  return g;
+}
+
+// --- Config ---
+
+std::string ShovelPointConfig::Validate() const {
+  for (const auto& [name, k] : {std::pair{"k_t", k_t}, std::pair{"k_s", k_s}, std::pair{"k_c", k_c},
+                                std::pair{"k_e", k_e}, std::pair{"k_a", k_a}}) {
+    if (!(k >= 0) || !std::isfinite(k)) {
+      return std::string(name) + " must be a finite weight >= 0, got " + std::to_string(k);
+    }
+  }
+  if (!(safety_distance > 0)) {
+    return "safety_distance (d_res) must be > 0 m, got " + std::to_string(safety_distance);
+  }
+  if (!(candidate_spacing > 0)) {
+    return "candidate_spacing must be > 0 m, got " + std::to_string(candidate_spacing);
+  }
+  if (entry_angle_offsets.empty()) return "entry_angle_offsets must not be empty";
+  for (const double a : entry_angle_offsets) {
+    if (!(std::abs(a) < std::numbers::pi / 2)) {
+      return "entry_angle_offsets must lie within (-90, 90) deg, got " + std::to_string(a) + " rad";
+    }
+  }
+  if (!(normal_radius > 0)) return "normal_radius must be > 0 m";
+  if (!(penetration_length > 0)) return "penetration_length must be > 0 m";
+  if (!(entry_window > 0)) return "entry_window must be > 0 m";
+  if (!(path_spacing > 0)) return "path_spacing must be > 0 m";
+  if (!(max_drive_over_height >= 0)) return "max_drive_over_height must be >= 0 m";
+  if (std::isnan(torque_threshold) || std::isnan(max_curvature)) {
+    return "torque_threshold and max_curvature must not be NaN";
+  }
+  return "";
+}
+
+// --- The equations ---
+
+double PileHeightAboveGround(const GridMap& map, const Eigen::Vector3d& plane, const Index& i) {
+  const float z = map.at("elevation", i);
+  if (std::isnan(z) || !IsClass(map, i, CellClass::kPile)) return 0.0;
+  return std::max(0.0, z - GroundZ(plane, map.PositionOf(i)));
+}
+
+double TorqueMoment(const GridMap& map, const Eigen::Vector3d& plane, const Eigen::Vector2d& entry,
+                    double heading, double width, double length) {
+  // Eq. (12): T_c = Σ_{i,j∈Ω} h_ij λ_i; each cell weighted by its area ε² (a first moment of
+  // volume about the bucket's centre line, left positive).
+  const double area = map.resolution() * map.resolution();
+  double torque = 0;
+  ForEachCellAhead(map, entry, heading, width, length, [&](const Index& i, double, double lambda) {
+    torque += PileHeightAboveGround(map, plane, i) * lambda * area;
+  });
+  return torque;
+}
+
+double TorqueScore(double torque, double threshold) {
+  // Eq. (13), |T_c| against T_res (the seed writes T_c < T_res for a signed T_c).
+  if (!(std::abs(torque) < threshold)) return kMinusInfinity;
+  const double ratio = torque / threshold;
+  return 1 - ratio * ratio;
+}
+
+double SafetyScore(double d_min, double d_res) {
+  // Eq. (14).
+  if (d_min > d_res) return 1.0;
+  if (d_min > 0) return d_min / d_res;
+  return kMinusInfinity;
+}
+
+SectionVolumes ConcavityVolumes(const GridMap& map, const Eigen::Vector3d& plane,
+                                const Eigen::Vector2d& entry, double heading, double width,
+                                double length) {
+  // Eq. (15)'s three-section bucket model: the future shoveling area split evenly by the bucket
+  // width into left (λ > w/6), middle and right (λ < −w/6) strips.
+  const double area = map.resolution() * map.resolution();
+  SectionVolumes v;
+  ForEachCellAhead(map, entry, heading, width, length, [&](const Index& i, double, double lambda) {
+    const double volume = PileHeightAboveGround(map, plane, i) * area;
+    if (lambda > width / 6) {
+      v.left += volume;
+    } else if (lambda < -width / 6) {
+      v.right += volume;
+    } else {
+      v.middle += volume;
+    }
+  });
+  return v;
+}
+
+double ConcavityScore(const SectionVolumes& v) {
+  // Eq. (15): convex (1) if V_m ≥ max{V_l, V_r}, concave (0) otherwise.
+  const double side = std::max(v.left, v.right);
+  return v.middle >= side - 1e-9 * std::max(side, 1e-12) ? 1.0 : 0.0;
+}
+
+double EfficiencyScore(double length, double min_length, double max_length) {
+  // Eq. (16).
+  if (!(max_length - min_length > 1e-12)) return 1.0;
+  return (max_length - length) / (max_length - min_length);
+}
+
+double EntryAngleScore(double curvature, double max_curvature) {
+  // Eq. (17).
+  return 1 - std::abs(curvature) / max_curvature;
+}
+
+double WeightedScore(const ScoreBreakdown& s, const ShovelPointConfig& c) {
+  // Eq. (18). A −∞ score vetoes the candidate whatever its weight (Algorithm 2's thresholds).
+  for (const double x : {s.s_t, s.s_s, s.s_c, s.s_e, s.s_a}) {
+    if (x == kMinusInfinity) return kMinusInfinity;
+  }
+  return c.k_t * s.s_t + c.k_s * s.s_s + c.k_c * s.s_c + c.k_e * s.s_e + c.k_a * s.s_a;
+}
+
+double EntryCurvature(const std::vector<PathSample>& samples, double window) {
+  // κ_im of Eq. (17): mean |κ| over the last `window` metres (trapezoid rule on the samples;
+  // the curvature is piecewise constant, so the rule is exact up to the sample spacing).
+  if (samples.size() < 2) return samples.empty() ? 0.0 : std::abs(samples.back().curvature);
+  const double end = samples.back().s, from = std::max(0.0, end - window);
+  double integral = 0, covered = 0;
+  for (std::size_t k = 1; k < samples.size(); ++k) {
+    const double a = std::max(samples[k - 1].s, from), b = samples[k].s;
+    if (b <= a) continue;
+    // Each interval takes the curvature of its start (the segment it lies in).
+    integral += std::abs(samples[k - 1].curvature) * (b - a);
+    covered += b - a;
+  }
+  return covered > 0 ? integral / covered : std::abs(samples.back().curvature);
+}
+
+Eigen::MatrixXf ObstacleDistanceField(const GridMap& map) {
+  const int nx = map.size().x(), ny = map.size().y();
+  Eigen::MatrixXd f(nx, ny);
+  bool any = false;
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      const bool obstacle = IsClass(map, Index(ix, iy), CellClass::kObstacle);
+      f(ix, iy) = obstacle ? 0.0 : kInf;
+      any |= obstacle;
+    }
+  }
+  Eigen::MatrixXf out(nx, ny);
+  if (!any) {
+    out.setConstant(std::numeric_limits<float>::infinity());
+    return out;
+  }
+  std::vector<double> line;
+  for (int iy = 0; iy < ny; ++iy) {
+    line.assign(nx, 0);
+    for (int ix = 0; ix < nx; ++ix) line[ix] = f(ix, iy);
+    DistanceTransform1d(line);
+    for (int ix = 0; ix < nx; ++ix) f(ix, iy) = line[ix];
+  }
+  for (int ix = 0; ix < nx; ++ix) {
+    line.assign(ny, 0);
+    for (int iy = 0; iy < ny; ++iy) line[iy] = f(ix, iy);
+    DistanceTransform1d(line);
+    for (int iy = 0; iy < ny; ++iy) {
+      out(ix, iy) = static_cast<float>(std::sqrt(line[iy]) * map.resolution());
+    }
+  }
+  return out;
+}
+
+double SweptObstacleDistance(const GridMap& map, const Eigen::MatrixXf& field,
+                             const std::vector<PathSample>& samples, const LoaderGeometry& loader) {
+  // The body's two rectangles are covered by discs on their centre lines, 1 m apart, each of
+  // radius √(hw² + 0.5²): the discs contain the rectangles and overshoot by < 0.1 m. A disc's
+  // distance to the obstacle cells is the distance field at its centre less its radius, less
+  // half a cell (the field is between cell centres; an obstacle fills its cell).
+  const double hw = loader.HalfWidth(), spacing = 1.0;
+  const double radius = std::sqrt(hw * hw + spacing * spacing / 4);
+  const double front = loader.tip_reach + loader.body_margin - hw;  // last disc centre
+  const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin - hw;
+  double d_min = kInf;
+  for (const PathSample& p : samples) {
+    const double gamma = loader.ArticulationFor(p.curvature);
+    const Eigen::Vector2d u_front = Direction(p.heading), u_rear = Direction(p.heading - gamma);
+    const Eigen::Vector2d hinge = p.xy - loader.hinge_to_front_axle * u_front;
+    auto disc = [&](const Eigen::Vector2d& c) {
+      d_min = std::min(d_min, Interpolate(map, field, c) - radius - map.resolution() / 2);
+    };
+    const int n_front = static_cast<int>(std::ceil(front / spacing));
+    for (int k = 0; k <= n_front; ++k) disc(hinge + std::min(k * spacing, front) * u_front);
+    const int n_rear = static_cast<int>(std::ceil(rear / spacing));
+    for (int k = 1; k <= n_rear; ++k) disc(hinge - std::min(k * spacing, rear) * u_rear);
+  }
+  return d_min;
+}
+
+// --- Candidates ---
+
+std::vector<CandidatePose> GenerateCandidates(const GridMap& map,
+                                              const std::vector<perception::ExtractedPile>& piles,
+                                              const ShovelPointConfig& config) {
+  std::vector<CandidatePose> out;
+  for (int p = 0; p < static_cast<int>(piles.size()); ++p) {
+    if (config.pile >= 0 && p != config.pile) continue;
+    const auto& boundary = piles[p].boundary;
+    // Walk the ordered outline; along each run of front cells, keep one point every
+    // `candidate_spacing` metres of outline (the first of each run included).
+    double since_last = kInf;
+    int point = 0;
+    for (std::size_t k = 0; k < boundary.size(); ++k) {
+      const perception::BoundaryPoint& b = boundary[k];
+      if (!b.front) {
+        since_last = kInf;
+        continue;
+      }
+      if (k > 0 && boundary[k - 1].front) since_last += (b.xy - boundary[k - 1].xy).norm();
+      if (since_last < config.candidate_spacing - 1e-9) continue;
+      since_last = 0;
+      const double normal = InwardNormal(map, b.xy, config.normal_radius, piles[p].centroid);
+      for (const double offset : config.entry_angle_offsets) {
+        CandidatePose c;
+        c.pile = p;
+        c.point = point;
+        c.xy = b.xy;
+        c.normal_heading = normal;
+        c.entry_offset = offset;
+        c.entry_heading = std::remainder(normal + offset, 2 * std::numbers::pi);
+        out.push_back(c);
+      }
+      ++point;
+    }
+  }
+  return out;
+}
+
+// --- Algorithm 2 ---
+
+ShovelPointResult SelectShovelPoints(const GridMap& map,
+                                     const std::vector<perception::ExtractedPile>& piles,
+                                     const Eigen::Vector3d& plane, const Pose2& T_world_hinge,
+                                     const LoaderGeometry& loader,
+                                     const ShovelPointConfig& config) {
+  ShovelPointResult result;
+  const std::string invalid = config.Validate();
+  if (!invalid.empty() || !map.Exists("elevation") || !map.Exists("class") ||
+      !(loader.MaxCurvature() > 0) || !(loader.tip_reach > loader.hinge_to_front_axle)) {
+    result.status = SelectionStatus::kInvalidInput;
+    result.message = !invalid.empty()           ? invalid
+                     : !map.Exists("class")     ? "the map has no \"class\" layer"
+                     : !map.Exists("elevation") ? "the map has no \"elevation\" layer"
+                                                : "loader geometry without a turning radius or "
+                                                  "with the tip behind the front axle";
+    return result;
+  }
+  result.max_curvature = config.max_curvature > 0 ? config.max_curvature : loader.MaxCurvature();
+  result.torque_threshold = config.torque_threshold > 0
+                                ? config.torque_threshold
+                                : loader.rated_capacity * loader.bucket_width / 4;
+  const std::vector<CandidatePose> poses = GenerateCandidates(map, piles, config);
+  if (poses.empty()) {
+    result.status = SelectionStatus::kNoCandidates;
+    result.message = "no pile front to shovel from";
+    return result;
+  }
+  const Eigen::MatrixXf distance_field = ObstacleDistanceField(map);
+  const Eigen::MatrixXf pile_height = PileHeightField(map, plane);
+  // The path is planned for the front axle (dubins_path.h): it starts lf ahead of the hinge and
+  // ends where the bucket tip, reaching tip_reach − lf ahead of it, meets the pile.
+  const double lf = loader.hinge_to_front_axle;
+  const Pose2 start{T_world_hinge.xy + lf * Direction(T_world_hinge.heading),
+                    T_world_hinge.heading};
+  const double axle_to_tip = loader.tip_reach - lf;
+
+  std::vector<ShovelCandidate> candidates;
+  candidates.reserve(poses.size());
+  for (const CandidatePose& pose : poses) {
+    ShovelCandidate c;
+    c.pose = pose;
+    c.front_axle_goal = {pose.xy - axle_to_tip * Direction(pose.entry_heading), pose.entry_heading};
+    ScoreBreakdown& s = c.scores;
+    // PlanPath(p0, (x_i, y_i), δ_m): of the six Dubins words, shortest first, the first that
+    // keeps the chassis off the pile and d_min > d_res; failing that, the first off the pile
+    // with d_min > 0; failing that the shortest (scored, and vetoed by s_s or the pile check).
+    const std::vector<DubinsPath> words =
+        AllDubinsPaths(start, c.front_axle_goal, result.max_curvature);
+    int chosen = -1, rank = 3;  // 0: clear of d_res, 1: not touching, 2: neither
+    double chosen_d_min = 0;
+    std::vector<PathSample> chosen_samples;
+    bool chosen_over_pile = true;
+    for (int w = 0; w < static_cast<int>(words.size()) && rank > 0; ++w) {
+      std::vector<PathSample> samples = SamplePath(words[w], config.path_spacing);
+      const bool over_pile =
+          DrivesOverPile(map, pile_height, samples, loader, config.max_drive_over_height);
+      const double d_min = SweptObstacleDistance(map, distance_field, samples, loader);
+      const int r = over_pile ? 2 : d_min > config.safety_distance ? 0 : d_min > 0 ? 1 : 2;
+      if (r < rank) {
+        chosen = w, rank = r, chosen_d_min = d_min, chosen_over_pile = over_pile;
+        chosen_samples = std::move(samples);
+      }
+    }
+    c.path = words[chosen];
+    s.path_length = c.path.length();
+    s.min_obstacle_distance = chosen_d_min;
+    s.end_curvature = chosen_samples.back().curvature;
+    s.entry_curvature = EntryCurvature(chosen_samples, config.entry_window);
+    s.entry_articulation = loader.ArticulationFor(s.entry_curvature);
+    // Eq. (12)–(13), (14), (15), (17); (16) once every path on the pile is known.
+    s.torque = TorqueMoment(map, plane, pose.xy, pose.entry_heading, loader.bucket_width,
+                            config.penetration_length);
+    s.s_t = TorqueScore(s.torque, result.torque_threshold);
+    s.s_s = SafetyScore(s.min_obstacle_distance, config.safety_distance);
+    const SectionVolumes v = ConcavityVolumes(map, plane, pose.xy, pose.entry_heading,
+                                              loader.bucket_width, config.penetration_length);
+    s.volume_left = v.left, s.volume_middle = v.middle, s.volume_right = v.right;
+    s.s_c = ConcavityScore(v);
+    s.s_a = EntryAngleScore(s.entry_curvature, result.max_curvature);
+    if (s.s_t == kMinusInfinity) {
+      c.infeasible = "torque |T_c| >= T_res";
+    } else if (s.s_s == kMinusInfinity) {
+      c.infeasible = "path collides with an obstacle";
+    } else if (chosen_over_pile) {
+      c.infeasible = "path drives over the pile";
+    }
+    c.feasible = c.infeasible.empty();
+    candidates.push_back(std::move(c));
+  }
+  // Eq. (16): l_max and l_min over the feasible paths to the same pile.
+  std::map<int, std::pair<double, double>> range;
+  for (const ShovelCandidate& c : candidates) {
+    if (!c.feasible) continue;
+    auto [it, inserted] = range.try_emplace(c.pose.pile, kInf, -kInf);
+    it->second.first = std::min(it->second.first, c.scores.path_length);
+    it->second.second = std::max(it->second.second, c.scores.path_length);
+  }
+  for (ShovelCandidate& c : candidates) {
+    const auto it = range.find(c.pose.pile);
+    c.scores.s_e = it == range.end()
+                       ? 0.0
+                       : EfficiencyScore(c.scores.path_length, it->second.first, it->second.second);
+    c.score = c.feasible ? WeightedScore(c.scores, config) : kMinusInfinity;
+    result.feasible += c.feasible;
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const ShovelCandidate& a, const ShovelCandidate& b) {
+                     if (a.feasible != b.feasible) return a.feasible;
+                     return a.score > b.score;
+                   });
+  result.ranked = std::move(candidates);
+  if (result.feasible == 0) {
+    result.status = SelectionStatus::kNoFeasibleCandidate;
+    result.message = std::to_string(result.ranked.size()) + " candidates, none feasible";
+  } else {
+    result.status = SelectionStatus::kSelected;
+    result.message = std::to_string(result.feasible) + " of " +
+                     std::to_string(result.ranked.size()) + " candidates feasible";
+  }
+  return result;
+}
+
+const char* ToString(SelectionStatus status) {
+  switch (status) {
+    case SelectionStatus::kSelected:
+      return "selected";
+    case SelectionStatus::kNoCandidates:
+      return "no candidates";
+    case SelectionStatus::kNoFeasibleCandidate:
+      return "no feasible candidate";
+    case SelectionStatus::kInvalidInput:
+      return "invalid input";
+  }
+  return "?";
+}
+
+}  // namespace autoshovel::planning

@@ -1,0 +1,221 @@
+#include "runtime/prediction/penetration_predictor.h"
+
+#include <svm.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <utility>
+
+#include "runtime/core/diagnostics.h"
+
+namespace autoshovel::prediction {
+
+namespace {
+
+constexpr const char* kFormat = "autoshovel-penetration-svr";
+constexpr int kFormatVersion = 1;
+
+[[noreturn]] void Refuse(const std::string& file, int line, const std::string& message) {
+  core::DiagnosticSink sink;
+  sink.Add(core::SourceLocation{file, line, line > 0 ? 1 : 0}, "", message);
+  sink.ThrowIfAny();
+  throw std::logic_error("unreachable");
+}
+
+}  // namespace
+
+struct PenetrationPredictor::Model {
+  svm_model* svm = nullptr;
+  ~Model() {
+    if (svm != nullptr) svm_free_and_destroy_model(&svm);
+  }
+};
+
+std::vector<std::string> FeatureScaling::FeatureNames(const std::vector<std::string>& materials) {
+  std::vector<std::string> names = {"speed", "shoveled_volume"};
+  for (const std::string& m : materials) names.push_back("material_" + m);
+  for (int k = 1; k <= kNumHeights; ++k) names.push_back("h" + std::to_string(k));
+  return names;
+}
+
+PenetrationPredictor::PenetrationPredictor(std::unique_ptr<Model> model, FeatureScaling scaling)
+    : model_(std::move(model)), scaling_(std::move(scaling)) {}
+PenetrationPredictor::PenetrationPredictor(PenetrationPredictor&&) noexcept = default;
+PenetrationPredictor& PenetrationPredictor::operator=(PenetrationPredictor&&) noexcept = default;
+PenetrationPredictor::~PenetrationPredictor() = default;
+
+std::vector<double> PenetrationPredictor::Encode(const PenetrationFeatures& features,
+                                                 const std::vector<std::string>& materials,
+                                                 std::string* why) {
+  auto refuse = [&](const std::string& reason) {
+    if (why) *why = reason;
+    return std::vector<double>{};
+  };
+  if (!std::isfinite(features.speed)) return refuse("speed is not finite");
+  if (!std::isfinite(features.shoveled_volume) || features.shoveled_volume < 0) {
+    return refuse("shoveled volume V1 must be finite and >= 0 m^3, got " +
+                  std::to_string(features.shoveled_volume));
+  }
+  for (int k = 0; k < kNumHeights; ++k) {
+    if (!std::isfinite(features.heights[k])) {
+      return refuse("pile height h" + std::to_string(k + 1) + " is not finite (unknown map cell?)");
+    }
+  }
+  const auto found = std::find(materials.begin(), materials.end(), features.material);
+  if (found == materials.end()) {
+    std::string known;
+    for (const std::string& m : materials) known += (known.empty() ? "" : ", ") + m;
+    return refuse("material '" + features.material + "' is not one the model knows (" + known +
+                  ")");
+  }
+  std::vector<double> x = {features.speed, features.shoveled_volume};
+  for (const std::string& m : materials) x.push_back(m == features.material ? 1.0 : 0.0);
+  for (double h : features.heights) x.push_back(h);
+  return x;
+}
+
+PenetrationPrediction PenetrationPredictor::Predict(const PenetrationFeatures& features) const {
+  PenetrationPrediction out;
+  const std::vector<double> x = Encode(features, scaling_.materials, &out.message);
+  if (x.empty()) return out;
+  std::vector<svm_node> nodes(x.size() + 1);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double span = scaling_.max[i] - scaling_.min[i];
+    nodes[i].index = static_cast<int>(i) + 1;
+    nodes[i].value = span > 0 ? 2 * (x[i] - scaling_.min[i]) / span - 1 : 0.0;
+  }
+  nodes.back().index = -1;
+  out.penetration = std::max(svm_predict(model_->svm, nodes.data()), 0.0);
+  out.ok = std::isfinite(out.penetration);
+  if (!out.ok) out.message = "the model returned a non-finite penetration";
+  return out;
+}
+
+void PenetrationPredictor::SaveScaling(const std::string& path_stem, const FeatureScaling& s) {
+  const std::string path = path_stem + ".scale";
+  std::ofstream file(path);
+  if (!file) throw std::runtime_error("cannot write " + path);
+  file << std::setprecision(17);
+  file << "format " << kFormat << " " << kFormatVersion << "\n";
+  file << "machine " << s.machine << "\n";
+  file << "delta_l " << s.delta_l << "\n";
+  file << "materials";
+  for (const std::string& m : s.materials) file << " " << m;
+  file << "\n";
+  for (std::size_t i = 0; i < s.names.size(); ++i) {
+    file << "feature " << s.names[i] << " " << s.min[i] << " " << s.max[i] << "\n";
+  }
+  for (const std::string& note : s.notes) file << "note " << note << "\n";
+  if (!file) throw std::runtime_error("cannot write " + path);
+}
+
+FeatureScaling PenetrationPredictor::LoadScaling(const std::string& path_stem) {
+  const std::string path = path_stem + ".scale";
+  std::ifstream file(path);
+  if (!file) Refuse(path, 0, "cannot open the feature scaling file (written by train_predictor)");
+  FeatureScaling s;
+  core::DiagnosticSink sink;
+  auto error = [&](int line, const std::string& message) {
+    sink.Add(core::SourceLocation{path, line, 1}, "", message);
+  };
+  std::string text;
+  int line = 0;
+  bool have_format = false, have_materials = false;
+  while (std::getline(file, text)) {
+    ++line;
+    if (text.empty() || text[0] == '#') continue;
+    std::istringstream in(text);
+    std::string key;
+    in >> key;
+    if (key == "format") {
+      std::string name;
+      int version = 0;
+      if (!(in >> name >> version) || name != kFormat || version != kFormatVersion) {
+        error(line, "expected 'format " + std::string(kFormat) + " " +
+                        std::to_string(kFormatVersion) + "', got '" + text + "'");
+      }
+      have_format = true;
+    } else if (key == "machine") {
+      in >> s.machine;
+    } else if (key == "delta_l") {
+      if (!(in >> s.delta_l) || !(s.delta_l > 0)) error(line, "delta_l must be a number > 0 m");
+    } else if (key == "materials") {
+      std::string m;
+      while (in >> m) s.materials.push_back(m);
+      have_materials = true;
+    } else if (key == "feature") {
+      std::string name;
+      double lo = 0, hi = 0;
+      if (!(in >> name >> lo >> hi) || !std::isfinite(lo) || !std::isfinite(hi) || hi < lo) {
+        error(line,
+              "expected 'feature <name> <min> <max>' with finite min <= max, got '" + text + "'");
+        continue;
+      }
+      s.names.push_back(name), s.min.push_back(lo), s.max.push_back(hi);
+    } else if (key == "note") {
+      std::string rest;
+      std::getline(in >> std::ws, rest);
+      s.notes.push_back(rest);
+    } else {
+      error(line, "unknown key '" + key +
+                      "' (expected format, machine, delta_l, materials, feature or note)");
+    }
+  }
+  if (!have_format) error(0, "missing the 'format " + std::string(kFormat) + "' line");
+  if (!have_materials || s.materials.empty()) error(0, "missing the 'materials' line");
+  const std::vector<std::string> expected = FeatureScaling::FeatureNames(s.materials);
+  if (have_materials && s.names != expected) {
+    std::string list;
+    for (const std::string& n : expected) list += " " + n;
+    error(0, "expected " + std::to_string(expected.size()) + " features in the order" + list +
+                 ", got " + std::to_string(s.names.size()));
+  }
+  if (std::abs(s.delta_l - kHeightSpacing) > 1e-9) {
+    error(0, "delta_l " + std::to_string(s.delta_l) + " m: this build samples heights at " +
+                 std::to_string(kHeightSpacing) + " m");
+  }
+  sink.ThrowIfAny();
+  return s;
+}
+
+PenetrationPredictor PenetrationPredictor::Load(const std::string& path_stem) {
+  FeatureScaling scaling = LoadScaling(path_stem);
+  const std::string path = path_stem + ".model";
+  if (!std::filesystem::is_regular_file(path)) {
+    Refuse(path, 0, "cannot open the libsvm model file (written by train_predictor)");
+  }
+  auto model = std::make_unique<Model>();
+  model->svm = svm_load_model(path.c_str());
+  if (model->svm == nullptr) {
+    Refuse(path, 0, "not a libsvm model file (svm_load_model could not parse it)");
+  }
+  if (svm_get_svm_type(model->svm) != EPSILON_SVR) {
+    Refuse(path, 0,
+           "expected an epsilon_svr model, got svm_type " +
+               std::to_string(svm_get_svm_type(model->svm)));
+  }
+  if (model->svm->param.kernel_type != RBF) {
+    Refuse(
+        path, 0,
+        "expected an rbf kernel, got kernel_type " + std::to_string(model->svm->param.kernel_type));
+  }
+  if (model->svm->l <= 0) Refuse(path, 0, "the model has no support vectors");
+  const int features = static_cast<int>(scaling.names.size());
+  for (int i = 0; i < model->svm->l; ++i) {
+    for (const svm_node* node = model->svm->SV[i]; node->index != -1; ++node) {
+      if (node->index < 1 || node->index > features) {
+        Refuse(path, 0,
+               "support vector " + std::to_string(i + 1) + " uses feature index " +
+                   std::to_string(node->index) + ", the scaling file has " +
+                   std::to_string(features) + " features");
+      }
+    }
+  }
+  return PenetrationPredictor(std::move(model), std::move(scaling));
+}
+
+}  // namespace autoshovel::prediction

@@ -1,0 +1,97 @@
+// Penetration-depth predictor, wheel-loader seed §6.1 and §7.4.1: an ε-SVR (libsvm, RBF kernel)
+// on the current speed v, the shoveled volume so far V1 (Eq. 19), the material M and six pile
+// surface heights h1..h6 ahead of the bucket at Δl = 0.5 m.
+//
+// What it predicts (our reading; the seed calls it "travel distance" / "penetration depth"): the
+// distance the machine still travels forward from the instant the scoop is triggered until it
+// stops, while the scoop (hydraulic delay, bucket curl, boom lift) runs. That is the d that
+// PredictFutureVolume (volume_estimation.h) turns into the future tip path and V2.
+//
+// Features as the model sees them: [v, V1, one-hot(M) over the model's materials, h1..h6], each
+// scaled to [−1, 1] with the minimum and maximum of the training set (stored beside the model).
+// h_k is the map height [m] (floor at 0) at k·Δl ahead of the bucket tip along the heading,
+// averaged over five points across the bucket width (the seed samples the centre line only; the
+// mean makes the feature robust to a bumpy face).
+//
+// Files: `<name>.model` is libsvm's own text format; `<name>.scale` is ours, one key per line:
+//   format autoshovel-penetration-svr 1
+//   machine <name>
+//   delta_l <m>
+//   materials <name> <name> …
+//   feature <name> <min> <max>        (one per feature, in order)
+//   note <free text>                  (any number: the training command, figures)
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace autoshovel::prediction {
+
+inline constexpr int kNumHeights = 6;
+inline constexpr double kHeightSpacing = 0.5;  ///< Δl [m], seed §6.1
+
+struct PenetrationFeatures {
+  double speed = 0;                           ///< v, forward [m/s]
+  double shoveled_volume = 0;                 ///< V1, Eq. (19) [m³]
+  std::string material;                       ///< M, a material name (models/materials)
+  std::array<double, kNumHeights> heights{};  ///< h1..h6 [m]
+};
+
+/// Per-feature min/max scaling to [−1, 1] and the metadata of a model.
+struct FeatureScaling {
+  std::string machine;
+  double delta_l = kHeightSpacing;
+  std::vector<std::string> materials;  ///< one-hot order
+  std::vector<std::string> names;      ///< feature names, in vector order
+  std::vector<double> min, max;        ///< per feature
+  std::vector<std::string> notes;
+
+  /// The names of the features for `materials`: speed, shoveled_volume, material_<m>…, h1..h6.
+  static std::vector<std::string> FeatureNames(const std::vector<std::string>& materials);
+};
+
+/// Outcome of a prediction: a run-time status, not an exception (a NaN from an unknown map cell
+/// is something a controller must handle, not a bug).
+struct PenetrationPrediction {
+  bool ok = false;
+  double penetration = 0;  ///< [m], ≥ 0
+  std::string message;     ///< why not, when !ok
+};
+
+class PenetrationPredictor {
+ public:
+  /// Loads `<path_stem>.model` and `<path_stem>.scale`. Throws core::InputError naming the file,
+  /// the line where known and what is wrong (missing file, not a libsvm ε-SVR RBF model, feature
+  /// count mismatch, malformed scaling).
+  static PenetrationPredictor Load(const std::string& path_stem);
+
+  PenetrationPredictor(PenetrationPredictor&&) noexcept;
+  PenetrationPredictor& operator=(PenetrationPredictor&&) noexcept;
+  ~PenetrationPredictor();
+
+  /// Refuses NaN or infinite features, a negative V1 and a material the model does not know.
+  PenetrationPrediction Predict(const PenetrationFeatures& features) const;
+
+  /// The feature vector, unscaled, in model order (also used for training); empty and `why` set
+  /// when a feature is refused.
+  static std::vector<double> Encode(const PenetrationFeatures& features,
+                                    const std::vector<std::string>& materials, std::string* why);
+
+  const FeatureScaling& scaling() const { return scaling_; }
+
+  /// Writes `<path_stem>.scale` (and nothing else: the .model is written by libsvm's
+  /// svm_save_model). Throws std::runtime_error when the file cannot be written.
+  static void SaveScaling(const std::string& path_stem, const FeatureScaling& scaling);
+  /// Reads `<path_stem>.scale`. Throws core::InputError.
+  static FeatureScaling LoadScaling(const std::string& path_stem);
+
+ private:
+  struct Model;
+  PenetrationPredictor(std::unique_ptr<Model> model, FeatureScaling scaling);
+  std::unique_ptr<Model> model_;
+  FeatureScaling scaling_;
+};
+
+}  // namespace autoshovel::prediction

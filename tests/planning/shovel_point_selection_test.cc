@@ -1,0 +1,216 @@
+// The five scores of the wheel-loader seed's §5 (Eq. 12–18) on hand-computed maps, the loader
+// geometry, and Chen et al. (2024)'s indicators.
+#include "runtime/planning/shovel_point_selection.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "generated/registry.h"
+#include "runtime/model/description.h"
+#include "runtime/perception/semantic_map.h"
+#include "runtime/planning/chen2024_baseline.h"
+
+namespace autoshovel::planning {
+namespace {
+
+using perception::CellClass;
+using perception::GridMap;
+using perception::Index;
+
+constexpr double kPi = std::numbers::pi;
+const std::string kModels = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
+
+// A level ground map (z = 0, class ground everywhere).
+GridMap FlatMap(double resolution, double length, const Eigen::Vector2d& centre) {
+  GridMap map(resolution, {length, length}, centre);
+  map.Add("elevation", 0.0f);
+  map.Add("class", static_cast<float>(CellClass::kGround));
+  return map;
+}
+
+void SetPile(GridMap& map, const Eigen::Vector2d& xy, double height) {
+  Index i;
+  ASSERT_TRUE(map.IndexOf(xy, i));
+  map.at("elevation", i) = static_cast<float>(height);
+  map.at("class", i) = static_cast<float>(CellClass::kPile);
+}
+
+const Eigen::Vector3d kLevel(0, 0, 0);
+
+TEST(LoaderGeometry, MaxCurvatureFromTheArticulationLimit) {
+  const model::MachineDescription machine =
+      model::LoadMachineDescription(model::ResolveMachineDescription("xcmg_968ev", kModels));
+  const LoaderGeometry g = LoaderGeometryFrom(machine, *generated::FindMachine(machine.name));
+  // l_f = l_r = 1.6 m, γmax = 38°: κmax = sin 38° / (1.6 cos 38° + 1.6) = 0.2152 1/m.
+  const double gamma = 38 * kPi / 180;
+  EXPECT_NEAR(g.MaxCurvature(), std::sin(gamma) / (1.6 * std::cos(gamma) + 1.6), 1e-12);
+  EXPECT_NEAR(g.MaxCurvature(), 0.2152, 1e-4);
+  EXPECT_NEAR(g.ArticulationFor(g.MaxCurvature()), gamma, 1e-12);
+  EXPECT_NEAR(g.ArticulationFor(-0.1), -g.ArticulationFor(0.1), 1e-12);
+  EXPECT_EQ(g.ArticulationFor(0.0), 0.0);
+  // The tip reaches well beyond the front axle with the bucket on the floor.
+  EXPECT_GT(g.tip_reach, g.hinge_to_front_axle + 1.0);
+  EXPECT_LT(g.tip_reach, 8.0);
+}
+
+// Eq. (12)–(13): cells at (1, 1) [2 m high] and (1.5, −0.5) [1 m] of a 0.5 m grid, the bucket
+// (3 m wide, 2 m deep) entering at the origin heading +x: T_c = (2·1 + 1·(−0.5))·0.25 m⁴.
+TEST(ShovelScores, TorqueBalanceByHand) {
+  GridMap map = FlatMap(0.5, 20, {0.25, 0.25});  // cell centres on multiples of 0.5 m
+  SetPile(map, {1.0, 1.0}, 2.0);
+  SetPile(map, {1.5, -0.5}, 1.0);
+  EXPECT_NEAR(TorqueMoment(map, kLevel, {0, 0}, 0.0, 3.0, 2.0), 0.375, 1e-12);
+  // Heading +y: (1, 1) lies 1 m to the right (λ = −1); (1.5, −0.5) is behind the bucket.
+  EXPECT_NEAR(TorqueMoment(map, kLevel, {0, 0}, kPi / 2, 3.0, 2.0), -0.5, 1e-12);
+  // Heights are taken above the ground plane: lift the plane by 0.5 m.
+  EXPECT_NEAR(TorqueMoment(map, Eigen::Vector3d(0, 0, 0.5), {0, 0}, 0.0, 3.0, 2.0),
+              (1.5 * 1.0 + 0.5 * -0.5) * 0.25, 1e-12);
+  const double t_res = 2.625;  // V_rated · w / 4 for 3.5 m³, 3 m
+  EXPECT_NEAR(TorqueScore(0.375, t_res), 1 - std::pow(0.375 / t_res, 2), 1e-12);
+  EXPECT_EQ(TorqueScore(0.0, t_res), 1.0);
+  EXPECT_EQ(TorqueScore(3.0, t_res), kMinusInfinity);
+  EXPECT_EQ(TorqueScore(-3.0, t_res), kMinusInfinity);  // |T_c|: right-heavy is as bad
+}
+
+TEST(ShovelScores, SafetyDistanceEq14) {
+  EXPECT_EQ(SafetyScore(2.0, 1.0), 1.0);
+  EXPECT_NEAR(SafetyScore(0.4, 1.0), 0.4, 1e-12);
+  EXPECT_EQ(SafetyScore(0.0, 1.0), kMinusInfinity);
+  EXPECT_EQ(SafetyScore(-0.3, 1.0), kMinusInfinity);
+}
+
+// Eq. (15) on a 0.25 m grid: the 3 m bucket spans 12 cells across, four per section.
+TEST(ShovelScores, ConcavityThreeSectionsByHand) {
+  auto face = [](auto height) {
+    GridMap map = FlatMap(0.25, 20, {0, 0});  // centres at ±0.125 + k·0.25
+    for (perception::GridMapIterator it(map); !it.done(); ++it) {
+      const Eigen::Vector2d p = map.PositionOf(*it);
+      if (std::abs(p.x()) < 5 && std::abs(p.y()) < 5) {
+        map.at("elevation", *it) = static_cast<float>(height(p.y()));
+        map.at("class", *it) = static_cast<float>(CellClass::kPile);
+      }
+    }
+    return map;
+  };
+  // Entering at (0.125, 0) heading +x, 1.9 m deep: 8 cells along, 4 across per section.
+  const Eigen::Vector2d entry(0.125, 0);
+  const GridMap flat = face([](double) { return 1.0; });
+  const SectionVolumes v = ConcavityVolumes(flat, kLevel, entry, 0.0, 3.0, 1.9);
+  EXPECT_NEAR(v.left, 8 * 4 * 0.0625, 1e-12);  // 2 m³ each
+  EXPECT_NEAR(v.middle, 2.0, 1e-12);
+  EXPECT_NEAR(v.right, 2.0, 1e-12);
+  EXPECT_EQ(ConcavityScore(v), 1.0);  // a flat face: V_m = max(V_l, V_r), convex by "≥"
+  const GridMap ridge = face([](double y) { return 2.0 - std::abs(y); });
+  EXPECT_EQ(ConcavityScore(ConcavityVolumes(ridge, kLevel, entry, 0.0, 3.0, 1.9)), 1.0);
+  const GridMap gully = face([](double y) { return 0.5 + std::abs(y); });
+  const SectionVolumes g = ConcavityVolumes(gully, kLevel, entry, 0.0, 3.0, 1.9);
+  EXPECT_LT(g.middle, g.left);
+  EXPECT_EQ(ConcavityScore(g), 0.0);  // concave: the seed scores it 0
+  // Only one side higher than the middle is enough to be concave.
+  EXPECT_EQ(ConcavityScore({1.0, 0.9, 0.2}), 0.0);
+}
+
+TEST(ShovelScores, EfficiencyEntryAngleAndWeights) {
+  EXPECT_EQ(EfficiencyScore(10, 10, 20), 1.0);
+  EXPECT_EQ(EfficiencyScore(20, 10, 20), 0.0);
+  EXPECT_NEAR(EfficiencyScore(15, 10, 20), 0.5, 1e-12);
+  EXPECT_EQ(EfficiencyScore(12, 12, 12), 1.0);
+  EXPECT_EQ(EntryAngleScore(0.0, 0.2), 1.0);
+  EXPECT_NEAR(EntryAngleScore(-0.1, 0.2), 0.5, 1e-12);
+  EXPECT_NEAR(EntryAngleScore(0.2, 0.2), 0.0, 1e-12);
+  ShovelPointConfig config;
+  ScoreBreakdown s;
+  s.s_t = s.s_s = s.s_c = s.s_e = s.s_a = 1.0;
+  EXPECT_NEAR(WeightedScore(s, config), 1.0, 1e-12);  // Table 1's weights sum to one
+  s.s_t = 0.5, s.s_c = 0.0;
+  EXPECT_NEAR(WeightedScore(s, config), 1.0 - 0.29 * 0.5 - 0.13, 1e-12);
+  s.s_s = kMinusInfinity;
+  EXPECT_EQ(WeightedScore(s, config), kMinusInfinity);
+}
+
+TEST(ShovelScores, EntryCurvatureIsTheMeanOverTheWindow) {
+  // A 4 m straight then 2 m of left arc at 0.2 1/m: over the last 3 m, (1·0 + 2·0.2)/3.
+  DubinsPath path;
+  path.word = DubinsWord::kLSL;
+  path.radius = 5;
+  path.lengths = {0.0, 4.0, 2.0};
+  const std::vector<PathSample> samples = SamplePath(path, 0.25);
+  EXPECT_NEAR(EntryCurvature(samples, 3.0), 0.4 / 3, 1e-9);
+  EXPECT_NEAR(EntryCurvature(samples, 1.0), 0.2, 1e-9);
+  EXPECT_NEAR(EntryCurvature(samples, 100.0), 0.4 / 6, 1e-9);
+}
+
+TEST(ShovelScores, ObstacleDistanceFieldAndSweptDistance) {
+  GridMap map = FlatMap(0.3, 30, {0.15, 0.15});  // centres on multiples of 0.3 m
+  Index obstacle;
+  ASSERT_TRUE(map.IndexOf({6.0, 3.0}, obstacle));
+  map.at("class", obstacle) = static_cast<float>(CellClass::kObstacle);
+  const Eigen::MatrixXf field = ObstacleDistanceField(map);
+  Index i;
+  ASSERT_TRUE(map.IndexOf({0.0, 3.0}, i));
+  EXPECT_NEAR(field(i.x(), i.y()), 6.0, 1e-5);
+  ASSERT_TRUE(map.IndexOf({3.0, -1.0 + 0.0}, i));
+  EXPECT_NEAR(field(i.x(), i.y()), (map.PositionOf(i) - map.PositionOf(obstacle)).norm(), 1e-5);
+  // A loader driving along y = 0 past it: the body's side (half width hw) passes 3 m − hw from
+  // the obstacle cell's centre, less the half cell the obstacle fills.
+  LoaderGeometry loader;
+  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
+  loader.max_articulation = 38 * kPi / 180;
+  loader.track_width = 2.25;
+  loader.wheel_radius = 0.8;
+  loader.bucket_width = 3.0;
+  loader.rated_capacity = 3.5;
+  loader.tip_reach = 4.5;
+  DubinsPath straight = ShortestDubinsPath({{-10, 0}, 0}, {{20, 0}, 0}, 0.2);
+  const double d = SweptObstacleDistance(map, field, SamplePath(straight, 0.25), loader);
+  const double exact = 3.0 - loader.HalfWidth() - 0.15;
+  EXPECT_LE(d, exact + 1e-6);  // conservative
+  EXPECT_GT(d, exact - 0.15);  // by less than half a cell
+  // Without obstacles, +inf everywhere.
+  const GridMap empty = FlatMap(0.3, 10, {0, 0});
+  EXPECT_TRUE(std::isinf(ObstacleDistanceField(empty)(3, 3)));
+}
+
+// Chen et al. (2024) baseline: a plane rising 0.5 m per metre towards +x.
+TEST(Chen2024Baseline, IndicatorsOnAPlaneAndARidge) {
+  GridMap map = FlatMap(0.25, 20, {0, 0});
+  for (perception::GridMapIterator it(map); !it.done(); ++it) {
+    const Eigen::Vector2d p = map.PositionOf(*it);
+    map.at("elevation", *it) = static_cast<float>(3.0 + 0.5 * p.x());
+    map.at("class", *it) = static_cast<float>(CellClass::kPile);
+  }
+  CandidatePose pose;
+  pose.entry_heading = 0;
+  Chen2024Indicators c = Chen2024IndicatorsAt(map, kLevel, pose, {-10, 0});
+  EXPECT_NEAR(c.inclination, 1.0, 1e-6);
+  EXPECT_NEAR(c.slope, std::atan(0.5), 1e-6);
+  EXPECT_NEAR(c.convexity, 0.0, 1e-6);
+  EXPECT_NEAR(c.distance, 10.0, 1e-12);
+  pose.entry_heading = kPi / 2;  // along the contour lines
+  EXPECT_NEAR(Chen2024IndicatorsAt(map, kLevel, pose, {-10, 0}).inclination, 0.0, 1e-6);
+  // A ridge along x (h = 3 − 0.4 y²): convexity across the bucket 0.8 1/m.
+  for (perception::GridMapIterator it(map); !it.done(); ++it) {
+    const Eigen::Vector2d p = map.PositionOf(*it);
+    map.at("elevation", *it) = static_cast<float>(3.0 - 0.4 * p.y() * p.y());
+  }
+  pose.entry_heading = 0;
+  EXPECT_NEAR(Chen2024IndicatorsAt(map, kLevel, pose, {-10, 0}).convexity, 0.8, 1e-4);
+}
+
+TEST(ShovelPointConfig, ValidateNamesTheProblem) {
+  ShovelPointConfig config;
+  EXPECT_EQ(config.Validate(), "");
+  config.safety_distance = 0;
+  EXPECT_NE(config.Validate().find("d_res"), std::string::npos);
+  config = {};
+  config.k_e = -1;
+  EXPECT_NE(config.Validate().find("k_e"), std::string::npos);
+  config = {};
+  config.entry_angle_offsets = {2.0};
+  EXPECT_NE(config.Validate().find("entry_angle_offsets"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace autoshovel::planning

@@ -1,0 +1,150 @@
+// The shipped penetration predictor (models/prediction/penetration_svr.*): it loads, refuses bad
+// files and bad features with clear messages, and on a small set of fresh plant runs (a seed the
+// training never used) it predicts within the error buckets of the seed's §7.4.1.
+#include "runtime/prediction/penetration_predictor.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "generated/registry.h"
+#include "identification/predictor/crowding_runs.h"
+#include "identification/predictor/evaluation.h"
+#include "runtime/core/diagnostics.h"
+
+namespace autoshovel::prediction {
+namespace {
+
+const std::string kShipped =
+    std::string(AUTOSHOVEL_SOURCE_DIR) + "/models/prediction/penetration_svr";
+
+PenetrationFeatures SomeFeatures() {
+  PenetrationFeatures f;
+  f.speed = 0.8;
+  f.shoveled_volume = 0.6;
+  f.material = "small_gravel";
+  f.heights = {0.9, 1.2, 1.5, 1.8, 2.0, 2.1};
+  return f;
+}
+
+std::string TempStem(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("autoshovel_prediction_test_" + name)).string();
+}
+
+void Write(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string LoadError(const std::string& stem) {
+  try {
+    PenetrationPredictor::Load(stem);
+  } catch (const core::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(PenetrationPredictor, ShippedModelLoadsAndPredicts) {
+  const PenetrationPredictor predictor = PenetrationPredictor::Load(kShipped);
+  EXPECT_EQ(predictor.scaling().machine, "xcmg_968ev");
+  EXPECT_EQ(predictor.scaling().names.size(), 2 + predictor.scaling().materials.size() + 6);
+  const PenetrationPrediction p = predictor.Predict(SomeFeatures());
+  ASSERT_TRUE(p.ok) << p.message;
+  EXPECT_GE(p.penetration, 0.0);
+  EXPECT_LT(p.penetration, 5.0);
+}
+
+TEST(PenetrationPredictor, RefusesNanAndUnknownFeatures) {
+  const PenetrationPredictor predictor = PenetrationPredictor::Load(kShipped);
+  PenetrationFeatures f = SomeFeatures();
+  f.heights[2] = std::nan("");
+  PenetrationPrediction p = predictor.Predict(f);
+  EXPECT_FALSE(p.ok);
+  EXPECT_NE(p.message.find("h3"), std::string::npos) << p.message;
+  f = SomeFeatures();
+  f.speed = std::nan("");
+  EXPECT_FALSE(predictor.Predict(f).ok);
+  f = SomeFeatures();
+  f.shoveled_volume = -1;
+  EXPECT_FALSE(predictor.Predict(f).ok);
+  f = SomeFeatures();
+  f.material = "granite";
+  p = predictor.Predict(f);
+  EXPECT_FALSE(p.ok);
+  EXPECT_NE(p.message.find("granite"), std::string::npos) << p.message;
+}
+
+TEST(PenetrationPredictor, BadModelFilesGiveClearErrors) {
+  const std::string stem = TempStem("bad");
+  std::filesystem::copy_file(kShipped + ".scale", stem + ".scale",
+                             std::filesystem::copy_options::overwrite_existing);
+  // Missing model file.
+  std::filesystem::remove(stem + ".model");
+  std::string error = LoadError(stem);
+  EXPECT_NE(error.find(stem + ".model"), std::string::npos) << error;
+  EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
+  // Not a libsvm model.
+  Write(stem + ".model", "this is not a model\n");
+  error = LoadError(stem);
+  EXPECT_NE(error.find(stem + ".model"), std::string::npos) << error;
+  EXPECT_NE(error.find("not a libsvm model"), std::string::npos) << error;
+  // A classifier instead of an ε-SVR.
+  Write(stem + ".model",
+        "svm_type c_svc\nkernel_type rbf\ngamma 0.5\nnr_class 2\ntotal_sv 2\nrho 0\nlabel 1 -1\n"
+        "nr_sv 1 1\nSV\n1 1:0.5\n-1 1:-0.5\n");
+  error = LoadError(stem);
+  EXPECT_NE(error.find("epsilon_svr"), std::string::npos) << error;
+  // A support vector on a feature the scaling does not have.
+  Write(stem + ".model",
+        "svm_type epsilon_svr\nkernel_type rbf\ngamma 0.5\nnr_class 2\ntotal_sv 1\nrho 0\nSV\n"
+        "1 1:0.5 40:0.1\n");
+  error = LoadError(stem);
+  EXPECT_NE(error.find("feature index 40"), std::string::npos) << error;
+  // A malformed scaling file names its line.
+  std::filesystem::copy_file(kShipped + ".model", stem + ".model",
+                             std::filesystem::copy_options::overwrite_existing);
+  Write(stem + ".scale", "format autoshovel-penetration-svr 1\nmaterials a b\nfeature speed x y\n");
+  error = LoadError(stem);
+  EXPECT_NE(error.find(stem + ".scale:3:"), std::string::npos) << error;
+  EXPECT_NE(error.find("expected 10 features"), std::string::npos) << error;
+  std::filesystem::remove(stem + ".scale");
+  error = LoadError(stem);
+  EXPECT_NE(error.find(stem + ".scale"), std::string::npos) << error;
+  std::filesystem::remove(stem + ".model");
+}
+
+// Fresh runs (seed 2024; the model was trained on seed 1). The figures the model reaches on its
+// 200 test runs (README: 92.5 / 95.0 / 96.5 %, volume 95.5 %) with the slack of a 100-run
+// estimate. The goals for the two outer buckets (97 / 99.5 %) are not reached: see README.
+TEST(PenetrationPredictor, FreshPlantRunsFallInTheErrorBuckets) {
+  const model::MachineDescription machine =
+      model::LoadMachineDescription(model::ResolveMachineDescription(
+          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+  ASSERT_NE(functions, nullptr);
+  const PenetrationPredictor predictor = PenetrationPredictor::Load(kShipped);
+  const std::vector<predictor::CrowdingRun> runs =
+      predictor::RunCrowdingBatch(machine, *functions, {}, 2024, 0, 100, 2);
+  std::vector<const predictor::CrowdingRun*> pointers;
+  for (const auto& run : runs) {
+    EXPECT_TRUE(run.ok) << "run " << run.spec.index << ": " << run.failure;
+    pointers.push_back(&run);
+  }
+  double capacity = 0;
+  for (const auto& run : runs) capacity = std::max(capacity, run.payload);
+  const predictor::PredictorEvaluation e =
+      predictor::EvaluatePredictor(predictor, machine, pointers, capacity);
+  SCOPED_TRACE(predictor::FormatEvaluation(e));
+  EXPECT_EQ(e.samples, 100);
+  std::printf("%s\n", predictor::FormatEvaluation(e).c_str());
+  EXPECT_EQ(e.refused, 0);
+  EXPECT_GE(e.within_010, 0.85);
+  EXPECT_GE(e.within_015, 0.90);
+  EXPECT_GE(e.within_020, 0.93);
+  EXPECT_GE(e.volume_accuracy, 0.90);
+  EXPECT_GE(e.volume_accuracy_capped, 0.93);
+}
+
+}  // namespace
+}  // namespace autoshovel::prediction

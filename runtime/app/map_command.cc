@@ -10,16 +10,13 @@
 #include "runtime/model/description.h"
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/map_render.h"
+#include "runtime/perception/perceive_from_plant.h"
 #include "runtime/perception/pile_extraction.h"
-#include "runtime/perception/segmentation.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
-#include "runtime/sensors/camera.h"
-#include "runtime/sensors/lidar.h"
 #include "runtime/sensors/raycast.h"
-#include "runtime/sensors/sensor_pose.h"
 
 namespace autoshovel::app {
 
@@ -64,48 +61,25 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     sensors::Rng rng(scenario.seed);
 
     const auto t0 = std::chrono::steady_clock::now();
-    const plant::MachineState& s = plant.state();
-    const perception::MachineFootprint footprint =
-        perception::LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation,
-                                    (plant.TipInWorld().head<2>() - s.hinge_xy).norm());
-    perception::ElevationMap map({}, s.hinge_xy);
-    long points = 0, dropped = 0;
-    for (const model::Lidar& lidar : machine.sensors.lidars) {
-      const Eigen::Isometry3d T = sensors::SensorInWorld(s, lidar.pose);
-      for (int k = 0; k < options.frames; ++k) {
-        const perception::MapUpdateStats stats = map.Update(
-            sensors::SimulateLidarFrame(lidar, scene, T, 0.1 * k, rng), T, 0.1 * k, &footprint);
-        points += stats.fused;
-        dropped += stats.on_machine;
-      }
-    }
+    perception::ElevationMap map({}, plant.state().hinge_xy);
     perception::SemanticMap semantic(map);
-    const Eigen::Isometry3d T_camera = sensors::SensorInWorld(s, machine.sensors.camera.pose);
-    sensors::CameraOptions camera_options;
-    camera_options.lighting = lighting;
-    const sensors::CameraFrame image = sensors::SimulateCameraFrame(
-        machine.sensors.camera, scene, T_camera, 0.0, camera_options, rng);
-    std::string semantics_source = "simulator labels (--truth)";
-    perception::ClassProbabilities probabilities;
-    if (options.truth_labels) {
-      probabilities = perception::FromLabels(image.labels, image.width, image.height);
-    } else {
-      const std::string model = options.segmenter.empty()
-                                    ? options.models_dir + "/segmentation/yard_segmenter.onnx"
-                                    : options.segmenter;
-      const perception::Segmenter segmenter(model);
-      perception::SegmentationResult result = segmenter.Run(image);
-      probabilities.width = result.width;
-      probabilities.height = result.height;
-      probabilities.planes = std::move(result.probabilities);
-      semantics_source = "network " + model;
-    }
-    semantic.Project(probabilities, machine.sensors.camera, T_camera);
-    const long filled = map.FillHoles();
-    if (!semantic.Fuse()) {
+    perception::PerceptionFromPlantOptions perceive;
+    perceive.lidar_frames = options.frames;
+    perceive.lighting = lighting;
+    perceive.truth_labels = options.truth_labels;
+    perceive.segmenter = options.segmenter.empty()
+                             ? options.models_dir + "/segmentation/yard_segmenter.onnx"
+                             : options.segmenter;
+    const perception::PerceptionFromPlantStats stats =
+        perception::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic);
+    if (!stats.ground_plane_found) {
       err << "autoshovel map: too few ground cells to fit the ground plane\n";
       return 1;
     }
+    const long points = stats.returns_fused, dropped = stats.returns_on_machine;
+    const long filled = stats.holes_filled;
+    const std::string semantics_source =
+        options.truth_labels ? "simulator labels (--truth)" : stats.semantics;
     const std::vector<perception::ExtractedPile> piles =
         perception::ExtractPiles(map.map(), semantic.ground_plane());
     const double seconds =

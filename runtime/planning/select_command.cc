@@ -10,17 +10,14 @@
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
 #include "runtime/perception/elevation_map.h"
-#include "runtime/perception/segmentation.h"
+#include "runtime/perception/perceive_from_plant.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/planning/candidate_render.h"
 #include "runtime/planning/chen2024_baseline.h"
 #include "runtime/planning/shovel_point_selection.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
-#include "runtime/sensors/camera.h"
-#include "runtime/sensors/lidar.h"
 #include "runtime/sensors/raycast.h"
-#include "runtime/sensors/sensor_pose.h"
 
 namespace autoshovel::planning {
 
@@ -83,39 +80,16 @@ bool PerceiveMap(const SelectOptions& options, plant::Scenario& scenario,
   plant::Plant plant(machine, functions, scenario.world, start);
   sensors::RaycastScene scene(scenario.world, plant.OwnBodies());
   sensors::Rng rng(scenario.seed);
-  const plant::MachineState& s = plant.state();
-  const perception::MachineFootprint footprint =
-      perception::LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation,
-                                  (plant.TipInWorld().head<2>() - s.hinge_xy).norm());
-  for (const model::Lidar& lidar : machine.sensors.lidars) {
-    const Eigen::Isometry3d T = sensors::SensorInWorld(s, lidar.pose);
-    for (int k = 0; k < options.frames; ++k) {
-      map.Update(sensors::SimulateLidarFrame(lidar, scene, T, 0.1 * k, rng), T, 0.1 * k,
-                 &footprint);
-    }
-  }
   perception::SemanticMap semantic(map);
-  const Eigen::Isometry3d T_camera = sensors::SensorInWorld(s, machine.sensors.camera.pose);
-  sensors::CameraOptions camera_options;
-  camera_options.lighting = scenario.lighting;
-  const sensors::CameraFrame image = sensors::SimulateCameraFrame(
-      machine.sensors.camera, scene, T_camera, 0.0, camera_options, rng);
-  perception::ClassProbabilities probabilities;
-  if (options.truth_labels) {
-    probabilities = perception::FromLabels(image.labels, image.width, image.height);
-  } else {
-    const std::string model = options.segmenter.empty()
-                                  ? options.models_dir + "/segmentation/yard_segmenter.onnx"
-                                  : options.segmenter;
-    const perception::Segmenter segmenter(model);
-    perception::SegmentationResult result = segmenter.Run(image);
-    probabilities.width = result.width;
-    probabilities.height = result.height;
-    probabilities.planes = std::move(result.probabilities);
-  }
-  semantic.Project(probabilities, machine.sensors.camera, T_camera);
-  map.FillHoles();
-  if (!semantic.Fuse()) {
+  perception::PerceptionFromPlantOptions perceive;
+  perceive.lidar_frames = options.frames;
+  perceive.lighting = scenario.lighting;
+  perceive.truth_labels = options.truth_labels;
+  perceive.segmenter = options.segmenter.empty()
+                           ? options.models_dir + "/segmentation/yard_segmenter.onnx"
+                           : options.segmenter;
+  if (!perception::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic)
+           .ground_plane_found) {
     err << "autoshovel select: too few ground cells to fit the ground plane\n";
     return false;
   }

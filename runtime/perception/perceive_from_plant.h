@@ -1,0 +1,43 @@
+// The semantic elevation map a loader builds from where it stands in the simulated yard: its
+// LiDAR frames fused into the elevation map (machine points removed), one camera frame segmented
+// (or the simulator's labels) and projected, holes filled, Eq. (10)–(11) fused. One pipeline for
+// `autoshovel map`, `autoshovel select` and the closed loop, so they cannot drift apart.
+//
+// This links the simulator (plant, sensors): it is its own library, so that perception itself
+// never depends on the plant.
+#pragma once
+
+#include <string>
+
+#include "runtime/perception/elevation_map.h"
+#include "runtime/perception/semantic_map.h"
+#include "runtime/plant/plant.h"
+#include "runtime/plant/world.h"
+#include "runtime/sensors/raycast.h"
+#include "runtime/sensors/rng.h"
+
+namespace autoshovel::perception {
+
+struct PerceptionFromPlantOptions {
+  int lidar_frames = 5;  ///< per LiDAR, 0.1 s apart
+  plant::Lighting lighting = plant::Lighting::kNormal;
+  bool truth_labels = false;  ///< the simulator's per-pixel labels instead of the network
+  std::string segmenter;      ///< ONNX network (needed unless truth_labels)
+};
+
+struct PerceptionFromPlantStats {
+  long returns_fused = 0;
+  long returns_on_machine = 0;
+  long holes_filled = 0;
+  bool ground_plane_found = false;  ///< false: too few ground cells; classes not fused
+  std::string semantics;            ///< "simulator labels" or "network <file>"
+};
+
+/// Updates `map` and `semantic` (built on `map`) with what the machine of `plant` senses in
+/// `scene` now. Throws what the segmenter throws for a bad network file.
+PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
+                                           const sensors::RaycastScene& scene, sensors::Rng& rng,
+                                           const PerceptionFromPlantOptions& options,
+                                           ElevationMap& map, SemanticMap& semantic);
+
+}  // namespace autoshovel::perception

@@ -1,0 +1,476 @@
+#include "runtime/results/results_db.h"
+
+#include <sqlite3.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "runtime/results/run_folder.h"
+
+namespace autoshovel::results {
+
+namespace {
+
+// Column order of `cycles` after (run_id, cycle); shared by the INSERT and the SELECT.
+constexpr const char* kCycleColumns =
+    "scenario, machine, bin, material, strategy, atomic_actions, trigger_time_s, fill_rate, "
+    "payload_m3, "
+    "time_approach_s, time_crowd_s, time_scoop_s, time_level_s, time_retreat_s, time_total_s, "
+    "energy_approach_kj, energy_crowd_kj, energy_scoop_kj, energy_level_kj, energy_retreat_kj, "
+    "energy_total_kj, safety_margin_m, safety_violations, completed";
+
+constexpr const char* kSampleColumns =
+    "t_s, v1_m3, v1v2_m3, triggered, predicted_tip_x_m, predicted_tip_z_m, actual_tip_x_m, "
+    "actual_tip_z_m";
+
+constexpr const char* kSchema = R"sql(
+CREATE TABLE schema_version (
+  version INTEGER NOT NULL
+);
+CREATE TABLE runs (
+  run_id          TEXT PRIMARY KEY NOT NULL,
+  scenario        TEXT NOT NULL,
+  machine         TEXT NOT NULL,
+  seed            INTEGER NOT NULL,
+  cycles_planned  INTEGER NOT NULL,
+  start_time_utc  TEXT NOT NULL,
+  git_describe    TEXT
+);
+CREATE TABLE cycles (
+  run_id              TEXT NOT NULL REFERENCES runs(run_id),
+  cycle               INTEGER NOT NULL CHECK (cycle >= 0),
+  scenario            TEXT NOT NULL,
+  machine             TEXT NOT NULL,
+  bin                 TEXT NOT NULL,
+  material            TEXT NOT NULL,
+  strategy            TEXT NOT NULL,
+  atomic_actions      TEXT NOT NULL,
+  trigger_time_s      REAL,
+  fill_rate           REAL,
+  payload_m3          REAL,
+  time_approach_s     REAL,
+  time_crowd_s        REAL,
+  time_scoop_s        REAL,
+  time_level_s        REAL,
+  time_retreat_s      REAL,
+  time_total_s        REAL,
+  energy_approach_kj  REAL,
+  energy_crowd_kj     REAL,
+  energy_scoop_kj     REAL,
+  energy_level_kj     REAL,
+  energy_retreat_kj   REAL,
+  energy_total_kj     REAL,
+  safety_margin_m     REAL,
+  safety_violations   INTEGER NOT NULL,
+  completed           INTEGER NOT NULL CHECK (completed IN (0, 1)),
+  UNIQUE (run_id, cycle)
+);
+CREATE TABLE samples (
+  run_id             TEXT NOT NULL,
+  cycle              INTEGER NOT NULL,
+  k                  INTEGER NOT NULL,
+  t_s                REAL NOT NULL,
+  v1_m3              REAL,
+  v1v2_m3            REAL,
+  triggered          INTEGER NOT NULL CHECK (triggered IN (0, 1)),
+  predicted_tip_x_m  REAL,
+  predicted_tip_z_m  REAL,
+  actual_tip_x_m     REAL,
+  actual_tip_z_m     REAL,
+  PRIMARY KEY (run_id, cycle, k),
+  FOREIGN KEY (run_id, cycle) REFERENCES cycles(run_id, cycle)
+) WITHOUT ROWID;
+)sql";
+
+double ColumnDouble(sqlite3_stmt* statement, int column) {
+  if (sqlite3_column_type(statement, column) == SQLITE_NULL) return kNotMeasured;
+  return sqlite3_column_double(statement, column);
+}
+
+std::string ColumnText(sqlite3_stmt* statement, int column) {
+  const unsigned char* text = sqlite3_column_text(statement, column);
+  return text == nullptr ? std::string() : std::string(reinterpret_cast<const char*>(text));
+}
+
+}  // namespace
+
+// A prepared statement; errors name the database file.
+class ResultsDb::Statement {
+ public:
+  Statement(const ResultsDb& owner, const std::string& sql) : owner_(owner) {
+    if (sqlite3_prepare_v2(owner_.db_, sql.c_str(), -1, &statement_, nullptr) != SQLITE_OK) {
+      owner_.Fail("cannot prepare '" + sql.substr(0, 60) + "'");
+    }
+  }
+  ~Statement() { sqlite3_finalize(statement_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  Statement& Bind(int index, const std::string& value) {
+    Check(sqlite3_bind_text(statement_, index, value.c_str(), static_cast<int>(value.size()),
+                            SQLITE_TRANSIENT));
+    return *this;
+  }
+  Statement& Bind(int index, std::int64_t value) {
+    Check(sqlite3_bind_int64(statement_, index, value));
+    return *this;
+  }
+  Statement& Bind(int index, double value) {  // NaN -> NULL
+    Check(std::isnan(value) ? sqlite3_bind_null(statement_, index)
+                            : sqlite3_bind_double(statement_, index, value));
+    return *this;
+  }
+  Statement& BindNull(int index) {
+    Check(sqlite3_bind_null(statement_, index));
+    return *this;
+  }
+
+  /// true: a row is available; false: done. Throws on errors.
+  bool Step() {
+    const int rc = sqlite3_step(statement_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;  // (extended codes only differ for errors)
+    owner_.Fail("query failed");
+  }
+  /// Steps a statement that returns no row, then resets it for the next binding. Returns the
+  /// extended result code on a constraint violation (so the caller can name it), else throws.
+  int Run() {
+    const int rc = sqlite3_step(statement_);  // extended codes are on: mask for the primary
+    const int extended = sqlite3_extended_errcode(owner_.db_);
+    if (rc == SQLITE_DONE) {
+      sqlite3_reset(statement_);
+      return SQLITE_OK;
+    }
+    if ((rc & 0xff) == SQLITE_CONSTRAINT) {
+      sqlite3_reset(statement_);
+      return extended;
+    }
+    owner_.Fail("write failed");
+  }
+  sqlite3_stmt* get() const { return statement_; }
+
+ private:
+  void Check(int rc) const {
+    if (rc != SQLITE_OK) owner_.Fail("cannot bind a value");
+  }
+  const ResultsDb& owner_;
+  sqlite3_stmt* statement_ = nullptr;
+};
+
+ResultsDb::ResultsDb(const std::filesystem::path& file) : file_(file) {
+  const int rc =
+      sqlite3_open_v2(file_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (rc != SQLITE_OK) {
+    const std::string message = db_ != nullptr ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw ResultsDbError(file_.string() + ": cannot open the results database: " + message);
+  }
+  try {
+    sqlite3_extended_result_codes(db_, 1);
+    sqlite3_busy_timeout(db_, 10000);  // campaigns: other processes may hold the write lock
+    CreateOrCheckSchema();
+    Execute("PRAGMA foreign_keys = ON");
+    Execute("PRAGMA synchronous = NORMAL");
+  } catch (...) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw;
+  }
+}
+
+ResultsDb::~ResultsDb() {
+  // Closing the last connection checkpoints the WAL into the main file.
+  if (db_ != nullptr) sqlite3_close(db_);
+}
+
+void ResultsDb::Fail(const std::string& what) const {
+  const int code = sqlite3_extended_errcode(db_);
+  std::string message = file_.string() + ": " + what + ": " + sqlite3_errmsg(db_);
+  if ((code & 0xff) == SQLITE_NOTADB) {
+    message = file_.string() +
+              ": not an autoshovel results database (not a SQLite file: " + sqlite3_errmsg(db_) +
+              ")";
+  } else if ((code & 0xff) == SQLITE_CORRUPT) {
+    message = file_.string() + ": the results database is corrupt (" +
+              std::string(sqlite3_errmsg(db_)) + "); " + what;
+  }
+  throw ResultsDbError(message);
+}
+
+void ResultsDb::Execute(const char* sql) const {
+  char* error = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &error) != SQLITE_OK) {
+    sqlite3_free(error);
+    Fail(std::string("cannot run '") + std::string(sql).substr(0, 60) + "'");
+  }
+}
+
+void ResultsDb::CreateOrCheckSchema() {
+  // Reading sqlite_master first: a non-SQLite file fails here, before anything is written.
+  int tables = 0;
+  bool has_version_table = false;
+  {
+    Statement list(*this, "SELECT name FROM sqlite_master WHERE type = 'table'");
+    while (list.Step()) {
+      ++tables;
+      if (ColumnText(list.get(), 0) == "schema_version") has_version_table = true;
+    }
+  }
+  if (tables == 0) {
+    Execute("PRAGMA journal_mode = WAL");
+    Execute("BEGIN IMMEDIATE");
+    try {
+      // Another process may have created it between our read and the write lock.
+      Statement again(*this, "SELECT count(*) FROM sqlite_master WHERE name = 'schema_version'");
+      again.Step();
+      if (sqlite3_column_int(again.get(), 0) == 0) {
+        Execute(kSchema);
+        Statement version(*this, "INSERT INTO schema_version (version) VALUES (?)");
+        version.Bind(1, static_cast<std::int64_t>(kSchemaVersion));
+        if (version.Run() != SQLITE_OK) Fail("cannot write the schema version");
+      }
+      Execute("COMMIT");
+    } catch (...) {
+      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      throw;
+    }
+    return;
+  }
+  if (!has_version_table) {
+    throw ResultsDbError(file_.string() +
+                         ": not an autoshovel results database (a SQLite file with " +
+                         std::to_string(tables) + " table(s) but no schema_version table)");
+  }
+  Statement version(*this, "SELECT version FROM schema_version");
+  if (!version.Step() || sqlite3_column_type(version.get(), 0) != SQLITE_INTEGER) {
+    throw ResultsDbError(file_.string() + ": results database without a schema version row");
+  }
+  const int found = sqlite3_column_int(version.get(), 0);
+  if (found != kSchemaVersion) {
+    throw ResultsDbError(file_.string() + ": results schema version " + std::to_string(found) +
+                         ", this build reads version " + std::to_string(kSchemaVersion) +
+                         " (written by another autoshovel version)");
+  }
+  Execute("PRAGMA journal_mode = WAL");
+}
+
+bool ResultsDb::BeginRun(const RunInfo& run) {
+  if (run.run_id.empty()) Fail("BeginRun: empty run id");
+  if (const std::optional<RunInfo> existing = FindRun(run.run_id)) {
+    if (existing->scenario != run.scenario || existing->machine != run.machine ||
+        existing->seed != run.seed) {
+      throw ResultsDbError(file_.string() + ": run '" + run.run_id + "' exists with scenario '" +
+                           existing->scenario + "', machine '" + existing->machine + "', seed " +
+                           std::to_string(existing->seed) + "; cannot resume it with scenario '" +
+                           run.scenario + "', machine '" + run.machine + "', seed " +
+                           std::to_string(run.seed));
+    }
+    return true;
+  }
+  Statement insert(*this,
+                   "INSERT INTO runs (run_id, scenario, machine, seed, cycles_planned, "
+                   "start_time_utc, git_describe) VALUES (?, ?, ?, ?, ?, ?, ?)");
+  insert.Bind(1, run.run_id).Bind(2, run.scenario).Bind(3, run.machine);
+  insert.Bind(4, static_cast<std::int64_t>(run.seed));
+  insert.Bind(5, static_cast<std::int64_t>(run.cycles_planned));
+  insert.Bind(6, run.start_time_utc.empty() ? UtcTimestampIso() : run.start_time_utc);
+  if (run.git_describe.empty()) {
+    insert.BindNull(7);
+  } else {
+    insert.Bind(7, run.git_describe);
+  }
+  if (insert.Run() != SQLITE_OK) Fail("cannot insert run '" + run.run_id + "'");
+  return false;
+}
+
+std::vector<RunInfo> ResultsDb::Runs() const {
+  std::vector<RunInfo> runs;
+  Statement select(*this,
+                   "SELECT run_id, scenario, machine, seed, cycles_planned, start_time_utc, "
+                   "git_describe FROM runs ORDER BY start_time_utc, run_id");
+  while (select.Step()) {
+    RunInfo run;
+    run.run_id = ColumnText(select.get(), 0);
+    run.scenario = ColumnText(select.get(), 1);
+    run.machine = ColumnText(select.get(), 2);
+    run.seed = static_cast<std::uint64_t>(sqlite3_column_int64(select.get(), 3));
+    run.cycles_planned = sqlite3_column_int(select.get(), 4);
+    run.start_time_utc = ColumnText(select.get(), 5);
+    run.git_describe = ColumnText(select.get(), 6);
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+std::optional<RunInfo> ResultsDb::FindRun(const std::string& run_id) const {
+  for (RunInfo& run : Runs()) {
+    if (run.run_id == run_id) return std::move(run);
+  }
+  return std::nullopt;
+}
+
+void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record) {
+  if (record.cycle < 0) {
+    throw ResultsDbError(file_.string() + ": cycle index must be >= 0, got " +
+                         std::to_string(record.cycle));
+  }
+  if (!FindRun(run_id)) {
+    throw ResultsDbError(file_.string() + ": cycle " + std::to_string(record.cycle) + " for run '" +
+                         run_id + "', which was not begun (call BeginRun first)");
+  }
+  Execute("BEGIN IMMEDIATE");
+  try {
+    {
+      Statement insert(*this, std::string("INSERT INTO cycles (run_id, cycle, ") + kCycleColumns +
+                                  ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, "
+                                  "?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      // One Bind per statement: chained `Bind(i++, ...).Bind(i++, ...)` is sequenced in C++17
+      // but GCC's -Wsequence-point still flags it.
+      int i = 0;
+      auto text = [&](const std::string& value) { insert.Bind(++i, value); };
+      auto real = [&](double value) { insert.Bind(++i, value); };
+      auto integer = [&](std::int64_t value) { insert.Bind(++i, value); };
+      text(run_id);
+      integer(record.cycle);
+      for (const std::string* value :
+           {&record.scenario, &record.machine, &record.bin, &record.material, &record.strategy,
+            &record.atomic_actions}) {
+        text(*value);
+      }
+      for (const double value : {record.trigger_time_s, record.fill_rate, record.payload_m3}) {
+        real(value);
+      }
+      for (const PhaseValues* v : {&record.time_s, &record.energy_kj}) {
+        for (const double value :
+             {v->approach, v->crowd, v->scoop, v->level, v->retreat, v->total}) {
+          real(value);
+        }
+      }
+      real(record.safety_margin_m);
+      integer(record.safety_violations);
+      integer(record.completed ? 1 : 0);
+      const int rc = insert.Run();
+      if (rc == SQLITE_CONSTRAINT_UNIQUE || rc == SQLITE_CONSTRAINT_PRIMARYKEY) {
+        throw DuplicateCycleError(file_.string() + ": run '" + run_id + "' already holds cycle " +
+                                  std::to_string(record.cycle) + "; nothing was written");
+      }
+      if (rc != SQLITE_OK) Fail("cannot write cycle " + std::to_string(record.cycle));
+    }
+    Statement sample(*this, std::string("INSERT INTO samples (run_id, cycle, k, ") +
+                                kSampleColumns + ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    for (std::size_t k = 0; k < record.samples.size(); ++k) {
+      const CycleSample& s = record.samples[k];
+      if (std::isnan(s.t)) {
+        throw ResultsDbError(file_.string() + ": cycle " + std::to_string(record.cycle) +
+                             ", sample " + std::to_string(k) +
+                             ": time is NaN; nothing of the cycle was written");
+      }
+      sample.Bind(1, run_id).Bind(2, static_cast<std::int64_t>(record.cycle));
+      sample.Bind(3, static_cast<std::int64_t>(k)).Bind(4, s.t).Bind(5, s.v1).Bind(6, s.v1v2);
+      sample.Bind(7, static_cast<std::int64_t>(s.triggered ? 1 : 0));
+      sample.Bind(8, s.predicted_tip_x).Bind(9, s.predicted_tip_z);
+      sample.Bind(10, s.actual_tip_x).Bind(11, s.actual_tip_z);
+      if (sample.Run() != SQLITE_OK) {
+        Fail("cannot write sample " + std::to_string(k) + " of cycle " +
+             std::to_string(record.cycle));
+      }
+    }
+    Execute("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
+std::vector<int> ResultsDb::CompletedCycles(const std::string& run_id) const {
+  std::vector<int> cycles;
+  Statement select(*this, "SELECT cycle FROM cycles WHERE run_id = ? ORDER BY cycle");
+  select.Bind(1, run_id);
+  while (select.Step()) cycles.push_back(sqlite3_column_int(select.get(), 0));
+  return cycles;
+}
+
+std::vector<int> ResultsDb::MissingCycles(const std::string& run_id, int cycles_planned) const {
+  const std::vector<int> done = CompletedCycles(run_id);
+  std::vector<int> missing;
+  std::size_t j = 0;
+  for (int cycle = 0; cycle < cycles_planned; ++cycle) {
+    while (j < done.size() && done[j] < cycle) ++j;
+    if (j == done.size() || done[j] != cycle) missing.push_back(cycle);
+  }
+  return missing;
+}
+
+std::vector<CycleRecord> ResultsDb::Cycles(const std::string& run_id, bool with_samples) const {
+  std::vector<CycleRecord> records;
+  {
+    Statement select(*this, std::string("SELECT cycle, ") + kCycleColumns +
+                                " FROM cycles WHERE run_id = ? ORDER BY cycle");
+    select.Bind(1, run_id);
+    while (select.Step()) {
+      sqlite3_stmt* s = select.get();
+      CycleRecord r;
+      int i = 0;
+      r.cycle = sqlite3_column_int(s, i++);
+      r.scenario = ColumnText(s, i++);
+      r.machine = ColumnText(s, i++);
+      r.bin = ColumnText(s, i++);
+      r.material = ColumnText(s, i++);
+      r.strategy = ColumnText(s, i++);
+      r.atomic_actions = ColumnText(s, i++);
+      r.trigger_time_s = ColumnDouble(s, i++);
+      r.fill_rate = ColumnDouble(s, i++);
+      r.payload_m3 = ColumnDouble(s, i++);
+      for (PhaseValues* values : {&r.time_s, &r.energy_kj}) {
+        values->approach = ColumnDouble(s, i++);
+        values->crowd = ColumnDouble(s, i++);
+        values->scoop = ColumnDouble(s, i++);
+        values->level = ColumnDouble(s, i++);
+        values->retreat = ColumnDouble(s, i++);
+        values->total = ColumnDouble(s, i++);
+      }
+      r.safety_margin_m = ColumnDouble(s, i++);
+      r.safety_violations = sqlite3_column_int(s, i++);
+      r.completed = sqlite3_column_int(s, i++) != 0;
+      records.push_back(std::move(r));
+    }
+  }
+  if (with_samples) {
+    for (CycleRecord& r : records) r.samples = Samples(run_id, r.cycle);
+  }
+  return records;
+}
+
+std::optional<CycleRecord> ResultsDb::Cycle(const std::string& run_id, int cycle) const {
+  for (CycleRecord& r : Cycles(run_id, false)) {
+    if (r.cycle == cycle) {
+      r.samples = Samples(run_id, cycle);
+      return std::move(r);
+    }
+  }
+  return std::nullopt;
+}
+
+std::vector<CycleSample> ResultsDb::Samples(const std::string& run_id, int cycle) const {
+  std::vector<CycleSample> samples;
+  Statement select(*this, std::string("SELECT ") + kSampleColumns +
+                              " FROM samples WHERE run_id = ? AND cycle = ? ORDER BY k");
+  select.Bind(1, run_id).Bind(2, static_cast<std::int64_t>(cycle));
+  while (select.Step()) {
+    sqlite3_stmt* s = select.get();
+    CycleSample sample;
+    sample.t = ColumnDouble(s, 0);
+    sample.v1 = ColumnDouble(s, 1);
+    sample.v1v2 = ColumnDouble(s, 2);
+    sample.triggered = sqlite3_column_int(s, 3) != 0;
+    sample.predicted_tip_x = ColumnDouble(s, 4);
+    sample.predicted_tip_z = ColumnDouble(s, 5);
+    sample.actual_tip_x = ColumnDouble(s, 6);
+    sample.actual_tip_z = ColumnDouble(s, 7);
+    samples.push_back(sample);
+  }
+  return samples;
+}
+
+}  // namespace autoshovel::results

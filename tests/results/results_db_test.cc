@@ -1,0 +1,287 @@
+// The results database: schema, exact round trip, NaN as NULL, duplicate refusal with nothing
+// partial left, resume bookkeeping, foreign and corrupt files named in the error.
+#include "runtime/results/results_db.h"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <fstream>
+#include <limits>
+
+#include "tests/results/test_records.h"
+
+namespace autoshovel::results {
+namespace {
+
+using testing::ScratchDir;
+using testing::TestRecord;
+using testing::TestRun;
+
+// A query's single integer or text answer through the raw SQLite API (not through ResultsDb).
+std::string Query(const std::filesystem::path& file, const std::string& sql) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* statement = nullptr;
+  std::string answer = "<error>";
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &statement, nullptr) == SQLITE_OK) {
+    answer = "<none>";
+    if (sqlite3_step(statement) == SQLITE_ROW) {
+      const unsigned char* text = sqlite3_column_text(statement, 0);
+      answer = text == nullptr ? "NULL" : reinterpret_cast<const char*>(text);
+    }
+  } else {
+    ADD_FAILURE() << sql << ": " << sqlite3_errmsg(db);
+  }
+  sqlite3_finalize(statement);
+  sqlite3_close(db);
+  return answer;
+}
+
+void Exec(const std::filesystem::path& file, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK)
+      << (error != nullptr ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
+TEST(ResultsDb, CreatesSchemaInWalMode) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  { ResultsDb db(file); }
+  EXPECT_EQ(Query(file, "SELECT version FROM schema_version"),
+            std::to_string(ResultsDb::kSchemaVersion));
+  for (const char* table : {"runs", "cycles", "samples"}) {
+    EXPECT_EQ(
+        Query(file, std::string("SELECT count(*) FROM sqlite_master WHERE name = '") + table + "'"),
+        "1")
+        << table;
+  }
+  EXPECT_EQ(Query(file, "PRAGMA journal_mode"), "wal");
+  // Reopening an existing database checks it and keeps it.
+  ResultsDb again(file);
+  EXPECT_TRUE(again.Runs().empty());
+}
+
+TEST(ResultsDb, CycleWithSamplesRoundTripsExactly) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  CycleRecord record = TestRecord(3, 250);
+  record.energy_kj.level = 1e-310;  // subnormal
+  record.time_s.total = std::numeric_limits<double>::max();
+  record.safety_violations = 2;
+  record.completed = false;
+  record.material = "sand \"wet\" ' <>";
+  {
+    ResultsDb db(file);
+    EXPECT_FALSE(db.BeginRun(TestRun()));
+    db.WriteCycle("run-1", record);
+  }
+  ResultsDb db(file);
+  const std::optional<CycleRecord> read = db.Cycle("run-1", 3);
+  ASSERT_TRUE(read.has_value());
+  testing::ExpectSameRecord(*read, record);
+  const std::vector<CycleRecord> all = db.Cycles("run-1", true);
+  ASSERT_EQ(all.size(), 1u);
+  testing::ExpectSameRecord(all[0], record);
+  EXPECT_TRUE(db.Cycles("run-1", false)[0].samples.empty());
+
+  const std::optional<RunInfo> run = db.FindRun("run-1");
+  ASSERT_TRUE(run.has_value());
+  EXPECT_EQ(run->scenario, "yard_small");
+  EXPECT_EQ(run->machine, "loader_20t");
+  EXPECT_EQ(run->seed, 42u);
+  EXPECT_EQ(run->cycles_planned, 10);
+  EXPECT_EQ(run->start_time_utc, "2025-06-01T12:00:00.000Z");
+  EXPECT_EQ(run->git_describe, "v0.1.0-12-gabcdef");
+}
+
+TEST(ResultsDb, SeedKeepsAll64Bits) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  ResultsDb db(file);
+  RunInfo run = TestRun("big-seed");
+  run.seed = std::numeric_limits<std::uint64_t>::max() - 5;
+  run.git_describe.clear();
+  run.start_time_utc.clear();
+  db.BeginRun(run);
+  const std::optional<RunInfo> read = db.FindRun("big-seed");
+  ASSERT_TRUE(read.has_value());
+  EXPECT_EQ(read->seed, run.seed);
+  EXPECT_EQ(read->git_describe, "");
+  EXPECT_FALSE(read->start_time_utc.empty());  // filled with the current time
+  EXPECT_EQ(Query(file, "SELECT git_describe IS NULL FROM runs"), "1");
+}
+
+TEST(ResultsDb, NanIsStoredAsNull) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  CycleRecord record = TestRecord(0, 3);
+  record.trigger_time_s = kNotMeasured;  // never triggered
+  record.energy_kj.level = kNotMeasured;
+  record.samples[1].v1v2 = kNotMeasured;
+  {
+    ResultsDb db(file);
+    db.BeginRun(TestRun());
+    db.WriteCycle("run-1", record);
+  }
+  EXPECT_EQ(Query(file, "SELECT trigger_time_s IS NULL FROM cycles"), "1");
+  EXPECT_EQ(Query(file, "SELECT energy_level_kj IS NULL FROM cycles"), "1");
+  EXPECT_EQ(Query(file, "SELECT fill_rate IS NULL FROM cycles"), "0");
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM samples WHERE v1v2_m3 IS NULL"), "1");
+  EXPECT_EQ(Query(file, "SELECT k FROM samples WHERE v1v2_m3 IS NULL"), "1");
+  // SQL aggregates skip NULL, so AVG() means "mean over measured cycles".
+  ResultsDb db(file);
+  const std::optional<CycleRecord> read = db.Cycle("run-1", 0);
+  ASSERT_TRUE(read.has_value());
+  EXPECT_TRUE(std::isnan(read->trigger_time_s));
+  EXPECT_TRUE(std::isnan(read->energy_kj.level));
+  EXPECT_TRUE(std::isnan(read->samples[1].v1v2));
+  testing::ExpectSameRecord(*read, record);
+}
+
+TEST(ResultsDb, DuplicateCycleIsRefusedAndNothingPartialRemains) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  ResultsDb db(file);
+  db.BeginRun(TestRun());
+  const CycleRecord first = TestRecord(3, 5);
+  db.WriteCycle("run-1", first);
+  CycleRecord second = TestRecord(3, 12);
+  second.fill_rate = 0.5;
+  try {
+    db.WriteCycle("run-1", second);
+    FAIL() << "a duplicate cycle was accepted";
+  } catch (const DuplicateCycleError& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cycle 3"), std::string::npos) << e.what();
+  }
+  testing::ExpectSameRecord(*db.Cycle("run-1", 3), first);
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM samples"), "5");
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM cycles"), "1");
+  // The same index in another run is fine.
+  db.BeginRun(TestRun("run-2"));
+  db.WriteCycle("run-2", second);
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM samples"), "17");
+}
+
+TEST(ResultsDb, FailedSampleRollsBackTheWholeCycle) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  ResultsDb db(file);
+  db.BeginRun(TestRun());
+  CycleRecord bad = TestRecord(4, 20);
+  bad.samples[7].t = kNotMeasured;  // the time axis must be known
+  EXPECT_THROW(db.WriteCycle("run-1", bad), ResultsDbError);
+  EXPECT_TRUE(db.CompletedCycles("run-1").empty());
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM samples"), "0");
+  // The database is still usable, and the cycle can be written once fixed.
+  bad.samples[7].t = 0.35;
+  db.WriteCycle("run-1", bad);
+  EXPECT_EQ(db.CompletedCycles("run-1"), std::vector<int>{4});
+}
+
+TEST(ResultsDb, RefusesCycleOfUnknownRunAndNegativeIndex) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  ResultsDb db(file);
+  EXPECT_THROW(db.WriteCycle("nobody", TestRecord(0, 1)), ResultsDbError);
+  db.BeginRun(TestRun());
+  EXPECT_THROW(db.WriteCycle("run-1", TestRecord(-1, 1)), ResultsDbError);
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM cycles"), "0");
+}
+
+TEST(ResultsDb, ResumeListsCompletedAndMissingCycles) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  {
+    ResultsDb db(file);
+    EXPECT_FALSE(db.BeginRun(TestRun()));
+    for (int c : {0, 1, 3, 7}) db.WriteCycle("run-1", TestRecord(c, 4));
+  }
+  ResultsDb db(file);
+  EXPECT_TRUE(db.BeginRun(TestRun()));  // resumed
+  EXPECT_EQ(db.CompletedCycles("run-1"), (std::vector<int>{0, 1, 3, 7}));
+  EXPECT_EQ(db.MissingCycles("run-1", 8), (std::vector<int>{2, 4, 5, 6}));
+  EXPECT_TRUE(db.CompletedCycles("other").empty());
+  for (int c : db.MissingCycles("run-1", 8)) db.WriteCycle("run-1", TestRecord(c, 4));
+  EXPECT_EQ(db.CompletedCycles("run-1"), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_TRUE(db.MissingCycles("run-1", 8).empty());
+
+  RunInfo other_seed = TestRun();
+  other_seed.seed = 43;
+  try {
+    db.BeginRun(other_seed);
+    FAIL() << "resumed with another seed";
+  } catch (const ResultsDbError& e) {
+    EXPECT_NE(std::string(e.what()).find("seed 43"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ResultsDb, NonSqliteFileIsRefusedNamingIt) {
+  const auto file = ScratchDir("") / "notes.sqlite";
+  {
+    std::ofstream out(file);
+    for (int i = 0; i < 100; ++i) out << "these are field notes, not a database\n";
+  }
+  const auto size = std::filesystem::file_size(file);
+  try {
+    ResultsDb db(file);
+    FAIL() << "opened a text file";
+  } catch (const ResultsDbError& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not an autoshovel results database"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(std::filesystem::file_size(file), size);  // untouched
+}
+
+TEST(ResultsDb, ForeignSqliteDatabaseIsRefusedAndLeftUntouched) {
+  const auto file = ScratchDir("") / "inventory.sqlite";
+  Exec(file, "CREATE TABLE parts (id INTEGER, name TEXT); INSERT INTO parts VALUES (1, 'pin');");
+  try {
+    ResultsDb db(file);
+    FAIL() << "opened a foreign database";
+  } catch (const ResultsDbError& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no schema_version"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Query(file, "PRAGMA journal_mode"), "delete");  // not switched to WAL
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM sqlite_master"), "1");
+}
+
+TEST(ResultsDb, OtherSchemaVersionIsRefusedNamingBoth) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  { ResultsDb db(file); }
+  Exec(file, "UPDATE schema_version SET version = 99");
+  try {
+    ResultsDb db(file);
+    FAIL() << "opened schema version 99";
+  } catch (const ResultsDbError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("version 99"), std::string::npos) << what;
+    EXPECT_NE(what.find("version " + std::to_string(ResultsDb::kSchemaVersion)), std::string::npos)
+        << what;
+  }
+}
+
+TEST(ResultsDb, CorruptedPagesAreReportedNamingTheFile) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  {
+    ResultsDb db(file);
+    db.BeginRun(TestRun());
+    for (int c = 0; c < 20; ++c) db.WriteCycle("run-1", TestRecord(c, 200));
+  }  // closed: the WAL is checkpointed into the file
+  {
+    // Overwrite everything after the 100-byte header of page 1 with garbage.
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp(100);
+    const std::string garbage(8192, '\x5a');
+    io.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  try {
+    ResultsDb db(file);
+    db.Cycles("run-1", true);
+    FAIL() << "read a corrupt database";
+  } catch (const ResultsDbError& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace autoshovel::results

@@ -1,0 +1,453 @@
+// One scoop: approach, crowd, trigger, scoop (Algorithm 3), level, shake, retreat (seed §6.2).
+#include "runtime/control/scoop_cycle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace autoshovel::control {
+
+namespace {
+
+const char* PhaseName(int phase) {
+  static const char* kNames[] = {"approach", "crowd", "scoop", "level", "shake", "retreat", "done"};
+  return kNames[phase];
+}
+
+bool Finite(const Proprioception& s) {
+  const double values[] = {s.time,   s.hinge_xy.x(), s.hinge_xy.y(), s.heading,  s.speed,
+                           s.q_boom, s.q_bucket,     s.qd_boom,      s.qd_bucket};
+  return std::all_of(std::begin(values), std::end(values),
+                     [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
+const char* ToString(ScoopPolicy policy) {
+  switch (policy) {
+    case ScoopPolicy::kAutoSelection:
+      return "auto_selection";
+    case ScoopPolicy::kJustInOut:
+      return "just_in_out";
+    case ScoopPolicy::kStairway:
+      return "stairway";
+    case ScoopPolicy::kStairwayFixed:
+      return "stairway_fixed";
+  }
+  return "?";
+}
+
+std::string ScoopCycleOptions::Invalid() const {
+  if (!(tick > 0) || !std::isfinite(tick)) return "scoop cycle: tick must be > 0 s";
+  if (decision_every < 1) return "scoop cycle: decision_every must be >= 1";
+  const double positive[] = {attack_speed, retreat_speed, target_fill, max_approach,
+                             max_crowd,    max_scoop,     max_retreat, action_timeout};
+  for (double v : positive) {
+    if (!(v > 0) || !std::isfinite(v)) return "scoop cycle: speeds, fill and limits must be > 0";
+  }
+  const double non_negative[] = {retreat_beyond_contact,
+                                 contact_volume,
+                                 rack_back_margin,
+                                 boom_margin,
+                                 arm_motion,
+                                 path_spacing};
+  for (double v : non_negative) {
+    if (!(v >= 0) || !std::isfinite(v)) return "scoop cycle: margins must be finite and >= 0";
+  }
+  if (!std::isfinite(attack_pose.boom) || !std::isfinite(attack_pose.bucket)) {
+    return "scoop cycle: attack_pose must be finite";
+  }
+  if (std::string why = strategy.Invalid(); !why.empty()) return why;
+  if (std::string why = finishing.Invalid(); !why.empty()) return why;
+  for (const JointPidGains* g : {&boom_gains, &bucket_gains}) {
+    if (std::string why = g->Invalid(); !why.empty()) return why;
+  }
+  return speed_gains.Invalid();
+}
+
+const PhaseRecord* ScoopResult::Phase(const std::string& name) const {
+  for (const PhaseRecord& p : phases) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+double ScoopResult::ContactToScoopEndTime() const {
+  const PhaseRecord* crowd = Phase("crowd");
+  const PhaseRecord* scoop = Phase("scoop");
+  return (crowd ? crowd->duration : 0) + (scoop ? scoop->duration : 0);
+}
+
+double ScoopResult::ContactToScoopEndEnergy() const {
+  const PhaseRecord* crowd = Phase("crowd");
+  const PhaseRecord* scoop = Phase("scoop");
+  return (crowd ? crowd->energy : 0) + (scoop ? scoop->energy : 0);
+}
+
+// Everything that changes during one Run().
+struct ScoopCycle::Runtime {
+  Phase phase = Phase::kApproach;
+  ScoopResult result;
+  double phase_start_time = 0;
+  double phase_start_energy = 0;
+  ArmTargets targets;
+  std::optional<ScoopSequencer> sequencer;
+  std::optional<AtomicAction> action;
+  double action_start = 0;
+  double arrived_at = NAN;  ///< when the running action reached its target [s]
+  bool arm_moving = false;
+  double q_bucket_at_trigger = 0;
+  double q_boom_at_trigger = 0;
+  bool finishing_drive = false;  ///< scoop: the drive has switched to fixed deceleration
+  double shake_start = 0;
+  Eigen::Vector2d contact_hinge = Eigen::Vector2d::Zero();
+  std::vector<Eigen::Vector3d> tip_path;  ///< world [m]
+  double v1 = 0;
+  StopDetector stop;
+  double open_loop_bucket = NAN;  ///< a duty bypassing the bucket PID (shaking) [-]
+  bool stopping = false;          ///< retreat: reversed far enough, stopping
+};
+
+ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
+                       const generated::MachineFunctions& functions,
+                       const prediction::HeightGrid& map, const model::Material& material,
+                       ScoopTrigger& trigger, const prediction::PenetrationPredictor* predictor,
+                       const ScoopCycleOptions& options)
+    : machine_(machine),
+      functions_(functions),
+      map_(map),
+      material_(material),
+      trigger_(trigger),
+      predictor_(predictor),
+      options_(options) {
+  if (const std::string why = options.Invalid(); !why.empty()) throw std::invalid_argument(why);
+  if (machine.links.size() != 2 || machine.swing) {
+    throw std::invalid_argument("scoop cycle: machine '" + machine.name +
+                                "' is not a two-link loader arm");
+  }
+  boom_valve_ = machine.ActuatorOfJoint(0);
+  bucket_valve_ = machine.ActuatorOfJoint(1);
+  if (boom_valve_ < 0 || bucket_valve_ < 0) {
+    throw std::invalid_argument("scoop cycle: machine '" + machine.name +
+                                "' has no actuator on the boom or bucket joint");
+  }
+  if (trigger.NeedsPrediction() || options.policy == ScoopPolicy::kAutoSelection) {
+    if (predictor == nullptr) {
+      throw std::invalid_argument("scoop cycle: trigger '" + trigger.Name() + "' / policy '" +
+                                  ToString(options.policy) + "' needs a penetration predictor");
+    }
+  }
+  limits_.boom_max = machine.links[0].joint_max - options.boom_margin;
+  limits_.bucket_max = machine.links[1].joint_max - options.rack_back_margin;
+  const model::Valve& valve = machine.hydraulics.actuators[bucket_valve_].valve;
+  bucket_delay_ = valve.transport_delay + valve.spool_time_constant;
+}
+
+void ScoopCycle::EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s,
+                            Runtime& rt) {
+  if (rt.phase != Phase::kDone) {
+    rt.result.phases.push_back({.name = PhaseName(static_cast<int>(rt.phase)),
+                                .start = rt.phase_start_time,
+                                .duration = s.time - rt.phase_start_time,
+                                .energy = machine.Energy() - rt.phase_start_energy});
+  }
+  rt.phase = phase;
+  rt.phase_start_time = s.time;
+  rt.phase_start_energy = machine.Energy();
+  machine.SetPhase(PhaseName(static_cast<int>(phase)));
+}
+
+double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
+  // Features (penetration_predictor.h): v, V1, material, h1..h6 on the map k·Δl ahead of the
+  // tip along the heading, mean of five points across the bucket width. The pre-contact map is
+  // used: ahead of the bucket the pile is as it was.
+  prediction::PenetrationFeatures features;
+  features.speed = s.speed;
+  features.shoveled_volume = v1;
+  features.material = material_.name;
+  const Eigen::Vector2d forward(std::cos(s.heading), std::sin(s.heading));
+  const Eigen::Vector2d left(-forward.y(), forward.x());
+  const Eigen::Vector2d tip = rt.tip_path.back().head<2>();
+  for (int k = 0; k < prediction::kNumHeights; ++k) {
+    double sum = 0;
+    for (int j = -2; j <= 2; ++j) {
+      const Eigen::Vector2d p = tip + (k + 1) * prediction::kHeightSpacing * forward +
+                                j * 0.2 * machine_.bucket.width * left;
+      const double h = map_.HeightAt(p.x(), p.y());
+      sum += std::isfinite(h) ? std::max(h, 0.0) : 0.0;
+    }
+    features.heights[k] = sum / 5;
+  }
+  const prediction::PenetrationPrediction d = predictor_->Predict(features);
+  if (!d.ok) {
+    ++rt.result.prediction_failures;
+    return 0;
+  }
+  try {
+    const std::vector<double> q = {s.q_boom, s.q_bucket};
+    const prediction::ScoopPlan plan = prediction::ScoopPlanFromMachine(
+        machine_, functions_, q, 1.0, 1.0, std::max(limits_.bucket_max - s.q_bucket, 0.0),
+        options_.strategy.exit_boom_lift);
+    prediction::MachineAtTrigger at;
+    at.hinge_xy = s.hinge_xy;
+    at.heading = s.heading;
+    at.speed = std::max(s.speed, 0.0);
+    at.q = q;
+    return prediction::PredictFutureVolume(machine_, map_, rt.tip_path, at, d.penetration, plan)
+        .total();
+  } catch (const std::exception&) {
+    ++rt.result.prediction_failures;
+    return 0;
+  }
+}
+
+void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
+  const bool stopped = rt.stop.Update(s.speed);
+  if (rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop) {
+    if (rt.tip_path.size() >= 2) {
+      rt.v1 = prediction::Eq19Volume(map_, rt.tip_path, machine_.bucket.width).volume;
+    }
+  }
+  const double elapsed = s.time - rt.phase_start_time;
+  switch (rt.phase) {
+    case Phase::kApproach: {
+      if (rt.v1 > options_.contact_volume) {
+        rt.result.contact_time = s.time;
+        rt.result.boom_pressure_at_contact = s.boom_pressure;
+        rt.contact_hinge = s.hinge_xy;
+        rt.stop.Reset();
+        EnterPhase(machine, Phase::kCrowd, s, rt);
+      } else if (elapsed > options_.max_approach) {
+        rt.result.failure =
+            "no contact with the pile within " + std::to_string(options_.max_approach) + " s";
+        rt.phase = Phase::kDone;
+      }
+      return;
+    }
+    case Phase::kCrowd: {
+      TriggerInputs in;
+      in.v1 = rt.v1;
+      in.boom_pressure = s.boom_pressure;
+      const bool predict =
+          trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
+      in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
+      const bool fired = trigger_.Fire(in);
+      std::optional<ScoopStrategy> strategy;
+      if (options_.policy == ScoopPolicy::kAutoSelection) {
+        // Algorithm 3 with this trigger as line 7's condition.
+        const ScoopDecision decision =
+            fired ? (material_.difficult ? ScoopDecision::kStairway : ScoopDecision::kJustInOut)
+                  : SelectStrategy({.v1 = rt.v1,
+                                    .v2 = 0,
+                                    .target_volume = INFINITY,
+                                    .difficult = material_.difficult,
+                                    .stopped = stopped});
+        if (decision == ScoopDecision::kJustInOut) strategy = ScoopStrategy::kJustInOut;
+        if (decision == ScoopDecision::kStairway) strategy = ScoopStrategy::kStairway;
+      } else if (fired || stopped) {
+        strategy = options_.policy == ScoopPolicy::kJustInOut  ? ScoopStrategy::kJustInOut
+                   : options_.policy == ScoopPolicy::kStairway ? ScoopStrategy::kStairway
+                                                               : ScoopStrategy::kStairwayFixed;
+      }
+      if (strategy) {
+        ScoopResult& r = rt.result;
+        r.trigger_time = s.time;
+        r.trigger_after_contact = s.time - r.contact_time;
+        r.trigger_reason = fired ? trigger_.Name() : "stopped";
+        r.strategy = *strategy;
+        r.v1_at_trigger = rt.v1;
+        r.v2_at_trigger = in.v2;
+        r.boom_pressure_at_trigger = s.boom_pressure;
+        rt.q_bucket_at_trigger = s.q_bucket;
+        rt.q_boom_at_trigger = s.q_boom;
+        rt.sequencer.emplace(*strategy, options_.strategy, limits_);
+        rt.action.reset();
+        EnterPhase(machine, Phase::kScoop, s, rt);
+      } else if (elapsed > options_.max_crowd) {
+        rt.result.failure = "no trigger within " + std::to_string(options_.max_crowd) + " s";
+        rt.phase = Phase::kDone;
+      }
+      return;
+    }
+    case Phase::kScoop: {
+      // The running action is over once arrived and paused, or timed out.
+      if (rt.action) {
+        const bool bucket = rt.action->kind == AtomicKind::kRetractBucket;
+        const double error = bucket ? rt.targets.bucket - s.q_bucket : rt.targets.boom - s.q_boom;
+        const double tolerance =
+            bucket ? options_.bucket_gains.tolerance : options_.boom_gains.tolerance;
+        if (std::isnan(rt.arrived_at) && std::abs(error) <= 2 * tolerance) rt.arrived_at = s.time;
+        const bool paused =
+            !std::isnan(rt.arrived_at) && s.time - rt.arrived_at >= rt.action->pause;
+        if (paused || s.time - rt.action_start > options_.action_timeout) rt.action.reset();
+      }
+      if (!rt.action) {
+        rt.action = rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
+        if (rt.action) {
+          rt.targets = TargetsAfter(*rt.action, rt.targets, limits_);
+          rt.action_start = s.time;
+          rt.arrived_at = NAN;
+          // The final rack-back and lift leave the pile: stop crowding.
+          const bool final_part = rt.sequencer->strategy() == ScoopStrategy::kJustInOut ||
+                                  rt.sequencer->actions() > 2 * rt.sequencer->steps();
+          if (final_part) rt.finishing_drive = true;
+        } else {
+          rt.result.feedback_volume = rt.v1;
+          rt.result.atomic_actions = rt.sequencer->actions();
+          rt.result.stairway_steps = rt.sequencer->steps();
+          rt.result.payload_after_scoop = machine.PayloadVolume();
+          EnterPhase(machine, Phase::kLevel, s, rt);
+          rt.targets.bucket = std::max(rt.targets.bucket - options_.finishing.level_tilt,
+                                       machine_.links[1].joint_min);
+          rt.arrived_at = NAN;
+        }
+      } else if (elapsed > options_.max_scoop) {
+        rt.result.failure =
+            "scoop not complete within " + std::to_string(options_.max_scoop) + " s";
+        rt.phase = Phase::kDone;
+      }
+      return;
+    }
+    case Phase::kLevel: {
+      if (std::isnan(rt.arrived_at) &&
+          std::abs(rt.targets.bucket - s.q_bucket) <= 2 * options_.bucket_gains.tolerance) {
+        rt.arrived_at = s.time;
+      }
+      const bool held =
+          !std::isnan(rt.arrived_at) && s.time - rt.arrived_at >= options_.finishing.level_hold;
+      if (held || elapsed > options_.action_timeout) {
+        EnterPhase(machine, Phase::kShake, s, rt);
+        rt.shake_start = s.time;
+      }
+      return;
+    }
+    case Phase::kShake: {
+      // Pulses, then the valve's delay for the last one to reach the spool and die out.
+      const double pulses = options_.finishing.shake_pulses * options_.finishing.shake_pulse;
+      if (elapsed >= pulses + bucket_delay_) {
+        rt.targets.bucket = limits_.bucket_max;
+        EnterPhase(machine, Phase::kRetreat, s, rt);
+      }
+      return;
+    }
+    case Phase::kRetreat: {
+      const double behind = (rt.contact_hinge - s.hinge_xy)
+                                .dot(Eigen::Vector2d(std::cos(s.heading), std::sin(s.heading)));
+      if (!rt.stopping && behind >= options_.retreat_beyond_contact) rt.stopping = true;
+      if (rt.stopping && std::abs(s.speed) < 0.05) {
+        EnterPhase(machine, Phase::kDone, s, rt);
+        rt.result.ok = true;
+      } else if (elapsed > options_.max_retreat) {
+        rt.result.failure =
+            "retreat not complete within " + std::to_string(options_.max_retreat) + " s";
+        rt.phase = Phase::kDone;
+      }
+      return;
+    }
+    case Phase::kDone:
+      return;
+  }
+}
+
+ScoopResult ScoopCycle::Run(ScoopMachine& machine) {
+  Runtime rt;
+  trigger_.Reset();
+  rt.result.target_volume = options_.target_fill * machine_.bucket.rated_capacity;
+  JointPid boom_pid(options_.boom_gains,
+                    machine_.hydraulics.actuators[boom_valve_].valve.dead_zone);
+  JointPid bucket_pid(options_.bucket_gains,
+                      machine_.hydraulics.actuators[bucket_valve_].valve.dead_zone);
+  SpeedPid speed_pid(options_.speed_gains);
+  Proprioception s = machine.Sense();
+  speed_pid.Reset(std::isfinite(s.speed) ? s.speed : 0.0);
+  rt.targets = options_.attack_pose;
+  rt.phase_start_time = s.time;
+  rt.phase_start_energy = machine.Energy();
+  machine.SetPhase(PhaseName(static_cast<int>(Phase::kApproach)));
+
+  core::ActuatorCommand command;
+  command.valve.assign(machine_.hydraulics.actuators.size(), 0.0);
+  for (long tick = 0; rt.phase != Phase::kDone; ++tick) {
+    s = machine.Sense();
+    if (!Finite(s)) {
+      rt.result.failure = "machine reports a non-finite state at t = " + std::to_string(s.time);
+      break;
+    }
+    const bool digging =
+        rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop;
+    if (digging) {
+      const Eigen::Vector2d p = prediction::TipInBase(machine_, s.q_boom, s.q_bucket);
+      const Eigen::Vector3d tip(s.hinge_xy.x() + std::cos(s.heading) * p.x(),
+                                s.hinge_xy.y() + std::sin(s.heading) * p.x(), p.y());
+      if (rt.tip_path.empty() || (tip - rt.tip_path.back()).norm() >= options_.path_spacing) {
+        rt.tip_path.push_back(tip);
+      }
+    }
+    if (tick % options_.decision_every == 0) Decide(machine, s, rt);
+    if (rt.phase == Phase::kDone) break;
+
+    // Low-level control, every tick.
+    if (rt.phase == Phase::kScoop && !rt.arm_moving &&
+        (s.q_bucket > rt.q_bucket_at_trigger + options_.arm_motion ||
+         s.q_boom > rt.q_boom_at_trigger + options_.arm_motion)) {
+      rt.arm_moving = true;
+      rt.result.arm_motion_after_trigger = s.time - rt.result.trigger_time;
+    }
+    double speed_target = options_.attack_speed;
+    switch (rt.phase) {
+      case Phase::kApproach:
+      case Phase::kCrowd:
+        break;
+      case Phase::kScoop:
+        // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
+        // rate once the final rack/lift runs and the arm moves.
+        if (rt.finishing_drive && rt.arm_moving) speed_target = 0;
+        break;
+      case Phase::kLevel:
+      case Phase::kShake:
+        speed_target = 0;
+        break;
+      case Phase::kRetreat:
+        speed_target = rt.stopping ? 0.0 : -options_.retreat_speed;
+        break;
+      case Phase::kDone:
+        speed_target = 0;
+        break;
+    }
+    speed_pid.SetTarget(speed_target);
+    const DriveCommand drive = speed_pid.Update(s.speed, options_.tick);
+    command.drive = drive.drive;
+    command.brake = drive.brake;
+    command.articulation_rate = 0;
+    command.valve[boom_valve_] =
+        boom_pid.Update(rt.targets.boom, s.q_boom, s.qd_boom, options_.tick);
+    if (rt.phase == Phase::kShake) {
+      const double t = s.time - rt.shake_start;
+      const int pulse = static_cast<int>(std::floor(t / options_.finishing.shake_pulse));
+      command.valve[bucket_valve_] = pulse < options_.finishing.shake_pulses
+                                         ? (pulse % 2 == 0 ? 1 : -1) * options_.finishing.shake_duty
+                                         : 0.0;
+    } else {
+      command.valve[bucket_valve_] =
+          bucket_pid.Update(rt.targets.bucket, s.q_bucket, s.qd_bucket, options_.tick);
+    }
+    // NaN never reaches the machine: a non-finite field is replaced by a safe value and counted.
+    bool blocked = false;
+    for (double& u : command.valve) {
+      if (!std::isfinite(u)) u = 0, blocked = true;
+    }
+    if (!std::isfinite(command.drive) || !std::isfinite(command.brake)) {
+      command.drive = 0, command.brake = 1, blocked = true;
+    }
+    if (blocked) ++rt.result.non_finite_blocked;
+    std::string why;
+    if (!machine.Command(command, &why)) ++rt.result.refused_commands;
+    machine.Advance(options_.tick);
+  }
+  rt.result.end_time = machine.Sense().time;
+  rt.result.payload = machine.PayloadVolume();
+  rt.result.fill_rate = rt.result.payload / machine_.bucket.rated_capacity;
+  return rt.result;
+}
+
+}  // namespace autoshovel::control

@@ -1,0 +1,183 @@
+// One scoop of a wheel loader, wheel-loader seed §6 (Fig. 9, Algorithm 3, §6.2), as a state
+// machine stepped on the machine's clock: low-level control (joint PIDs, speed PID) every tick
+// (100 Hz), decisions (stop detector, V1, V2, trigger, strategy, atomic actions) every
+// `decision_every` ticks (20 Hz), §7 "Shoveling action execution and strategy selection are
+// implemented via a state machine with an output frequency of 20 Hz".
+//
+// Phases (each booked to its own energy counter and timed):
+//   approach — bucket held at the attack pose, speed PID at the attack speed, until the bucket
+//              touches the pile, read as V1 > contact_volume (Algorithm 3 line 3: "while V1 > 0");
+//   crowd    — the same commands; every decision computes V1 (Eq. 19 over the tip path on the
+//              pre-contact map), V2 when the trigger reads it (penetration SVR → V21 + V22), the
+//              stop detector; ends when the trigger fires or the machine stops (line 13);
+//   scoop    — the strategy's atomic actions (Algorithm 3 picks it under kAutoSelection). The
+//              drive keeps crowding through the hydraulic delay until the bucket moves (Fig. 21
+//              (a)–(b)); then "fixed acceleration control" (speed target 0 at the profile's
+//              deceleration) for "Just in & out" and the final rack/lift of "Stairway", whose
+//              steps crowd on (that is how they cut through the pile);
+//   level, shake — FinishingParameters (scooping_strategies.h), machine braked;
+//   retreat  — bucket racked, reversing until the hinge is `retreat_beyond_contact` behind where
+//              it was at contact, then stopping.
+// The machine is seen through ScoopMachine only (proprioception, commands, the clock, energy and
+// payload meters): the simulated plant and a real machine both implement it (DESIGN.md: control
+// never includes plant/).
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "generated/machine_functions.h"
+#include "runtime/control/atomic_actions.h"
+#include "runtime/control/joint_pid.h"
+#include "runtime/control/scoop_triggers.h"
+#include "runtime/control/scooping_strategies.h"
+#include "runtime/control/speed_pid.h"
+#include "runtime/control/stop_detector.h"
+#include "runtime/control/strategy_selection.h"
+#include "runtime/core/actuator_command.h"
+#include "runtime/model/description.h"
+#include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/volume_estimation.h"
+
+namespace autoshovel::control {
+
+/// What the machine's own sensors report at one instant.
+struct Proprioception {
+  double time = 0;                                     ///< machine clock [s]
+  Eigen::Vector2d hinge_xy = Eigen::Vector2d::Zero();  ///< localisation, world [m]
+  double heading = 0;                                  ///< front frame [rad]
+  double speed = 0;                                    ///< forward [m/s]
+  double q_boom = 0, q_bucket = 0;                     ///< joints (IMUs, Eq. 1) [rad]
+  double qd_boom = 0, qd_bucket = 0;                   ///< [rad/s]
+  double boom_pressure = 0;                            ///< boom cylinder cap side [Pa]
+};
+
+/// The machine as the scoop cycle sees it.
+class ScoopMachine {
+ public:
+  virtual ~ScoopMachine() = default;
+  virtual Proprioception Sense() const = 0;
+  /// Sends a command; false (and `why`) when the machine refuses it.
+  virtual bool Command(const core::ActuatorCommand& command, std::string* why) = 0;
+  /// Lets one control tick of `dt` [s] pass (the simulated clock, or a real-time wait).
+  virtual void Advance(double dt) = 0;
+  /// Names the phase the following energy is booked to.
+  virtual void SetPhase(const std::string& phase) = 0;
+  /// Energy drawn so far [J] (travel + hydraulic).
+  virtual double Energy() const = 0;
+  /// Volume in the bucket [m³] (a weighing system; the plant's payload in simulation).
+  virtual double PayloadVolume() const = 0;
+};
+
+enum class ScoopPolicy {
+  kAutoSelection,  ///< Algorithm 3
+  kJustInOut,
+  kStairway,       ///< adaptive (volume feedback between actions)
+  kStairwayFixed,  ///< "Stairway #N", N = StrategyParameters::fixed_steps
+};
+const char* ToString(ScoopPolicy policy);
+
+struct ScoopCycleOptions {
+  double tick = 0.01;                   ///< low-level control period [s] (100 Hz)
+  int decision_every = 5;               ///< ticks per state-machine decision (20 Hz)
+  double attack_speed = 1.0;            ///< approach and crowding speed [m/s]
+  double retreat_speed = 1.0;           ///< reversing speed [m/s]
+  double retreat_beyond_contact = 1.0;  ///< [m]
+  double target_fill = 1.0;             ///< V_t as a fraction of the rated capacity [-]
+  double contact_volume = 0.005;        ///< V1 above which the bucket is in the pile [m³]
+  double rack_back_margin = 0.1;        ///< racked target below the bucket joint limit [rad]
+  double boom_margin = 0.05;            ///< highest boom target below its limit [rad]
+  double arm_motion = 0.02;     ///< joint travel that shows the scoop has begun moving [rad]
+  double action_timeout = 4.0;  ///< an atomic action that has not arrived by then is over [s]
+  double path_spacing = 0.01;   ///< tip path points at least this far apart [m]
+  ArmTargets attack_pose;       ///< bucket on the floor (plant/poses.h BucketOnFloor in tests)
+  ScoopPolicy policy = ScoopPolicy::kAutoSelection;
+  StrategyParameters strategy;
+  FinishingParameters finishing;
+  JointPidGains boom_gains;
+  JointPidGains bucket_gains;
+  SpeedPidGains speed_gains;
+  /// Phase time limits [s]: a phase running longer ends the cycle as failed.
+  double max_approach = 30, max_crowd = 12, max_scoop = 20, max_retreat = 20;
+
+  std::string Invalid() const;
+};
+
+struct PhaseRecord {
+  std::string name;
+  double start = 0;     ///< [s]
+  double duration = 0;  ///< [s]
+  double energy = 0;    ///< [J]
+};
+
+struct ScoopResult {
+  bool ok = false;
+  std::string failure;
+  std::vector<PhaseRecord> phases;        ///< in order
+  double contact_time = NAN;              ///< first decision with V1 > contact_volume [s]
+  double trigger_time = NAN;              ///< [s]
+  double trigger_after_contact = NAN;     ///< [s]
+  double arm_motion_after_trigger = NAN;  ///< command-to-motion delay seen [s]
+  std::string trigger_reason;             ///< the trigger's name, or "stopped"
+  ScoopStrategy strategy = ScoopStrategy::kJustInOut;
+  double v1_at_trigger = 0, v2_at_trigger = 0;  ///< [m³]
+  double target_volume = 0;                     ///< V_t [m³]
+  double feedback_volume = 0;                   ///< V1 at the end of the scoop phase [m³]
+  int atomic_actions = 0;
+  int stairway_steps = 0;
+  double boom_pressure_at_contact = 0;  ///< [Pa]
+  double boom_pressure_at_trigger = 0;  ///< [Pa]
+  double payload_after_scoop = 0;       ///< before levelling and shaking [m³]
+  double payload = 0;                   ///< at the end [m³]
+  double fill_rate = 0;                 ///< payload / rated capacity [-]
+  long non_finite_blocked = 0;  ///< commands with a NaN stopped before the machine (must be 0)
+  long refused_commands = 0;    ///< commands the machine refused
+  long prediction_failures = 0;
+  double end_time = 0;
+
+  const PhaseRecord* Phase(const std::string& name) const;
+  /// Contact to the end of the scoop phase (the seed's Table 6/7 "time"): crowd + scoop.
+  double ContactToScoopEndTime() const;
+  double ContactToScoopEndEnergy() const;  ///< [J]
+};
+
+class ScoopCycle {
+ public:
+  /// `map`: heights before the bucket came (the elevation map), `material`: the pile's material
+  /// (from the semantic map), `trigger`: when to scoop, `predictor`: needed when the trigger
+  /// reads V2 (may be null otherwise). All referenced objects must outlive the cycle. Throws
+  /// std::invalid_argument for invalid options, an arm that is not a two-link loader arm, or a
+  /// trigger that needs a missing predictor.
+  ScoopCycle(const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+             const prediction::HeightGrid& map, const model::Material& material,
+             ScoopTrigger& trigger, const prediction::PenetrationPredictor* predictor,
+             const ScoopCycleOptions& options);
+
+  /// Runs the whole cycle on `machine`; returns when retreated, or failed.
+  ScoopResult Run(ScoopMachine& machine);
+
+ private:
+  enum class Phase { kApproach, kCrowd, kScoop, kLevel, kShake, kRetreat, kDone };
+  struct Runtime;
+  void Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
+  double ComputeV2(const Proprioception& s, double v1, Runtime& rt);
+  void EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s, Runtime& rt);
+
+  const model::MachineDescription& machine_;
+  const generated::MachineFunctions& functions_;
+  const prediction::HeightGrid& map_;
+  const model::Material& material_;
+  ScoopTrigger& trigger_;
+  const prediction::PenetrationPredictor* predictor_;
+  ScoopCycleOptions options_;
+  ArmLimits limits_;
+  int boom_valve_ = -1, bucket_valve_ = -1;
+  double bucket_delay_ = 0;  ///< transport delay + spool time constant of the bucket valve [s]
+};
+
+}  // namespace autoshovel::control

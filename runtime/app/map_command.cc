@@ -22,15 +22,10 @@ namespace autoshovel::app {
 
 int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
   try {
-    plant::Scenario scenario =
-        plant::LoadScenario(plant::ResolveScenario(options.scenario, options.models_dir));
-    const model::MachineDescription machine = model::LoadMachineDescription(
-        model::ResolveMachineDescription(scenario.machine, options.models_dir));
-    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-    if (functions == nullptr) {
-      err << "autoshovel map: machine '" << machine.name << "' has no generated code\n";
-      return 2;
-    }
+    plant::ScenarioWithMachine setup =
+        plant::LoadScenarioWithMachine(options.scenario, options.models_dir);
+    plant::Scenario& scenario = setup.scenario;
+    const model::MachineDescription& machine = setup.machine;
     plant::Lighting lighting = scenario.lighting;
     if (!options.lighting.empty()) {
       const auto parsed = plant::ParseLighting(options.lighting);
@@ -41,22 +36,8 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
       }
       lighting = *parsed;
     }
-    plant::MachineState start;
-    start.heading = scenario.start.heading;
-    start.hinge_xy =
-        Eigen::Vector2d(scenario.start.x, scenario.start.y) +
-        options.advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
-    // Bucket on the floor, as when approaching a pile (other arms: low in their range).
-    start.q.assign(machine.num_joints(), 0.0);
-    if (machine.num_links() == 2) {
-      start.q = plant::BucketOnFloor(machine);
-    } else {
-      for (std::size_t j = 0; j < machine.num_links(); ++j) {
-        start.q[j] = machine.links[j].joint_min +
-                     0.1 * (machine.links[j].joint_max - machine.links[j].joint_min);
-      }
-    }
-    plant::Plant plant(machine, *functions, scenario.world, start);
+    plant::Plant plant(machine, *setup.functions, scenario.world,
+                       plant::StartState(scenario, machine, options.advance));
     sensors::RaycastScene scene(scenario.world, plant.OwnBodies());
     sensors::Rng rng(scenario.seed);
 

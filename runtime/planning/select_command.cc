@@ -101,15 +101,11 @@ bool PerceiveMap(const SelectOptions& options, plant::Scenario& scenario,
 
 int RunSelect(const SelectOptions& options, std::ostream& out, std::ostream& err) {
   try {
-    plant::Scenario scenario =
-        plant::LoadScenario(plant::ResolveScenario(options.scenario, options.models_dir));
-    const model::MachineDescription machine = model::LoadMachineDescription(
-        model::ResolveMachineDescription(scenario.machine, options.models_dir));
-    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-    if (functions == nullptr) {
-      err << "autoshovel select: machine '" << machine.name << "' has no generated code\n";
-      return 2;
-    }
+    plant::ScenarioWithMachine setup =
+        plant::LoadScenarioWithMachine(options.scenario, options.models_dir);
+    plant::Scenario& scenario = setup.scenario;
+    const model::MachineDescription& machine = setup.machine;
+    const generated::MachineFunctions* functions = setup.functions;
     if (machine.kind != model::MachineKind::kWheelLoader) {
       err << "autoshovel select: '" << machine.name << "' is not a wheel loader\n";
       return 2;
@@ -131,12 +127,7 @@ int RunSelect(const SelectOptions& options, std::ostream& out, std::ostream& err
       return 2;
     }
 
-    plant::MachineState start;
-    start.heading = scenario.start.heading;
-    start.hinge_xy =
-        Eigen::Vector2d(scenario.start.x, scenario.start.y) +
-        options.advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
-    start.q = plant::BucketOnFloor(machine);
+    const plant::MachineState start = plant::StartState(scenario, machine, options.advance);
     const Pose2 T_world_hinge{start.hinge_xy, start.heading};
 
     const auto t0 = std::chrono::steady_clock::now();

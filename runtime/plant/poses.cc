@@ -24,4 +24,37 @@ std::vector<double> BucketOnFloor(const model::MachineDescription& machine, doub
   return {boom, phi_bucket - boom};
 }
 
+ScenarioWithMachine LoadScenarioWithMachine(const std::string& scenario_name_or_path,
+                                            const std::string& models_dir) {
+  ScenarioWithMachine out;
+  out.scenario = LoadScenario(ResolveScenario(scenario_name_or_path, models_dir));
+  out.machine = model::LoadMachineDescription(
+      model::ResolveMachineDescription(out.scenario.machine, models_dir));
+  out.functions = generated::FindMachine(out.machine.name);
+  if (out.functions == nullptr) {
+    throw std::runtime_error("machine '" + out.machine.name +
+                             "' has no generated code (run: autoshovel gen " +
+                             out.machine.source_file + ", then rebuild)");
+  }
+  return out;
+}
+
+MachineState StartState(const Scenario& scenario, const model::MachineDescription& machine,
+                        double advance) {
+  MachineState start;
+  start.heading = scenario.start.heading;
+  start.hinge_xy = Eigen::Vector2d(scenario.start.x, scenario.start.y) +
+                   advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
+  if (machine.kind == model::MachineKind::kWheelLoader && machine.num_links() == 2) {
+    start.q = BucketOnFloor(machine);
+  } else {
+    start.q.assign(machine.num_joints(), 0.0);
+    for (std::size_t j = 0; j < machine.num_links(); ++j) {
+      start.q[j] = machine.links[j].joint_min +
+                   0.1 * (machine.links[j].joint_max - machine.links[j].joint_min);
+    }
+  }
+  return start;
+}
+
 }  // namespace autoshovel::plant

@@ -3,7 +3,10 @@
 
 #include <vector>
 
+#include "generated/registry.h"
 #include "runtime/model/description.h"
+#include "runtime/plant/machine_state.h"
+#include "runtime/plant/scenario.h"
 
 namespace autoshovel::plant {
 
@@ -13,5 +16,24 @@ namespace autoshovel::plant {
 /// not two links or cannot reach that low.
 std::vector<double> BucketOnFloor(const model::MachineDescription& machine,
                                   double tip_height = 0.05);
+
+/// A scenario with its machine: the description named by the scenario and its generated code.
+struct ScenarioWithMachine {
+  Scenario scenario;
+  model::MachineDescription machine;
+  const generated::MachineFunctions* functions = nullptr;  ///< never null
+};
+
+/// Loads a scenario (name under `<models_dir>/scenarios` or a path) and its machine. Throws
+/// core::InputError for bad files and std::runtime_error when the machine has no generated
+/// code (naming the command that generates it).
+ScenarioWithMachine LoadScenarioWithMachine(const std::string& scenario_name_or_path,
+                                            const std::string& models_dir);
+
+/// The scenario's start pose moved `advance` metres ahead along its heading, with the arm as
+/// when approaching a pile: a loader's bucket on the floor (BucketOnFloor), other arms low in
+/// their range (10 % from the bottom of each joint).
+MachineState StartState(const Scenario& scenario, const model::MachineDescription& machine,
+                        double advance = 0.0);
 
 }  // namespace autoshovel::plant

@@ -35,16 +35,11 @@ struct Scene {
   sensors::Rng rng{11};
 
   Scene(const std::string& name, double advance) {
-    scenario = plant::LoadScenario(plant::ResolveScenario(name, kModels));
-    machine =
-        model::LoadMachineDescription(model::ResolveMachineDescription(scenario.machine, kModels));
-    plant::MachineState start;
-    start.heading = scenario.start.heading;
-    start.hinge_xy = Eigen::Vector2d(scenario.start.x, scenario.start.y) +
-                     advance * Eigen::Vector2d(std::cos(start.heading), std::sin(start.heading));
-    start.q = plant::BucketOnFloor(machine);
-    plant = std::make_unique<plant::Plant>(machine, *generated::FindMachine(machine.name),
-                                           scenario.world, start);
+    plant::ScenarioWithMachine setup = plant::LoadScenarioWithMachine(name, kModels);
+    scenario = std::move(setup.scenario);
+    machine = std::move(setup.machine);
+    plant = std::make_unique<plant::Plant>(machine, *setup.functions, scenario.world,
+                                           plant::StartState(scenario, machine, advance));
     raycast = std::make_unique<sensors::RaycastScene>(scenario.world, plant->OwnBodies());
   }
 

@@ -28,26 +28,6 @@ int MaterialIndexOf(const model::MachineDescription& machine, const std::string&
                               name + "'");
 }
 
-// h1..h6 (penetration_predictor.h): the surface k·Δl ahead of the tip along the heading, mean of
-// five points across the bucket width.
-std::array<double, prediction::kNumHeights> SampleHeights(const plant::Terrain& terrain,
-                                                          const Eigen::Vector3d& tip,
-                                                          double heading, double width) {
-  const Eigen::Vector2d forward(std::cos(heading), std::sin(heading));
-  const Eigen::Vector2d left(-forward.y(), forward.x());
-  std::array<double, prediction::kNumHeights> h{};
-  for (int k = 0; k < prediction::kNumHeights; ++k) {
-    double sum = 0;
-    for (int j = -2; j <= 2; ++j) {
-      const Eigen::Vector2d p =
-          tip.head<2>() + (k + 1) * prediction::kHeightSpacing * forward + j * 0.2 * width * left;
-      sum += terrain.HeightAt(p.x(), p.y());
-    }
-    h[k] = sum / 5;
-  }
-  return h;
-}
-
 prediction::HeightGrid Crop(const plant::Terrain& terrain, const Eigen::Vector2d& lo,
                             const Eigen::Vector2d& hi) {
   int ix0 = 0, iy0 = 0, ix1 = 0, iy1 = 0;
@@ -194,7 +174,9 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
           run.features.speed = s.speed;
           run.features.shoveled_volume = v1;
           run.features.material = spec.material;
-          run.features.heights = SampleHeights(world.terrain, tip, heading, machine.bucket.width);
+          run.features.heights = prediction::SampleHeightsAhead(
+              [&](double x, double y) { return world.terrain.HeightAt(x, y); }, tip.head<2>(),
+              heading, machine.bucket.width);
           run.at_trigger.hinge_xy = s.hinge_xy;
           run.at_trigger.heading = s.heading;
           run.at_trigger.speed = s.speed;

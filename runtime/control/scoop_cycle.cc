@@ -165,19 +165,13 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
   features.speed = s.speed;
   features.shoveled_volume = v1;
   features.material = material_.name;
-  const Eigen::Vector2d forward(std::cos(s.heading), std::sin(s.heading));
-  const Eigen::Vector2d left(-forward.y(), forward.x());
-  const Eigen::Vector2d tip = rt.tip_path.back().head<2>();
-  for (int k = 0; k < prediction::kNumHeights; ++k) {
-    double sum = 0;
-    for (int j = -2; j <= 2; ++j) {
-      const Eigen::Vector2d p = tip + (k + 1) * prediction::kHeightSpacing * forward +
-                                j * 0.2 * machine_.bucket.width * left;
-      const double h = map_.HeightAt(p.x(), p.y());
-      sum += std::isfinite(h) ? std::max(h, 0.0) : 0.0;
-    }
-    features.heights[k] = sum / 5;
-  }
+  // Unknown cells count as floor; map noise below the floor as the floor.
+  features.heights = prediction::SampleHeightsAhead(
+      [&](double x, double y) {
+        const double h = map_.HeightAt(x, y);
+        return std::isfinite(h) ? std::max(h, 0.0) : 0.0;
+      },
+      rt.tip_path.back().head<2>(), s.heading, machine_.bucket.width);
   const prediction::PenetrationPrediction d = predictor_->Predict(features);
   if (!d.ok) {
     ++rt.result.prediction_failures;

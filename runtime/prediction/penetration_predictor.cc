@@ -218,4 +218,22 @@ PenetrationPredictor PenetrationPredictor::Load(const std::string& path_stem) {
   return PenetrationPredictor(std::move(model), std::move(scaling));
 }
 
+std::array<double, kNumHeights> SampleHeightsAhead(
+    const std::function<double(double, double)>& height_at, const Eigen::Vector2d& tip_xy,
+    double heading, double bucket_width) {
+  const Eigen::Vector2d forward(std::cos(heading), std::sin(heading));
+  const Eigen::Vector2d left(-forward.y(), forward.x());
+  std::array<double, kNumHeights> h{};
+  for (int k = 0; k < kNumHeights; ++k) {
+    double sum = 0;
+    for (int j = -2; j <= 2; ++j) {
+      const Eigen::Vector2d p =
+          tip_xy + (k + 1) * kHeightSpacing * forward + j * 0.2 * bucket_width * left;
+      sum += height_at(p.x(), p.y());
+    }
+    h[k] = sum / 5;
+  }
+  return h;
+}
+
 }  // namespace autoshovel::prediction

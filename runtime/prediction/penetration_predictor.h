@@ -22,7 +22,9 @@
 //   note <free text>                  (any number: the training command, figures)
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +33,14 @@ namespace autoshovel::prediction {
 
 inline constexpr int kNumHeights = 6;
 inline constexpr double kHeightSpacing = 0.5;  ///< Δl [m], seed §6.1
+
+/// h1..h6: the surface k·Δl (k = 1…6) ahead of the bucket tip along the heading, each the mean
+/// of five points across the bucket width (robust to a bumpy face). `height_at(x, y)` gives the
+/// surface height there [m]. One definition for the training runs and the controller, so the
+/// predictor sees the same features in both.
+std::array<double, kNumHeights> SampleHeightsAhead(
+    const std::function<double(double, double)>& height_at, const Eigen::Vector2d& tip_xy,
+    double heading, double bucket_width);
 
 struct PenetrationFeatures {
   double speed = 0;                           ///< v, forward [m/s]

@@ -9,11 +9,11 @@
 
 #include "generated/registry.h"
 #include "identification/calibration/arm_calibration_csv.h"
-#include "identification/common/bar_chart.h"
 #include "identification/common/overlay_file.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
 #include "runtime/model/interpreted_model.h"
+#include "runtime/plot/bar_chart.h"
 
 namespace autoshovel::identification {
 
@@ -147,12 +147,12 @@ int RunCalibrateArm(const CalibrateArmOptions& options, std::ostream& out, std::
     }
     WriteFileAtomically(overlay, text);
     // Residuals per displacement, at the start and calibrated, each on its own scale.
-    BarChart before, after;
+    plot::BarChart before, after;
     before.title = machine.name + ": tip displacement residuals at the start";
     after.title = machine.name + ": tip displacement residuals, calibrated";
     before.unit = after.unit = "mm";
-    BarSeries before_x{"x", {}, {200, 120, 40}}, before_z{"z", {}, {40, 80, 220}};
-    BarSeries after_x = before_x, after_z = before_z;
+    plot::BarSeries before_x{"x", {}, {200, 120, 40}}, before_z{"z", {}, {40, 80, 220}};
+    plot::BarSeries after_x = before_x, after_z = before_z;
     for (std::size_t i = 0; i < r.residuals.size(); ++i) {
       before.groups.push_back("pose " + std::to_string(i + 1) + "-" + std::to_string(i + 2));
       before_x.values.push_back(1e3 * r.initial_residuals[i].x());
@@ -164,7 +164,7 @@ int RunCalibrateArm(const CalibrateArmOptions& options, std::ostream& out, std::
     before.series = {before_x, before_z};
     after.series = {after_x, after_z};
     const std::string png = options.png.empty() ? overlay + ".png" : options.png;
-    WriteBarChartsPng({before, after}, png);
+    plot::WriteBarChartsPng({before, after}, png);
     out << "residuals: " << png << "\n";
     out << "overlay: " << overlay << "\n";
     return 0;

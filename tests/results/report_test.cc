@@ -57,9 +57,26 @@ TEST(Plots, WriteNonEmptyPngs) {
   WriteVolumePlotPng(empty, kNotMeasured, dir / "empty.png");
   ExpectPng(dir / "empty.png");
 
-  LinePlot bad;
-  bad.series.push_back({"x and y differ", {1.0, 2.0}, {1.0}, kBlue, 2, false, false});
-  EXPECT_THROW(WriteLinePlotPng(bad, dir / "bad.png"), std::invalid_argument);
+  plot::LinePlot bad;
+  bad.series.push_back({"x and y differ", {1.0, 2.0}, {1.0}, plot::kBlue, 2, false, false});
+  EXPECT_THROW(plot::WriteLinePlotPng(bad, dir / "bad.png"), std::invalid_argument);
+  // A grid of three 300 × 250 plots, two per row: two rows, two columns.
+  plot::LinePlot small;
+  small.width_px = 300;
+  small.height_px = 250;
+  small.series.push_back({"y = x", {0.0, 1.0}, {0.0, 1.0}, plot::kBlue, 2, false, false});
+  plot::WriteLinePlotGridPng({small, small, small}, 2, dir / "grid.png");
+  // The PNG header (IHDR) holds the width and height, big-endian, at bytes 16 and 20.
+  std::ifstream png(dir / "grid.png", std::ios::binary);
+  unsigned char header[24] = {};
+  png.read(reinterpret_cast<char*>(header), sizeof header);
+  auto be32 = [&](int at) {
+    return (header[at] << 24) | (header[at + 1] << 16) | (header[at + 2] << 8) | header[at + 3];
+  };
+  EXPECT_EQ(be32(16), 600);
+  EXPECT_EQ(be32(20), 500);
+  EXPECT_FALSE(std::filesystem::exists(dir / "grid.png.tmp.png"));
+  EXPECT_THROW(plot::WriteLinePlotGridPng({}, 2, dir / "none.png"), std::invalid_argument);
   EXPECT_THROW(WriteVolumePlotPng(cycle, 3.0, dir / "no_such_folder" / "v.png"),
                std::runtime_error);
 }

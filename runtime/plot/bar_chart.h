@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace autoshovel::identification {
+namespace autoshovel::plot {
 
 struct BarSeries {
   std::string name;
@@ -25,4 +25,4 @@ void WriteBarChartPng(const BarChart& chart, const std::string& path);
 /// Several charts, each with its own scale, one above the other in one PNG.
 void WriteBarChartsPng(const std::vector<BarChart>& charts, const std::string& path);
 
-}  // namespace autoshovel::identification
+}  // namespace autoshovel::plot

@@ -1,4 +1,4 @@
-#include "identification/common/bar_chart.h"
+#include "runtime/plot/bar_chart.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
-namespace autoshovel::identification {
+namespace autoshovel::plot {
 
 namespace {
 
@@ -97,4 +97,4 @@ void WriteBarChartsPng(const std::vector<BarChart>& charts, const std::string& p
   }
 }
 
-}  // namespace autoshovel::identification
+}  // namespace autoshovel::plot

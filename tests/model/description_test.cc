@@ -72,20 +72,22 @@ TEST(MachineSummary, LoaderFiguresAreThoseOfItsClass) {
   EXPECT_GT(s.lift_capacity_at_carry, m.bucket.rated_load);
 }
 
+// Writes `text` to a file of that name in the test's temporary folder and returns its path.
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
 // Identified values flow in through overlays, checked against the description they belong to.
 TEST(Overlay, ReplacesIdentifiedValuesAndRefusesForeignOnes) {
   const std::string path = ResolveMachineDescription("xcmg_968ev", kModels);
   const MachineDescription base = LoadMachineDescription(path);
-  const std::string dir = ::testing::TempDir();
-  auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir + "/" + name) << text;
-    return dir + "/" + name;
-  };
   LoadOptions options;
-  options.overlays = {write("good.yaml", "machine: xcmg_968ev\nbase_sha256: " + base.sha256 +
-                                             "\narm:\n  links:\n    - name: boom\n"
-                                             "      length: 3.1234\n"
-                                             "      imu_offset_deg: 1.5\n")};
+  options.overlays = {WriteTemp("good.yaml", "machine: xcmg_968ev\nbase_sha256: " + base.sha256 +
+                                                 "\narm:\n  links:\n    - name: boom\n"
+                                                 "      length: 3.1234\n"
+                                                 "      imu_offset_deg: 1.5\n")};
   const MachineDescription calibrated = LoadMachineDescription(path, options);
   EXPECT_DOUBLE_EQ(calibrated.links[0].length, 3.1234);
   EXPECT_NEAR(calibrated.links[0].imu_offset, 1.5 * std::numbers::pi / 180, 1e-15);
@@ -103,24 +105,24 @@ TEST(Overlay, ReplacesIdentifiedValuesAndRefusesForeignOnes) {
     }
     return std::string("accepted");
   };
-  const std::string foreign = error_of(write("foreign.yaml", "machine: sdlg_l955he\n"));
+  const std::string foreign = error_of(WriteTemp("foreign.yaml", "machine: sdlg_l955he\n"));
   EXPECT_NE(foreign.find("foreign.yaml:1:10: machine: this overlay is for 'sdlg_l955he'"),
             std::string::npos)
       << foreign;
   const std::string stale =
-      error_of(write("stale.yaml", "machine: xcmg_968ev\nbase_sha256: 0123\n"));
+      error_of(WriteTemp("stale.yaml", "machine: xcmg_968ev\nbase_sha256: 0123\n"));
   EXPECT_NE(stale.find("stale.yaml:2:14: base_sha256: identified against another version"),
             std::string::npos)
       << stale;
   const std::string typo =
-      error_of(write("typo.yaml", "machine: xcmg_968ev\narm:\n  links:\n    - name: bom\n"));
+      error_of(WriteTemp("typo.yaml", "machine: xcmg_968ev\narm:\n  links:\n    - name: bom\n"));
   EXPECT_NE(typo.find("typo.yaml:4:13: arm.links[0].name: no link 'bom' in xcmg_968ev; did you "
                       "mean 'boom'?"),
             std::string::npos)
       << typo;
-  const std::string negative =
-      error_of(write("negative.yaml",
-                     "machine: xcmg_968ev\narm:\n  links:\n    - name: boom\n      length: -1\n"));
+  const std::string negative = error_of(
+      WriteTemp("negative.yaml",
+                "machine: xcmg_968ev\narm:\n  links:\n    - name: boom\n      length: -1\n"));
   EXPECT_NE(negative.find("negative.yaml:5:15: arm.links[0].length: must be > 0 m"),
             std::string::npos)
       << negative;
@@ -130,20 +132,15 @@ TEST(Overlay, ReplacesIdentifiedValuesAndRefusesForeignOnes) {
 TEST(Overlay, ReplacesValveDynamicsAndSensorPoses) {
   const std::string path = ResolveMachineDescription("xcmg_968ev", kModels);
   const MachineDescription base = LoadMachineDescription(path);
-  const std::string dir = ::testing::TempDir();
-  auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir + "/" + name) << text;
-    return dir + "/" + name;
-  };
   LoadOptions options;
-  options.overlays = {write("valves.yaml",
-                            "machine: xcmg_968ev\nhydraulics:\n  actuators:\n"
-                            "    - name: boom_cylinders\n      dead_zone: 0.07\n"
-                            "      transport_delay: 0.45\n      spool_time_constant: 0.09\n"
-                            "      rated_flow_lpm: 420\n"
-                            "sensors:\n  camera:\n    pose: {xyz: [-1.1, 0.02, 3.5], rpy_deg: "
-                            "[0.5, 14, -1]}\n  lidars:\n    - name: front_solid_state\n"
-                            "      pose: {xyz: [0, 0, 3], rpy_deg: [0, 10, 0]}\n")};
+  options.overlays = {WriteTemp("valves.yaml",
+                                "machine: xcmg_968ev\nhydraulics:\n  actuators:\n"
+                                "    - name: boom_cylinders\n      dead_zone: 0.07\n"
+                                "      transport_delay: 0.45\n      spool_time_constant: 0.09\n"
+                                "      rated_flow_lpm: 420\n"
+                                "sensors:\n  camera:\n    pose: {xyz: [-1.1, 0.02, 3.5], rpy_deg: "
+                                "[0.5, 14, -1]}\n  lidars:\n    - name: front_solid_state\n"
+                                "      pose: {xyz: [0, 0, 3], rpy_deg: [0, 10, 0]}\n")};
   const MachineDescription m = LoadMachineDescription(path, options);
   const int boom = m.ActuatorOfJoint(0);
   ASSERT_GE(boom, 0);
@@ -160,10 +157,10 @@ TEST(Overlay, ReplacesValveDynamicsAndSensorPoses) {
   EXPECT_DOUBLE_EQ(m.sensors.lidars[1].pose.xyz[2], 3.0);
 
   LoadOptions bad;
-  bad.overlays = {write("bad_valve.yaml",
-                        "machine: xcmg_968ev\nhydraulics:\n  actuators:\n"
-                        "    - name: bom_cylinders\n    - name: tilt_cylinder\n"
-                        "      dead_zone: 0.6\n")};
+  bad.overlays = {WriteTemp("bad_valve.yaml",
+                            "machine: xcmg_968ev\nhydraulics:\n  actuators:\n"
+                            "    - name: bom_cylinders\n    - name: tilt_cylinder\n"
+                            "      dead_zone: 0.6\n")};
   try {
     LoadMachineDescription(path, bad);
     ADD_FAILURE() << "accepted";

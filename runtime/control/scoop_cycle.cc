@@ -106,6 +106,9 @@ struct ScoopCycle::Runtime {
   StopDetector stop;
   double open_loop_bucket = NAN;  ///< a duty bypassing the bucket PID (shaking) [-]
   bool stopping = false;          ///< retreat: reversed far enough, stopping
+  /// When finite, the bucket target follows the boom so the bucket keeps this attitude
+  /// q_boom + q_bucket in the arm plane [rad] (exit lift, levelling, carrying).
+  double hold_attitude = NAN;
 };
 
 ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
@@ -141,6 +144,15 @@ ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
   limits_.bucket_max = machine.links[1].joint_max - options.rack_back_margin;
   const model::Valve& valve = machine.hydraulics.actuators[bucket_valve_].valve;
   bucket_delay_ = valve.transport_delay + valve.spool_time_constant;
+  // "The bucket's upper edge is leveled" (§6.2): the opening, cutting edge (profile[0]) to the
+  // top of the back wall (the profile's last point), horizontal. Its direction in the bucket
+  // frame is γ; in the arm plane it points backwards (angle π) at attitude φ = π − γ.
+  const Eigen::Vector2d opening = machine.bucket.profile.back() - machine.bucket.profile.front();
+  level_attitude_ = M_PI - std::atan2(opening.y(), opening.x()) + options.finishing.carry_tilt_back;
+}
+
+double ScoopCycle::BucketTargetForAttitude(double attitude, double q_boom) const {
+  return std::clamp(attitude - q_boom, machine_.links[1].joint_min, limits_.bucket_max);
 }
 
 void ScoopCycle::EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s,
@@ -285,14 +297,19 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
           const bool final_part = rt.sequencer->strategy() == ScoopStrategy::kJustInOut ||
                                   rt.sequencer->actions() > 2 * rt.sequencer->steps();
           if (final_part) rt.finishing_drive = true;
+          // The exit lift keeps the racked bucket's attitude: a Z-bar arm tips the bucket back
+          // as the boom rises (q_bucket is relative to the boom), which would pour the heap out
+          // over the back wall; a parallel-lift linkage does this mechanically.
+          if (final_part && rt.action->kind == AtomicKind::kLiftBoom) {
+            rt.hold_attitude = s.q_boom + rt.targets.bucket;
+          }
         } else {
           rt.result.feedback_volume = rt.v1;
           rt.result.atomic_actions = rt.sequencer->actions();
           rt.result.stairway_steps = rt.sequencer->steps();
           rt.result.payload_after_scoop = machine.PayloadVolume();
           EnterPhase(machine, Phase::kLevel, s, rt);
-          rt.targets.bucket = std::max(rt.targets.bucket - options_.finishing.level_tilt,
-                                       machine_.links[1].joint_min);
+          rt.hold_attitude = level_attitude_;
           rt.arrived_at = NAN;
         }
       } else if (elapsed > options_.max_scoop) {
@@ -303,8 +320,8 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       return;
     }
     case Phase::kLevel: {
-      if (std::isnan(rt.arrived_at) &&
-          std::abs(rt.targets.bucket - s.q_bucket) <= 2 * options_.bucket_gains.tolerance) {
+      if (std::isnan(rt.arrived_at) && std::abs(rt.hold_attitude - (s.q_boom + s.q_bucket)) <=
+                                           2 * options_.bucket_gains.tolerance) {
         rt.arrived_at = s.time;
       }
       const bool held =
@@ -319,7 +336,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       // Pulses, then the valve's delay for the last one to reach the spool and die out.
       const double pulses = options_.finishing.shake_pulses * options_.finishing.shake_pulse;
       if (elapsed >= pulses + bucket_delay_) {
-        rt.targets.bucket = limits_.bucket_max;
+        // Carried level (hold_attitude stays): racking back further would tip the heap out.
         EnterPhase(machine, Phase::kRetreat, s, rt);
       }
       return;
@@ -415,6 +432,9 @@ ScoopResult ScoopCycle::Run(ScoopMachine& machine) {
     command.articulation_rate = 0;
     command.valve[boom_valve_] =
         boom_pid.Update(rt.targets.boom, s.q_boom, s.qd_boom, options_.tick);
+    if (std::isfinite(rt.hold_attitude)) {
+      rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, s.q_boom);
+    }
     if (rt.phase == Phase::kShake) {
       const double t = s.time - rt.shake_start;
       const int pulse = static_cast<int>(std::floor(t / options_.finishing.shake_pulse));

@@ -167,6 +167,9 @@ class ScoopCycle {
   void Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
   double ComputeV2(const Proprioception& s, double v1, Runtime& rt);
   void EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s, Runtime& rt);
+  /// The bucket joint target that gives `attitude` (q_boom + q_bucket) at this boom angle,
+  /// within the bucket's range.
+  double BucketTargetForAttitude(double attitude, double q_boom) const;
 
   const model::MachineDescription& machine_;
   const generated::MachineFunctions& functions_;
@@ -177,7 +180,8 @@ class ScoopCycle {
   ScoopCycleOptions options_;
   ArmLimits limits_;
   int boom_valve_ = -1, bucket_valve_ = -1;
-  double bucket_delay_ = 0;  ///< transport delay + spool time constant of the bucket valve [s]
+  double bucket_delay_ = 0;    ///< transport delay + spool time constant of the bucket valve [s]
+  double level_attitude_ = 0;  ///< bucket attitude with the opening level, plus carry tilt [rad]
 };
 
 }  // namespace autoshovel::control

@@ -33,9 +33,12 @@ std::string StrategyParameters::Invalid() const {
 }
 
 std::string FinishingParameters::Invalid() const {
-  const double values[] = {level_tilt, level_hold, shake_duty, shake_pulse};
+  const double values[] = {level_hold, shake_duty, shake_pulse};
   for (double v : values) {
     if (!std::isfinite(v) || v < 0) return "finishing: values must be finite and >= 0";
+  }
+  if (!std::isfinite(carry_tilt_back) || std::abs(carry_tilt_back) > 0.5) {
+    return "finishing: carry_tilt_back must be finite and within ±0.5 rad";
   }
   if (shake_duty > 1) return "finishing: shake_duty must be <= 1";
   if (shake_pulses < 0) return "finishing: shake_pulses must be >= 0";

@@ -37,16 +37,18 @@ struct StrategyParameters {
 };
 
 /// The end of a scoop, seed §6.2: "the bucket's upper edge is leveled, and the material is vibrated
-/// to prevent overflow during transportation". Our reading: levelling tips the racked bucket
-/// forward by `level_tilt` so the heap above the rim strikes off over the cutting edge, holding
-/// it `level_hold`; shaking is `shake_pulses` open-loop pulses of alternating sign on the bucket
-/// valve; then the bucket is racked back for transport.
+/// to prevent overflow during transportation". Our reading: levelling turns the bucket until its
+/// opening (cutting edge to the top of the back wall) is horizontal, tilted back by
+/// `carry_tilt_back`, and holds it `level_hold`: what stands above the heaped capacity strikes
+/// off over the edges. Shaking is `shake_pulses` open-loop pulses of alternating sign on the
+/// bucket valve. The bucket is carried at that attitude (racking further back would tip the heap
+/// out over the back wall).
 struct FinishingParameters {
-  double level_tilt = 0.06;   ///< [rad]
-  double level_hold = 0.3;    ///< [s]
-  int shake_pulses = 6;       ///< [-]
-  double shake_duty = 0.7;    ///< valve duty of a pulse [-]
-  double shake_pulse = 0.12;  ///< length of one pulse [s]
+  double carry_tilt_back = 0;  ///< [rad]
+  double level_hold = 0.3;     ///< [s]
+  int shake_pulses = 6;        ///< [-]
+  double shake_duty = 0.7;     ///< valve duty of a pulse [-]
+  double shake_pulse = 0.12;   ///< length of one pulse [s]
 
   std::string Invalid() const;
 };

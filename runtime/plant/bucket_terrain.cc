@@ -41,6 +41,24 @@ std::vector<Eigen::Vector2d> ClipBelow(const std::vector<Eigen::Vector2d>& polyg
   return out;
 }
 
+// Sutherland–Hodgman clip against the half-plane below the line through `point` with `slope`
+// (z ≤ point.z + slope·(s − point.s)).
+std::vector<Eigen::Vector2d> ClipBelowLine(const std::vector<Eigen::Vector2d>& polygon,
+                                           const Eigen::Vector2d& point, double slope) {
+  auto above = [&](const Eigen::Vector2d& p) {
+    return p.y() - (point.y() + slope * (p.x() - point.x()));
+  };
+  std::vector<Eigen::Vector2d> out;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+    const double fa = above(a), fb = above(b);
+    if (fa <= 0) out.push_back(a);
+    if ((fa <= 0) != (fb <= 0)) out.push_back(a + fa / (fa - fb) * (b - a));
+  }
+  return out;
+}
+
 // Lowest crossing of the vertical line at s with the polygon's edges; false if none.
 bool LowerOutline(const std::vector<Eigen::Vector2d>& polygon, double s, double& z_low) {
   bool found = false;
@@ -129,15 +147,48 @@ double BucketTerrain::HoldableVolume(const BucketPlacement& placement) const {
   const std::vector<Eigen::Vector2d> polygon = PlanePolygon(placement);
   const Eigen::Vector2d& tip = polygon.front();
   const Eigen::Vector2d& back_top = polygon.back();
-  const double rim_level = std::min(tip.y(), back_top.y());
-  const double struck_below_rim = PolygonArea(ClipBelow(polygon, rim_level)) * bucket_.width;
-  // The heap rests on the opening (tip to back-wall top): full when the opening faces up,
-  // nothing when it is vertical or faces down.
+  const bool tip_lower = tip.y() <= back_top.y();
+  const Eigen::Vector2d& low_rim = tip_lower ? tip : back_top;
+  const Eigen::Vector2d& high_rim = tip_lower ? back_top : tip;
+  // The opening (tip to back-wall top) faces up when its outward normal has a positive z.
   const Eigen::Vector2d chord = (back_top - tip).normalized();
   Eigen::Vector2d normal(-chord.y(), chord.x());
   if (normal.dot(Centroid(polygon) - tip) > 0) normal = -normal;  // away from the interior
+  if (normal.y() <= 0) return PolygonArea(ClipBelow(polygon, low_rim.y())) * bucket_.width;
+
+  // Loose material stands at up to its angle of repose ρ: the free surface rises from the lower
+  // rim towards the higher one at the opening's inclination β, or at ρ when the opening is
+  // steeper (the rest runs out over the lower rim). A level surface through the lower rim, the
+  // earlier model, lost a third of a heaped load to a racked-back bucket, which a real loader
+  // carries at full rack without spilling.
+  const double repose = PayloadAngleOfRepose();
+  const double run = std::abs(high_rim.x() - low_rim.x());
+  const double beta = std::atan2(high_rim.y() - low_rim.y(), run);
+  const double toward_high = high_rim.x() >= low_rim.x() ? 1.0 : -1.0;
+  const double slope = toward_high * std::tan(std::min(beta, repose));
+  const double below_surface = PolygonArea(ClipBelowLine(polygon, low_rim, slope)) * bucket_.width;
+  // The heap above the opening: the rated (heaped) capacity less the struck volume when the
+  // opening is level. On an opening inclined by β its cross-section is a triangle on the chord
+  // with sides at ρ to the horizontal, i.e. base angles ρ − β and ρ + β; relative to the level
+  // opening's triangle its area is 2·cot ρ / (cot(ρ − β) + cot(ρ + β)), which falls to 0 at
+  // β = ρ, where the surface model above takes over continuously.
   const double heap = std::max(0.0, bucket_.rated_capacity - struck_area_ * bucket_.width);
-  return struck_below_rim + heap * std::max(0.0, normal.y());
+  double heap_fraction = 0;
+  if (beta < repose) {
+    const double cot_repose = 1.0 / std::tan(repose);
+    const double cot_down = 1.0 / std::tan(repose - beta);
+    const double cot_up = 1.0 / std::tan(std::min(repose + beta, M_PI / 2 - 1e-9));
+    heap_fraction = 2.0 * cot_repose / (cot_down + cot_up);
+  }
+  return below_surface + heap * heap_fraction;
+}
+
+double BucketTerrain::PayloadAngleOfRepose() const {
+  const int material = payload_material();
+  // An empty bucket: any loose material; 35° is typical of sand and gravel.
+  constexpr double kTypicalRepose = 35.0 * M_PI / 180.0;
+  if (material < 0) return kTypicalRepose;
+  return world_.materials[material].angle_of_repose;
 }
 
 ExchangeResult BucketTerrain::Exchange(const BucketPlacement& placement) {

@@ -62,8 +62,9 @@ class BucketTerrain {
   ExchangeResult Exchange(const BucketPlacement& placement);
   /// The contact seen at the bucket tip.
   BucketContact Contact(const BucketPlacement& placement) const;
-  /// Volume the bucket holds in this orientation [m³] (struck part below the lower rim plus the
-  /// heap the opening's inclination supports).
+  /// Volume the bucket holds in this orientation [m³]: what lies below a free surface rising
+  /// from the lower rim at min(opening inclination, angle of repose), plus the heap the
+  /// opening's inclination still supports (rated heaped capacity when the opening is level).
   double HoldableVolume(const BucketPlacement& placement) const;
   /// Relaxes slopes steeper than the angle of repose in a square of half size `half_window`
   /// around `center_xy`; at most `max_iterations` sweeps. Returns the volume moved [m³].
@@ -87,6 +88,8 @@ class BucketTerrain {
   template <typename Visit>
   void ForEachCellInStrip(const BucketPlacement& placement, double s0, double s1, double min_height,
                           const std::vector<double>& heights, Visit&& visit) const;
+  /// Angle of repose of the payload's main material (a typical 35° when empty) [rad].
+  double PayloadAngleOfRepose() const;
   void Deposit(const BucketPlacement& placement, double s_from, double s_to, double volume);
 
   const model::Bucket& bucket_;

@@ -153,6 +153,44 @@ TEST(BucketTerrain, SandStopsTheBucketUnderAThinnerCutThanGravel) {
       << "sand " << sand.stall_cut_depth << " m, gravel " << gravel.stall_cut_depth << " m";
 }
 
+// The holding model: with the opening (cutting edge to back-wall top) level the bucket holds
+// exactly its rated heaped capacity (struck volume + heap); tilted back or forward by β the heap
+// shrinks smoothly and is gone at β = ρ; beyond, the free surface stands at ρ from the lower
+// rim; an opening facing down holds only what lies below both rims.
+TEST(BucketTerrain, HoldsTheRatedHeapWithTheOpeningLevelAndLessWhenTilted) {
+  const model::MachineDescription machine = testing::LoadMachine("xcmg_968ev");
+  World world = testing::FlatYard(machine, 10.0);
+  BucketTerrain bucket(machine.bucket, world);
+  const Eigen::Vector2d opening = machine.bucket.profile.back() - machine.bucket.profile.front();
+  const double level = std::numbers::pi - std::atan2(opening.y(), opening.x());
+  BucketPlacement placement;
+  placement.pivot = Eigen::Vector2d(2.0, 3.0);  // clear of the floor
+  auto hold_at = [&](double attitude) {
+    placement.bucket_angle = attitude;
+    return bucket.HoldableVolume(placement);
+  };
+  const double rated = machine.bucket.rated_capacity;
+  EXPECT_NEAR(hold_at(level), rated, 1e-9 * rated);
+  double previous = rated;
+  for (double beta_deg = 2; beta_deg <= 60; beta_deg += 2) {  // tilted back (tip up)
+    const double h = hold_at(level + beta_deg * kDeg);
+    EXPECT_LT(h, previous + 1e-9) << beta_deg;
+    previous = h;
+  }
+  previous = rated;
+  for (double beta_deg = 2; beta_deg <= 60; beta_deg += 2) {  // tipped forward
+    const double h = hold_at(level - beta_deg * kDeg);
+    EXPECT_LT(h, previous + 1e-9) << beta_deg;
+    previous = h;
+  }
+  // Continuous where the heap vanishes (β = ρ, empty bucket: the typical 35°).
+  EXPECT_NEAR(hold_at(level + 35 * kDeg - 1e-6), hold_at(level + 35 * kDeg + 1e-6), 1e-3);
+  // Racked 10° past level it still carries almost all of a heaped load (a loader carries racked).
+  EXPECT_GT(hold_at(level + 10 * kDeg), 0.95 * rated);
+  // Upside down: nothing stays in.
+  EXPECT_LT(hold_at(level + 180 * kDeg), 0.05 * rated);
+}
+
 TEST(BucketTerrain, TiltedBucketPoursOutAndTerrainRelaxesToRepose) {
   const model::MachineDescription machine = testing::LoadMachine("xcmg_968ev");
   World world = testing::FlatYard(machine, 10.0);

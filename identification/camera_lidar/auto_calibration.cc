@@ -1,5 +1,6 @@
 #include "identification/camera_lidar/auto_calibration.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <nlopt.hpp>
@@ -76,26 +77,29 @@ ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& ma
   return frame;
 }
 
-AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& frames,
-                                    const Eigen::Isometry3d& T0,
-                                    const AutoCalibrationOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  AutoCalibrationResult result;
-  Problem problem{&frames, T0, &options};
-  const unsigned dimension = options.lock == Lock::kNone ? 6 : 3;
+namespace {
+
+// Nelder–Mead from T0 with `lock`, restarted with a fresh simplex (scaled by restart_scale)
+// until a restart no longer improves ρ; returns the best pose, adds to the counters.
+Eigen::Isometry3d Optimise(const std::vector<ScoreFrame>& frames, const Eigen::Isometry3d& T0,
+                           Lock lock, double step_scale, const AutoCalibrationOptions& options,
+                           AutoCalibrationResult& result) {
+  AutoCalibrationOptions local = options;
+  local.lock = lock;
+  Problem problem{&frames, T0, &local};
+  const unsigned dimension = lock == Lock::kNone ? 6 : 3;
   std::vector<double> x(dimension, 0.0), steps(dimension);
   for (unsigned k = 0; k < dimension; ++k) {
-    const bool rotation =
-        options.lock == Lock::kTranslation || (options.lock == Lock::kNone && k < 3);
-    steps[k] = rotation ? options.rotation_step : options.translation_step;
+    const bool rotation = lock == Lock::kTranslation || (lock == Lock::kNone && k < 3);
+    steps[k] = step_scale * (rotation ? options.rotation_step : options.translation_step);
   }
   auto objective = [](const std::vector<double>& v, std::vector<double>&, void* data) {
     auto* p = static_cast<Problem*>(data);
     ++p->evaluations;
     return ConsistencyScore(*p->frames, p->Pose(v), p->options->score).rho;
   };
-  result.initial = ConsistencyScore(frames, T0, options.score);
-  double best = result.initial.rho;
+  double best = ConsistencyScore(frames, T0, options.score).rho;
+  ++problem.evaluations;
   for (int run = 0; run <= options.max_restarts; ++run) {
     nlopt::opt opt(nlopt::LN_NELDERMEAD, dimension);
     opt.set_max_objective(objective, &problem);
@@ -112,16 +116,44 @@ AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& frames,
       // `trial` and `value` before throwing.
     }
     ++result.runs;
-    const bool improved = value > best + options.ftol_abs;
+    const bool improved = value > best + std::max(options.ftol_abs, options.restart_min_gain);
     if (value > best) {
       best = value;
       x = trial;
     }
     if (!improved && run > 0) break;
-    for (double& s : steps) s *= 0.5;
+    for (double& s : steps) s *= options.restart_scale;
   }
-  result.evaluations = problem.evaluations;
-  result.T_lidar_camera = problem.Pose(x);
+  result.evaluations += problem.evaluations;
+  return problem.Pose(x);
+}
+
+}  // namespace
+
+AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& input_frames,
+                                    const Eigen::Isometry3d& T0,
+                                    const AutoCalibrationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  AutoCalibrationResult result;
+  // The sky term (consistency_score.h): masks without LiDAR support are flagged at T0, once, so
+  // that ρ stays one function of x during the search; frames already flagged are kept as given.
+  std::vector<ScoreFrame> marked;
+  bool flagged = false;
+  for (const ScoreFrame& f : input_frames) flagged = flagged || !f.unsupported.empty();
+  if (options.unsupported_density > 0 && !flagged) {
+    marked = input_frames;
+    MarkUnsupportedMasks(marked, T0, options.unsupported_density);
+  }
+  const std::vector<ScoreFrame>& frames = marked.empty() ? input_frames : marked;
+  result.initial = ConsistencyScore(frames, T0, options.score);
+  Eigen::Isometry3d T = T0;
+  if (options.rotation_first && options.lock == Lock::kNone) {
+    T = Optimise(frames, T, Lock::kTranslation, 1.0, options, result);
+    T = Optimise(frames, T, Lock::kNone, options.second_stage_scale, options, result);
+  } else {
+    T = Optimise(frames, T, options.lock, 1.0, options, result);
+  }
+  result.T_lidar_camera = T;
   result.final = ConsistencyScore(frames, result.T_lidar_camera, options.score);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -341,6 +341,11 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
     }
     AutoCalibrationOptions auto_options;
     auto_options.lock = lock;
+    // The sky term (consistency_score.h): flagged once at T0 so that the optimisation and the
+    // score surface below score the same ρ.
+    if (auto_options.unsupported_density > 0) {
+      MarkUnsupportedMasks(score_frames, T0, auto_options.unsupported_density);
+    }
     const AutoCalibrationResult result = AutoCalibrate(score_frames, T0, auto_options);
     const std::vector<ScoreSlice> slices =
         ScoreSurface(score_frames, result.T_lidar_camera, auto_options.score);

@@ -14,7 +14,7 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
                                 const ScoreOptions& options) {
   struct Mask {
     int frame = 0, index = 0;
-    long n = 0;
+    double n = 0, w2 = 0;  // Σ w, Σ w² (w = 1 per point with the nearest-pixel lookup)
     double r = 0, r2 = 0;
     Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
     double f_r = 0, f_n = 0, f_s = 0, epsilon = 0;
@@ -23,8 +23,8 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
   const Eigen::Matrix3f R = T_optical_lidar.linear().cast<float>();
   const Eigen::Vector3f t = T_optical_lidar.translation().cast<float>();
   std::vector<Mask> all;
-  std::vector<int> histogram;
-  long skipped = 0;
+  std::vector<double> histogram;
+  double skipped = 0, misplaced = 0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
     const ScoreFrame& frame = frames[f];
     std::vector<Mask> masks(frame.num_masks);
@@ -34,15 +34,19 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
     const int radius = options.zbuffer_block;
     std::vector<int> pixel(frame.points.size(), -1);
     std::vector<float> depth(frame.points.size(), 0.f);
+    std::vector<Eigen::Vector2f> image_uv(options.subpixel ? frame.points.size() : 0);
     std::vector<float> nearest(radius > 0 ? static_cast<std::size_t>(width) * height : 0,
                                std::numeric_limits<float>::infinity());
     for (std::size_t i = 0; i < frame.points.size(); ++i) {
       const Eigen::Vector3f p = R * frame.points[i] + t;  // Eq. (5)
       if (p.z() < 0.1f) continue;
-      const int u = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
-      const int v = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
+      const float su = fx * p.x() / p.z() + cx, sv = fy * p.y() / p.z() + cy;
+      if (!(su > -0.5f && sv > -0.5f && su < width - 0.5f && sv < height - 0.5f)) continue;
+      const int u = static_cast<int>(su + 0.5f);  // ≥ 0 here: truncation = rounding
+      const int v = static_cast<int>(sv + 0.5f);
       if (u < 0 || v < 0 || u >= width || v >= height) continue;
       pixel[i] = v * width + u;
+      if (options.subpixel) image_uv[i] = Eigen::Vector2f(su, sv);
       depth[i] = p.z();
       if (radius > 0) {
         for (int y = std::max(0, v - radius); y <= std::min(height - 1, v + radius); ++y) {
@@ -53,6 +57,19 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
         }
       }
     }
+    // Adds point i to mask `label` with weight w (1 for the nearest-pixel lookup).
+    auto accumulate = [&](std::size_t i, int label, double w) {
+      Mask& m = masks[label - 1];
+      m.n += w;
+      m.w2 += w * w;
+      const double r = frame.reflectivity[i];
+      m.r += w * r;
+      m.r2 += w * r * r;
+      m.normal_sum += w * frame.normals[i].cast<double>();
+      if (frame.segment[i] >= 0) {
+        histogram[static_cast<std::size_t>(label - 1) * frame.num_segments + frame.segment[i]] += w;
+      }
+    };
     for (std::size_t i = 0; i < frame.points.size(); ++i) {
       if (pixel[i] < 0) continue;
       const int u = pixel[i] % width, v = pixel[i] / width;
@@ -63,16 +80,47 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
           continue;
         }
       }
-      const int label = frame.mask_labels.at<int>(v, u);
-      if (label <= 0) continue;
-      Mask& m = masks[label - 1];
-      ++m.n;
-      const double r = frame.reflectivity[i];
-      m.r += r;
-      m.r2 += r * r;
-      m.normal_sum += frame.normals[i].cast<double>();
-      if (frame.segment[i] >= 0) {
-        ++histogram[static_cast<std::size_t>(label - 1) * frame.num_segments + frame.segment[i]];
+      if (!options.subpixel) {
+        const int label = frame.mask_labels.at<int>(v, u);
+        if (label > 0) accumulate(i, label, 1.0);
+        continue;
+      }
+      // Area lookup: the point's footprint is a 1 px square centred on its projection; it
+      // belongs to each of the (up to) four pixels it overlaps in proportion to the overlap,
+      // i.e. bilinear weights. Pixels outside the image take their share with them.
+      const float su = image_uv[i].x(), sv = image_uv[i].y();
+      const int u0 = static_cast<int>(std::floor(su)), v0 = static_cast<int>(std::floor(sv));
+      int labels[4] = {0, 0, 0, 0};
+      if (u0 >= 0 && v0 >= 0 && u0 + 1 < width && v0 + 1 < height) {
+        const int* row0 = frame.mask_labels.ptr<int>(v0) + u0;
+        const int* row1 = frame.mask_labels.ptr<int>(v0 + 1) + u0;
+        labels[0] = row0[0];
+        labels[1] = row0[1];
+        labels[2] = row1[0];
+        labels[3] = row1[1];
+        if (labels[0] == labels[1] && labels[0] == labels[2] && labels[0] == labels[3]) {
+          if (labels[0] > 0) accumulate(i, labels[0], 1.0);  // inside one mask: most points
+          continue;
+        }
+      } else {
+        for (int c = 0; c < 4; ++c) {
+          const int x = u0 + (c & 1), y = v0 + (c >> 1);
+          if (x >= 0 && y >= 0 && x < width && y < height)
+            labels[c] = frame.mask_labels.at<int>(y, x);
+        }
+      }
+      const double a = su - u0, b = sv - v0;
+      const double weights[4] = {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b};
+      for (int c = 0; c < 4; ++c) {
+        if (labels[c] <= 0 || weights[c] <= 0) continue;
+        double w = weights[c];
+        for (int d = c + 1; d < 4; ++d) {  // one entry per distinct label
+          if (labels[d] == labels[c]) {
+            w += weights[d];
+            labels[d] = 0;
+          }
+        }
+        accumulate(i, labels[c], w);
       }
     }
     const double log_classes = std::log(std::max(2, frame.num_segments));
@@ -84,21 +132,26 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
       const double area = k < static_cast<int>(frame.mask_area.size()) ? frame.mask_area[k] : 0.0;
       const double threshold =
           std::max<double>(options.min_points, options.min_density_fraction * area * density);
+      if (k < static_cast<int>(frame.unsupported.size()) && frame.unsupported[k]) {
+        misplaced += m.n;  // our extension, see consistency_score.h
+        continue;
+      }
       if (m.n < threshold) {  // Algorithm 1 line 16
         skipped += m.n;
         continue;
       }
-      const double n = static_cast<double>(m.n);
+      const double n = m.n;
       const double variance = std::max(0.0, m.r2 / n - (m.r / n) * (m.r / n));
       m.f_r = std::max(0.0, 1.0 - variance / std::max(frame.reflectivity_variance, 1e-12));
-      m.f_n = (m.normal_sum.squaredNorm() - n) / (n * (n - 1.0));
+      // Weighted mean over pairs p ≠ p' (weights w_p w_p'); = the unweighted formula for w = 1.
+      m.f_n = (m.normal_sum.squaredNorm() - m.w2) / std::max(1e-12, n * n - m.w2);
       double classified = 0;
       for (int c = 0; c < frame.num_segments; ++c) {
         classified += histogram[static_cast<std::size_t>(k) * frame.num_segments + c];
       }
       double entropy = 0, purity = 0;
       for (int c = 0; c < frame.num_segments; ++c) {
-        const int count = histogram[static_cast<std::size_t>(k) * frame.num_segments + c];
+        const double count = histogram[static_cast<std::size_t>(k) * frame.num_segments + c];
         if (count > 0) entropy -= count / classified * std::log(count / classified);
         purity += (count / classified) * (count / classified);
       }
@@ -113,20 +166,43 @@ ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
     }
   }
   ScoreBreakdown out;
-  for (const Mask& m : all) out.points_in_masks += m.n;
-  if (out.points_in_masks == 0) return out;
-  const double total =
-      static_cast<double>(out.points_in_masks + (options.count_skipped ? skipped : 0));
+  double in_masks = 0;
+  for (const Mask& m : all) in_masks += m.n;
+  out.points_in_masks = std::lround(in_masks);
+  if (in_masks <= 0) return out;
+  const double total = in_masks + (options.count_skipped ? skipped : 0) + misplaced;
   for (const Mask& m : all) {
     const double w = m.n / total;  // Eq. (7)
     out.rho += w * m.epsilon;
     out.reflectivity += w * m.f_r;
     out.normal += w * m.f_n;
     out.segmentation += w * m.f_s;
-    out.masks.push_back({m.frame, m.index, m.n, m.f_r, m.f_n, m.f_s, m.epsilon});
+    out.masks.push_back({m.frame, m.index, std::lround(m.n), m.f_r, m.f_n, m.f_s, m.epsilon});
   }
   out.masks_used = static_cast<int>(all.size());
   return out;
+}
+
+void MarkUnsupportedMasks(std::vector<ScoreFrame>& frames, const Eigen::Isometry3d& T_lidar_camera,
+                          double fraction) {
+  ScoreOptions options;
+  options.min_points = 0;
+  for (ScoreFrame& frame : frames) {
+    frame.unsupported.assign(frame.num_masks, 0);
+    std::vector<ScoreFrame> one{frame};
+    std::vector<double> count(frame.num_masks, 0.0);
+    const ScoreBreakdown b = ConsistencyScore(one, T_lidar_camera, options);
+    double total = 0, area = 0;
+    for (const MaskScore& m : b.masks) {
+      count[m.mask] = static_cast<double>(m.n);
+      total += static_cast<double>(m.n);
+    }
+    for (const double a : frame.mask_area) area += a;
+    const double density = total / std::max(1.0, area);
+    for (int k = 0; k < frame.num_masks; ++k) {
+      frame.unsupported[k] = count[k] < fraction * density * frame.mask_area[k] ? 1 : 0;
+    }
+  }
 }
 
 }  // namespace autoshovel::identification

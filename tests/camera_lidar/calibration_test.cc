@@ -1,6 +1,6 @@
 // Seed §3.2, Algorithm 1 on simulated data with a known extrinsic: the board step (PnP from the
 // hole corners) and the auto-calibration from perturbed starts (issue 5: 2°/5 cm back within
-// 0.3° and 2 cm; 3° per axis back within 0.5°).
+// 0.3° and 2 cm, of which 2 cm is not met yet; 3° per axis back within 0.5°).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -150,20 +150,21 @@ void ExpectRecovered(const Eigen::Vector3d& w, const Eigen::Vector3d& t, Lock lo
   EXPECT_GE(r.final.rho, r.initial.rho);
 }
 
-// Issue 5 asks for 0.3° and 2 cm. The rotation meets it; the translation does NOT: every axis
-// alone now peaks at the truth (test above), but along a coupled direction (z up with a pitch
-// that keeps far structure in place, x back) ρ still rises by ≈ 0.1–0.2 % over 3–4 cm, so
-// Nelder–Mead ends 3–4 cm away (ρ there exceeds ρ at the truth). The bound below records what
-// the method achieves today (docs/camera_lidar_calibration.md, "Limits"), not the issue's 2 cm.
+// Issue 5 asks for 0.3° and 2 cm. The rotation meets it; the translation does NOT yet: with the
+// area lookup ρ is continuous and every start tried (six directions) reaches the same maximum,
+// but that maximum is 21–28 mm from the truth (z up ≈ 2 cm, x back ≈ 1 cm; the F_S, F_N and
+// F_R optima alone lie 4–10 cm away in different directions; docs/camera_lidar_calibration.md,
+// "Limits"). Measured here: 0.13°, 22.6 mm; the bound records that with a margin, not the 2 cm.
 TEST(AutoCalibration, TwoDegreesFiveCentimetresRotationBackWithinSpec) {
   const Eigen::Vector3d axis = Eigen::Vector3d(1, -2, 1.5).normalized();
   const Eigen::Vector3d shift = Eigen::Vector3d(-1, 1, 0.5).normalized();
-  ExpectRecovered(2 * kDeg * axis, 0.05 * shift, Lock::kNone, 0.3 * kDeg, 0.06);
+  ExpectRecovered(2 * kDeg * axis, 0.05 * shift, Lock::kNone, 0.3 * kDeg, 0.03);
 }
 
+// Measured: 0.13°, 21.6 mm.
 TEST(AutoCalibration, ThreeDegreesPerAxisBackWithinHalfADegree) {
   ExpectRecovered(Eigen::Vector3d(3, -3, 3) * kDeg, Eigen::Vector3d::Zero(), Lock::kNone,
-                  0.5 * kDeg, 0.06);
+                  0.5 * kDeg, 0.03);
 }
 
 TEST(AutoCalibration, ThreeDegreesPerAxisTranslationLocked) {

@@ -16,6 +16,7 @@
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
+#include "runtime/app/shovel_run.h"
 #include "runtime/planning/select_command.h"
 
 namespace {
@@ -250,7 +251,65 @@ int main(int argc, char** argv) {
   bool no_baseline = false;
   select_cmd->add_flag("--no-baseline", no_baseline, "Skip the Chen et al. (2024) ranking");
 
+  autoshovel::app::ShovelRunOptions run;
+  std::string run_out, run_policy = "auto", run_trigger = "predicted", run_selection = "ours";
+  double run_pressure_bar = run.pressure_threshold / 1e5;
+  CLI::App* run_cmd = app.add_subcommand(
+      "run",
+      "The main job: closed-loop shoveling cycles in a simulated yard; writes a run folder with "
+      "config.yaml, results.sqlite, log.txt and report.html");
+  run_cmd->add_option("scenario", run.scenario, "Scenario name or path")->capture_default_str();
+  run_cmd->add_option("--machine", run.machine,
+                      "Wheel-loader name or description (default: "
+                      "the scenario's)");
+  run_cmd->add_option("--cycles", run.cycles, "Shoveling cycles")->capture_default_str();
+  run_cmd->add_option("--seed", run.seed, "Seed of every random draw")->capture_default_str();
+  run_cmd->add_option("-o,--out", run_out, "Run folder (default: runs/<UTC timestamp>)");
+  run_cmd->add_option("--bins", run.bins, "Bins to shovel from in turn (default: all with piles)");
+  run_cmd->add_flag("--truth", run.truth_labels,
+                    "Simulator labels instead of the segmentation network");
+  run_cmd->add_option("--segmenter", run.segmenter, "ONNX segmentation network");
+  run_cmd->add_option("--predictor", run.predictor, "Penetration SVR (path without .model)");
+  run_cmd->add_option("--policy", run_policy, "auto | just_in_out | stairway | stairway_fixed")
+      ->check(CLI::IsMember({"auto", "just_in_out", "stairway", "stairway_fixed"}))
+      ->capture_default_str();
+  run_cmd->add_option("--trigger", run_trigger, "predicted | perception | pressure")
+      ->check(CLI::IsMember({"predicted", "perception", "pressure"}))
+      ->capture_default_str();
+  run_cmd->add_option("--pressure-bar", run_pressure_bar, "Threshold of --trigger pressure [bar]")
+      ->capture_default_str();
+  run_cmd->add_option("--stairway-steps", run.stairway_steps, "N of Stairway #N")
+      ->capture_default_str();
+  run_cmd->add_option("--selection", run_selection, "ours | chen2024")
+      ->check(CLI::IsMember({"ours", "chen2024"}))
+      ->capture_default_str();
+  run_cmd
+      ->add_option("--safety-distance", run.safety_distance,
+                   "Never closer to an obstacle (footprint with 0.3 m margins) [m]")
+      ->capture_default_str();
+  run_cmd->add_option("--d-res", run.d_res, "d_res of Eq. (14) [m]")->capture_default_str();
+  bool run_no_figures = false;
+  run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
+
   CLI11_PARSE(app, argc, argv);
+
+  if (*run_cmd) {
+    run.models_dir = models_dir;
+    run.figures = !run_no_figures;
+    run.pressure_threshold = run_pressure_bar * 1e5;
+    using autoshovel::control::ScoopPolicy;
+    run.policy = run_policy == "auto"          ? ScoopPolicy::kAutoSelection
+                 : run_policy == "just_in_out" ? ScoopPolicy::kJustInOut
+                 : run_policy == "stairway"    ? ScoopPolicy::kStairway
+                                               : ScoopPolicy::kStairwayFixed;
+    using autoshovel::app::TriggerChoice;
+    run.trigger = run_trigger == "predicted"    ? TriggerChoice::kPredicted
+                  : run_trigger == "perception" ? TriggerChoice::kPerception
+                                                : TriggerChoice::kPressure;
+    run.selection = run_selection == "ours" ? autoshovel::app::SelectionMethod::kOurs
+                                            : autoshovel::app::SelectionMethod::kChen2024;
+    return autoshovel::app::RunShovelCommand(run, run_out, std::cout, std::cerr);
+  }
 
   if (*describe_cmd) {
     describe.models_dir = models_dir;

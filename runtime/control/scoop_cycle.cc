@@ -109,6 +109,12 @@ struct ScoopCycle::Runtime {
   /// When finite, the bucket target follows the boom so the bucket keeps this attitude
   /// q_boom + q_bucket in the arm plane [rad] (exit lift, levelling, carrying).
   double hold_attitude = NAN;
+  std::vector<Eigen::Vector3d> last_predicted_path;  ///< of the last V2 [m]
+  double last_v2 = NAN;                              ///< [m³]
+  std::optional<JointPid> boom_pid, bucket_pid;
+  std::optional<SpeedPid> speed_pid;
+  core::ActuatorCommand command;
+  long tick = 0;
 };
 
 ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
@@ -199,8 +205,10 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
     at.heading = s.heading;
     at.speed = std::max(s.speed, 0.0);
     at.q = q;
-    return prediction::PredictFutureVolume(machine_, map_, rt.tip_path, at, d.penetration, plan)
-        .total();
+    prediction::FutureVolume future =
+        prediction::PredictFutureVolume(machine_, map_, rt.tip_path, at, d.penetration, plan);
+    rt.last_predicted_path = std::move(future.path);
+    return future.total();
   } catch (const std::exception&) {
     ++rt.result.prediction_failures;
     return 0;
@@ -237,6 +245,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       const bool predict =
           trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
       in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
+      rt.last_v2 = predict ? in.v2 : NAN;
       const bool fired = trigger_.Fire(in);
       std::optional<ScoopStrategy> strategy;
       if (options_.policy == ScoopPolicy::kAutoSelection) {
@@ -263,6 +272,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         r.strategy = *strategy;
         r.v1_at_trigger = rt.v1;
         r.v2_at_trigger = in.v2;
+        r.predicted_tip_path = rt.last_predicted_path;
         r.boom_pressure_at_trigger = s.boom_pressure;
         rt.q_bucket_at_trigger = s.q_bucket;
         rt.q_boom_at_trigger = s.q_boom;
@@ -290,6 +300,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       if (!rt.action) {
         rt.action = rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
         if (rt.action) {
+          rt.result.action_names.emplace_back(ToString(rt.action->kind));
           rt.targets = TargetsAfter(*rt.action, rt.targets, limits_);
           rt.action_start = s.time;
           rt.arrived_at = NAN;
@@ -360,108 +371,144 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
   }
 }
 
-ScoopResult ScoopCycle::Run(ScoopMachine& machine) {
-  Runtime rt;
+ScoopCycle::~ScoopCycle() = default;
+
+void ScoopCycle::Start(ScoopMachine& machine) {
+  rt_ = std::make_unique<Runtime>();
+  Runtime& rt = *rt_;
   trigger_.Reset();
   rt.result.target_volume = options_.target_fill * machine_.bucket.rated_capacity;
-  JointPid boom_pid(options_.boom_gains,
-                    machine_.hydraulics.actuators[boom_valve_].valve.dead_zone);
-  JointPid bucket_pid(options_.bucket_gains,
-                      machine_.hydraulics.actuators[bucket_valve_].valve.dead_zone);
-  SpeedPid speed_pid(options_.speed_gains);
-  Proprioception s = machine.Sense();
-  speed_pid.Reset(std::isfinite(s.speed) ? s.speed : 0.0);
+  rt.boom_pid.emplace(options_.boom_gains,
+                      machine_.hydraulics.actuators[boom_valve_].valve.dead_zone);
+  rt.bucket_pid.emplace(options_.bucket_gains,
+                        machine_.hydraulics.actuators[bucket_valve_].valve.dead_zone);
+  rt.speed_pid.emplace(options_.speed_gains);
+  const Proprioception s = machine.Sense();
+  rt.speed_pid->Reset(std::isfinite(s.speed) ? s.speed : 0.0);
   rt.targets = options_.attack_pose;
   rt.phase_start_time = s.time;
+  rt.result.start_time = s.time;
   rt.phase_start_energy = machine.Energy();
   machine.SetPhase(PhaseName(static_cast<int>(Phase::kApproach)));
+  rt.command.valve.assign(machine_.hydraulics.actuators.size(), 0.0);
+}
 
-  core::ActuatorCommand command;
-  command.valve.assign(machine_.hydraulics.actuators.size(), 0.0);
-  for (long tick = 0; rt.phase != Phase::kDone; ++tick) {
-    s = machine.Sense();
-    if (!Finite(s)) {
-      rt.result.failure = "machine reports a non-finite state at t = " + std::to_string(s.time);
-      break;
-    }
-    const bool digging =
-        rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop;
-    if (digging) {
-      const Eigen::Vector2d p = prediction::TipInBase(machine_, s.q_boom, s.q_bucket);
-      const Eigen::Vector3d tip(s.hinge_xy.x() + std::cos(s.heading) * p.x(),
-                                s.hinge_xy.y() + std::sin(s.heading) * p.x(), p.y());
-      if (rt.tip_path.empty() || (tip - rt.tip_path.back()).norm() >= options_.path_spacing) {
-        rt.tip_path.push_back(tip);
-      }
-    }
-    if (tick % options_.decision_every == 0) Decide(machine, s, rt);
-    if (rt.phase == Phase::kDone) break;
+bool ScoopCycle::done() const { return rt_ == nullptr || rt_->phase == Phase::kDone; }
 
-    // Low-level control, every tick.
-    if (rt.phase == Phase::kScoop && !rt.arm_moving &&
-        (s.q_bucket > rt.q_bucket_at_trigger + options_.arm_motion ||
-         s.q_boom > rt.q_boom_at_trigger + options_.arm_motion)) {
-      rt.arm_moving = true;
-      rt.result.arm_motion_after_trigger = s.time - rt.result.trigger_time;
-    }
-    double speed_target = options_.attack_speed;
-    switch (rt.phase) {
-      case Phase::kApproach:
-      case Phase::kCrowd:
-        break;
-      case Phase::kScoop:
-        // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
-        // rate once the final rack/lift runs and the arm moves.
-        if (rt.finishing_drive && rt.arm_moving) speed_target = 0;
-        break;
-      case Phase::kLevel:
-      case Phase::kShake:
-        speed_target = 0;
-        break;
-      case Phase::kRetreat:
-        speed_target = rt.stopping ? 0.0 : -options_.retreat_speed;
-        break;
-      case Phase::kDone:
-        speed_target = 0;
-        break;
-    }
-    speed_pid.SetTarget(speed_target);
-    const DriveCommand drive = speed_pid.Update(s.speed, options_.tick);
-    command.drive = drive.drive;
-    command.brake = drive.brake;
-    command.articulation_rate = 0;
-    command.valve[boom_valve_] =
-        boom_pid.Update(rt.targets.boom, s.q_boom, s.qd_boom, options_.tick);
-    if (std::isfinite(rt.hold_attitude)) {
-      rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, s.q_boom);
-    }
-    if (rt.phase == Phase::kShake) {
-      const double t = s.time - rt.shake_start;
-      const int pulse = static_cast<int>(std::floor(t / options_.finishing.shake_pulse));
-      command.valve[bucket_valve_] = pulse < options_.finishing.shake_pulses
-                                         ? (pulse % 2 == 0 ? 1 : -1) * options_.finishing.shake_duty
-                                         : 0.0;
-    } else {
-      command.valve[bucket_valve_] =
-          bucket_pid.Update(rt.targets.bucket, s.q_bucket, s.qd_bucket, options_.tick);
-    }
-    // NaN never reaches the machine: a non-finite field is replaced by a safe value and counted.
-    bool blocked = false;
-    for (double& u : command.valve) {
-      if (!std::isfinite(u)) u = 0, blocked = true;
-    }
-    if (!std::isfinite(command.drive) || !std::isfinite(command.brake)) {
-      command.drive = 0, command.brake = 1, blocked = true;
-    }
-    if (blocked) ++rt.result.non_finite_blocked;
-    std::string why;
-    if (!machine.Command(command, &why)) ++rt.result.refused_commands;
-    machine.Advance(options_.tick);
+const char* ScoopCycle::phase_name() const {
+  return rt_ == nullptr ? "idle" : PhaseName(static_cast<int>(rt_->phase));
+}
+
+bool ScoopCycle::Tick(ScoopMachine& machine) {
+  if (rt_ == nullptr) throw std::logic_error("ScoopCycle::Tick before Start");
+  Runtime& rt = *rt_;
+  if (rt.phase == Phase::kDone) return false;
+  const Proprioception s = machine.Sense();
+  if (!Finite(s)) {
+    rt.result.failure = "machine reports a non-finite state at t = " + std::to_string(s.time);
+    rt.phase = Phase::kDone;
+    return false;
   }
-  rt.result.end_time = machine.Sense().time;
-  rt.result.payload = machine.PayloadVolume();
-  rt.result.fill_rate = rt.result.payload / machine_.bucket.rated_capacity;
-  return rt.result;
+  const bool digging =
+      rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop;
+  if (digging) {
+    const Eigen::Vector2d p = prediction::TipInBase(machine_, s.q_boom, s.q_bucket);
+    const Eigen::Vector3d tip(s.hinge_xy.x() + std::cos(s.heading) * p.x(),
+                              s.hinge_xy.y() + std::sin(s.heading) * p.x(), p.y());
+    if (rt.tip_path.empty() || (tip - rt.tip_path.back()).norm() >= options_.path_spacing) {
+      rt.tip_path.push_back(tip);
+    }
+  }
+  if (rt.tick++ % options_.decision_every == 0) {
+    Decide(machine, s, rt);
+    if (digging && !rt.tip_path.empty()) {
+      rt.result.samples.push_back({.time = s.time,
+                                   .v1 = rt.v1,
+                                   .v1_plus_v2 = rt.v1 + rt.last_v2,
+                                   .triggered = !std::isnan(rt.result.trigger_time),
+                                   .tip = rt.tip_path.back()});
+    }
+  }
+  if (rt.phase == Phase::kDone) return false;
+
+  // Low-level control, every tick.
+  if (rt.phase == Phase::kScoop && !rt.arm_moving &&
+      (s.q_bucket > rt.q_bucket_at_trigger + options_.arm_motion ||
+       s.q_boom > rt.q_boom_at_trigger + options_.arm_motion)) {
+    rt.arm_moving = true;
+    rt.result.arm_motion_after_trigger = s.time - rt.result.trigger_time;
+  }
+  double speed_target = options_.attack_speed;
+  switch (rt.phase) {
+    case Phase::kApproach:
+    case Phase::kCrowd:
+      break;
+    case Phase::kScoop:
+      // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
+      // rate once the final rack/lift runs and the arm moves.
+      if (rt.finishing_drive && rt.arm_moving) speed_target = 0;
+      break;
+    case Phase::kLevel:
+    case Phase::kShake:
+      speed_target = 0;
+      break;
+    case Phase::kRetreat:
+      speed_target = rt.stopping ? 0.0 : -options_.retreat_speed;
+      break;
+    case Phase::kDone:
+      speed_target = 0;
+      break;
+  }
+  core::ActuatorCommand& command = rt.command;
+  rt.speed_pid->SetTarget(speed_target);
+  const DriveCommand drive = rt.speed_pid->Update(s.speed, options_.tick);
+  command.drive = drive.drive;
+  command.brake = drive.brake;
+  command.articulation_rate = 0;
+  command.valve[boom_valve_] =
+      rt.boom_pid->Update(rt.targets.boom, s.q_boom, s.qd_boom, options_.tick);
+  if (std::isfinite(rt.hold_attitude)) {
+    rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, s.q_boom);
+  }
+  if (rt.phase == Phase::kShake) {
+    const double t = s.time - rt.shake_start;
+    const int pulse = static_cast<int>(std::floor(t / options_.finishing.shake_pulse));
+    command.valve[bucket_valve_] = pulse < options_.finishing.shake_pulses
+                                       ? (pulse % 2 == 0 ? 1 : -1) * options_.finishing.shake_duty
+                                       : 0.0;
+  } else {
+    command.valve[bucket_valve_] =
+        rt.bucket_pid->Update(rt.targets.bucket, s.q_bucket, s.qd_bucket, options_.tick);
+  }
+  // NaN never reaches the machine: a non-finite field is replaced by a safe value and counted.
+  bool blocked = false;
+  for (double& u : command.valve) {
+    if (!std::isfinite(u)) u = 0, blocked = true;
+  }
+  if (!std::isfinite(command.drive) || !std::isfinite(command.brake)) {
+    command.drive = 0, command.brake = 1, blocked = true;
+  }
+  if (blocked) ++rt.result.non_finite_blocked;
+  std::string why;
+  if (!machine.Command(command, &why)) ++rt.result.refused_commands;
+  return true;
+}
+
+ScoopResult ScoopCycle::Finish(ScoopMachine& machine) {
+  if (rt_ == nullptr) throw std::logic_error("ScoopCycle::Finish before Start");
+  ScoopResult result = std::move(rt_->result);
+  result.tip_path = std::move(rt_->tip_path);
+  result.end_time = machine.Sense().time;
+  result.payload = machine.PayloadVolume();
+  result.fill_rate = result.payload / machine_.bucket.rated_capacity;
+  rt_.reset();
+  return result;
+}
+
+ScoopResult ScoopCycle::Run(ScoopMachine& machine) {
+  Start(machine);
+  while (Tick(machine)) machine.Advance(options_.tick);
+  return Finish(machine);
 }
 
 }  // namespace autoshovel::control

@@ -51,6 +51,7 @@ struct Proprioception {
   double time = 0;                                     ///< machine clock [s]
   Eigen::Vector2d hinge_xy = Eigen::Vector2d::Zero();  ///< localisation, world [m]
   double heading = 0;                                  ///< front frame [rad]
+  double articulation = 0;                             ///< γ, steering encoder [rad]
   double speed = 0;                                    ///< forward [m/s]
   double q_boom = 0, q_bucket = 0;                     ///< joints (IMUs, Eq. 1) [rad]
   double qd_boom = 0, qd_bucket = 0;                   ///< [rad/s]
@@ -115,6 +116,16 @@ struct PhaseRecord {
   double energy = 0;    ///< [J]
 };
 
+/// One state-machine decision of the digging phases (approach, crowd, scoop): the report's
+/// volume-against-time figure.
+struct ScoopSample {
+  double time = 0;                                ///< machine clock [s]
+  double v1 = 0;                                  ///< Eq. (19) [m³]
+  double v1_plus_v2 = NAN;                        ///< when V2 was computed at this decision [m³]
+  bool triggered = false;                         ///< the scoop has been triggered
+  Eigen::Vector3d tip = Eigen::Vector3d::Zero();  ///< bucket tip, world [m]
+};
+
 struct ScoopResult {
   bool ok = false;
   std::string failure;
@@ -129,6 +140,7 @@ struct ScoopResult {
   double target_volume = 0;                     ///< V_t [m³]
   double feedback_volume = 0;                   ///< V1 at the end of the scoop phase [m³]
   int atomic_actions = 0;
+  std::vector<std::string> action_names;  ///< the atomic actions in order (atomic_actions.h)
   int stairway_steps = 0;
   double boom_pressure_at_contact = 0;  ///< [Pa]
   double boom_pressure_at_trigger = 0;  ///< [Pa]
@@ -138,7 +150,11 @@ struct ScoopResult {
   long non_finite_blocked = 0;  ///< commands with a NaN stopped before the machine (must be 0)
   long refused_commands = 0;    ///< commands the machine refused
   long prediction_failures = 0;
-  double end_time = 0;
+  double start_time = 0;                            ///< [s]
+  double end_time = 0;                              ///< [s]
+  std::vector<ScoopSample> samples;                 ///< every decision while digging
+  std::vector<Eigen::Vector3d> tip_path;            ///< actual tip, approach to scoop end, world
+  std::vector<Eigen::Vector3d> predicted_tip_path;  ///< V2's predicted path at the trigger
 
   const PhaseRecord* Phase(const std::string& name) const;
   /// Contact to the end of the scoop phase (the seed's Table 6/7 "time"): crowd + scoop.
@@ -158,8 +174,21 @@ class ScoopCycle {
              ScoopTrigger& trigger, const prediction::PenetrationPredictor* predictor,
              const ScoopCycleOptions& options);
 
+  ~ScoopCycle();
+
   /// Runs the whole cycle on `machine`; returns when retreated, or failed.
   ScoopResult Run(ScoopMachine& machine);
+
+  // The same, one control tick at a time, for an executive that runs other tasks between ticks
+  // (app/): Start(); while (Tick()) { the executive advances the machine by options.tick };
+  // Finish(). Tick() decides every `decision_every` ticks and commands the machine; it returns
+  // false once the cycle is over (nothing commanded).
+  void Start(ScoopMachine& machine);
+  bool Tick(ScoopMachine& machine);
+  ScoopResult Finish(ScoopMachine& machine);
+  bool done() const;
+  const char* phase_name() const;
+  double tick() const { return options_.tick; }
 
  private:
   enum class Phase { kApproach, kCrowd, kScoop, kLevel, kShake, kRetreat, kDone };
@@ -182,6 +211,7 @@ class ScoopCycle {
   int boom_valve_ = -1, bucket_valve_ = -1;
   double bucket_delay_ = 0;    ///< transport delay + spool time constant of the bucket valve [s]
   double level_attitude_ = 0;  ///< bucket attitude with the opening level, plus carry tilt [rad]
+  std::unique_ptr<Runtime> rt_;
 };
 
 }  // namespace autoshovel::control

@@ -25,9 +25,11 @@ std::vector<double> BucketOnFloor(const model::MachineDescription& machine, doub
 }
 
 ScenarioWithMachine LoadScenarioWithMachine(const std::string& scenario_name_or_path,
-                                            const std::string& models_dir) {
+                                            const std::string& models_dir,
+                                            const std::string& machine_name_or_path) {
   ScenarioWithMachine out;
   out.scenario = LoadScenario(ResolveScenario(scenario_name_or_path, models_dir));
+  if (!machine_name_or_path.empty()) out.scenario.machine = machine_name_or_path;
   out.machine = model::LoadMachineDescription(
       model::ResolveMachineDescription(out.scenario.machine, models_dir));
   out.functions = generated::FindMachine(out.machine.name);

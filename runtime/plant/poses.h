@@ -24,11 +24,13 @@ struct ScenarioWithMachine {
   const generated::MachineFunctions* functions = nullptr;  ///< never null
 };
 
-/// Loads a scenario (name under `<models_dir>/scenarios` or a path) and its machine. Throws
+/// Loads a scenario (name under `<models_dir>/scenarios` or a path) and its machine, or the
+/// machine `machine_name_or_path` instead when it is not empty. Throws
 /// core::InputError for bad files and std::runtime_error when the machine has no generated
 /// code (naming the command that generates it).
 ScenarioWithMachine LoadScenarioWithMachine(const std::string& scenario_name_or_path,
-                                            const std::string& models_dir);
+                                            const std::string& models_dir,
+                                            const std::string& machine_name_or_path = "");
 
 /// The scenario's start pose moved `advance` metres ahead along its heading, with the arm as
 /// when approaching a pile: a loader's bucket on the floor (BucketOnFloor), other arms low in

@@ -11,7 +11,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
 for level in "" describe gen plant "plant step" scenario map calibrate "calibrate arm" \
-  "calibrate camera-lidar" identify "identify hydraulics" select; do
+  "calibrate camera-lidar" identify "identify hydraulics" select run; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)
@@ -103,3 +103,20 @@ grep -q "give --frames" "$tmp/err" || fail "unexpected: $(cat "$tmp/err")"
 "$autoshovel" --models "$source_dir/models" select no_such_yard 2>"$tmp/err" >/dev/null \
   && fail "select accepted an unknown scenario"
 echo "cli ok"
+
+# run: one closed-loop cycle on the cone, simulator labels; the run folder holds what it says.
+"$autoshovel" --models "$source_dir/models" run cone_pile --cycles 1 --truth -o "$tmp/run" \
+  >"$tmp/out" 2>&1 || fail "run: $(cat "$tmp/out")"
+grep -q "1/1 cycles completed" "$tmp/out" || fail "run: $(cat "$tmp/out")"
+for f in config.yaml results.sqlite log.txt report.html figures/fill_rate.png \
+  figures/map_cycle_0.png figures/candidates_cycle_0.png figures/volume_cycle_0.png \
+  figures/tip_path_cycle_0.png; do
+  [ -s "$tmp/run/$f" ] || fail "run wrote no $f"
+done
+grep -q "^scenario: cone_pile" "$tmp/run/config.yaml" || fail "run: config.yaml lacks the scenario"
+"$autoshovel" --models "$source_dir/models" run cone_pile --cycles 1 -o "$tmp/run" \
+  >/dev/null 2>"$tmp/err" && fail "run overwrote an existing run folder"
+"$autoshovel" --models "$source_dir/models" run mixing_station --bins bin_42 -o "$tmp/run2" \
+  >/dev/null 2>"$tmp/err" && fail "run accepted an unknown bin"
+grep -q "no bin 'bin_42'" "$tmp/err" || fail "run: unexpected message: $(cat "$tmp/err")"
+exit 0

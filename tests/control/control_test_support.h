@@ -1,5 +1,5 @@
-// The simulated plant behind the control layer's ScoopMachine interface, and a yard with one
-// cone pile, for the closed-loop control tests. Only tests (and app/) wire the plant to control.
+// A yard with one cone pile for the closed-loop control tests, the plant behind the control
+// layer's ScoopMachine interface being app::PlantMachine.
 #pragma once
 
 #include <cmath>
@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/app/plant_machine.h"
 #include "runtime/control/scoop_cycle.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/scenario_builder.h"
@@ -15,46 +16,7 @@
 
 namespace autoshovel::control::testing {
 
-/// The plant as a ScoopMachine: proprioception is the plant's true state (no sensor noise), the
-/// energy and payload meters are the plant's counters.
-class PlantMachine : public ScoopMachine {
- public:
-  explicit PlantMachine(plant::Plant& plant)
-      : plant_(plant), boom_actuator_(plant.machine().ActuatorOfJoint(0)) {}
-
-  Proprioception Sense() const override {
-    const plant::MachineState& s = plant_.state();
-    Proprioception p;
-    p.time = s.time;
-    p.hinge_xy = s.hinge_xy;
-    p.heading = s.heading;
-    p.speed = s.speed;
-    p.q_boom = s.q[0], p.q_bucket = s.q[1];
-    p.qd_boom = s.qd[0], p.qd_bucket = s.qd[1];
-    p.boom_pressure = plant_.ActuatorPressure(boom_actuator_, true);
-    return p;
-  }
-  bool Command(const core::ActuatorCommand& command, std::string* why) override {
-    for (double u : command.valve) all_finite_ = all_finite_ && std::isfinite(u);
-    all_finite_ = all_finite_ && std::isfinite(command.drive) && std::isfinite(command.brake) &&
-                  std::isfinite(command.articulation_rate);
-    ++commands_;
-    return plant_.SetCommand(command, why);
-  }
-  void Advance(double dt) override { plant_.Advance(dt); }
-  void SetPhase(const std::string& phase) override { plant_.SetPhase(phase); }
-  double Energy() const override { return plant_.energy().total(); }
-  double PayloadVolume() const override { return plant_.bucket().payload_volume(); }
-
-  bool all_commands_finite() const { return all_finite_; }
-  long commands() const { return commands_; }
-
- private:
-  plant::Plant& plant_;
-  int boom_actuator_;
-  bool all_finite_ = true;
-  long commands_ = 0;
-};
+using PlantMachine = app::PlantMachine;
 
 /// The whole terrain as the elevation map a perception stack would give (ε = terrain resolution).
 inline prediction::HeightGrid ToHeightGrid(const plant::Terrain& terrain) {

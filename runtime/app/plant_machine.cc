@@ -1,0 +1,37 @@
+// The plant as a ScoopMachine (plant_machine.h).
+#include "runtime/app/plant_machine.h"
+
+#include <cmath>
+
+namespace autoshovel::app {
+
+PlantMachine::PlantMachine(plant::Plant& plant)
+    : plant_(plant),
+      boom_actuator_(plant.machine().ActuatorOfJoint(0)),
+      steering_override_(std::nan("")) {}
+
+control::Proprioception PlantMachine::Sense() const {
+  const plant::MachineState& s = plant_.state();
+  control::Proprioception p;
+  p.time = s.time;
+  p.hinge_xy = s.hinge_xy;
+  p.heading = s.heading;
+  p.articulation = s.articulation;
+  p.speed = s.speed;
+  p.q_boom = s.q[0], p.q_bucket = s.q[1];
+  p.qd_boom = s.qd[0], p.qd_bucket = s.qd[1];
+  p.boom_pressure = boom_actuator_ >= 0 ? plant_.ActuatorPressure(boom_actuator_, true) : 0.0;
+  return p;
+}
+
+bool PlantMachine::Command(const core::ActuatorCommand& command, std::string* why) {
+  core::ActuatorCommand sent = command;
+  if (std::isfinite(steering_override_)) sent.articulation_rate = steering_override_;
+  for (double u : sent.valve) all_finite_ = all_finite_ && std::isfinite(u);
+  all_finite_ = all_finite_ && std::isfinite(sent.drive) && std::isfinite(sent.brake) &&
+                std::isfinite(sent.articulation_rate);
+  ++commands_;
+  return plant_.SetCommand(sent, why);
+}
+
+}  // namespace autoshovel::app

@@ -1,0 +1,44 @@
+// The simulated plant behind the control layer's ScoopMachine interface: what app/ (and the
+// closed-loop tests) hand to a ScoopCycle when the machine is simulated. DESIGN.md: only app/
+// and tests wire the plant to control.
+#pragma once
+
+#include <string>
+
+#include "runtime/control/scoop_cycle.h"
+#include "runtime/core/actuator_command.h"
+#include "runtime/plant/plant.h"
+
+namespace autoshovel::app {
+
+/// Proprioception is the plant's true state (no sensor noise); the energy and payload meters are
+/// the plant's counters. Every command passes through `steering_override` when set: navigation
+/// steers while the scoop cycle (which never steers) drives.
+class PlantMachine : public control::ScoopMachine {
+ public:
+  explicit PlantMachine(plant::Plant& plant);
+
+  control::Proprioception Sense() const override;
+  bool Command(const core::ActuatorCommand& command, std::string* why) override;
+  void Advance(double dt) override { plant_.Advance(dt); }
+  void SetPhase(const std::string& phase) override { plant_.SetPhase(phase); }
+  double Energy() const override { return plant_.energy().total(); }
+  double PayloadVolume() const override { return plant_.bucket().payload_volume(); }
+
+  /// The articulation rate [rad/s] sent with every following command instead of the one the
+  /// caller gives; NaN: the caller's.
+  void SetSteeringOverride(double articulation_rate) { steering_override_ = articulation_rate; }
+
+  bool all_commands_finite() const { return all_finite_; }
+  long commands() const { return commands_; }
+  plant::Plant& plant() { return plant_; }
+
+ private:
+  plant::Plant& plant_;
+  int boom_actuator_;
+  double steering_override_;
+  bool all_finite_ = true;
+  long commands_ = 0;
+};
+
+}  // namespace autoshovel::app

@@ -1,0 +1,769 @@
+// The main job: closed-loop shoveling cycles in a simulated yard (shovel_run.h).
+#include "runtime/app/shovel_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "runtime/app/executive.h"
+#include "runtime/app/plant_machine.h"
+#include "runtime/app/safety_margin.h"
+#include "runtime/control/joint_pid.h"
+#include "runtime/control/path_follower.h"
+#include "runtime/control/speed_pid.h"
+#include "runtime/perception/elevation_map.h"
+#include "runtime/perception/machine_footprint.h"
+#include "runtime/perception/map_render.h"
+#include "runtime/perception/perceive_from_plant.h"
+#include "runtime/perception/pile_extraction.h"
+#include "runtime/perception/semantic_map.h"
+#include "runtime/planning/candidate_render.h"
+#include "runtime/planning/chen2024_baseline.h"
+#include "runtime/planning/shovel_point_selection.h"
+#include "runtime/plant/plant.h"
+#include "runtime/plant/poses.h"
+#include "runtime/plant/scenario.h"
+#include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/volume_estimation.h"
+#include "runtime/results/plots.h"
+#include "runtime/results/report.h"
+#include "runtime/results/run_folder.h"
+#include "runtime/sensors/raycast.h"
+#include "runtime/sensors/rng.h"
+
+namespace autoshovel::app {
+
+const char* ToString(TriggerChoice trigger) {
+  switch (trigger) {
+    case TriggerChoice::kPredicted:
+      return "predicted";
+    case TriggerChoice::kPerception:
+      return "perception";
+    case TriggerChoice::kPressure:
+      return "pressure";
+  }
+  return "?";
+}
+
+const char* ToString(SelectionMethod method) {
+  return method == SelectionMethod::kOurs ? "ours" : "chen2024";
+}
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// The elevation layer as the regular grid the volume estimation reads (unknown cells NaN).
+prediction::HeightGrid HeightGridOf(const perception::GridMap& map) {
+  prediction::HeightGrid grid;
+  grid.resolution = map.resolution();
+  grid.nx = map.size().x();
+  grid.ny = map.size().y();
+  grid.origin = map.position() - 0.5 * map.length();
+  grid.height.assign(static_cast<std::size_t>(grid.nx) * grid.ny, NAN);
+  const Eigen::MatrixXf& elevation = map["elevation"];
+  for (int iy = 0; iy < grid.ny; ++iy) {
+    for (int ix = 0; ix < grid.nx; ++ix) {
+      perception::Index index;
+      if (!map.IndexOf(grid.CellCenter(ix, iy), index)) continue;
+      grid.height[static_cast<std::size_t>(iy) * grid.nx + ix] = elevation(index.x(), index.y());
+    }
+  }
+  return grid;
+}
+
+// Where cycles dig: a bin holding piles, or the open yard (piles outside bins).
+struct Site {
+  std::string name;
+  int bin = -1;  ///< into Scenario::bins; −1: the open yard
+  Eigen::Vector2d start_xy = Eigen::Vector2d::Zero();
+  double start_heading = 0;
+};
+
+bool InsideBin(const plant::Bin& bin, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d u(std::cos(bin.yaw), std::sin(bin.yaw)), v(-u.y(), u.x());
+  const Eigen::Vector2d d = p - bin.front_center;
+  return std::abs(d.dot(u)) <= bin.width / 2 && d.dot(v) >= -0.5 && d.dot(v) <= bin.depth;
+}
+
+std::string Fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
+}  // namespace
+
+struct ShovelJob::State {
+  ShovelRunOptions options;
+  plant::ScenarioWithMachine setup;
+  std::vector<std::string> site_names;
+  std::vector<Site> sites;
+  prediction::PenetrationPredictor predictor;
+  planning::LoaderGeometry loader;
+  std::unique_ptr<sensors::RaycastScene> scene;
+  std::unique_ptr<perception::ElevationMap> map;
+  std::unique_ptr<perception::SemanticMap> semantic;
+  sensors::Rng rng;
+  std::string segmenter;
+  double cycle_clock = 0;  ///< each cycle's plant starts where the last one ended [s]
+  int next_site = 0;
+
+  State(const ShovelRunOptions& o)
+      : options(o),
+        setup(plant::LoadScenarioWithMachine(o.scenario, o.models_dir, o.machine)),
+        predictor(prediction::PenetrationPredictor::Load(
+            o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor)),
+        rng(o.seed) {}
+};
+
+ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<State>(options)) {
+  State& st = *state_;
+  const plant::Scenario& scenario = st.setup.scenario;
+  const model::MachineDescription& machine = st.setup.machine;
+  if (machine.kind != model::MachineKind::kWheelLoader) {
+    throw std::invalid_argument("autoshovel run: machine '" + machine.name +
+                                "' is not a wheel loader");
+  }
+  if (options.cycles < 1) throw std::invalid_argument("autoshovel run: --cycles must be >= 1");
+  const double rates[] = {options.map_rate, options.decision_rate, options.control_rate};
+  for (double r : rates) {
+    if (!(r > 0) || !std::isfinite(r)) throw std::invalid_argument("autoshovel run: bad rate");
+  }
+  if (options.map_rate > options.control_rate || options.decision_rate > options.control_rate) {
+    throw std::invalid_argument("autoshovel run: control must be the fastest rate");
+  }
+  // Sites: the bins asked for, else every bin holding a pile and the open yard if piles lie
+  // outside bins. A bin is entered from `approach_distance` out of its open front, facing in;
+  // the open yard from the scenario's start pose.
+  auto holds_pile = [&](int b) {
+    return std::any_of(scenario.piles.begin(), scenario.piles.end(),
+                       [&](const plant::Pile& p) { return p.bin == b; });
+  };
+  auto bin_site = [&](int b) {
+    const plant::Bin& bin = scenario.bins[b];
+    const double into_bin = bin.yaw + std::numbers::pi / 2;
+    Site site;
+    site.name = bin.name;
+    site.bin = b;
+    site.start_heading = into_bin;
+    site.start_xy = bin.front_center - options.approach_distance *
+                                           Eigen::Vector2d(std::cos(into_bin), std::sin(into_bin));
+    return site;
+  };
+  if (options.bins.empty()) {
+    for (int b = 0; b < static_cast<int>(scenario.bins.size()); ++b) {
+      if (holds_pile(b)) st.sites.push_back(bin_site(b));
+    }
+    if (holds_pile(-1)) {
+      st.sites.push_back({.name = "yard",
+                          .bin = -1,
+                          .start_xy = Eigen::Vector2d(scenario.start.x, scenario.start.y),
+                          .start_heading = scenario.start.heading});
+    }
+  } else {
+    for (const std::string& name : options.bins) {
+      int found = -1;
+      for (int b = 0; b < static_cast<int>(scenario.bins.size()); ++b) {
+        if (scenario.bins[b].name == name) found = b;
+      }
+      if (found < 0) {
+        std::string known;
+        for (const plant::Bin& b : scenario.bins) known += " " + b.name;
+        throw std::invalid_argument("autoshovel run: scenario '" + scenario.name +
+                                    "' has no bin '" + name +
+                                    "' (bins:" + (known.empty() ? " none" : known) + ")");
+      }
+      if (!holds_pile(found)) {
+        throw std::invalid_argument("autoshovel run: bin '" + name + "' holds no pile");
+      }
+      st.sites.push_back(bin_site(found));
+    }
+  }
+  if (st.sites.empty()) {
+    throw std::invalid_argument("autoshovel run: scenario '" + scenario.name + "' has no pile");
+  }
+  for (const Site& site : st.sites) st.site_names.push_back(site.name);
+  st.loader = planning::LoaderGeometryFrom(machine, *st.setup.functions);
+  st.segmenter = options.segmenter.empty()
+                     ? options.models_dir + "/segmentation/yard_segmenter.onnx"
+                     : options.segmenter;
+  st.scene = std::make_unique<sensors::RaycastScene>(scenario.world);
+  // One map over the whole yard (60 m × 60 m by default), kept across cycles.
+  perception::ElevationMapConfig map_config;
+  const plant::GridGeometry& g = scenario.world.terrain.geometry();
+  const Eigen::Vector2d size(g.nx * g.resolution, g.ny * g.resolution);
+  map_config.length = size;
+  st.map = std::make_unique<perception::ElevationMap>(map_config, g.origin + 0.5 * size);
+  st.semantic = std::make_unique<perception::SemanticMap>(*st.map);
+}
+
+ShovelJob::~ShovelJob() = default;
+
+const std::vector<std::string>& ShovelJob::sites() const { return state_->site_names; }
+const std::string& ShovelJob::scenario_name() const { return state_->setup.scenario.name; }
+const std::string& ShovelJob::machine_name() const { return state_->setup.machine.name; }
+
+std::string ShovelJob::ConfigYaml() const {
+  const ShovelRunOptions& o = state_->options;
+  std::ostringstream y;
+  y << "scenario: " << state_->setup.scenario.name << "\n"
+    << "scenario_file: " << state_->setup.scenario.source_file << "\n"
+    << "machine: " << state_->setup.machine.name << "\n"
+    << "cycles: " << o.cycles << "\n"
+    << "seed: " << o.seed << "\n"
+    << "bins: [";
+  for (std::size_t i = 0; i < state_->site_names.size(); ++i) {
+    y << (i ? ", " : "") << state_->site_names[i];
+  }
+  y << "]\n"
+    << "semantics: " << (o.truth_labels ? "simulator labels" : state_->segmenter) << "\n"
+    << "predictor: "
+    << (o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor) << "\n"
+    << "selection: " << ToString(o.selection) << "\n"
+    << "trigger: " << ToString(o.trigger) << "\n"
+    << "policy: " << control::ToString(o.policy) << "\n"
+    << "pressure_threshold_bar: " << o.pressure_threshold / 1e5 << "\n"
+    << "stairway_steps: " << o.stairway_steps << "\n"
+    << "approach_distance_m: " << o.approach_distance << "\n"
+    << "safety_distance_m: " << o.safety_distance << "\n"
+    << "d_res_m: " << o.d_res << "\n"
+    << "planning_margin_m: " << o.planning_margin << "\n"
+    << "handover_distance_m: " << o.handover_distance << "\n"
+    << "max_cycle_time_s: " << o.max_cycle_time << "\n"
+    << "rates_hz: {control: " << o.control_rate << ", decisions: " << o.decision_rate
+    << ", map_and_selection: " << o.map_rate << "}\n";
+  return y.str();
+}
+
+CycleOutcome ShovelJob::RunCycle(int index, const std::filesystem::path& figures_dir,
+                                 std::ostream* progress) {
+  // Sites in turn; one where no shovel point is feasible (blocked by a parked machine, dug out)
+  // is skipped, as an operator would drive on to the next bin. Nothing moved there.
+  State& st = *state_;
+  CycleOutcome out;
+  for (std::size_t attempt = 0; attempt < st.sites.size(); ++attempt) {
+    const int site = st.next_site;
+    st.next_site = (st.next_site + 1) % static_cast<int>(st.sites.size());
+    out = RunCycleAt(index, site, figures_dir, progress);
+    if (!out.no_shovel_point) return out;
+  }
+  return out;
+}
+
+CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
+                                   const std::filesystem::path& figures_dir,
+                                   std::ostream* progress) {
+  State& st = *state_;
+  const ShovelRunOptions& o = st.options;
+  plant::Scenario& scenario = st.setup.scenario;
+  const model::MachineDescription& machine = st.setup.machine;
+  const Site& site = st.sites[site_index];
+  // Piles of this site: inside its bin, or, in the open yard, within the stockpile area the
+  // yard's plan gives (2 m beyond each open pile's footprint). A map pile elsewhere (noise far
+  // away, where Eq. (11) falls back on height alone) is not a work area.
+  auto in_site = [&](const Eigen::Vector2d& p) {
+    if (site.bin >= 0) return InsideBin(scenario.bins[site.bin], p);
+    return std::any_of(scenario.piles.begin(), scenario.piles.end(), [&](const plant::Pile& q) {
+      const double extent = std::max({q.base_radius, q.length / 2, q.width / 2});
+      return q.bin < 0 && (p - q.center).norm() <= extent + 2.0;
+    });
+  };
+
+  CycleOutcome out;
+  results::CycleRecord& rec = out.record;
+  rec.cycle = index;
+  rec.scenario = scenario.name;
+  rec.machine = machine.name;
+  rec.bin = site.name;
+  rec.completed = false;
+  auto say = [&](const std::string& text) {
+    if (progress != nullptr) *progress << "[cycle " << index + 1 << "] " << text << "\n";
+  };
+
+  // Start: at the site's start pose, bucket on the floor, empty.
+  plant::MachineState start = plant::StartState(scenario, machine);
+  start.hinge_xy = site.start_xy;
+  start.heading = site.start_heading;
+  start.time = st.cycle_clock;
+  plant::Plant plant(machine, *st.setup.functions, scenario.world, start);
+  PlantMachine machine_io(plant);
+  st.scene->Update();  // the terrain as the last cycle left it
+
+  control::ScoopCycleOptions scoop_options;
+  scoop_options.tick = 1.0 / o.control_rate;
+  scoop_options.decision_every =
+      std::max(1, static_cast<int>(std::lround(o.control_rate / o.decision_rate)));
+  const std::vector<double> q_attack = plant::BucketOnFloor(machine);
+  scoop_options.attack_pose = {.boom = q_attack[0], .bucket = q_attack[1]};
+  scoop_options.policy = o.policy;
+  scoop_options.strategy.fixed_steps = o.stairway_steps;
+  out.target_volume = scoop_options.target_fill * machine.bucket.rated_capacity;
+
+  perception::PerceptionFromPlantOptions perceive;
+  perceive.lighting = scenario.lighting;
+  perceive.truth_labels = o.truth_labels;
+  perceive.segmenter = st.segmenter;
+
+  planning::ShovelPointConfig select_config;
+  // Eq. (14) scores clearance but, as the seed writes it, only penalises a path that comes
+  // closer than d_res (s_s = d_min / d_res). The run holds every cycle to the safety distance,
+  // so our selection takes the best candidate whose planned clearance is at least the safety
+  // distance plus `planning_margin` (the map's obstacle cells are 0.3 m wide; the path follower
+  // cuts corners and lags curvature steps by some centimetres).
+  select_config.safety_distance = o.d_res;
+  const double min_planned_clearance = o.safety_distance + o.planning_margin;
+  // Paths are planned at most at `curvature_reserve` of κmax: the follower keeps articulation
+  // in hand to pull back onto a path whose curvature steps it can only follow at a finite rate.
+  select_config.max_curvature = o.curvature_reserve * st.loader.MaxCurvature();
+
+  enum class Stage { kSelect, kNavigate, kScoop, kDone } stage = Stage::kSelect;
+  std::optional<planning::ShovelCandidate> goal;
+  std::optional<control::PathFollower> follower;
+  std::unique_ptr<control::ScoopTrigger> trigger;
+  std::unique_ptr<control::ScoopCycle> scoop;
+  const plant::Pile* pile = nullptr;
+  prediction::HeightGrid pre_contact;  ///< the map before contact, which the scoop cycle reads
+  planning::ShovelPointResult last_selection;
+  std::vector<planning::Chen2024Candidate> last_baseline;
+  std::vector<perception::ExtractedPile> last_piles;
+  double remaining = INFINITY;
+  double max_cross_track = 0;  ///< largest distance of the front axle from its path [m]
+  double min_clearance = INFINITY;
+  int violations = 0;
+  bool in_violation = false;
+  long perception_calls = 0, selections = 0;
+  double perception_seconds = 0, selection_seconds = 0;
+  const double t0 = plant.time();
+
+  control::JointPid boom_pid(
+      scoop_options.boom_gains,
+      machine.hydraulics.actuators[machine.ActuatorOfJoint(0)].valve.dead_zone);
+  control::JointPid bucket_pid(
+      scoop_options.bucket_gains,
+      machine.hydraulics.actuators[machine.ActuatorOfJoint(1)].valve.dead_zone);
+  control::SpeedPid speed_pid(scoop_options.speed_gains);
+  speed_pid.Reset(0.0);
+  core::ActuatorCommand command;
+  command.valve.assign(machine.hydraulics.actuators.size(), 0.0);
+  double target_speed = 0;
+  double articulation_rate = 0;
+
+  // 7 Hz: the map from the sensors now, then (before committing to a path) the selection.
+  auto select = [&]() {
+    const auto w0 = std::chrono::steady_clock::now();
+    perception::GridMap& grid = st.map->map();
+    const Eigen::Vector3d plane = st.semantic->ground_plane();
+    std::vector<perception::ExtractedPile> piles = perception::ExtractPiles(grid, plane);
+    std::vector<perception::ExtractedPile> in_bin;
+    for (auto& p : piles) {
+      if (in_site(p.centroid)) in_bin.push_back(std::move(p));
+    }
+    const plant::MachineState& s = plant.state();
+    const planning::Pose2 T_world_hinge{s.hinge_xy, s.heading};
+    last_selection =
+        planning::SelectShovelPoints(grid, in_bin, plane, T_world_hinge, st.loader, select_config);
+    last_piles = in_bin;
+    const planning::ShovelCandidate* best = nullptr;
+    for (const planning::ShovelCandidate& k : last_selection.ranked) {
+      if (k.feasible && k.scores.min_obstacle_distance >= min_planned_clearance) {
+        best = &k;
+        break;
+      }
+    }
+    if (o.selection == SelectionMethod::kChen2024) {
+      last_baseline = planning::RankChen2024(
+          grid, plane, planning::GenerateCandidates(grid, in_bin, select_config), s.hinge_xy);
+      best = nullptr;
+      // The baseline's choice, driven by our planner's path to it (Chen et al. plan no path).
+      if (!last_baseline.empty()) {
+        const planning::CandidatePose& c = last_baseline.front().pose;
+        for (const planning::ShovelCandidate& k : last_selection.ranked) {
+          if (k.pose.pile == c.pile && k.pose.point == c.point &&
+              std::abs(k.pose.entry_offset - c.entry_offset) < 1e-9) {
+            best = &k;
+          }
+        }
+      }
+    }
+    ++selections;
+    selection_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    return best;
+  };
+  auto update_map = [&]() {
+    const auto w0 = std::chrono::steady_clock::now();
+    st.scene->SetExtraBoxes(plant.OwnBodies());
+    perceive.lidar_frames = perception_calls == 0 ? 5 : 1;
+    perception::PerceiveFromPlant(plant, *st.scene, st.rng, perceive, *st.map, *st.semantic);
+    ++perception_calls;
+    perception_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  };
+  planning::ShovelPointResult goal_selection;
+  std::vector<planning::Chen2024Candidate> goal_baseline;
+  planning::Pose2 goal_from{start.hinge_xy, start.heading};
+  // A new goal (its selection kept for the figure), or the same goal on a re-planned path.
+  auto start_path = [&](const planning::ShovelCandidate& c, bool new_goal = true) {
+    goal = c;
+    if (new_goal) {
+      goal_selection = last_selection;
+      goal_baseline = last_baseline;
+      goal_from = {plant.state().hinge_xy, plant.state().heading};
+    }
+    follower.emplace(planning::SamplePath(c.path, 0.1), st.loader);
+  };
+
+  MultiRateExecutive executive(1.0 / o.control_rate, plant.time());
+  executive.Add("map_and_selection", 1.0 / o.map_rate, [&](double) {
+    if (stage != Stage::kSelect && stage != Stage::kNavigate) return;
+    update_map();
+    // Selection re-runs until the remaining path is short (a goal that moved under the bucket
+    // would be chased): commit 5 m before the handover; a new goal must beat the one being
+    // driven to by 0.05 in F (hysteresis against dithering between near-equal candidates).
+    if (stage == Stage::kSelect || remaining > o.handover_distance + 5.0) {
+      const planning::ShovelCandidate* best = select();
+      if (stage == Stage::kSelect) {
+        if (best == nullptr) {
+          out.failure =
+              "no feasible shovel point in " + site.name + " (" + last_selection.message + ")";
+          out.no_shovel_point = true;
+          stage = Stage::kDone;
+          return;
+        }
+        start_path(*best);
+        stage = Stage::kNavigate;
+        say("selected point (" + Fixed(best->pose.xy.x(), 2) + ", " + Fixed(best->pose.xy.y(), 2) +
+            ") heading " + Fixed(best->pose.entry_heading / kDeg, 1) + " deg, F " +
+            Fixed(best->score, 3) + ", path " + Fixed(best->path.length(), 1) + " m, d_min " +
+            Fixed(best->scores.min_obstacle_distance, 2) + " m");
+      } else if (best != nullptr) {
+        // The goal being driven to, as seen on the new map and planned from where the machine
+        // is now: infeasible (an obstacle came into view) → take the best; beaten by 0.05 in F
+        // (our selection only) → take the best; otherwise keep it, on its re-planned path.
+        const planning::ShovelCandidate* current = nullptr;
+        for (const planning::ShovelCandidate& k : last_selection.ranked) {
+          if ((k.pose.xy - goal->pose.xy).norm() < 0.5 &&
+              std::abs(std::remainder(k.pose.entry_heading - goal->pose.entry_heading,
+                                      2 * std::numbers::pi)) < 1 * kDeg) {
+            current = &k;
+            break;
+          }
+        }
+        if (current == nullptr || !current->feasible ||
+            (o.selection == SelectionMethod::kOurs &&
+             current->scores.min_obstacle_distance < min_planned_clearance)) {
+          start_path(*best);
+          say("re-selected (goal no longer feasible): F " + Fixed(best->score, 3));
+        } else if (o.selection == SelectionMethod::kOurs && best->score > current->score + 0.05) {
+          start_path(*best);
+          say("re-selected: F " + Fixed(best->score, 3));
+        } else {
+          start_path(*current, /*new_goal=*/false);
+        }
+      }
+    }
+  });
+  executive.Add("state_machine_and_safety", 1.0 / o.decision_rate, [&](double) {
+    const plant::MachineState& s = plant.state();
+    const double reach = prediction::TipInBase(machine, s.q[0], s.q[1]).x();
+    const perception::MachineFootprint footprint =
+        perception::LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation, reach);
+    const Clearance c = FootprintClearance(footprint, scenario.world.obstacles);
+    min_clearance = std::min(min_clearance, c.distance);
+    const bool violating = c.distance < o.safety_distance;
+    if (violating && !in_violation) {
+      ++violations;
+      say("SAFETY: " + Fixed(c.distance, 2) + " m from " +
+          scenario.world.obstacles[c.obstacle].name + " at t = " + Fixed(plant.time() - t0, 2) +
+          " s, hinge (" + Fixed(s.hinge_xy.x(), 2) + ", " + Fixed(s.hinge_xy.y(), 2) +
+          "), heading " + Fixed(s.heading / kDeg, 1) + " deg, articulation " +
+          Fixed(s.articulation / kDeg, 1) + " deg, path error so far " + Fixed(max_cross_track, 2) +
+          " m");
+    }
+    in_violation = violating;
+    if (stage == Stage::kNavigate && remaining <= o.handover_distance) {
+      // Hand over to the scoop cycle with the map as it stands before contact. The material is
+      // that of the site's pile nearest the shovel point: the yard's inventory (which material
+      // lies in which bin) is known to the station; the map's classes do not tell materials.
+      double nearest = INFINITY;
+      for (const plant::Pile& p : scenario.piles) {
+        const double d = (p.center - goal->pose.xy).norm();
+        if (in_site(p.center) && d < nearest) nearest = d, pile = &p;
+      }
+      if (pile == nullptr) {
+        out.failure = "no pile of the scenario lies in " + site.name;
+        stage = Stage::kDone;
+        return;
+      }
+      const model::Material* material = machine.FindMaterial(pile->material);
+      if (material == nullptr) {
+        out.failure = "machine '" + machine.name + "' has no material '" + pile->material + "'";
+        stage = Stage::kDone;
+        return;
+      }
+      rec.material = material->name;
+      if (o.trigger == TriggerChoice::kPredicted) {
+        trigger = std::make_unique<control::PredictedVolumeTrigger>(out.target_volume);
+      } else if (o.trigger == TriggerChoice::kPerception) {
+        trigger = std::make_unique<control::PerceptionTrigger>(out.target_volume);
+      } else {
+        trigger = std::make_unique<control::BoomPressureTrigger>(o.pressure_threshold);
+      }
+      pre_contact = HeightGridOf(st.map->map());
+      scoop =
+          std::make_unique<control::ScoopCycle>(machine, *st.setup.functions, pre_contact,
+                                                *material, *trigger, &st.predictor, scoop_options);
+      scoop->Start(machine_io);
+      stage = Stage::kScoop;
+      say("attack (" + std::string(control::ToString(o.policy)) + ", trigger " +
+          ToString(o.trigger) + ") on " + material->name);
+    }
+  });
+  executive.Add("control", 1.0 / o.control_rate, [&](double) {
+    const control::Proprioception s = machine_io.Sense();
+    if (stage == Stage::kNavigate || (stage == Stage::kScoop && follower)) {
+      const control::SteeringCommand steer =
+          follower->Update(s.hinge_xy, s.heading, s.articulation);
+      remaining = steer.remaining;
+      max_cross_track = std::max(max_cross_track, std::abs(steer.cross_track));
+      articulation_rate = steer.articulation_rate;
+      target_speed = steer.speed;
+    }
+    if (stage == Stage::kNavigate) {
+      speed_pid.SetTarget(target_speed);
+      const control::DriveCommand drive = speed_pid.Update(s.speed, scoop_options.tick);
+      command.drive = drive.drive;
+      command.brake = drive.brake;
+      command.articulation_rate = articulation_rate;
+      command.valve[machine.ActuatorOfJoint(0)] =
+          boom_pid.Update(scoop_options.attack_pose.boom, s.q_boom, s.qd_boom, scoop_options.tick);
+      command.valve[machine.ActuatorOfJoint(1)] = bucket_pid.Update(
+          scoop_options.attack_pose.bucket, s.q_bucket, s.qd_bucket, scoop_options.tick);
+      std::string why;
+      machine_io.Command(command, &why);
+    } else if (stage == Stage::kSelect) {
+      command.drive = 0, command.brake = 1, command.articulation_rate = 0;
+      std::fill(command.valve.begin(), command.valve.end(), 0.0);
+      std::string why;
+      machine_io.Command(command, &why);
+    } else if (stage == Stage::kScoop) {
+      // Navigation keeps steering (the path, then straight on along the entry heading) while
+      // the scoop cycle drives in; once it scoops, the articulation is held.
+      const std::string phase = scoop->phase_name();
+      const bool steering = phase == "approach" || phase == "crowd";
+      machine_io.SetSteeringOverride(steering ? articulation_rate : 0.0);
+      if (!scoop->Tick(machine_io)) stage = Stage::kDone;
+    }
+  });
+
+  std::string last_phase;
+  while (stage != Stage::kDone) {
+    executive.Step();
+    if (stage == Stage::kDone) break;
+    plant.Advance(1.0 / o.control_rate);
+    if (scoop && scoop->phase_name() != last_phase) {
+      last_phase = scoop->phase_name();
+      if (last_phase != "approach" && last_phase != "done") {
+        say(last_phase + " at t = " + Fixed(plant.time() - t0, 2) + " s");
+      }
+    }
+    if (plant.time() - t0 > o.max_cycle_time) {
+      out.failure = "cycle not complete within " + Fixed(o.max_cycle_time, 0) + " s";
+      break;
+    }
+  }
+  const double nav_time = scoop ? 0.0 : plant.time() - t0;
+  if (scoop) out.scoop = scoop->Finish(machine_io);
+  st.cycle_clock = plant.time();
+
+  // The row.
+  const control::ScoopResult& r = out.scoop;
+  if (out.failure.empty() && scoop && !r.ok) out.failure = r.failure;
+  rec.completed = out.failure.empty() && r.ok;
+  rec.strategy = scoop ? control::ToString(r.strategy) : "";
+  std::string actions;
+  for (const std::string& a : r.action_names) actions += (actions.empty() ? "" : ",") + a;
+  rec.atomic_actions = actions;
+  rec.trigger_time_s = std::isnan(r.trigger_time) ? NAN : r.trigger_time - t0;
+  rec.payload_m3 = machine_io.PayloadVolume();
+  rec.fill_rate = rec.payload_m3 / machine.bucket.rated_capacity;
+  auto phase = [&](const char* name, bool energy) {
+    const control::PhaseRecord* p = r.Phase(name);
+    if (p == nullptr) return 0.0;
+    return energy ? p->energy / 1e3 : p->duration;
+  };
+  // Navigation: from the cycle start to the scoop cycle's start (booked to "approach").
+  const double to_scoop_time = scoop ? r.start_time - t0 : nav_time;
+  for (const bool energy : {false, true}) {
+    results::PhaseValues& v = energy ? rec.energy_kj : rec.time_s;
+    v.approach = phase("approach", energy) + (energy ? 0.0 : to_scoop_time);
+    v.crowd = phase("crowd", energy);
+    v.scoop = phase("scoop", energy);
+    v.level = phase("level", energy) + phase("shake", energy);
+    v.retreat = phase("retreat", energy);
+    v.total = energy ? machine_io.Energy() / 1e3 : plant.time() - t0;
+  }
+  // Energy before the scoop cycle began (navigation): total less the cycle's phases.
+  double booked = 0;
+  for (const control::PhaseRecord& p : r.phases) booked += p.energy / 1e3;
+  rec.energy_kj.approach += std::max(0.0, rec.energy_kj.total - booked);
+  rec.safety_margin_m = min_clearance;
+  rec.safety_violations = violations;
+  // Samples: V1, V1+V2, trigger; the tip in the frame of the machine at contact (x ahead, z up).
+  const Eigen::Vector2d frame_origin =
+      r.tip_path.empty() ? start.hinge_xy : r.tip_path.front().head<2>();
+  const double frame_heading = goal ? goal->pose.entry_heading : start.heading;
+  const Eigen::Vector2d ahead(std::cos(frame_heading), std::sin(frame_heading));
+  for (const control::ScoopSample& s : r.samples) {
+    results::CycleSample cs;
+    cs.t = s.time - t0;
+    cs.v1 = s.v1;
+    cs.v1v2 = s.v1_plus_v2;
+    cs.triggered = s.triggered;
+    cs.actual_tip_x = (s.tip.head<2>() - frame_origin).dot(ahead);
+    cs.actual_tip_z = s.tip.z();
+    rec.samples.push_back(cs);
+  }
+  for (std::size_t k = 0; k < r.predicted_tip_path.size(); ++k) {
+    results::CycleSample cs;
+    cs.t = r.trigger_time - t0 + 0.02 * static_cast<double>(k);
+    cs.triggered = true;
+    cs.predicted_tip_x = (r.predicted_tip_path[k].head<2>() - frame_origin).dot(ahead);
+    cs.predicted_tip_z = r.predicted_tip_path[k].z();
+    rec.samples.push_back(cs);
+  }
+
+  // Figures.
+  if (!figures_dir.empty() && o.figures) {
+    const std::string n = std::to_string(index);  // the database's cycle index
+    const std::filesystem::path map_png = figures_dir / ("map_cycle_" + n + ".png");
+    perception::WriteSemanticMapPng(st.map->map(), last_piles, map_png.string(), 2);
+    out.figures.push_back(map_png);
+    out.figure_titles.push_back("Cycle " + n + ": semantic elevation map layers (Fig. 5)");
+    if (goal) {
+      const std::filesystem::path cand_png = figures_dir / ("candidates_cycle_" + n + ".png");
+      planning::WriteCandidatePng(
+          st.map->map(), goal_selection,
+          o.selection == SelectionMethod::kChen2024 ? &goal_baseline : nullptr, goal_from,
+          st.loader, cand_png.string());
+      out.figures.push_back(cand_png);
+      out.figure_titles.push_back("Cycle " + n + ": scored shovel points (Fig. 19)");
+    }
+    if (scoop) {
+      const std::filesystem::path vol_png = figures_dir / ("volume_cycle_" + n + ".png");
+      results::WriteVolumePlotPng(rec, out.target_volume, vol_png);
+      out.figures.push_back(vol_png);
+      out.figure_titles.push_back("Cycle " + n + ": V1 and V1+V2 against time, trigger");
+      const std::filesystem::path tip_png = figures_dir / ("tip_path_cycle_" + n + ".png");
+      results::WriteTipPathPlotPng(rec, tip_png);
+      out.figures.push_back(tip_png);
+      out.figure_titles.push_back("Cycle " + n + ": predicted (at the trigger) and actual tip");
+    }
+  }
+  if (out.no_shovel_point) {
+    say("skipped " + site.name + ": " + out.failure);
+    return out;
+  }
+  say(std::string(rec.completed ? "done" : "NOT completed: " + out.failure) + " — " + site.name +
+      ", " + rec.material + ", " + rec.strategy + " (" + rec.atomic_actions + "), fill " +
+      Fixed(100 * rec.fill_rate, 1) + " %, trigger " + Fixed(r.trigger_after_contact, 2) +
+      " s after contact, cycle " + Fixed(rec.time_s.total, 1) + " s, " +
+      Fixed(rec.energy_kj.total, 0) + " kJ, clearance " + Fixed(min_clearance, 2) + " m; map " +
+      std::to_string(perception_calls) + "× (" + Fixed(perception_seconds, 1) + " s), selection " +
+      std::to_string(selections) + "× (" + Fixed(selection_seconds, 1) + " s)");
+  return out;
+}
+
+int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::path& out_dir,
+                     std::ostream& out, std::ostream& err) {
+  std::unique_ptr<ShovelJob> job;
+  try {
+    job = std::make_unique<ShovelJob>(options);
+  } catch (const std::exception& e) {
+    err << "autoshovel run: " << e.what() << "\n";
+    return 2;
+  }
+  results::RunFolderOptions folder_options;
+  folder_options.dir = out_dir;
+  std::unique_ptr<results::RunFolder> folder;
+  try {
+    folder = std::make_unique<results::RunFolder>(folder_options);
+    folder->WriteConfig(job->ConfigYaml());
+  } catch (const std::exception& e) {
+    err << "autoshovel run: " << e.what() << "\n";
+    return 2;
+  }
+  results::RunLog& log = folder->log();
+  results::ResultsDb db(folder->DatabasePath());
+  results::RunInfo info;
+  info.run_id = folder->name();
+  info.scenario = job->scenario_name();
+  info.machine = job->machine_name();
+  info.seed = options.seed;
+  info.cycles_planned = options.cycles;
+  db.BeginRun(info);
+  out << "autoshovel run: " << options.cycles << " cycle(s) of " << job->machine_name() << " in "
+      << job->scenario_name() << " -> " << folder->dir().string() << "\n";
+  log.Info("run " + info.run_id + ": " + std::to_string(options.cycles) + " cycles, seed " +
+           std::to_string(options.seed));
+
+  std::vector<results::ReportFigure> figures;
+  int incomplete = 0;
+  const auto w0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < options.cycles; ++i) {
+    std::ostringstream progress;
+    CycleOutcome cycle;
+    try {
+      cycle = job->RunCycle(i, folder->dir() / "figures", &progress);
+    } catch (const std::exception& e) {
+      err << "autoshovel run: cycle " << i + 1 << ": " << e.what() << "\n";
+      log.Error("cycle " + std::to_string(i + 1) + ": " + e.what());
+      return 2;
+    }
+    std::istringstream lines(progress.str());
+    for (std::string line; std::getline(lines, line);) log.Info(line);
+    db.WriteCycle(info.run_id, cycle.record);
+    if (!cycle.record.completed) ++incomplete;
+    for (std::size_t k = 0; k < cycle.figures.size(); ++k) {
+      figures.push_back(
+          {cycle.figure_titles[k], std::filesystem::relative(cycle.figures[k], folder->dir()), ""});
+    }
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    const double eta = elapsed / (i + 1) * (options.cycles - i - 1);
+    const results::CycleRecord& rec = cycle.record;
+    char line[400];
+    std::snprintf(line, sizeof line,
+                  "[%d/%d] %-6s %-8s %-12s %-14s fill %5.1f %%  cycle %5.1f s  %6.0f kJ  "
+                  "clearance %.2f m  %s  (%.0f s elapsed, ETA %.0f s)\n",
+                  i + 1, options.cycles, rec.bin.c_str(), rec.completed ? "ok" : "FAILED",
+                  rec.material.c_str(), rec.strategy.c_str(), 100 * rec.fill_rate, rec.time_s.total,
+                  rec.energy_kj.total, rec.safety_margin_m, cycle.failure.c_str(), elapsed, eta);
+    out << line << std::flush;
+  }
+  const std::vector<results::CycleRecord> cycles = db.Cycles(info.run_id, false);
+  const std::filesystem::path fill_png = folder->FigurePath("fill_rate.png");
+  results::WriteFillRatePlotPng(cycles, fill_png);
+  figures.insert(figures.begin(), {"Fill rate per cycle", "figures/fill_rate.png", ""});
+  results::WriteReportHtml(db, info.run_id, figures, folder->ReportPath());
+  const results::RunSummary summary = results::Summarize(cycles);
+  char line[300];
+  std::snprintf(line, sizeof line,
+                "%d/%d cycles completed, mean fill %.1f %%, min clearance %.2f m, %d safety "
+                "violation(s)\nreport: %s\n",
+                summary.cycles_completed, summary.cycles, 100 * summary.mean_fill_rate,
+                summary.min_safety_margin_m, summary.safety_violations,
+                folder->ReportPath().string().c_str());
+  out << line;
+  log.Info(line);
+  return incomplete == 0 ? 0 : 1;
+}
+
+}  // namespace autoshovel::app

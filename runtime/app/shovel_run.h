@@ -1,0 +1,114 @@
+// `autoshovel run`: the main job (wheel-loader seed §4–§6, issue 6). Closed-loop shoveling cycles
+// in a simulated yard, each: perceive (semantic elevation map, Eq. 8–11) → select a shovel point
+// (Algorithm 2) → drive the planned path → attack, crowd, trigger on V1 + V2 (Eq. 19, SVR) →
+// scoop (Algorithm 3) → level, shake, retreat. A multi-rate executive steps everything on the
+// simulated clock: 100 Hz control, 20 Hz state machines, 7 Hz map update and shovel point
+// selection (executive.h).
+//
+// A cycle begins `approach_distance` out of a bin's open front, facing in, with an empty bucket
+// (for piles in the open yard: at the scenario's start pose); cycles go round the bins that hold
+// piles. What happens between a retreat and the next
+// approach (haul to the hopper, dump) is not simulated: the load is booked and the next cycle
+// starts empty at the next bin. The yard persists across cycles: piles are as the earlier cycles
+// left them, and the map keeps what it has seen (the loader's own map, updated at 7 Hz).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "runtime/control/scoop_cycle.h"
+#include "runtime/results/results_db.h"
+
+namespace autoshovel::app {
+
+enum class TriggerChoice { kPredicted, kPerception, kPressure };
+const char* ToString(TriggerChoice trigger);
+enum class SelectionMethod { kOurs, kChen2024 };
+const char* ToString(SelectionMethod method);
+
+struct ShovelRunOptions {
+  std::string scenario = "mixing_station";  ///< name under <models_dir>/scenarios, or a path
+  std::string models_dir;
+  std::string machine;  ///< name or path of a wheel-loader description; empty: the scenario's
+  int cycles = 3;
+  std::uint64_t seed = 1;
+  /// Bins to shovel from, in turn; empty: every bin that holds a pile, in the scenario's order,
+  /// then the open yard when piles lie outside bins.
+  std::vector<std::string> bins;
+  bool truth_labels = false;  ///< simulator labels instead of the segmentation network
+  std::string segmenter;      ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
+  std::string predictor;      ///< SVR model prefix; empty: models/prediction/penetration_svr
+  control::ScoopPolicy policy = control::ScoopPolicy::kAutoSelection;
+  TriggerChoice trigger = TriggerChoice::kPredicted;
+  double pressure_threshold = 150e5;  ///< boom cylinder pressure of the pressure trigger [Pa]
+  int stairway_steps = 3;             ///< N of "Stairway #N"
+  SelectionMethod selection = SelectionMethod::kOurs;
+  double approach_distance = 12.0;  ///< cycle start, out of the bin's open front [m]
+  /// The safety rule every cycle is held to and checked against (ground truth, 20 Hz): the
+  /// machine's footprint (body and bucket plus 0.3 m on every side, 2.5 m of counterweight
+  /// behind the rear axle: perception/machine_footprint.h) never comes closer than this to an
+  /// obstacle, so the body itself keeps 0.8 m by default [m].
+  double safety_distance = 0.5;
+  /// Our selection only takes candidates planned with at least safety_distance + this much
+  /// clearance: path tracking error and the map's 0.3 m cells [m].
+  double planning_margin = 0.15;
+  double d_res = 1.0;  ///< Eq. (14)'s safety distance: clearance below it lowers s_s [m]
+  double curvature_reserve = 0.9;  ///< paths are planned at most at this fraction of κmax
+  double handover_distance = 2.0;  ///< path left when the scoop cycle takes over [m]
+  double max_cycle_time = 120.0;   ///< a cycle running longer is aborted [s]
+  double map_rate = 7.0;           ///< map update and selection [Hz]
+  double decision_rate = 20.0;     ///< navigation state machine and safety check [Hz]
+  double control_rate = 100.0;     ///< [Hz]
+  bool figures = true;             ///< per-cycle PNGs for the report
+};
+
+/// What one cycle did (one row of the results database, plus what the figures need).
+struct CycleOutcome {
+  results::CycleRecord record;
+  control::ScoopResult scoop;
+  std::string failure;           ///< empty when completed
+  bool no_shovel_point = false;  ///< failed before moving: no feasible candidate at the site
+  double target_volume = 0;
+  std::vector<std::filesystem::path> figures;  ///< written for this cycle
+  std::vector<std::string> figure_titles;
+};
+
+/// The yard, the machine, the map and the models of one run; cycles are run one after another.
+class ShovelJob {
+ public:
+  /// Loads everything; throws core::InputError / std::runtime_error / std::invalid_argument
+  /// naming the file or option at fault.
+  explicit ShovelJob(const ShovelRunOptions& options);
+  ~ShovelJob();
+
+  /// Runs cycle `index` at the next site in turn (sites()), skipping sites where no shovel point
+  /// is feasible. `figures_dir`: where its PNGs go (empty: none). `progress`: phase changes and
+  /// the summary line (may be null).
+  CycleOutcome RunCycle(int index, const std::filesystem::path& figures_dir,
+                        std::ostream* progress);
+
+  /// Where cycles dig, in turn: bins holding piles, and "yard" for piles outside bins.
+  const std::vector<std::string>& sites() const;
+  const std::string& scenario_name() const;
+  const std::string& machine_name() const;
+  /// The resolved configuration, as YAML (config.yaml of the run folder).
+  std::string ConfigYaml() const;
+
+ private:
+  CycleOutcome RunCycleAt(int index, int site, const std::filesystem::path& figures_dir,
+                          std::ostream* progress);
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// `autoshovel run`: a run folder (config.yaml, results.sqlite, log.txt, figures/, report.html)
+/// under `out_dir` (empty: runs/<UTC timestamp>). Returns 0 when every cycle completed, 1 when
+/// some did not, 2 on bad input.
+int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::path& out_dir,
+                     std::ostream& out, std::ostream& err);
+
+}  // namespace autoshovel::app

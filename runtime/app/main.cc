@@ -12,6 +12,7 @@
 #include "identification/calibration/calibrate_arm_command.h"
 #include "identification/camera_lidar/calibrate_camera_lidar_command.h"
 #include "identification/hydraulics/identify_hydraulics_command.h"
+#include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
@@ -291,7 +292,31 @@ int main(int argc, char** argv) {
   bool run_no_figures = false;
   run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
 
+  autoshovel::app::CompareOptions compare;
+  double compare_pressure_bar = compare.pressure_threshold / 1e5;
+  CLI::App* compare_cmd = app.add_subcommand(
+      "compare",
+      "Rerun the seed's Table 4 (shovel point selection) or Table 5 (trigger and "
+      "scooping strategy) in simulation, beside the seed's figures");
+  compare_cmd->add_option("table", compare.table, "table4 | table5")
+      ->required()
+      ->check(CLI::IsMember({"table4", "table5"}));
+  compare_cmd->add_option("--trials", compare.trials, "Single-cycle runs per cell")
+      ->capture_default_str();
+  compare_cmd->add_flag("--network", compare.network,
+                        "Segmentation network instead of the simulator's labels");
+  compare_cmd
+      ->add_option("--pressure-bar", compare_pressure_bar,
+                   "Threshold of the pressure trigger [bar]")
+      ->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
+
+  if (*compare_cmd) {
+    compare.models_dir = models_dir;
+    compare.pressure_threshold = compare_pressure_bar * 1e5;
+    return autoshovel::app::RunCompare(compare, std::cout, std::cerr);
+  }
 
   if (*run_cmd) {
     run.models_dir = models_dir;

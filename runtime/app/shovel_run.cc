@@ -2,6 +2,7 @@
 #include "runtime/app/shovel_run.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -85,6 +86,29 @@ struct Site {
   Eigen::Vector2d start_xy = Eigen::Vector2d::Zero();
   double start_heading = 0;
 };
+
+// The map with only the obstacle cells the map is sure of: obstacle confidence at least 0.95
+// and above the pile confidence by `margin` (Eq. (11)'s confidences). What the crowd look-ahead
+// stops for: a wall, a machine or a person seen as such. A pile's top that the camera saw only
+// obliquely comes out as obstacle by height with both confidences middling (0.6–0.8 against
+// 0.4–0.9); the bucket already in the pile must not stop for it.
+perception::GridMap ClearObstacles(const perception::GridMap& map, double margin) {
+  perception::GridMap out = map;
+  Eigen::MatrixXf& cls = out["class"];
+  const Eigen::MatrixXf& obstacle_confidence = map["obstacle_confidence"];
+  const Eigen::MatrixXf& pile_confidence = map["pile_confidence"];
+  const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
+  const float ground = static_cast<float>(perception::CellClass::kGround);
+  for (int iy = 0; iy < cls.cols(); ++iy) {
+    for (int ix = 0; ix < cls.rows(); ++ix) {
+      if (cls(ix, iy) != obstacle) continue;
+      const double p_pile = std::isfinite(pile_confidence(ix, iy)) ? pile_confidence(ix, iy) : 0.0;
+      const double p_obstacle = obstacle_confidence(ix, iy);
+      if (!(p_obstacle >= 0.95 && p_obstacle - p_pile >= margin)) cls(ix, iy) = ground;
+    }
+  }
+  return out;
+}
 
 bool InsideBin(const plant::Bin& bin, const Eigen::Vector2d& p) {
   const Eigen::Vector2d u(std::cos(bin.yaw), std::sin(bin.yaw)), v(-u.y(), u.x());
@@ -330,6 +354,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   std::unique_ptr<control::ScoopCycle> scoop;
   const plant::Pile* pile = nullptr;
   prediction::HeightGrid pre_contact;  ///< the map before contact, which the scoop cycle reads
+  Eigen::MatrixXf obstacle_distance;   ///< of the pre-contact map's obstacle cells [m]
   planning::ShovelPointResult last_selection;
   std::vector<planning::Chen2024Candidate> last_baseline;
   std::vector<perception::ExtractedPile> last_piles;
@@ -338,6 +363,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   double min_clearance = INFINITY;
   int violations = 0;
   bool in_violation = false;
+  bool stop_requested = false;
   long perception_calls = 0, selections = 0;
   double perception_seconds = 0, selection_seconds = 0;
   const double t0 = plant.time();
@@ -488,6 +514,53 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
           " m");
     }
     in_violation = violating;
+    // Look-ahead on the map (the machine's own knowledge, not the truth above): while the scoop
+    // cycle drives in, the front edge of what the scoop will sweep must keep the safety distance
+    // plus the planning margin plus the stopping distance from the map's obstacle cells;
+    // closer, crowding ends here (a pile against a wall is dug up to the wall's safety
+    // distance, never into it).
+    const std::string scoop_phase = scoop ? scoop->phase_name() : "";
+    // From contact on: before it the planned path (clearance d_min with its margin) holds.
+    const bool driving_in = scoop_phase == "crowd" || scoop_phase == "scoop";
+    if (stage == Stage::kScoop && driving_in && !stop_requested) {
+      // The bucket reaches farther when the boom lifts it out: the outline ahead is the tip's
+      // reach with the boom raised by the exit lift from where it is.
+      perception::MachineFootprint sweep = footprint;
+      const double lifted_reach =
+          prediction::TipInBase(
+              machine,
+              std::min(s.q[0] + scoop_options.strategy.exit_boom_lift, machine.links[0].joint_max),
+              s.q[1])
+              .x();
+      sweep.front_length = std::max(footprint.front_length, lifted_reach + 0.3);
+      // Only the front edge: the sides' clearance is the planner's (d_min with its margin);
+      // this guards against driving into what stands ahead, a wall behind a pile.
+      const Quad front = FootprintQuads(sweep)[0];
+      double ahead = INFINITY;
+      const perception::GridMap& grid = st.map->map();
+      const Eigen::Vector2d a = front[1], b = front[2];
+      const int n = 1 + static_cast<int>((b - a).norm() / 0.1);
+      for (int i = 0; i <= n; ++i) {
+        perception::Index cell;
+        if (!grid.IndexOf(a + (b - a) * (static_cast<double>(i) / n), cell)) continue;
+        // Cell centres: the obstacle's edge is up to half a cell nearer.
+        ahead = std::min(ahead, static_cast<double>(obstacle_distance(cell.x(), cell.y())) -
+                                    0.5 * grid.resolution());
+      }
+      // Stopping takes the decision latency (one 20 Hz period) plus v² / 2 a_dec of the speed
+      // profile; in a pile the resistance shortens it, on the floor it does not.
+      const double v = std::max(0.0, s.speed);
+      const double stopping =
+          v / o.decision_rate + v * v / (2 * scoop_options.speed_gains.max_deceleration);
+      // One more cell: a wall cell next to the pile's crest is not sure (pile evidence too).
+      if (ahead < o.safety_distance + o.planning_margin + stopping + grid.resolution()) {
+        scoop->RequestStop("obstacle_ahead");
+        stop_requested = true;
+        say("obstacle " + Fixed(ahead, 2) + " m ahead on the map (scoop " + scoop_phase +
+            ", sweep reach " + Fixed(sweep.front_length, 2) + " m, stopping " + Fixed(stopping, 2) +
+            " m): crowding ends");
+      }
+    }
     if (stage == Stage::kNavigate && remaining <= o.handover_distance) {
       // Hand over to the scoop cycle with the map as it stands before contact. The material is
       // that of the site's pile nearest the shovel point: the yard's inventory (which material
@@ -517,6 +590,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         trigger = std::make_unique<control::BoomPressureTrigger>(o.pressure_threshold);
       }
       pre_contact = HeightGridOf(st.map->map());
+      obstacle_distance =
+          planning::ObstacleDistanceField(ClearObstacles(st.map->map(), o.clear_obstacle_margin));
       scoop =
           std::make_unique<control::ScoopCycle>(machine, *st.setup.functions, pre_contact,
                                                 *material, *trigger, &st.predictor, scoop_options);

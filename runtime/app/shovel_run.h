@@ -57,6 +57,9 @@ struct ShovelRunOptions {
   /// clearance: path tracking error and the map's 0.3 m cells [m].
   double planning_margin = 0.15;
   double d_res = 1.0;  ///< Eq. (14)'s safety distance: clearance below it lowers s_s [m]
+  /// The crowd look-ahead stops for map obstacle cells whose obstacle confidence exceeds their
+  /// pile confidence by this much [-].
+  double clear_obstacle_margin = 0.5;
   double curvature_reserve = 0.9;  ///< paths are planned at most at this fraction of κmax
   double handover_distance = 2.0;  ///< path left when the scoop cycle takes over [m]
   double max_cycle_time = 120.0;   ///< a cycle running longer is aborted [s]

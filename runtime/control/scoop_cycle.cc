@@ -109,6 +109,8 @@ struct ScoopCycle::Runtime {
   /// When finite, the bucket target follows the boom so the bucket keeps this attitude
   /// q_boom + q_bucket in the arm plane [rad] (exit lift, levelling, carrying).
   double hold_attitude = NAN;
+  std::string stop_request;  ///< RequestStop's reason: crowding ends at the next decision
+  bool drive_held = false;   ///< after a stop request the scoop does not crowd on
   std::vector<Eigen::Vector3d> last_predicted_path;  ///< of the last V2 [m]
   double last_v2 = NAN;                              ///< [m³]
   std::optional<JointPid> boom_pid, bucket_pid;
@@ -216,7 +218,7 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
 }
 
 void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
-  const bool stopped = rt.stop.Update(s.speed);
+  const bool stopped = rt.stop.Update(s.speed) || !rt.stop_request.empty();
   if (rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop) {
     if (rt.tip_path.size() >= 2) {
       rt.v1 = prediction::Eq19Volume(map_, rt.tip_path, machine_.bucket.width).volume;
@@ -225,6 +227,11 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
   const double elapsed = s.time - rt.phase_start_time;
   switch (rt.phase) {
     case Phase::kApproach: {
+      if (!rt.stop_request.empty()) {
+        rt.result.failure = "stopped before contact: " + rt.stop_request;
+        rt.phase = Phase::kDone;
+        return;
+      }
       if (rt.v1 > options_.contact_volume) {
         rt.result.contact_time = s.time;
         rt.result.boom_pressure_at_contact = s.boom_pressure;
@@ -268,7 +275,10 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         ScoopResult& r = rt.result;
         r.trigger_time = s.time;
         r.trigger_after_contact = s.time - r.contact_time;
-        r.trigger_reason = fired ? trigger_.Name() : "stopped";
+        r.trigger_reason = fired                      ? trigger_.Name()
+                           : !rt.stop_request.empty() ? rt.stop_request
+                                                      : "stopped";
+        if (!fired && !rt.stop_request.empty()) rt.drive_held = true;
         r.strategy = *strategy;
         r.v1_at_trigger = rt.v1;
         r.v2_at_trigger = in.v2;
@@ -393,6 +403,12 @@ void ScoopCycle::Start(ScoopMachine& machine) {
   rt.command.valve.assign(machine_.hydraulics.actuators.size(), 0.0);
 }
 
+void ScoopCycle::RequestStop(const std::string& reason) {
+  if (rt_ == nullptr) return;
+  if (rt_->stop_request.empty()) rt_->stop_request = reason;
+  rt_->drive_held = true;  // after the trigger: the steps no longer crowd on
+}
+
 bool ScoopCycle::done() const { return rt_ == nullptr || rt_->phase == Phase::kDone; }
 
 const char* ScoopCycle::phase_name() const {
@@ -446,7 +462,7 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     case Phase::kScoop:
       // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
       // rate once the final rack/lift runs and the arm moves.
-      if (rt.finishing_drive && rt.arm_moving) speed_target = 0;
+      if ((rt.finishing_drive && rt.arm_moving) || rt.drive_held) speed_target = 0;
       break;
     case Phase::kLevel:
     case Phase::kShake:

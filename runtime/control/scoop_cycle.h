@@ -187,6 +187,11 @@ class ScoopCycle {
   bool Tick(ScoopMachine& machine);
   ScoopResult Finish(ScoopMachine& machine);
   bool done() const;
+  /// Ends crowding: before the trigger at the next decision, as if the machine had stopped
+  /// (Algorithm 3's v ≈ 0 branch: Stairway) with `reason` as the trigger reason; after it, the
+  /// Stairway steps stop crowding on. The drive is held from then on. What the executive calls
+  /// when an obstacle comes too close ahead; before contact it ends the cycle as failed.
+  void RequestStop(const std::string& reason);
   const char* phase_name() const;
   double tick() const { return options_.tick; }
 

@@ -354,7 +354,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   std::unique_ptr<control::ScoopCycle> scoop;
   const plant::Pile* pile = nullptr;
   prediction::HeightGrid pre_contact;  ///< the map before contact, which the scoop cycle reads
-  Eigen::MatrixXf obstacle_distance;   ///< of the pre-contact map's obstacle cells [m]
+  std::vector<Eigen::Vector2d> sure_obstacles;  ///< the pre-contact map's sure obstacle cells
+  double obstacle_resolution = 0;
   planning::ShovelPointResult last_selection;
   std::vector<planning::Chen2024Candidate> last_baseline;
   std::vector<perception::ExtractedPile> last_piles;
@@ -533,19 +534,16 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
               s.q[1])
               .x();
       sweep.front_length = std::max(footprint.front_length, lifted_reach + 0.3);
-      // Only the front edge: the sides' clearance is the planner's (d_min with its margin);
-      // this guards against driving into what stands ahead, a wall behind a pile.
-      const Quad front = FootprintQuads(sweep)[0];
+      // Only what stands in the corridor ahead: the sides' clearance is the planner's (d_min
+      // with its margin); this guards against driving into a wall behind a pile.
+      const Eigen::Vector2d u(std::cos(s.heading), std::sin(s.heading)), lateral(-u.y(), u.x());
       double ahead = INFINITY;
-      const perception::GridMap& grid = st.map->map();
-      const Eigen::Vector2d a = front[1], b = front[2];
-      const int n = 1 + static_cast<int>((b - a).norm() / 0.1);
-      for (int i = 0; i <= n; ++i) {
-        perception::Index cell;
-        if (!grid.IndexOf(a + (b - a) * (static_cast<double>(i) / n), cell)) continue;
-        // Cell centres: the obstacle's edge is up to half a cell nearer.
-        ahead = std::min(ahead, static_cast<double>(obstacle_distance(cell.x(), cell.y())) -
-                                    0.5 * grid.resolution());
+      for (const Eigen::Vector2d& p : sure_obstacles) {
+        const Eigen::Vector2d d = p - s.hinge_xy;
+        if (std::abs(d.dot(lateral)) > sweep.half_width) continue;
+        // Cell centres: the obstacle's face is up to half a cell nearer.
+        const double along = d.dot(u) - sweep.front_length - 0.5 * obstacle_resolution;
+        if (d.dot(u) > 0) ahead = std::min(ahead, along);
       }
       // Stopping takes the decision latency (one 20 Hz period) plus v² / 2 a_dec of the speed
       // profile; in a pile the resistance shortens it, on the floor it does not.
@@ -553,7 +551,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       const double stopping =
           v / o.decision_rate + v * v / (2 * scoop_options.speed_gains.max_deceleration);
       // One more cell: a wall cell next to the pile's crest is not sure (pile evidence too).
-      if (ahead < o.safety_distance + o.planning_margin + stopping + grid.resolution()) {
+      if (ahead < o.safety_distance + o.planning_margin + stopping + obstacle_resolution) {
         scoop->RequestStop("obstacle_ahead");
         stop_requested = true;
         say("obstacle " + Fixed(ahead, 2) + " m ahead on the map (scoop " + scoop_phase +
@@ -590,8 +588,15 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         trigger = std::make_unique<control::BoomPressureTrigger>(o.pressure_threshold);
       }
       pre_contact = HeightGridOf(st.map->map());
-      obstacle_distance =
-          planning::ObstacleDistanceField(ClearObstacles(st.map->map(), o.clear_obstacle_margin));
+      {
+        const perception::GridMap sure = ClearObstacles(st.map->map(), o.clear_obstacle_margin);
+        const Eigen::MatrixXf& cls = sure["class"];
+        const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
+        for (perception::GridMap::Iterator it(sure); !it.done(); ++it) {
+          if (cls((*it).x(), (*it).y()) == obstacle) sure_obstacles.push_back(sure.PositionOf(*it));
+        }
+        obstacle_resolution = sure.resolution();
+      }
       scoop =
           std::make_unique<control::ScoopCycle>(machine, *st.setup.functions, pre_contact,
                                                 *material, *trigger, &st.predictor, scoop_options);

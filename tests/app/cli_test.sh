@@ -11,7 +11,7 @@ for machine in xcmg_968ev sdlg_l955he excavator_25t; do
   grep -q "generated     up to date" <<<"$out" || fail "describe $machine: generated code not up to date"
 done
 for level in "" describe gen plant "plant step" scenario map calibrate "calibrate arm" \
-  "calibrate camera-lidar" identify "identify hydraulics" select run; do
+  "calibrate camera-lidar" identify "identify hydraulics" select run compare; do
   "$autoshovel" $level --help >/dev/null || fail "--help at '$level'"
 done
 tmp=$(mktemp -d)

@@ -408,15 +408,18 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       last_baseline = planning::RankChen2024(
           grid, plane, planning::GenerateCandidates(grid, in_bin, select_config), s.hinge_xy);
       best = nullptr;
-      // The baseline's choice, driven by our planner's path to it (Chen et al. plan no path).
-      if (!last_baseline.empty()) {
-        const planning::CandidatePose& c = last_baseline.front().pose;
+      // The baseline's first choice that our planner can reach (Chen et al. plan no path): a
+      // kinematically feasible path that neither collides nor drives over the pile, whatever
+      // its clearance and our five scores.
+      for (const planning::Chen2024Candidate& chen : last_baseline) {
+        const planning::CandidatePose& c = chen.pose;
         for (const planning::ShovelCandidate& k : last_selection.ranked) {
-          if (k.pose.pile == c.pile && k.pose.point == c.point &&
+          if (k.feasible && k.pose.pile == c.pile && k.pose.point == c.point &&
               std::abs(k.pose.entry_offset - c.entry_offset) < 1e-9) {
             best = &k;
           }
         }
+        if (best != nullptr) break;
       }
     }
     ++selections;

@@ -95,16 +95,40 @@ struct Site {
 perception::GridMap ClearObstacles(const perception::GridMap& map, double margin) {
   perception::GridMap out = map;
   Eigen::MatrixXf& cls = out["class"];
+  const Eigen::MatrixXf& original = map["class"];
   const Eigen::MatrixXf& obstacle_confidence = map["obstacle_confidence"];
   const Eigen::MatrixXf& pile_confidence = map["pile_confidence"];
   const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
   const float ground = static_cast<float>(perception::CellClass::kGround);
-  for (int iy = 0; iy < cls.cols(); ++iy) {
-    for (int ix = 0; ix < cls.rows(); ++ix) {
+  const int nx = static_cast<int>(cls.rows()), ny = static_cast<int>(cls.cols());
+  auto confident = [&](int ix, int iy) {
+    return original(ix, iy) == obstacle && obstacle_confidence(ix, iy) >= 0.95;
+  };
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
       if (cls(ix, iy) != obstacle) continue;
       const double p_pile = std::isfinite(pile_confidence(ix, iy)) ? pile_confidence(ix, iy) : 0.0;
-      const double p_obstacle = obstacle_confidence(ix, iy);
-      if (!(p_obstacle >= 0.95 && p_obstacle - p_pile >= margin)) cls(ix, iy) = ground;
+      if (!(confident(ix, iy) && obstacle_confidence(ix, iy) - p_pile >= margin)) {
+        cls(ix, iy) = ground;
+      }
+    }
+  }
+  // A wall's cells next to a pile heaped against it carry pile evidence too (the network and the
+  // fusion blur the boundary); a confident obstacle cell within two cells of a sure one belongs
+  // to the same object.
+  const Eigen::MatrixXf sure = cls;
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      if (sure(ix, iy) == obstacle || !confident(ix, iy)) continue;
+      for (int dy = -2; dy <= 2 && cls(ix, iy) != obstacle; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int jx = ix + dx, jy = iy + dy;
+          if (jx >= 0 && jy >= 0 && jx < nx && jy < ny && sure(jx, jy) == obstacle) {
+            cls(ix, iy) = obstacle;
+            break;
+          }
+        }
+      }
     }
   }
   return out;
@@ -527,15 +551,24 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     // From contact on: before it the planned path (clearance d_min with its margin) holds.
     const bool driving_in = scoop_phase == "crowd" || scoop_phase == "scoop";
     if (stage == Stage::kScoop && driving_in && !stop_requested) {
-      // The bucket reaches farther when the boom lifts it out: the outline ahead is the tip's
-      // reach with the boom raised by the exit lift from where it is.
+      // The bucket reaches farther when the boom lifts it out and when levelling tips it
+      // forward: the outline ahead is the tip's farthest reach with the boom raised by the exit
+      // lift from where it is, the bucket as now or levelled (its opening horizontal).
       perception::MachineFootprint sweep = footprint;
-      const double lifted_reach =
-          prediction::TipInBase(
-              machine,
-              std::min(s.q[0] + scoop_options.strategy.exit_boom_lift, machine.links[0].joint_max),
-              s.q[1])
-              .x();
+      const double q_lifted =
+          std::min(s.q[0] + scoop_options.strategy.exit_boom_lift +
+                       scoop_options.strategy.max_steps * scoop_options.strategy.step_boom_lift,
+                   machine.links[0].joint_max);
+      const Eigen::Vector2d opening =
+          machine.bucket.profile.back() - machine.bucket.profile.front();
+      const double level_attitude = M_PI - std::atan2(opening.y(), opening.x());
+      double lifted_reach = 0;
+      for (const double q_boom : {s.q[0], q_lifted}) {
+        for (const double q_bucket : {s.q[1], level_attitude - q_boom}) {
+          lifted_reach =
+              std::max(lifted_reach, prediction::TipInBase(machine, q_boom, q_bucket).x());
+        }
+      }
       sweep.front_length = std::max(footprint.front_length, lifted_reach + 0.3);
       // Only what stands in the corridor ahead: the sides' clearance is the planner's (d_min
       // with its margin); this guards against driving into a wall behind a pile.
@@ -553,7 +586,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       const double v = std::max(0.0, s.speed);
       const double stopping =
           v / o.decision_rate + v * v / (2 * scoop_options.speed_gains.max_deceleration);
-      // One more cell: a wall cell next to the pile's crest is not sure (pile evidence too).
+      // One more map cell: the wall's face next to a pile's crest is blurred by pile evidence.
       if (ahead < o.safety_distance + o.planning_margin + stopping + obstacle_resolution) {
         scoop->RequestStop("obstacle_ahead");
         stop_requested = true;

@@ -65,7 +65,10 @@ TEST(ShovelCycle, GravelConeIsJustInAndOutAndFull) {
   EXPECT_GE(out.record.fill_rate, 0.95);
 }
 
-// River sand in the mixing station's bin_4 (a difficult material, γ ∈ 𝒴): "Stairway".
+// River sand in the mixing station's bin_4 (a difficult material, γ ∈ 𝒴): "Stairway". The
+// ridge lies against the bin's back wall, so the crowd look-ahead ends crowding 1.7 m from it
+// (docs/main_job.md): fill measured 0.923, held at 0.9 (0.999 without the look-ahead, which
+// brought the footprint 0.34 m from the wall on pile_against_wall).
 TEST(ShovelCycle, SandInABinIsStairwayAndFull) {
   ShovelRunOptions options = Options("mixing_station");
   options.bins = {"bin_4"};
@@ -73,7 +76,7 @@ TEST(ShovelCycle, SandInABinIsStairwayAndFull) {
   ExpectSafeAndWhole(options, out);
   EXPECT_EQ(out.record.material, "river_sand");
   EXPECT_EQ(out.record.strategy, "stairway");
-  EXPECT_GE(out.record.fill_rate, 0.95);
+  EXPECT_GE(out.record.fill_rate, 0.9);
 }
 
 // The thin low sand remainder in dim light (0.45 m high): the bucket crosses the whole pile;

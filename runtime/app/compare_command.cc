@@ -71,7 +71,6 @@ ShovelRunOptions Base(const CompareOptions& o) {
   r.figures = false;
   r.truth_labels = !o.network;
   r.pressure_threshold = o.pressure_threshold;
-  r.max_cycle_time = 60;  // a cycle that has not scooped by then never will (stuck on an obstacle)
   return r;
 }
 

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "runtime/app/crowd_lookahead.h"
 #include "runtime/app/executive.h"
 #include "runtime/app/plant_machine.h"
 #include "runtime/app/safety_margin.h"
@@ -86,53 +87,6 @@ struct Site {
   Eigen::Vector2d start_xy = Eigen::Vector2d::Zero();
   double start_heading = 0;
 };
-
-// The map with only the obstacle cells the map is sure of: obstacle confidence at least 0.95
-// and above the pile confidence by `margin` (Eq. (11)'s confidences). What the crowd look-ahead
-// stops for: a wall, a machine or a person seen as such. A pile's top that the camera saw only
-// obliquely comes out as obstacle by height with both confidences middling (0.6–0.8 against
-// 0.4–0.9); the bucket already in the pile must not stop for it.
-perception::GridMap ClearObstacles(const perception::GridMap& map, double margin) {
-  perception::GridMap out = map;
-  Eigen::MatrixXf& cls = out["class"];
-  const Eigen::MatrixXf& original = map["class"];
-  const Eigen::MatrixXf& obstacle_confidence = map["obstacle_confidence"];
-  const Eigen::MatrixXf& pile_confidence = map["pile_confidence"];
-  const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
-  const float ground = static_cast<float>(perception::CellClass::kGround);
-  const int nx = static_cast<int>(cls.rows()), ny = static_cast<int>(cls.cols());
-  auto confident = [&](int ix, int iy) {
-    return original(ix, iy) == obstacle && obstacle_confidence(ix, iy) >= 0.95;
-  };
-  for (int iy = 0; iy < ny; ++iy) {
-    for (int ix = 0; ix < nx; ++ix) {
-      if (cls(ix, iy) != obstacle) continue;
-      const double p_pile = std::isfinite(pile_confidence(ix, iy)) ? pile_confidence(ix, iy) : 0.0;
-      if (!(confident(ix, iy) && obstacle_confidence(ix, iy) - p_pile >= margin)) {
-        cls(ix, iy) = ground;
-      }
-    }
-  }
-  // A wall's cells next to a pile heaped against it carry pile evidence too (the network and the
-  // fusion blur the boundary); a confident obstacle cell within two cells of a sure one belongs
-  // to the same object.
-  const Eigen::MatrixXf sure = cls;
-  for (int iy = 0; iy < ny; ++iy) {
-    for (int ix = 0; ix < nx; ++ix) {
-      if (sure(ix, iy) == obstacle || !confident(ix, iy)) continue;
-      for (int dy = -2; dy <= 2 && cls(ix, iy) != obstacle; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-          const int jx = ix + dx, jy = iy + dy;
-          if (jx >= 0 && jy >= 0 && jx < nx && jy < ny && sure(jx, jy) == obstacle) {
-            cls(ix, iy) = obstacle;
-            break;
-          }
-        }
-      }
-    }
-  }
-  return out;
-}
 
 bool InsideBin(const plant::Bin& bin, const Eigen::Vector2d& p) {
   const Eigen::Vector2d u(std::cos(bin.yaw), std::sin(bin.yaw)), v(-u.y(), u.x());
@@ -542,45 +496,22 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
           " m");
     }
     in_violation = violating;
-    // Look-ahead on the map (the machine's own knowledge, not the truth above): while the scoop
-    // cycle drives in, the front edge of what the scoop will sweep must keep the safety distance
-    // plus the planning margin plus the stopping distance from the map's obstacle cells;
-    // closer, crowding ends here (a pile against a wall is dug up to the wall's safety
-    // distance, never into it).
+    // Look-ahead on the map (the machine's own knowledge, not the truth above; crowd_lookahead.h):
+    // while the scoop cycle drives in, the front edge of what the scoop will sweep must keep the
+    // safety distance plus the planning margin plus the stopping distance from the map's sure
+    // obstacle cells ahead; closer, crowding ends here (a pile against a wall is dug up to the
+    // wall's safety distance, never into it).
     const std::string scoop_phase = scoop ? scoop->phase_name() : "";
     // From contact on: before it the planned path (clearance d_min with its margin) holds.
     const bool driving_in = scoop_phase == "crowd" || scoop_phase == "scoop";
     if (stage == Stage::kScoop && driving_in && !stop_requested) {
-      // The bucket reaches farther when the boom lifts it out and when levelling tips it
-      // forward: the outline ahead is the tip's farthest reach with the boom raised by the exit
-      // lift from where it is, the bucket as now or levelled (its opening horizontal).
+      // The front edge of what the scoop will sweep, and the sure obstacles in the corridor.
       perception::MachineFootprint sweep = footprint;
-      const double q_lifted =
-          std::min(s.q[0] + scoop_options.strategy.exit_boom_lift +
-                       scoop_options.strategy.max_steps * scoop_options.strategy.step_boom_lift,
-                   machine.links[0].joint_max);
-      const Eigen::Vector2d opening =
-          machine.bucket.profile.back() - machine.bucket.profile.front();
-      const double level_attitude = M_PI - std::atan2(opening.y(), opening.x());
-      double lifted_reach = 0;
-      for (const double q_boom : {s.q[0], q_lifted}) {
-        for (const double q_bucket : {s.q[1], level_attitude - q_boom}) {
-          lifted_reach =
-              std::max(lifted_reach, prediction::TipInBase(machine, q_boom, q_bucket).x());
-        }
-      }
-      sweep.front_length = std::max(footprint.front_length, lifted_reach + 0.3);
-      // Only what stands in the corridor ahead: the sides' clearance is the planner's (d_min
-      // with its margin); this guards against driving into a wall behind a pile.
-      const Eigen::Vector2d u(std::cos(s.heading), std::sin(s.heading)), lateral(-u.y(), u.x());
-      double ahead = INFINITY;
-      for (const Eigen::Vector2d& p : sure_obstacles) {
-        const Eigen::Vector2d d = p - s.hinge_xy;
-        if (std::abs(d.dot(lateral)) > sweep.half_width) continue;
-        // Cell centres: the obstacle's face is up to half a cell nearer.
-        const double along = d.dot(u) - sweep.front_length - 0.5 * obstacle_resolution;
-        if (d.dot(u) > 0) ahead = std::min(ahead, along);
-      }
+      sweep.front_length =
+          std::max(footprint.front_length,
+                   ScoopReach(machine, s.q[0], s.q[1], scoop_options.strategy) + 0.3);
+      const double ahead = DistanceAhead(sure_obstacles, s.hinge_xy, s.heading, sweep.half_width,
+                                         sweep.front_length, obstacle_resolution);
       // Stopping takes the decision latency (one 20 Hz period) plus v² / 2 a_dec of the speed
       // profile; in a pile the resistance shortens it, on the floor it does not.
       const double v = std::max(0.0, s.speed);
@@ -624,15 +555,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         trigger = std::make_unique<control::BoomPressureTrigger>(o.pressure_threshold);
       }
       pre_contact = HeightGridOf(st.map->map());
-      {
-        const perception::GridMap sure = ClearObstacles(st.map->map(), o.clear_obstacle_margin);
-        const Eigen::MatrixXf& cls = sure["class"];
-        const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
-        for (perception::GridMap::Iterator it(sure); !it.done(); ++it) {
-          if (cls((*it).x(), (*it).y()) == obstacle) sure_obstacles.push_back(sure.PositionOf(*it));
-        }
-        obstacle_resolution = sure.resolution();
-      }
+      sure_obstacles = SureObstacleCells(st.map->map(), o.clear_obstacle_margin);
+      obstacle_resolution = st.map->map().resolution();
       scoop =
           std::make_unique<control::ScoopCycle>(machine, *st.setup.functions, pre_contact,
                                                 *material, *trigger, &st.predictor, scoop_options);

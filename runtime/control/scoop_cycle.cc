@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "runtime/model/interpreted_model.h"
+
 namespace autoshovel::control {
 
 namespace {
@@ -152,11 +154,8 @@ ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
   limits_.bucket_max = machine.links[1].joint_max - options.rack_back_margin;
   const model::Valve& valve = machine.hydraulics.actuators[bucket_valve_].valve;
   bucket_delay_ = valve.transport_delay + valve.spool_time_constant;
-  // "The bucket's upper edge is leveled" (§6.2): the opening, cutting edge (profile[0]) to the
-  // top of the back wall (the profile's last point), horizontal. Its direction in the bucket
-  // frame is γ; in the arm plane it points backwards (angle π) at attitude φ = π − γ.
-  const Eigen::Vector2d opening = machine.bucket.profile.back() - machine.bucket.profile.front();
-  level_attitude_ = M_PI - std::atan2(opening.y(), opening.x()) + options.finishing.carry_tilt_back;
+  // "The bucket's upper edge is leveled" (§6.2).
+  level_attitude_ = model::BucketLevelAttitude(machine) + options.finishing.carry_tilt_back;
 }
 
 double ScoopCycle::BucketTargetForAttitude(double attitude, double q_boom) const {
@@ -278,7 +277,6 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         r.trigger_reason = fired                      ? trigger_.Name()
                            : !rt.stop_request.empty() ? rt.stop_request
                                                       : "stopped";
-        if (!fired && !rt.stop_request.empty()) rt.drive_held = true;
         r.strategy = *strategy;
         r.v1_at_trigger = rt.v1;
         r.v2_at_trigger = in.v2;

@@ -1,5 +1,6 @@
 #include "runtime/model/interpreted_model.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace autoshovel::model {
@@ -24,6 +25,14 @@ double BucketProfileArea(const MachineDescription& machine) {
     twice_area += a.x() * b.y() - b.x() * a.y();
   }
   return std::abs(twice_area) / 2.0;
+}
+
+double BucketLevelAttitude(const MachineDescription& machine) {
+  const auto& profile = machine.bucket.profile;
+  if (profile.size() < 2) throw std::invalid_argument("bucket profile has fewer than 2 points");
+  // The opening's direction in the bucket frame is γ; it points backwards (π) at φ = π − γ.
+  const Eigen::Vector2d opening = profile.back() - profile.front();
+  return M_PI - std::atan2(opening.y(), opening.x());
 }
 
 Eigen::Vector2d BucketPayloadCenter(const MachineDescription& machine) {

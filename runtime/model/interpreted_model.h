@@ -63,6 +63,11 @@ Eigen::Vector2d BucketPayloadCenter(const MachineDescription& machine);
 /// Cross-section area of the bucket profile [m²] (struck volume = area × width).
 double BucketProfileArea(const MachineDescription& machine);
 
+/// The bucket's attitude in the arm plane (q_boom + q_bucket for a loader) at which its opening,
+/// the cutting edge (profile's first point) to the top of the back wall (its last), is
+/// horizontal: the seed's §6.2 "upper edge leveled" [rad].
+double BucketLevelAttitude(const MachineDescription& machine);
+
 /// A planar point or vector [x, z] over any scalar (Eigen matrices would need NumTraits for the
 /// nested dual numbers used for lever arms).
 template <typename S>

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "runtime/app/crowd_lookahead.h"
+
 namespace autoshovel::app {
 namespace {
 
@@ -43,6 +45,18 @@ TEST(SafetyMargin, FootprintClearanceFindsTheNearestBox) {
   // "beside"; the front frame still faces "ahead" (2 m; "beside" is 2.12 m from its corner).
   f.articulation = -std::numbers::pi / 2;
   EXPECT_NEAR(FootprintClearance(f, {ahead, beside}).distance, 2.0, 1e-12);
+}
+
+// The look-ahead's distance: only cells ahead and within the corridor count, measured from the
+// front edge to the cell's near face (half a cell before its centre).
+TEST(CrowdLookahead, DistanceAheadCountsOnlyTheCorridorAhead) {
+  const std::vector<Eigen::Vector2d> cells = {
+      {10.0, 0.5},   // ahead, in the corridor: 10 − 6 − 0.15
+      {7.0, 3.0},    // nearer but beside the corridor (|y| > 2)
+      {-3.0, 0.0}};  // behind
+  EXPECT_NEAR(DistanceAhead(cells, {0, 0}, 0.0, 2.0, 6.0, 0.3), 3.85, 1e-12);
+  // Heading north, the same cells are all outside the corridor or behind.
+  EXPECT_TRUE(std::isinf(DistanceAhead(cells, {0, 0}, std::numbers::pi / 2, 0.4, 6.0, 0.3)));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "runtime/model/interpreted_model.h"
 #include "runtime/plant/bucket_terrain.h"
 #include "runtime/plant/earthmoving.h"
 #include "runtime/plant/plant.h"
@@ -161,8 +162,7 @@ TEST(BucketTerrain, HoldsTheRatedHeapWithTheOpeningLevelAndLessWhenTilted) {
   const model::MachineDescription machine = testing::LoadMachine("xcmg_968ev");
   World world = testing::FlatYard(machine, 10.0);
   BucketTerrain bucket(machine.bucket, world);
-  const Eigen::Vector2d opening = machine.bucket.profile.back() - machine.bucket.profile.front();
-  const double level = std::numbers::pi - std::atan2(opening.y(), opening.x());
+  const double level = model::BucketLevelAttitude(machine);
   BucketPlacement placement;
   placement.pivot = Eigen::Vector2d(2.0, 3.0);  // clear of the floor
   auto hold_at = [&](double attitude) {

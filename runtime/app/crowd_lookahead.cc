@@ -1,0 +1,73 @@
+// The crowd look-ahead (crowd_lookahead.h).
+#include "runtime/app/crowd_lookahead.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "runtime/model/interpreted_model.h"
+#include "runtime/perception/semantic_map.h"
+#include "runtime/prediction/volume_estimation.h"
+
+namespace autoshovel::app {
+
+std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, double margin) {
+  const Eigen::MatrixXf& cls = map["class"];
+  const Eigen::MatrixXf& obstacle_confidence = map["obstacle_confidence"];
+  const Eigen::MatrixXf& pile_confidence = map["pile_confidence"];
+  const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
+  const int nx = static_cast<int>(cls.rows()), ny = static_cast<int>(cls.cols());
+  auto confident = [&](int ix, int iy) {
+    return cls(ix, iy) == obstacle && obstacle_confidence(ix, iy) >= 0.95;
+  };
+  Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> sure(nx, ny);
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      const double p_pile = std::isfinite(pile_confidence(ix, iy)) ? pile_confidence(ix, iy) : 0.0;
+      sure(ix, iy) = confident(ix, iy) && obstacle_confidence(ix, iy) - p_pile >= margin;
+    }
+  }
+  std::vector<Eigen::Vector2d> cells;
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      bool take = sure(ix, iy);
+      for (int dy = -2; dy <= 2 && !take && confident(ix, iy); ++dy) {
+        for (int dx = -2; dx <= 2 && !take; ++dx) {
+          const int jx = ix + dx, jy = iy + dy;
+          take = jx >= 0 && jy >= 0 && jx < nx && jy < ny && sure(jx, jy);
+        }
+      }
+      if (take) cells.push_back(map.PositionOf(perception::Index(ix, iy)));
+    }
+  }
+  return cells;
+}
+
+double ScoopReach(const model::MachineDescription& machine, double q_boom, double q_bucket,
+                  const control::StrategyParameters& strategy) {
+  const double q_lifted =
+      std::min(q_boom + strategy.exit_boom_lift + strategy.max_steps * strategy.step_boom_lift,
+               machine.links[0].joint_max);
+  const double level_attitude = model::BucketLevelAttitude(machine);
+  double reach = 0;
+  for (const double boom : {q_boom, q_lifted}) {
+    for (const double bucket : {q_bucket, level_attitude - boom}) {
+      reach = std::max(reach, prediction::TipInBase(machine, boom, bucket).x());
+    }
+  }
+  return reach;
+}
+
+double DistanceAhead(const std::vector<Eigen::Vector2d>& cells, const Eigen::Vector2d& hinge_xy,
+                     double heading, double half_width, double front_length, double cell_size) {
+  const Eigen::Vector2d u(std::cos(heading), std::sin(heading)), lateral(-u.y(), u.x());
+  double ahead = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& p : cells) {
+    const Eigen::Vector2d d = p - hinge_xy;
+    if (d.dot(u) <= 0 || std::abs(d.dot(lateral)) > half_width) continue;
+    ahead = std::min(ahead, d.dot(u) - front_length - 0.5 * cell_size);
+  }
+  return ahead;
+}
+
+}  // namespace autoshovel::app

@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
+#include <utility>
 
 #include "identification/camera_lidar/auto_calibration.h"
 #include "identification/camera_lidar/board_detection.h"
@@ -192,6 +194,23 @@ TEST(AutoCalibration, LockedRotationKeepsIt) {
   const AutoCalibrationResult r = AutoCalibrate(s.frames, T0, options);
   EXPECT_TRUE(r.T_lidar_camera.linear().isApprox(T0.linear(), 1e-12));
   EXPECT_LT(ComparePoses(r.T_lidar_camera, s.T_lidar_camera).translation, 0.03);
+}
+
+// Opt-in (AUTOSHOVEL_CALIBRATION_EXPLORE=1): other start directions than the tests', printed,
+// for docs/camera_lidar_calibration.md's table. The bounds are the 3° tests' (0.5°, 3 cm).
+TEST(AutoCalibration, Explore) {
+  if (std::getenv("AUTOSHOVEL_CALIBRATION_EXPLORE") == nullptr) GTEST_SKIP();
+  const std::pair<Eigen::Vector3d, Eigen::Vector3d> twos[] = {{{1, -2, 1.5}, {-1, 1, 0.5}},
+                                                              {{-2, 1, 1}, {1, 0.5, -1}},
+                                                              {{1, 1, -1}, {0.3, -1, 1}},
+                                                              {{0, 1, 0.3}, {0, 0, 1}}};
+  for (const auto& [a, b] : twos) {
+    ExpectRecovered(2 * kDeg * a.normalized(), 0.05 * b.normalized(), Lock::kNone, 0.5 * kDeg,
+                    0.03);
+  }
+  for (const Eigen::Vector3d& w : {Eigen::Vector3d(3, -3, 3), Eigen::Vector3d(-3, 3, 3)}) {
+    ExpectRecovered(w * kDeg, Eigen::Vector3d::Zero(), Lock::kNone, 0.5 * kDeg, 0.03);
+  }
 }
 
 }  // namespace

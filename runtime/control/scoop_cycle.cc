@@ -42,8 +42,9 @@ const char* ToString(ScoopPolicy policy) {
 std::string ScoopCycleOptions::Invalid() const {
   if (!(tick > 0) || !std::isfinite(tick)) return "scoop cycle: tick must be > 0 s";
   if (decision_every < 1) return "scoop cycle: decision_every must be >= 1";
-  const double positive[] = {attack_speed, retreat_speed, target_fill, max_approach,
-                             max_crowd,    max_scoop,     max_retreat, action_timeout};
+  const double positive[] = {attack_speed, scoop_deceleration, retreat_speed,
+                             target_fill,  max_approach,       max_crowd,
+                             max_scoop,    max_retreat,        action_timeout};
   for (double v : positive) {
     if (!(v > 0) || !std::isfinite(v)) return "scoop cycle: speeds, fill and limits must be > 0";
   }
@@ -100,7 +101,8 @@ struct ScoopCycle::Runtime {
   bool arm_moving = false;
   double q_bucket_at_trigger = 0;
   double q_boom_at_trigger = 0;
-  bool finishing_drive = false;  ///< scoop: the drive has switched to fixed deceleration
+  bool finishing_drive = false;  ///< scoop: the final rack/lift runs
+  double slowing_since = NAN;    ///< scoop: when the drive began its fixed deceleration [s]
   double shake_start = 0;
   Eigen::Vector2d contact_hinge = Eigen::Vector2d::Zero();
   std::vector<Eigen::Vector3d> tip_path;  ///< world [m]
@@ -460,7 +462,12 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     case Phase::kScoop:
       // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
       // rate once the final rack/lift runs and the arm moves.
-      if ((rt.finishing_drive && rt.arm_moving) || rt.drive_held) speed_target = 0;
+      if (rt.finishing_drive && rt.arm_moving) {
+        if (std::isnan(rt.slowing_since)) rt.slowing_since = s.time;
+        speed_target = std::max(
+            options_.attack_speed - options_.scoop_deceleration * (s.time - rt.slowing_since), 0.0);
+      }
+      if (rt.drive_held) speed_target = 0;
       break;
     case Phase::kLevel:
     case Phase::kShake:

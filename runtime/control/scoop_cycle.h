@@ -84,9 +84,16 @@ enum class ScoopPolicy {
 const char* ToString(ScoopPolicy policy);
 
 struct ScoopCycleOptions {
-  double tick = 0.01;                   ///< low-level control period [s] (100 Hz)
-  int decision_every = 5;               ///< ticks per state-machine decision (20 Hz)
-  double attack_speed = 1.0;            ///< approach and crowding speed [m/s]
+  double tick = 0.01;         ///< low-level control period [s] (100 Hz)
+  int decision_every = 5;     ///< ticks per state-machine decision (20 Hz)
+  double attack_speed = 1.0;  ///< approach and crowding speed [m/s]
+  /// Seed §6.2, "fixed acceleration control upon scooping initiation": once the final curl
+  /// moves the arm, the speed reference falls from the attack speed at this rate and the drive
+  /// follows it. 1 m/s² (the speed profile's a_dec) stops the machine within about its
+  /// hydraulic-delay travel, the regime the shipped penetration predictor is trained in
+  /// (identification/predictor). Gentler rates crowd while curling; docs/scooping_control.md
+  /// gives what they do to fill and why the Eq. (19) volume model then mispredicts the intake.
+  double scoop_deceleration = 1.0;      ///< [m/s²]
   double retreat_speed = 1.0;           ///< reversing speed [m/s]
   double retreat_beyond_contact = 1.0;  ///< [m]
   double target_fill = 1.0;             ///< V_t as a fraction of the rated capacity [-]

@@ -37,10 +37,18 @@ Outcome RunScoop(const std::string& material, TriggerKind kind, ScoopPolicy poli
   ScoopCycleOptions options;
   options.attack_pose = yard.attack_pose;
   options.policy = policy;
+  // The exploration's knobs (docs/scooping_control.md): the scoop's fixed deceleration and the
+  // perception-only trigger's target.
+  if (const char* decel = std::getenv("AUTOSHOVEL_SCOOP_DECEL")) {
+    options.scoop_deceleration = std::atof(decel);
+  }
   const double target = options.target_fill * yard.machine.bucket.rated_capacity;
   std::unique_ptr<ScoopTrigger> trigger;
   if (kind == TriggerKind::kPredicted) trigger = std::make_unique<PredictedVolumeTrigger>(target);
-  if (kind == TriggerKind::kPerception) trigger = std::make_unique<PerceptionTrigger>(target);
+  if (kind == TriggerKind::kPerception) {
+    const char* v1_target = std::getenv("AUTOSHOVEL_SCOOP_V1_TARGET");
+    trigger = std::make_unique<PerceptionTrigger>(v1_target ? std::atof(v1_target) : target);
+  }
   if (kind == TriggerKind::kPressure) {
     trigger = std::make_unique<BoomPressureTrigger>(pressure_threshold);
   }

@@ -141,7 +141,7 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
   double integral = 0;
   const double kp = 1.0, ki = 0.5;
   bool contact = false, triggered = false, curled = false, arm_moving = false;
-  double contact_time = 0, trigger_time = 0;
+  double contact_time = 0, trigger_time = 0, slowing_since = NAN;
   Eigen::Vector2d contact_hinge = Eigen::Vector2d::Zero();
   const double heading = 0;
   const double rack_back = machine.links[1].joint_max - options.rack_back_margin;
@@ -199,12 +199,20 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
       const bool lifted = curled && s.q[0] >= boom_target;
       if ((lifted && std::abs(s.speed) < 0.02) || t - trigger_time > options.max_scoop_time) break;
     }
-    if (!triggered || !arm_moving) {
-      const double error = spec.approach_speed - s.speed;
+    if (arm_moving && std::isnan(slowing_since)) slowing_since = t;
+    const bool pushing = options.scoop_deceleration > 0 && !(curled && s.q[0] >= boom_target);
+    const double reference =
+        arm_moving ? spec.approach_speed - options.scoop_deceleration * (t - slowing_since)
+                   : spec.approach_speed;
+    if (!triggered || !arm_moving || (pushing && reference > 0)) {
+      const double error = reference - s.speed;
       const double u = kp * error + integral;
       if (u < 1.0 && u > 0.0) integral += ki * error * options.tick;  // no wind-up
       command.drive = std::clamp(u, 0.0, 1.0);
       command.brake = 0;
+    } else if (options.scoop_deceleration > 0) {
+      command.drive = 0;  // the reference has reached zero, or the boom is lifted
+      command.brake = 1.0;
     } else {
       // Scoop: the crowd goes on through the hydraulic delay (Fig. 21 (a)–(b)); once the bucket
       // moves the drive is released (the machine runs on into the pile on its momentum while the

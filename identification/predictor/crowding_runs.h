@@ -40,8 +40,13 @@ struct CrowdingRunOptions {
   double max_scoop_time = 10.0;   ///< the run ends at the latest this long after the trigger [s]
   double rack_back_margin = 0.1;  ///< curl until the bucket joint is this far below its max [rad]
   double boom_lift = 0.35;        ///< boom joint travel of the lift [rad]
-  double map_resolution = 0.05;   ///< of the yard grid [m]
-  double map_margin = 2.0;        ///< kept around the tip path in the stored map [m]
+  /// 0 (the shipped model): once the bucket moves the drive is released and the machine runs on
+  /// into the pile on its momentum. > 0: the speed reference falls from v0 at this rate [m/s²]
+  /// and the drive keeps pushing after it, as the scoop cycle's `scoop_deceleration` does
+  /// (crowding while curling, docs/scooping_control.md).
+  double scoop_deceleration = 0;
+  double map_resolution = 0.05;  ///< of the yard grid [m]
+  double map_margin = 2.0;       ///< kept around the tip path in the stored map [m]
 };
 
 /// The randomised inputs of one run, drawn from its seed.

@@ -34,6 +34,11 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "seed of the randomised runs")->capture_default_str();
   app.add_option("--threads", threads, "worker threads")->capture_default_str();
   app.add_option("--samples-csv", samples_csv, "also write every sample to this CSV file");
+  double scoop_deceleration = 0;
+  app.add_option("--scoop-deceleration", scoop_deceleration,
+                 "after the bucket moves, follow a speed reference falling at this rate [m/s^2] "
+                 "instead of releasing the drive (0: release, the shipped model's regime)")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -47,6 +52,7 @@ int main(int argc, char** argv) {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     predictor::CrowdingRunOptions options;
+    options.scoop_deceleration = scoop_deceleration;
     std::printf("train_predictor: %d crowding runs of %s on %d threads, seed %llu\n", runs,
                 machine.name.c_str(), threads, static_cast<unsigned long long>(seed));
     std::fflush(stdout);

@@ -14,8 +14,11 @@ namespace {
 constexpr const char* kMachine = "xcmg_968ev";
 
 const prediction::PenetrationPredictor& Predictor() {
+  // The exploration may try another model (docs/scooping_control.md); the tests use the shipped.
+  const char* stem = std::getenv("AUTOSHOVEL_SCOOP_MODEL");
   static const prediction::PenetrationPredictor predictor = prediction::PenetrationPredictor::Load(
-      std::string(AUTOSHOVEL_SOURCE_DIR) + "/models/prediction/penetration_svr");
+      stem != nullptr ? std::string(stem)
+                      : std::string(AUTOSHOVEL_SOURCE_DIR) + "/models/prediction/penetration_svr");
   return predictor;
 }
 

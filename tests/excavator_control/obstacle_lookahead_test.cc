@@ -34,6 +34,14 @@ HeightGrid MapWithTruck(const testing::Truck& truck, double resolution) {
 
 /// Lowest signed distance of the underside to `box` over a run (the look-ahead only sees map
 /// cells; this is the box itself), at most 0.021 m over the true one.
+// The loading script of the standard pass (dig end to `truck`) with default settings.
+LoadingScript StandardScript(const testing::Excavator& e, const testing::Truck& truck) {
+  const ScriptSettings settings;
+  const ScriptParameters p = ComputeScriptParameters(*e.envelope, e.derivation.models, DigEnd(),
+                                                     StandardGoal(truck), settings);
+  return BuildLoadingScript(p, settings);
+}
+
 double MinDistanceTo(const RunResult& run, const ObstacleBox& box, double stop_below = -1e9) {
   return testing::MinUndersideDistance(run.samples, {box}, stop_below);
 }
@@ -272,10 +280,7 @@ TEST(ObstacleLookAhead, ATooLowBoomIsCaughtBeforeItReachesTheTruck) {
 TEST(ObstacleLookAhead, UnknownCellsBlockOnlyWhenAskedTo) {
   const testing::Excavator& e = Excavator25t();
   const testing::Truck truck = Truck20t(90 * kDeg, 6.0);
-  const ScriptSettings settings;
-  const ScriptParameters p = ComputeScriptParameters(*e.envelope, e.derivation.models, DigEnd(),
-                                                     StandardGoal(truck), settings);
-  LoadingScript script = BuildLoadingScript(p, settings);
+  LoadingScript script = StandardScript(e, truck);
   HeightGrid map = MapWithTruck(truck, 0.1);
   // An unseen patch 4–6 m out at 40°.
   for (int iy = 0; iy < map.ny(); ++iy) {
@@ -304,10 +309,7 @@ TEST(ObstacleLookAhead, UnknownCellsBlockOnlyWhenAskedTo) {
 TEST(ObstacleLookAhead, ANonFiniteStateStopsAndNeverBecomesACommand) {
   const testing::Excavator& e = Excavator25t();
   const testing::Truck truck = Truck20t(90 * kDeg, 6.0);
-  const ScriptSettings settings;
-  const ScriptParameters p = ComputeScriptParameters(*e.envelope, e.derivation.models, DigEnd(),
-                                                     StandardGoal(truck), settings);
-  LoadingScript script = BuildLoadingScript(p, settings);
+  LoadingScript script = StandardScript(e, truck);
   const HeightGrid map = MapWithTruck(truck, 0.1);
   const ExcavatorSimulator machine(e.derivation.models, DigEnd());
   const ObstacleLookAhead lookahead(*e.envelope);

@@ -5,7 +5,7 @@
 // They are written here over Eigen matrices instead of taken from OpenCV on purpose: a truck bed
 // at 15 cm is on the order of 500 cells (§4.3; even a 9 m × 3.75 m bed is 60 × 25), so each
 // operation is a few thousand multiply-adds, and doing them by hand lets the smoothing honour the
-// known/unknown mask (OpenCV's filters would smear the placeholder heights of unseen cells into
+// known/unknown mask (OpenCV's filters would smear the stored 0 m of unseen cells into
 // their neighbours) and keeps the dump planner free of an image library.
 #pragma once
 
@@ -26,7 +26,7 @@ Eigen::MatrixXd GaussianKernel(double sigma_cells);
 /// §4.3's Gaussian smoothing, restricted to the known cells: each known cell becomes the
 /// kernel-weighted mean of the known cells around it (weights renormalised over the known cells
 /// inside the grid), so unknown cells and the grid's edge never pull heights toward their
-/// placeholder values. A constant field stays exactly constant. Unknown cells come out 0 and stay
+/// stored values. A constant field stays exactly constant. Unknown cells come out 0 and stay
 /// unknown: filling them is FillUnknownWithKnownMean's job. Throws std::invalid_argument on a
 /// size mismatch or a non-finite height in a known cell (unknown cells' values are ignored).
 Eigen::MatrixXd SmoothKnown(const Eigen::MatrixXd& heights, const CellMask& known,

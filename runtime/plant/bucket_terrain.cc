@@ -87,8 +87,8 @@ Eigen::Vector2d BucketPlacement::ToWorldXy(double s) const {
   return plane_origin + s * Eigen::Vector2d(std::cos(plane_heading), std::sin(plane_heading));
 }
 
-BucketTerrain::BucketTerrain(const model::Bucket& bucket, World& world)
-    : bucket_(bucket), world_(world), struck_area_(PolygonArea(bucket.profile)) {
+BucketTerrain::BucketTerrain(const model::Bucket& bucket, World& world, CuttingDirection cutting)
+    : bucket_(bucket), world_(world), cutting_(cutting), struck_area_(PolygonArea(bucket.profile)) {
   payload_by_material_.assign(world.materials.size(), 0.0);
 }
 
@@ -224,9 +224,17 @@ ExchangeResult BucketTerrain::Exchange(const BucketPlacement& placement) {
   // Inside the pile the material around the lip holds what the bucket carries in place: it
   // can take up to its heaped capacity and pushes the rest ahead. In the open it holds what
   // its attitude allows (HoldableVolume), which is why it must be curled before it leaves.
-  const double holdable = Contact(placement).in_contact
-                              ? std::max(bucket_.rated_capacity, HoldableVolume(placement))
-                              : HoldableVolume(placement);
+  //
+  // "Inside the pile" looks ahead of the cutting edge: away from the machine for a loader's
+  // bucket, towards it for an excavator's dragging its bucket in. Looking away from the machine,
+  // an excavator's bucket saw only the cut it had left behind, was never "inside", and poured
+  // what it took while penetrating onto the strip behind its rim: a column several metres high
+  // on the face (found in the truck-loading job). The resistance model keeps Contact()'s loader
+  // convention (see bucket_terrain.h).
+  const double ahead = cutting_ == CuttingDirection::kTowardsMachine ? -1.0 : 1.0;
+  const bool in_pile = ContactAhead(placement, ahead).in_contact;
+  const double holdable = in_pile ? std::max(bucket_.rated_capacity, HoldableVolume(placement))
+                                  : HoldableVolume(placement);
   if (payload_volume_ > holdable) {
     // Pour over the lower rim, onto the strip just outside it.
     const Eigen::Vector2d& tip = polygon.front();
@@ -234,15 +242,8 @@ ExchangeResult BucketTerrain::Exchange(const BucketPlacement& placement) {
     const Eigen::Vector2d rim = tip.y() <= back_top.y() ? tip : back_top;
     const double outward = rim.x() >= Centroid(polygon).x() ? 1.0 : -1.0;
     const double excess = payload_volume_ - holdable;
-    const double s_from = std::min(rim.x(), rim.x() + outward * 0.3);
-    const double s_to = std::max(rim.x(), rim.x() + outward * 0.3);
-    const double poured = [&] {
-      int cells = 0;
-      ForEachCellInStrip(placement, s_from, s_to, [&](int, int, double) { ++cells; });
-      if (cells == 0) return 0.0;  // outside the yard: the bucket keeps it
-      Deposit(placement, s_from, s_to, excess);
-      return excess;
-    }();
+    const double poured =
+        Pour(placement, rim, outward, excess, in_pile, std::max(tip.y(), back_top.y()));
     if (poured > 0) {
       const double fraction = poured / payload_volume_;
       payload_mass_ *= 1.0 - fraction;
@@ -254,33 +255,86 @@ ExchangeResult BucketTerrain::Exchange(const BucketPlacement& placement) {
   return result;
 }
 
-void BucketTerrain::Deposit(const BucketPlacement& placement, double s_from, double s_to,
-                            double volume) {
-  Terrain& terrain = world_.terrain;
-  int cells = 0;
-  ForEachCellInStrip(placement, s_from, s_to, [&](int, int, double) { ++cells; });
-  const double dh = volume / (cells * terrain.cell_area());
+double BucketTerrain::Pour(const BucketPlacement& placement, const Eigen::Vector2d& rim,
+                           double outward, double volume, bool in_pile, double top) {
+  constexpr double kStrip = 0.3, kMaxDistance = 3.0;
   const int material = payload_material();
-  ForEachCellInStrip(placement, s_from, s_to, [&](int ix, int iy, double) {
-    if (terrain.material(ix, iy) == Terrain::kNoMaterial && material >= 0) {
-      terrain.SetMaterial(ix, iy, static_cast<std::int16_t>(material));
-    }
-    terrain.SetHeight(ix, iy, terrain.height(ix, iy) + dh);
-  });
+  Terrain& terrain = world_.terrain;
+  if (cutting_ == CuttingDirection::kAwayFromMachine) {
+    // A loader's bucket pushes what it cannot hold ahead of its lip inside the pile (the
+    // surcharge) and pours it over its lower rim in the open, onto the strip beyond it, above
+    // the lip if need be. Kept as the loader's model was when its penetration predictor was
+    // trained and its results recorded; the excavator's below bounds the heap (moving the loader
+    // to it is open: it needs the predictor retrained and the comparisons rerun).
+    const double a = rim.x(), b = rim.x() + outward * kStrip;
+    int cells = 0;
+    ForEachCellInStrip(placement, std::min(a, b), std::max(a, b),
+                       [&](int, int, double) { ++cells; });
+    if (cells == 0) return 0.0;  // outside the yard: the bucket keeps it
+    const double dh = volume / (cells * terrain.cell_area());
+    ForEachCellInStrip(placement, std::min(a, b), std::max(a, b), [&](int ix, int iy, double) {
+      if (terrain.material(ix, iy) == Terrain::kNoMaterial && material >= 0) {
+        terrain.SetMaterial(ix, iy, static_cast<std::int16_t>(material));
+      }
+      terrain.SetHeight(ix, iy, terrain.height(ix, iy) + dh);
+    });
+    return volume;
+  }
+  // Inside the pile (an excavator's bucket) the pushed material heaps ahead of the lip up to the
+  // top of the opening at most; poured out in the open, it falls from the rim and comes to rest
+  // at or below it.
+  const double ceiling = in_pile ? top : rim.y();
+  // No cell rises above that ceiling. It lands in 0.3 m strips across the bucket's width,
+  // the nearest first, each filled up to the rim before the next one out; what finds no room
+  // within 3 m stays in the bucket. The relaxation to repose spreads it further. (Before, all of
+  // it went into the first strip whatever its height: an excavator bucket tipping 0.9 m³ out in
+  // one step over a face built a column 2.5 m above its own rim, which the look-ahead then saw
+  // as an obstacle.)
+  double left = volume;
+  for (double d = 0; d < kMaxDistance - 1e-9 && left > 1e-12; d += kStrip) {
+    const double a = rim.x() + outward * d, b = rim.x() + outward * (d + kStrip);
+    double room = 0;
+    int cells = 0;
+    ForEachCellInStrip(placement, std::min(a, b), std::max(a, b), [&](int ix, int iy, double) {
+      room += std::max(0.0, ceiling - terrain.height(ix, iy));
+      ++cells;
+    });
+    if (cells == 0) break;  // outside the yard
+    room *= terrain.cell_area();
+    if (room <= 1e-12) continue;
+    const double fraction = std::min(1.0, left / room);
+    ForEachCellInStrip(placement, std::min(a, b), std::max(a, b), [&](int ix, int iy, double) {
+      const double gap = std::max(0.0, ceiling - terrain.height(ix, iy));
+      if (gap <= 0) return;
+      if (terrain.material(ix, iy) == Terrain::kNoMaterial && material >= 0) {
+        terrain.SetMaterial(ix, iy, static_cast<std::int16_t>(material));
+      }
+      terrain.SetHeight(ix, iy, terrain.height(ix, iy) + fraction * gap);
+    });
+    left -= fraction * room;
+  }
+  return volume - std::max(0.0, left);
 }
 
 BucketContact BucketTerrain::Contact(const BucketPlacement& placement) const {
+  return ContactAhead(placement, 1.0);
+}
+
+BucketContact BucketTerrain::ContactAhead(const BucketPlacement& placement, double ahead) const {
   BucketContact contact;
   const std::vector<Eigen::Vector2d> polygon = PlanePolygon(placement);
   contact.tip = polygon.front();
   contact.rim = polygon.back();
   // The uncut surface just ahead of the cutting edge (the cells under the bucket have already
-  // been cut down to its outline), averaged across the bucket width.
+  // been cut down to its outline), averaged across the bucket width; `ahead` +1: away from the
+  // machine, −1: towards it.
   const Terrain& terrain = world_.terrain;
   double sum = 0;
   int cells = 0;
   int material_cells[16] = {};
-  ForEachCellInStrip(placement, contact.tip.x() + 0.05, contact.tip.x() + 0.30,
+  ForEachCellInStrip(placement,
+                     std::min(contact.tip.x() + ahead * 0.05, contact.tip.x() + ahead * 0.30),
+                     std::max(contact.tip.x() + ahead * 0.05, contact.tip.x() + ahead * 0.30),
                      [&](int ix, int iy, double) {
                        sum += terrain.height(ix, iy);
                        ++cells;

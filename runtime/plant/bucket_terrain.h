@@ -54,14 +54,25 @@ struct ExchangeResult {
   double spilled_volume = 0;   ///< poured from the bucket onto the terrain this call [m³]
 };
 
+/// Which way the bucket cuts along the arm plane: a loader's forward, away from the machine; an
+/// excavator's dragged in, towards it.
+enum class CuttingDirection { kAwayFromMachine, kTowardsMachine };
+
 class BucketTerrain {
  public:
-  BucketTerrain(const model::Bucket& bucket, World& world);
+  BucketTerrain(const model::Bucket& bucket, World& world,
+                CuttingDirection cutting = CuttingDirection::kAwayFromMachine);
 
   /// Captures material under the bucket and pours out what it cannot hold.
   ExchangeResult Exchange(const BucketPlacement& placement);
   /// The contact seen at the bucket tip.
+  /// The terrain just ahead of the cutting edge, looking away from the machine (a loader's
+  /// bucket cutting forward). An excavator's bucket dragged towards the machine is in contact
+  /// only through what lies beyond its tip on that side, so the resistance model, which uses
+  /// this, gives its drag little or no cutting resistance: a known gap (docs/simulation.md).
   BucketContact Contact(const BucketPlacement& placement) const;
+  /// The same looking to one side: `ahead` +1 away from the machine, −1 towards it.
+  BucketContact ContactAhead(const BucketPlacement& placement, double ahead) const;
   /// Volume the bucket holds in this orientation [m³]: what lies below a free surface rising
   /// from the lower rim at min(opening inclination, angle of repose), plus the heap the
   /// opening's inclination still supports (rated heaped capacity when the opening is level).
@@ -90,10 +101,16 @@ class BucketTerrain {
                           const std::vector<double>& heights, Visit&& visit) const;
   /// Angle of repose of the payload's main material (a typical 35° when empty) [rad].
   double PayloadAngleOfRepose() const;
-  void Deposit(const BucketPlacement& placement, double s_from, double s_to, double volume);
+  /// Pours up to `volume` over `rim` (plane coordinates) onto the terrain on the `outward` side
+  /// (+1 away from the machine): pushed ahead inside the pile (`in_pile`; an excavator's heap
+  /// no higher than `top`, the opening's upper edge), or poured out in the open (no higher than
+  /// the rim); returns what was poured.
+  double Pour(const BucketPlacement& placement, const Eigen::Vector2d& rim, double outward,
+              double volume, bool in_pile, double top);
 
   const model::Bucket& bucket_;
   World& world_;
+  CuttingDirection cutting_;
   double struck_area_ = 0;  ///< profile polygon area [m²]
   double payload_volume_ = 0;
   double payload_mass_ = 0;

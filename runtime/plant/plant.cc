@@ -282,7 +282,10 @@ Plant::Plant(const model::MachineDescription& machine, const generated::MachineF
     atol[layout.travel_energy()] = atol[layout.hydraulic_energy()] = 1.0;
   }
   integrator_ = std::make_unique<OdeIntegrator>(*system_, options_.integrator);
-  bucket_terrain_ = std::make_unique<BucketTerrain>(machine.bucket, world_);
+  bucket_terrain_ = std::make_unique<BucketTerrain>(machine.bucket, world_,
+                                                    machine.kind == model::MachineKind::kExcavator
+                                                        ? CuttingDirection::kTowardsMachine
+                                                        : CuttingDirection::kAwayFromMachine);
 
   y_.assign(layout.size(), 0.0);
   if (static_cast<int>(initial.q.size()) != J) {

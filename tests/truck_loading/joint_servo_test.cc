@@ -45,14 +45,17 @@ TEST(ExcavatorJointServo, StopAndNonFiniteStateCloseEveryValve) {
   for (double u : servo.Update(command, state)) EXPECT_EQ(u, 0.0);
 }
 
-// Each arm joint alone, from the reference pose, a step the size of a loading pass's moves: it
-// arrives within 0.01 rad and overshoots by less than 0.03 rad. The swing is left out: on the
-// plant it still overshoots a 90° step by about 0.5 rad (issue 7 note), which this test is to
-// include once fixed.
-TEST(ExcavatorJointServo, ArmStepsReachTheirTargetsOnThePlant) {
+// Each joint alone, from the reference pose, a step the size of a loading pass's moves: an arm
+// joint arrives within 0.01 rad and overshoots by less than 0.03 rad; the swing's 90° overshoots
+// by less than 0.12 rad and settles within 0.06 rad. The swing is looser because, braked by a
+// closed valve, it rebounds on the oil trapped at relief pressure (the plant models no leakage
+// and no anti-rebound valve), a slow ±0.05 rad oscillation the servo damps only weakly.
+TEST(ExcavatorJointServo, StepsReachTheirTargetsOnThePlant) {
   const Machine m;
-  const double steps[3] = {0.25, -0.4, 0.6};
-  for (int j = 0; j < 3; ++j) {
+  const double steps[4] = {0.25, -0.4, 0.6, 1.5708};
+  const double arrive[4] = {0.01, 0.01, 0.01, 0.06};
+  const double overshoot_limit[4] = {0.03, 0.03, 0.03, 0.12};
+  for (int j = 0; j < 4; ++j) {
     plant::World world = plant::EmptyYard(m.description, 40.0);
     plant::MachineState start;
     const control::JointVector q0 = control::DefaultReferencePose();
@@ -71,8 +74,8 @@ TEST(ExcavatorJointServo, ArmStepsReachTheirTargetsOnThePlant) {
       overshoot = std::max(overshoot, (q - command.position[j]) * (steps[j] > 0 ? 1 : -1));
     }
     const double error = std::abs(excavator.Sense().q[j] - command.position[j]);
-    EXPECT_LT(error, 0.01) << "joint " << j;
-    EXPECT_LT(overshoot, 0.03) << "joint " << j;
+    EXPECT_LT(error, arrive[j]) << "joint " << j;
+    EXPECT_LT(overshoot, overshoot_limit[j]) << "joint " << j;
     std::printf("joint %d: step %.2f rad, final error %.4f rad, overshoot %.4f rad\n", j, steps[j],
                 error, overshoot);
   }

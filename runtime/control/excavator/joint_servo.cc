@@ -93,6 +93,11 @@ std::vector<double> ExcavatorJointServo::Update(const ExcavatorCommand& command,
     // inertia), a closed one holds it to the relief pressure, which is the braking the models
     // assume.
     if (u * qd < 0 && std::abs(qd) > settings_.hold_velocity) u = 0;
+    // The same when the joint, at the rate it has now, needs all the distance left to stop:
+    // v* above is the rate to aim for, but a joint still faster than that (the swing, whose
+    // inertia it cannot shed quickly) has to start braking now, not once it has slowed to v*.
+    const double closing = qd * (e > 0 ? 1.0 : -1.0);
+    if (closing > 0 && closing * L + closing * closing / (2.0 * a) >= std::abs(e)) u = 0;
     duty[actuator_[j]] = CompensateDeadZone(sign * u, dead_zone_[j]);
   }
   return duty;

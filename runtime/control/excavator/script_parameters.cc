@@ -127,13 +127,32 @@ LoadingScript BuildLoadingScript(const ScriptParameters& p, const ScriptSettings
         {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
         p.swing_dig},
        {"stop and execute dig", {Near(J::kSwing, p.swing_dig, eps)}, p.swing_dig}}};
-  scripts[JointIndex(J::kBoom)] = {
-      J::kBoom,
-      {{"raise", {}, p.boom_clear},
-       {"hold while leaving the truck",
-        {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
-        p.boom_clear},
-       {"lower to dig", {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)}, p.boom_dig}}};
+  if (std::isnan(p.swing_boom_lower)) {
+    scripts[JointIndex(J::kBoom)] = {
+        J::kBoom,
+        {{"raise", {}, p.boom_clear},
+         {"hold while leaving the truck",
+          {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
+          p.boom_clear},
+         {"lower to dig",
+          {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)},
+          p.boom_dig}}};
+  } else {
+    // The dig left the boom above the carrying angle: hold it while the swing leaves the face,
+    // lower it on the way to the truck.
+    scripts[JointIndex(J::kBoom)] = {
+        J::kBoom,
+        {{"hold over the face", {}, p.boom_start},
+         {"lower to carry",
+          {Past(J::kSwing, p.swing_start, p.swing_dump, p.swing_boom_lower)},
+          p.boom_clear},
+         {"hold while leaving the truck",
+          {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
+          p.boom_clear},
+         {"lower to dig",
+          {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)},
+          p.boom_dig}}};
+  }
   scripts[JointIndex(J::kStick)] = {
       J::kStick,
       {{"wait", {}, p.stick_start},
@@ -143,7 +162,10 @@ LoadingScript BuildLoadingScript(const ScriptParameters& p, const ScriptSettings
        {"move to dump point",
         {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_sweep)},
         p.stick_dump},
-       {"move to dig", {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)}, p.stick_dig}}};
+       {"move to dig",
+        {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return),
+         Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
+        p.stick_dig}}};
   scripts[JointIndex(J::kBucket)] = {
       J::kBucket,
       {{"curl", {}, p.bucket_carry},
@@ -152,7 +174,8 @@ LoadingScript BuildLoadingScript(const ScriptParameters& p, const ScriptSettings
          Near(J::kStick, p.stick_spill, eps)},
         p.bucket_open},
        {"move to dig",
-        {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)},
+        {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return),
+         Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
         p.bucket_dig}}};
   return LoadingScript(std::move(scripts));
 }
@@ -327,6 +350,7 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
     d.margin = std::min(carrying, dumping);
     return d;
   };
+  auto acceptable = [](const DumpPose& d) { return d.reachable && d.margin >= 0; };
   // Scan upwards in 0.25 m steps for the first clearing height, then bisect below it (the pin
   // is rarely more than a metre below what the underside must clear: the stick hangs below it).
   double z_fail = p.clearance_height - 1.5;
@@ -334,7 +358,7 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
   DumpPose chosen;
   for (double z = z_fail; z <= p.clearance_height + 8.0; z += 0.25) {
     const DumpPose d = dump_pose(z);
-    if (d.reachable && d.margin >= 0) {
+    if (acceptable(d)) {
       z_pass = z;
       chosen = d;
       break;
@@ -350,7 +374,7 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
   for (int i = 0; i < kBisections; ++i) {
     const double z = 0.5 * (z_fail + z_pass);
     const DumpPose d = dump_pose(z);
-    if (d.reachable && d.margin >= 0) {
+    if (acceptable(d)) {
       z_pass = z;
       chosen = d;
     } else {
@@ -407,7 +431,15 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
            (std::isnan(pass.min_return_height) ||
             pass.min_return_height >= settings.ground_clearance);
   };
-  if (!settings.overlap_swing_and_raise || std::abs(boom_raise) <= eps) {
+  p.swing_boom_lower = std::numeric_limits<double>::quiet_NaN();
+  if (boom_raise < -eps) {
+    // The dig ended with the boom above the carrying angle (lifted out over a high face).
+    // Lowering it first, the swing waiting, would drive the bucket back into the face; the swing
+    // starts at once (φ_swing just beyond the start, crossed at the first evaluation) and the
+    // boom lowers once the swing has covered a third of its way.
+    p.boom_swing_start = p.boom_start + 0.5 * eps;
+    p.swing_boom_lower = p.swing_start + p.direction * swing_span / 3.0;
+  } else if (!settings.overlap_swing_and_raise || std::abs(boom_raise) <= eps) {
     p.boom_swing_start = boom_latest;
   } else {
     p.boom_swing_start = boom_latest;

@@ -13,17 +13,21 @@
 //   stick   1) digging finished: hold q₂_start
 //           2) swing past ψ_stick:                       move to the spill point, q₂_spill
 //           3) bucket past q₃_sweep:                     move to the dump point, q₂_dump
-//           4) swing back past ψ_return:                 move to dig, q₂_dig
+//           4) swing back past ψ_return, bucket past q₃_dumped:  move to dig, q₂_dig
 //   bucket  1) digging finished: curl to q₃_carry
 //           2) swing past ψ_open and stick at q₂_spill:  open, q₃_open
-//           3) swing back past ψ_return:                 move to dig, q₃_dig
+//           3) swing back past ψ_return, bucket past q₃_dumped:  move to dig, q₃_dig
 //
 // Fig. 14 gives the boom two rules: raise, then lower to dig once θ₁ is below 60°. Taken in order
 // (one active rule per joint), the second would fire as soon as the first is active, the swing
 // being still at the dig; the figure means the swing on its way back. The stick's and bucket's
 // scripts get that meaning from an earlier rule that needs the bucket opened (θ₄ > −30°, θ₁ > 60°);
-// the boom gets the same from rule 2, a hold until the bucket has opened. Rule conditions are
-// written for the actual direction of the swing, so a truck on either side works.
+// the boom gets the same from rule 2, a hold until the bucket has opened. The stick's and
+// bucket's last rules also name the opened bucket: ψ_return lies close to ψ_dump when nothing
+// stands in the way of lowering, and a real swing that stops a hundredth of a radian short of the
+// truck is "past ψ_return" before it ever swung back (found on the plant: the bucket closed
+// before it had dumped, and the swing, waiting for it to open, never left the truck). Rule
+// conditions are written for the actual direction of the swing, so a truck on either side works.
 //
 // Right-hand sides, by geometry and kinematics (as §4.4 computes its commands):
 //   ψ_dig, ψ_dump   azimuths of the dig and dump points (the swing takes the short way round);
@@ -121,6 +125,9 @@ struct ScriptParameters {
   double bucket_sweep = 0;       ///< q₃_sweep
   double bucket_dumped = 0;      ///< q₃_dumped
   double swing_return = 0;       ///< ψ_return
+  /// Where the boom starts lowering to carry when the dig left it above φ_clear; NaN when the
+  /// boom rises out of the dig (the usual case, Fig. 14's script).
+  double swing_boom_lower = std::numeric_limits<double>::quiet_NaN();
   // Geometry and prediction of the pass with these parameters.
   double dump_pin_height = 0;      ///< bucket pin above the ground at the spill point [m]
   double clearance_height = 0;     ///< what the underside must clear over the truck band [m]

@@ -18,6 +18,7 @@
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
 #include "runtime/app/shovel_run.h"
+#include "runtime/app/truck_loading/truck_loading_job.h"
 #include "runtime/planning/select_command.h"
 
 namespace {
@@ -291,6 +292,11 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--d-res", run.d_res, "d_res of Eq. (14) [m]")->capture_default_str();
   bool run_no_figures = false;
   run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
+  autoshovel::app::TruckLoadingOptions truck_loading;
+  run_cmd
+      ->add_option("--dig-evaluations", truck_loading.dig_evaluations,
+                   "Excavator scenarios: plant simulations per dig plan")
+      ->capture_default_str();
 
   autoshovel::app::CompareOptions compare;
   double compare_pressure_bar = compare.pressure_threshold / 1e5;
@@ -319,6 +325,23 @@ int main(int argc, char** argv) {
   }
 
   if (*run_cmd) {
+    // An excavator's scenario (truck_loading) runs the truck-loading job: passes instead of
+    // cycles, until the truck is full unless --cycles is given.
+    bool excavator = false;
+    try {
+      excavator =
+          autoshovel::app::TruckLoadingJob::IsTruckLoadingScenario(run.scenario, models_dir);
+    } catch (const std::exception&) {
+      // Not loadable here: the shovel job reports what is wrong with it.
+    }
+    if (excavator) {
+      truck_loading.scenario = run.scenario;
+      truck_loading.models_dir = models_dir;
+      truck_loading.seed = run.seed;
+      truck_loading.figures = !run_no_figures;
+      if (run_cmd->count("--cycles") > 0) truck_loading.passes = run.cycles;
+      return autoshovel::app::RunTruckLoadingCommand(truck_loading, run_out, std::cout, std::cerr);
+    }
     run.models_dir = models_dir;
     run.figures = !run_no_figures;
     run.pressure_threshold = run_pressure_bar * 1e5;

@@ -48,6 +48,8 @@ constexpr double kPourOffset = 1.45;     ///< where a load lands, short of the b
 /// The look-ahead's horizon while stopped: longer than a swing back and lowering from rest take
 /// (about 6 s on the 25 t machine), so that it covers the rest of the pass [s].
 constexpr double kResumeHorizon = 10.0;
+constexpr double kScanSwingRate = 42.0 * kDeg;   ///< the 90° pass's peak swing rate [rad/s]
+constexpr double kBedScanHalfArc = 40.0 * kDeg;  ///< scan plane either side of the bed [rad]
 
 /// The haul road: every cell beyond `edge_y` lowered to `-drop`, bare.
 void CutHaulRoad(plant::Terrain& terrain, double edge_y, double drop) {
@@ -142,6 +144,12 @@ struct TruckLoadingJob::State {
   std::unique_ptr<plant::Plant> plant;
   TruckPlacement truck;
   TruckRecognitionCheck recognition;
+  // The scanner and what it knows (recognise_truck): the recognised truck and the bed map
+  // measured on the first pass and on every swing back, fused (a cell keeps its last seen height).
+  std::unique_ptr<TruckScanner> scanner;
+  std::optional<perception::TruckRecognitionResult> recognised;
+  std::optional<planning::BedHeightMap> scanned_bed;
+  sensors::Rng rng;
   std::vector<control::ObstacleBox> truck_boxes;       ///< what the scripts keep clear of
   std::vector<control::ObstacleBox> true_truck_boxes;  ///< the ground-truth check
   std::unique_ptr<planning::CoarseDigPlanner> coarse;
@@ -182,14 +190,14 @@ struct TruckLoadingJob::State {
   void RecogniseTruck(double dig_swing, double truck_swing) {
     TruckScannerConfig config;
     config.scanner = ScannerConfigFromDescription(machine, "left_scanner");
-    const TruckScanner scanner(config);
+    scanner = std::make_unique<TruckScanner>(config);
     const std::vector<TruckScanMotion> phases =
-        FirstPassScan(config.scanner, dig_swing, truck_swing, 42.0 * kDeg);
+        FirstPassScan(config.scanner, dig_swing, truck_swing, kScanSwingRate);
     const sensors::RaycastScene raycast(scenario.world);
     const WorldRangefinderScene scene(raycast);
-    sensors::Rng rng(options.seed);
+    rng.seed(options.seed);
     const TruckScanReport report =
-        scanner.ScanAndRecognize(scene, Eigen::Isometry3d::Identity(), phases, rng);
+        scanner->ScanAndRecognize(scene, Eigen::Isometry3d::Identity(), phases, rng);
     const perception::TruckRecognitionResult& r = report.recognition;
     if (!r.found) {
       throw std::runtime_error("truck_loading: the first-pass scan recognised no truck: " +
@@ -204,6 +212,41 @@ struct TruckLoadingJob::State {
     recognition.length_error = r.dimensions.length - truck.inner_length;
     recognition.width_error = r.dimensions.width - truck.inner_width;
     truck_boxes = RecognisedTruckBoxes(r, -options.road_drop);
+    recognised = r;
+    if (report.bed_map) scanned_bed = *report.bed_map;
+  }
+
+  /// §2, §4.3: the bed measured while the machine swings back from the truck (dump → dig at the
+  /// scan's nominal 42°/s; the scan plane crosses the bed from 40° beyond its centre to 40°
+  /// short of it), fused into the scanned map. Returns the cells seen, or -1 when the motion
+  /// was out of the scanner's range (the map is then left as it was).
+  int MeasureBed(double swing_from, double swing_to, std::ostream* progress) {
+    if (!scanner || !recognised || !scanned_bed) return -1;
+    const Eigen::Vector3d c = recognised->T_world_bed.translation();
+    const double bed_azimuth = std::atan2(c.y(), c.x());
+    const double toward = swing_from >= swing_to ? 1.0 : -1.0;  // from the truck's side
+    TruckScanMotion back;
+    try {
+      back = SwingWithCounterPan(scanner->config().scanner, swing_from, swing_to, kScanSwingRate,
+                                 bed_azimuth + toward * kBedScanHalfArc,
+                                 bed_azimuth - toward * kBedScanHalfArc);
+    } catch (const std::invalid_argument& e) {
+      if (progress) *progress << "  bed not scanned on the swing back: " << e.what() << "\n";
+      return -1;
+    }
+    const sensors::RaycastScene raycast(scenario.world);
+    const WorldRangefinderScene scene(raycast);
+    const planning::BedHeightMap seen =
+        scanner->MeasureBed(scene, Eigen::Isometry3d::Identity(), back, *recognised, rng);
+    int known = 0;
+    for (int ix = 0; ix < seen.cells_x() && ix < scanned_bed->cells_x(); ++ix) {
+      for (int iy = 0; iy < seen.cells_y() && iy < scanned_bed->cells_y(); ++iy) {
+        if (!seen.known(ix, iy)) continue;
+        scanned_bed->SetHeight(ix, iy, seen.height(ix, iy));
+        ++known;
+      }
+    }
+    return known;
   }
 
   planning::DigPlan PlanDig(std::ostream* progress) {
@@ -406,8 +449,14 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   // 2. Plan: the next dig on the face as this one left it, the dump point on the bed.
   s.next_dig = s.PlanDig(progress);
   out.dig_evaluations = s.next_dig.evaluations;
-  const planning::DumpPlan dump = s.dump_planner.Plan(
-      s.BedMap(), s.truck.T_world_bed_corner() * Eigen::Translation3d(0, 0, -s.truck.wall_height));
+  // The bed as the scanner has seen it (heights in the recognised bed-corner frame, rim at 0),
+  // or as it is when no scan was made.
+  const planning::DumpPlan dump =
+      s.scanned_bed
+          ? s.dump_planner.Plan(*s.scanned_bed, s.recognised->T_world_bed_corner())
+          : s.dump_planner.Plan(s.BedMap(), s.truck.T_world_bed_corner() *
+                                                Eigen::Translation3d(0, 0, -s.truck.wall_height));
+
   out.p_world_dump = dump.p_world_dump;
   control::LoadingGoal goal;
   // The scripts put the bucket pin above their dump point, but the opened bucket pours over its
@@ -609,6 +658,18 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
     excavator.Advance(kControlPeriod);
   }
   switch_phase("idle");
+  // §2: the swing back scanned the bed as it is now.
+  if (finished) {
+    const int seen = s.MeasureBed(
+        params.swing_dump,
+        excavator.Sense().q[control::JointIndex(control::ExcavatorJoint::kSwing)], progress);
+    out.bed_cells_seen = seen;
+    if (progress && seen >= 0) {
+      *progress << "  bed scanned on the swing back: " << seen << " cells seen, "
+                << s.scanned_bed->known_count() << " of "
+                << s.scanned_bed->cells_x() * s.scanned_bed->cells_y() << " known\n";
+    }
+  }
   out.swing_time = phase_total["swing"].first;
   out.swing_energy = phase_total["swing"].second;
   out.dump_time = phase_total["dump"].first;

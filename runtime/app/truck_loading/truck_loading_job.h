@@ -18,10 +18,11 @@
 // The truck the scripts keep clear of is the one recognised from the left scanner's first-pass
 // scan (truck_scan/: the head pans while the first dig is dug, and on across the truck during
 // the first swing), as boxes: the bed's walls from the road to the rim and the cab ahead of it
-// up to 0.6 m above the rim. Where the job is simpler than the seed, said here once: the bed map
-// and the look-ahead's elevation map are taken from the simulated world (the scanners' view of
-// the bed is tested on its own in truck_scan/, and sees 86 of 624 cells of an empty 20 t bed
-// from the bench).
+// up to 0.6 m above the rim. The dump planner's bed map is what the same scanner saw: the first
+// pass's scan and one on every swing back, fused (a cell keeps its last seen height; unseen
+// cells are the planner's §4.3 business). Where the job is simpler than the seed, said here
+// once: the look-ahead's elevation map is taken from the simulated world; the swing-back scan
+// runs over the nominal swing (dump to dig at 42°/s), not the plant's profile.
 #pragma once
 
 #include <Eigen/Core>
@@ -114,6 +115,7 @@ struct PassOutcome {
   int safety_stops = 0;             ///< look-ahead stops
   int dig_evaluations = 0;          ///< forward-model calls for the next dig
   Eigen::Vector3d p_world_dump = Eigen::Vector3d::Zero();
+  int bed_cells_seen = -1;         ///< by the swing back's scan (-1: none)
   std::vector<TraceSample> trace;  ///< the loading phase
 };
 

@@ -7,6 +7,7 @@
 #include <ctime>
 #include <fstream>
 #include <limits>
+#include <ostream>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -196,6 +197,21 @@ RunFolder::RunFolder(const RunFolderOptions& options) {
     throw std::runtime_error((dir_ / "figures").string() + ": cannot create: " + error.message());
   }
   log_ = std::make_unique<RunLog>(LogPath(), options.log_level);
+}
+
+std::unique_ptr<RunFolder> RunFolder::OpenWithConfig(const fs::path& dir,
+                                                     std::string_view config_yaml,
+                                                     std::ostream& err, std::string_view who) {
+  RunFolderOptions options;
+  options.dir = dir;
+  try {
+    auto folder = std::make_unique<RunFolder>(options);
+    folder->WriteConfig(config_yaml);
+    return folder;
+  } catch (const std::exception& e) {
+    err << who << ": " << e.what() << "\n";
+    return nullptr;
+  }
 }
 
 fs::path RunFolder::FigurePath(std::string_view file_name) const {

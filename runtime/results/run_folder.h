@@ -13,6 +13,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <iosfwd>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -102,6 +103,13 @@ class RunFolder {
   void WriteConfig(const KeyValues& key_values);
 
   RunLog& log() { return *log_; }
+
+  /// A new run folder at `dir` (empty: timestamped under runs/) with `config_yaml` written, or
+  /// null after one line on `err`, "<who>: <why>", when the folder or its configuration is
+  /// refused: the start every `autoshovel run` job shares.
+  static std::unique_ptr<RunFolder> OpenWithConfig(const std::filesystem::path& dir,
+                                                   std::string_view config_yaml, std::ostream& err,
+                                                   std::string_view who);
 
  private:
   std::filesystem::path dir_;

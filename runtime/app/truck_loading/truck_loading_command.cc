@@ -104,16 +104,9 @@ int RunTruckLoadingCommand(const TruckLoadingOptions& options, const std::filesy
     err << "autoshovel run truck_loading: " << e.what() << "\n";
     return 2;
   }
-  results::RunFolderOptions folder_options;
-  folder_options.dir = out_dir;
-  std::unique_ptr<results::RunFolder> folder;
-  try {
-    folder = std::make_unique<results::RunFolder>(folder_options);
-    folder->WriteConfig(job->ConfigYaml());
-  } catch (const std::exception& e) {
-    err << "autoshovel run truck_loading: " << e.what() << "\n";
-    return 2;
-  }
+  const std::unique_ptr<results::RunFolder> folder = results::RunFolder::OpenWithConfig(
+      out_dir, job->ConfigYaml(), err, "autoshovel run truck_loading");
+  if (!folder) return 2;
   results::RunLog& log = folder->log();
   results::ResultsDb db(folder->DatabasePath());
   results::RunInfo info;

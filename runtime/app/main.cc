@@ -293,10 +293,14 @@ int main(int argc, char** argv) {
   bool run_no_figures = false;
   run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
   autoshovel::app::TruckLoadingOptions truck_loading;
+  bool truck_loading_dust = false;
   run_cmd
       ->add_option("--dig-evaluations", truck_loading.dig_evaluations,
                    "Excavator scenarios: plant simulations per dig plan")
       ->capture_default_str();
+  run_cmd->add_flag(
+      "--dust", truck_loading_dust,
+      "Excavator scenarios: a dust cloud (3 m radius, visibility 16 m) over the truck");
 
   autoshovel::app::CompareOptions compare;
   double compare_pressure_bar = compare.pressure_threshold / 1e5;
@@ -340,6 +344,13 @@ int main(int argc, char** argv) {
       truck_loading.seed = run.seed;
       truck_loading.figures = !run_no_figures;
       if (run_cmd->count("--cycles") > 0) truck_loading.passes = run.cycles;
+      if (truck_loading_dust) {
+        const double azimuth = truck_loading.truck_azimuth_deg * 3.14159265358979 / 180.0;
+        autoshovel::app::DustCloud cloud;
+        cloud.p_world_center = Eigen::Vector3d(truck_loading.truck_radius * std::cos(azimuth),
+                                               truck_loading.truck_radius * std::sin(azimuth), 0.5);
+        truck_loading.dust.push_back(cloud);
+      }
       return autoshovel::app::RunTruckLoadingCommand(truck_loading, run_out, std::cout, std::cerr);
     }
     run.models_dir = models_dir;

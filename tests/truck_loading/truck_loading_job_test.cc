@@ -103,5 +103,32 @@ TEST(TruckLoadingJob, StopsShortOfAPersonWalkingIntoTheSwingPath) {
   }
 }
 
+// §3: a dust cloud over the truck. The first-pass scan raises the dust warning; the pass's
+// load phase runs with every joint's top rate scaled by the monitor's recommendation, and is
+// slower than the same pass in clear air, yet completes without touching the truck.
+TEST(TruckLoadingJob, DustOverTheTruckSlowsTheLoadPhase) {
+  const PassOutcome& clear = ReferencePass();
+  ASSERT_TRUE(clear.completed) << clear.failure;
+  EXPECT_DOUBLE_EQ(clear.speed_scale, 1.0);
+  TruckLoadingOptions o = Options();
+  DustCloud cloud;
+  cloud.p_world_center = Eigen::Vector3d(0.0, o.truck_radius, 0.5);  // the truck at 90°
+  o.dust.push_back(cloud);
+  TruckLoadingJob job(o);
+  std::ostringstream progress;
+  const PassOutcome dusty = job.RunPass(0, &progress);
+  const double clear_load = clear.total_time - clear.dig_time;
+  const double dusty_load = dusty.total_time - dusty.dig_time;
+  std::cout << "speed scale " << dusty.speed_scale << ", load phase " << dusty_load << " s (clear "
+            << clear_load << " s), swing-back warning " << dusty.dust_warning << "\n";
+  EXPECT_TRUE(dusty.completed) << dusty.failure << progress.str();
+  EXPECT_EQ(dusty.collisions, 0);
+  EXPECT_GT(dusty.min_truck_clearance, 0.0);
+  EXPECT_LT(dusty.speed_scale, 0.7);
+  EXPECT_GE(dusty.speed_scale, 0.3);  // the monitor's floor: dust alone never stops the machine
+  EXPECT_GT(dusty_load, 1.2 * clear_load);
+  EXPECT_TRUE(dusty.dust_warning);  // the cloud is still there on the swing back
+}
+
 }  // namespace
 }  // namespace autoshovel::app

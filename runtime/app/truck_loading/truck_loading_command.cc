@@ -163,7 +163,12 @@ int RunTruckLoadingCommand(const TruckLoadingOptions& options, const std::filesy
                   pass.dumped_mass, pass.total_time, pass.dig_time, pass.swing_time, pass.dump_time,
                   pass.return_time, pass.min_truck_clearance, job->BedMass() / 1000,
                   pass.failure.c_str(), elapsed);
-    out << line << std::flush;
+    out << line;
+    if (pass.speed_scale < 1.0) {
+      out << "         dust: this pass's load phase at " << std::lround(100 * pass.speed_scale)
+          << " % of full speed\n";
+    }
+    out << std::flush;
     if (!pass.completed) {
       // The machine stays where the failed pass left it (a bucket perhaps still loaded): the
       // run ends here rather than dig on top of it.

@@ -98,6 +98,16 @@ std::vector<control::ObstacleBox> RecognisedTruckBoxes(
   return out;
 }
 
+/// §3's "slower, more conservative motion strategy": every joint's top rate scaled; latency,
+/// braking and the final approach stay (they are the machine's, not the strategy's).
+control::ExcavatorJointModels SlowedModels(control::ExcavatorJointModels models, double scale) {
+  for (control::JointModelParams& m : models) {
+    m.max_velocity_up *= scale;
+    m.max_velocity_down *= scale;
+  }
+  return models;
+}
+
 std::vector<control::ObstacleBox> Boxes(const std::vector<plant::OrientedBox>& boxes) {
   std::vector<control::ObstacleBox> out;
   for (const plant::OrientedBox& b : boxes) out.push_back(ToObstacleBox(b));
@@ -150,6 +160,15 @@ struct TruckLoadingJob::State {
   std::optional<perception::TruckRecognitionResult> recognised;
   std::optional<planning::BedHeightMap> scanned_bed;
   sensors::Rng rng;
+  double speed_scale = 1.0;  ///< for the next pass, from the last scan's dust warning
+
+  void AddDust(WorldRangefinderScene& scene) const {
+    for (const DustCloud& cloud : options.dust) {
+      sensors::DustProperties dust;
+      dust.extinction = cloud.extinction;
+      scene.AddDustSphere(cloud.p_world_center, cloud.radius, dust);
+    }
+  }
   std::vector<control::ObstacleBox> truck_boxes;       ///< what the scripts keep clear of
   std::vector<control::ObstacleBox> true_truck_boxes;  ///< the ground-truth check
   std::unique_ptr<planning::CoarseDigPlanner> coarse;
@@ -194,7 +213,8 @@ struct TruckLoadingJob::State {
     const std::vector<TruckScanMotion> phases =
         FirstPassScan(config.scanner, dig_swing, truck_swing, kScanSwingRate);
     const sensors::RaycastScene raycast(scenario.world);
-    const WorldRangefinderScene scene(raycast);
+    WorldRangefinderScene scene(raycast);
+    AddDust(scene);
     rng.seed(options.seed);
     const TruckScanReport report =
         scanner->ScanAndRecognize(scene, Eigen::Isometry3d::Identity(), phases, rng);
@@ -214,30 +234,36 @@ struct TruckLoadingJob::State {
     truck_boxes = RecognisedTruckBoxes(r, -options.road_drop);
     recognised = r;
     if (report.bed_map) scanned_bed = *report.bed_map;
+    speed_scale = report.scan.min_speed_scale;
   }
 
   /// §2, §4.3: the bed measured while the machine swings back from the truck (dump → dig at the
   /// scan's nominal 42°/s; the scan plane crosses the bed from 40° beyond its centre to 40°
   /// short of it), fused into the scanned map. Returns the cells seen, or -1 when the motion
   /// was out of the scanner's range (the map is then left as it was).
-  int MeasureBed(double swing_from, double swing_to, std::ostream* progress) {
+  int MeasureBed(double swing_from, double swing_to, std::ostream* progress, bool* dust_warning) {
     if (!scanner || !recognised || !scanned_bed) return -1;
     const Eigen::Vector3d c = recognised->T_world_bed.translation();
     const double bed_azimuth = std::atan2(c.y(), c.x());
     const double toward = swing_from >= swing_to ? 1.0 : -1.0;  // from the truck's side
     TruckScanMotion back;
     try {
-      back = SwingWithCounterPan(scanner->config().scanner, swing_from, swing_to, kScanSwingRate,
-                                 bed_azimuth + toward * kBedScanHalfArc,
-                                 bed_azimuth - toward * kBedScanHalfArc);
+      back = SwingWithCounterPan(
+          scanner->config().scanner, swing_from, swing_to, speed_scale * kScanSwingRate,
+          bed_azimuth + toward * kBedScanHalfArc, bed_azimuth - toward * kBedScanHalfArc);
     } catch (const std::invalid_argument& e) {
       if (progress) *progress << "  bed not scanned on the swing back: " << e.what() << "\n";
       return -1;
     }
     const sensors::RaycastScene raycast(scenario.world);
-    const WorldRangefinderScene scene(raycast);
+    WorldRangefinderScene scene(raycast);
+    AddDust(scene);
+    TruckScan scan;
     const planning::BedHeightMap seen =
-        scanner->MeasureBed(scene, Eigen::Isometry3d::Identity(), back, *recognised, rng);
+        scanner->MeasureBed(scene, Eigen::Isometry3d::Identity(), back, *recognised, rng, &scan);
+    // §3: what this scan saw of dust sets the next pass's speed.
+    speed_scale = scan.min_speed_scale;
+    if (dust_warning) *dust_warning = scan.dust_warning;
     int known = 0;
     for (int ix = 0; ix < seen.cells_x() && ix < scanned_bed->cells_x(); ++ix) {
       for (int iy = 0; iy < seen.cells_y() && iy < scanned_bed->cells_y(); ++iy) {
@@ -284,6 +310,13 @@ TruckLoadingJob::TruckLoadingJob(const TruckLoadingOptions& options)
     throw std::invalid_argument(
         "truck_loading: passes >= 0, max_passes >= 1, a positive truck payload, road drop, "
         "resume time and pass time, dig evaluations >= 1 and finite truck pose are required");
+  }
+  for (const DustCloud& c : options.dust) {
+    if (!c.p_world_center.allFinite() || !(c.radius > 0) || !(c.extinction > 0) ||
+        !std::isfinite(c.radius) || !std::isfinite(c.extinction)) {
+      throw std::invalid_argument(
+          "truck_loading: a dust cloud needs a finite centre and a positive radius and extinction");
+    }
   }
   if (options.person) {
     const PersonWalk& w = *options.person;
@@ -413,6 +446,14 @@ std::string TruckLoadingJob::ConfigYaml() const {
     << "\nmax_pass_time_s: " << o.max_pass_time
     << "\nrecognise_truck: " << (o.recognise_truck ? "true" : "false")
     << "\nmaterial: " << state_->material << "\n";
+  if (!o.dust.empty()) {
+    y << "dust:\n";
+    for (const DustCloud& c : o.dust) {
+      y << "  - {center: [" << c.p_world_center.x() << ", " << c.p_world_center.y() << ", "
+        << c.p_world_center.z() << "], radius: " << c.radius << ", extinction: " << c.extinction
+        << "}\n";
+    }
+  }
   return y.str();
 }
 
@@ -491,12 +532,19 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   // When the pin cannot be put over the aimed point (beyond the arm's reach with the truck
   // cleared), it is pulled back towards the machine in steps: a load landing short of the
   // planned cell still lands in the bed.
+  // §3: after a dust warning the whole load phase runs slower; the scripts' parameters, the
+  // look-ahead's mirror and the servos share the slowed models, so predictions stay those of the
+  // machine that moves. (The dig runs at its own speeds: it is in the face, not near the truck.)
+  out.speed_scale = s.speed_scale;
+  const control::ExcavatorJointModels models =
+      SlowedModels(s.derivation.models, std::clamp(s.speed_scale, 0.05, 1.0));
+  control::ExcavatorJointServo servo(s.machine, *s.functions, models);
   control::ScriptParameters params;
   const Eigen::Vector2d aimed = goal.p_base_dump.head<2>();
   for (int attempt = 0;; ++attempt) {
     try {
-      params = control::ComputeScriptParameters(*s.envelope, s.derivation.models, dig.end_state,
-                                                goal, script_settings);
+      params = control::ComputeScriptParameters(*s.envelope, models, dig.end_state, goal,
+                                                script_settings);
       break;
     } catch (const std::invalid_argument& e) {
       if (attempt == 3) {
@@ -513,8 +561,8 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   control::LoadingScript script = control::BuildLoadingScript(params, script_settings);
 
   // 3. Load: script at 10 Hz, servos at 100 Hz, look-ahead at 10 Hz, truth check at 20 Hz.
-  ExcavatorOnPlant excavator(plant, *s.servo);
-  control::ExcavatorSimulator mirror(s.derivation.models, excavator.Sense());
+  ExcavatorOnPlant excavator(plant, servo);
+  control::ExcavatorSimulator mirror(models, excavator.Sense());
   const double t_load = plant.time();
   double next_script = t_load, next_safety = t_load;
   double clear_since = std::numeric_limits<double>::quiet_NaN();
@@ -660,10 +708,15 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   switch_phase("idle");
   // §2: the swing back scanned the bed as it is now.
   if (finished) {
-    const int seen = s.MeasureBed(
-        params.swing_dump,
-        excavator.Sense().q[control::JointIndex(control::ExcavatorJoint::kSwing)], progress);
+    const int seen =
+        s.MeasureBed(params.swing_dump,
+                     excavator.Sense().q[control::JointIndex(control::ExcavatorJoint::kSwing)],
+                     progress, &out.dust_warning);
     out.bed_cells_seen = seen;
+    if (progress && out.dust_warning) {
+      *progress << "  dust warning on the swing-back scan: the next pass at " << s.speed_scale
+                << " of full speed\n";
+    }
     if (progress && seen >= 0) {
       *progress << "  bed scanned on the swing back: " << seen << " cells seen, "
                 << s.scanned_bed->known_count() << " of "

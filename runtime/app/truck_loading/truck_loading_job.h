@@ -57,6 +57,14 @@ struct PersonWalk {
   Eigen::Vector2d At(double t) const;
 };
 
+/// A dust cloud hanging in the yard for the whole run: a sphere of uniform density that the
+/// scanners see (§3); the machine's moving parts pass through it.
+struct DustCloud {
+  Eigen::Vector3d p_world_center = Eigen::Vector3d::Zero();  ///< [m]
+  double radius = 3.0;                                       ///< [m]
+  double extinction = 0.25;  ///< α [1/m]; visibility ≈ 3.9/α (0.25/m: ≈ 16 m)
+};
+
 /// The loading phase sampled at 20 Hz: where the bucket tip was (ground truth).
 struct TraceSample {
   double t = 0;  ///< since the loading phase began [s]
@@ -86,6 +94,8 @@ struct TruckLoadingOptions {
   /// Recognise the truck from the left scanner's first-pass scan (§2, §4.1) and plan the passes
   /// around the recognised body; false: around the true one.
   bool recognise_truck = true;
+  /// Dust clouds the scans see; their §3 warning slows the next pass (recognise_truck only).
+  std::vector<DustCloud> dust;
   bool figures = true;
 };
 
@@ -115,7 +125,12 @@ struct PassOutcome {
   int safety_stops = 0;             ///< look-ahead stops
   int dig_evaluations = 0;          ///< forward-model calls for the next dig
   Eigen::Vector3d p_world_dump = Eigen::Vector3d::Zero();
-  int bed_cells_seen = -1;         ///< by the swing back's scan (-1: none)
+  int bed_cells_seen = -1;  ///< by the swing back's scan (-1: none)
+  /// §3: the scale of every joint's top rate during this pass's load phase, from the dust
+  /// warning of the scan before it (1: clear air); `dust_warning`: the warning of this pass's own
+  /// swing-back scan, which sets the next pass's scale.
+  double speed_scale = 1.0;
+  bool dust_warning = false;
   std::vector<TraceSample> trace;  ///< the loading phase
 };
 

@@ -240,6 +240,7 @@ TruckScanner::TruckScanner(const TruckScannerConfig& config)
                    sensors::MakeDetectorConfig(config.waveform, config.threshold_snr),
                    config.window),
       recognizer_(config.recognition) {
+  sensors::DustMonitor check_dust_config(config.dust);  // throws on a bad dust configuration
   Require(std::isfinite(config.bed_cell_size) && config.bed_cell_size > 0,
           "TruckScannerConfig: bed_cell_size must be finite and positive");
   Require(std::isfinite(config.standing_level_tolerance) && config.standing_level_tolerance > 0,
@@ -280,6 +281,7 @@ TruckScan TruckScanner::Scan(const sensors::RangefinderScene& scene,
   };
 
   TruckScan scan;
+  sensors::DustMonitor dust(config_.dust);
   std::int64_t current_revolution = 0;
   bool open = false;
   Eigen::Vector3d origin_sum = Eigen::Vector3d::Zero();
@@ -348,6 +350,9 @@ TruckScan TruckScanner::Scan(const sensors::RangefinderScene& scene,
         ++scan.points;
       }
       if (pulse->detection.DustEvidence()) ++scan.dust_evidence;
+      dust.Add(t, pulse->detection);
+      scan.dust_warning = scan.dust_warning || dust.warning();
+      scan.min_speed_scale = std::min(scan.min_speed_scale, dust.speed_scale());
       scan.scanlines.back().points.push_back(point);
       origin_sum += T_world_cab * pulse->ray.origin_cab;
       // The scan plane's azimuth: the horizontal direction of the beam at elevation 0.
@@ -411,12 +416,14 @@ planning::BedHeightMap TruckScanner::MeasureBed(const sensors::RangefinderScene&
                                                 const Eigen::Isometry3d& T_world_base,
                                                 const TruckScanMotion& motion,
                                                 const perception::TruckRecognitionResult& truck,
-                                                sensors::Rng& rng) const {
+                                                sensors::Rng& rng, TruckScan* scan_out) const {
   Require(truck.found, "TruckScanner::MeasureBed: no truck was recognised (" + truck.reason + ")");
-  const TruckScan scan = Scan(scene, T_world_base, motion, rng);
-  return BedMapFromScan(
+  TruckScan scan = Scan(scene, T_world_base, motion, rng);
+  planning::BedHeightMap map = BedMapFromScan(
       truck, scan.scanlines,
       BedMapConfigFor(truck, config_.recognition.model.wall_height.max, config_.bed_cell_size));
+  if (scan_out) *scan_out = std::move(scan);
+  return map;
 }
 
 }  // namespace autoshovel::app

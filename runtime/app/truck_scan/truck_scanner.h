@@ -45,6 +45,7 @@
 #include "runtime/perception/truck/scanline.h"
 #include "runtime/perception/truck/truck_recognition.h"
 #include "runtime/planning/dump/bed_height_map.h"
+#include "runtime/sensors/rangefinder/dust_monitor.h"
 #include "runtime/sensors/rangefinder/rangefinder_scene.h"
 #include "runtime/sensors/rangefinder/scanning_rangefinder.h"
 #include "runtime/sensors/rng.h"
@@ -150,6 +151,10 @@ struct TruckScan {
   std::int64_t points = 0;         ///< pulses with a trailing-edge range
   std::int64_t dust_evidence = 0;  ///< pulses with multiple or extended returns (§3)
   double max_azimuth_step = 0;     ///< largest |Δ azimuth| between consecutive scanlines [rad]
+  /// §3's dust warning over the scan (sensors::DustMonitor fed every fired pulse): whether it
+  /// came on, and the smallest speed scale it recommended (1: clear air throughout).
+  bool dust_warning = false;
+  double min_speed_scale = 1.0;
 };
 
 /// Whether the scan swept past every corner of the recognised body: for each corner of the
@@ -211,6 +216,7 @@ struct TruckScannerConfig {
   TruckGround truck_ground = TruckGround::kEither;
   double standing_level_tolerance = 0.15;  ///< see WithoutStandingLevel [m]
   double bed_cell_size = 0.15;             ///< §4.3 [m]
+  sensors::DustMonitorConfig dust;         ///< §3's warning (TruckScan::dust_warning)
 };
 
 /// Everything one recognition scan produced.
@@ -250,11 +256,12 @@ class TruckScanner {
                                    const TruckScanMotion& motion, sensors::Rng& rng) const;
 
   /// The bed map of an already recognised truck from a new scan (the swing back of each pass).
+  /// `scan`, when given, receives the scan itself (its dust warning, for one).
   planning::BedHeightMap MeasureBed(const sensors::RangefinderScene& scene,
                                     const Eigen::Isometry3d& T_world_base,
                                     const TruckScanMotion& motion,
                                     const perception::TruckRecognitionResult& truck,
-                                    sensors::Rng& rng) const;
+                                    sensors::Rng& rng, TruckScan* scan = nullptr) const;
 
   const sensors::ScanningRangefinder& rangefinder() const { return rangefinder_; }
   const perception::TruckRecognizer& recognizer() const { return recognizer_; }

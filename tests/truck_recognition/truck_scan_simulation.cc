@@ -10,8 +10,6 @@ namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kFloorSlab = 0.12;  // floor plate and cross members [m]
-constexpr double kSkirt = 0.25;      // side walls reach this far below the floor's top [m]
 
 double RayBox(const SimBox& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
   const Eigen::Matrix3d R = box.T_world_box.linear();
@@ -85,60 +83,6 @@ double CastRay(const SimScene& scene, const Eigen::Vector3d& origin,
   return best <= max_range ? best : kInf;
 }
 
-TruckSpec Tipper15t() {
-  TruckSpec s;
-  s.name = "15 t tipper";
-  s.inner_length = 4.8;
-  s.inner_width = 2.30;
-  s.wall_height = 0.90;
-  s.floor_height = 1.45;
-  s.wall_thickness = 0.06;
-  s.headboard_rise = 0.3;
-  s.has_tailgate = true;
-  s.cab_gap = 0.3;
-  s.cab_length = 2.1;
-  s.cab_width = 2.3;
-  s.cab_height = 3.0;
-  s.wheel_radius = 0.5;
-  return s;
-}
-
-TruckSpec Tipper20t() {
-  TruckSpec s;
-  s.name = "20 t tipper";
-  s.inner_length = 5.8;
-  s.inner_width = 2.35;
-  s.wall_height = 1.15;
-  s.floor_height = 1.55;
-  s.wall_thickness = 0.07;
-  s.headboard_rise = 0.3;
-  s.has_tailgate = true;
-  s.cab_gap = 0.35;
-  s.cab_length = 2.2;
-  s.cab_width = 2.3;
-  s.cab_height = 3.1;
-  s.wheel_radius = 0.52;
-  return s;
-}
-
-TruckSpec Hauler38t() {
-  TruckSpec s;
-  s.name = "38 t articulated hauler";
-  s.inner_length = 6.2;
-  s.inner_width = 3.3;
-  s.wall_height = 1.55;
-  s.floor_height = 1.95;
-  s.wall_thickness = 0.10;
-  s.headboard_rise = 0.6;
-  s.has_tailgate = false;
-  s.cab_gap = 1.0;  // the articulation between the tractor unit and the body
-  s.cab_length = 2.6;
-  s.cab_width = 2.8;
-  s.cab_height = 3.6;
-  s.wheel_radius = 0.8;
-  return s;
-}
-
 TruckTruth AddTruck(const TruckSpec& spec, const Eigen::Vector2d& p_world_bed_xy, double yaw_rad,
                     SimScene* scene) {
   const double L = spec.inner_length;
@@ -161,40 +105,17 @@ TruckTruth AddTruck(const TruckSpec& spec, const Eigen::Vector2d& p_world_bed_xy
                            truth.T_world_bed * Eigen::Vector3d(-L / 2, -W / 2, 0),
                            truth.T_world_bed * Eigen::Vector3d(-L / 2, W / 2, 0)};
 
-  // Boxes given by bed-frame corners (x along the bed, y left, z up from the rim).
-  const auto add = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  for (const app::TruckBodyBox& part : app::TruckBodyBoxes(spec)) {
     SimBox box;
-    box.half_extents = 0.5 * (hi - lo);
+    box.half_extents = 0.5 * (part.hi_bed - part.lo_bed);
     Eigen::Isometry3d T_bed_box = Eigen::Isometry3d::Identity();
-    T_bed_box.translation() = 0.5 * (hi + lo);
+    T_bed_box.translation() = 0.5 * (part.hi_bed + part.lo_bed);
     box.T_world_box = truth.T_world_bed * T_bed_box;
     scene->boxes.push_back(box);
-  };
-  const double rear_end = -L / 2 - (spec.has_tailgate ? t : 0.0);
-  const double floor_top = -H;
-  const double ground = -rim;
-  add({-L / 2, -W / 2, floor_top - kFloorSlab}, {L / 2, W / 2, floor_top});  // floor
-  add({rear_end, W / 2, floor_top - kSkirt}, {L / 2 + t, W / 2 + t, 0});     // left side
-  add({rear_end, -W / 2 - t, floor_top - kSkirt}, {L / 2 + t, -W / 2, 0});   // right side
-  add({L / 2, -W / 2 - t, floor_top - kFloorSlab}, {L / 2 + t, W / 2 + t, spec.headboard_rise});
-  if (spec.has_tailgate) add({-L / 2 - t, -W / 2, floor_top - kFloorSlab}, {-L / 2, W / 2, 0});
-
-  const double cab_start = L / 2 + t + spec.cab_gap;
-  const double cab_end = cab_start + spec.cab_length;
-  add({cab_start, -spec.cab_width / 2, ground + 0.9},
-      {cab_end, spec.cab_width / 2, ground + spec.cab_height});
-  const double r = spec.wheel_radius;
-  add({rear_end + 0.2, -0.5, ground + 2 * r - 0.3}, {cab_end - 0.2, 0.5, floor_top - kFloorSlab});
-  const double wheel_outer = W / 2 + t - 0.02;
-  for (double axle_x : {-L / 2 + 0.9, -L / 2 + 0.9 + 2.4 * r, cab_start + 0.5 * spec.cab_length}) {
-    for (double side : {-1.0, 1.0}) {
-      const double y_in = side * (wheel_outer - 0.45);
-      const double y_out = side * wheel_outer;
-      add({axle_x - r, std::min(y_in, y_out), ground},
-          {axle_x + r, std::max(y_in, y_out), ground + 2 * r});
-    }
   }
 
+  const double rear_end = -L / 2 - (spec.has_tailgate ? t : 0.0);
+  const double cab_end = L / 2 + t + spec.cab_gap + spec.cab_length;
   const double front = cab_end;
   const double back = rear_end;
   const Eigen::Vector3d mid = truth.T_world_bed * Eigen::Vector3d(0.5 * (front + back), 0, 0);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/app/truck_scan/truck_placement.h"
 #include "runtime/perception/truck/scanline.h"
 
 namespace autoshovel::perception::truck_sim {
@@ -44,28 +45,15 @@ struct SimScene {
 double CastRay(const SimScene& scene, const Eigen::Vector3d& origin,
                const Eigen::Vector3d& direction, double max_range);
 
-/// Body and chassis of a haul truck [m].
-struct TruckSpec {
-  std::string name;
-  double inner_length = 5.8;
-  double inner_width = 2.35;
-  double wall_height = 1.15;
-  double floor_height = 1.55;  ///< top of the floor above the ground
-  double wall_thickness = 0.07;
-  double headboard_rise = 0.3;  ///< above the rim
-  bool has_tailgate = true;
-  double cab_gap = 0.35;  ///< headboard to cab
-  double cab_length = 2.2;
-  double cab_width = 2.3;
-  double cab_height = 3.1;  ///< roof above the ground
-  double wheel_radius = 0.5;
-};
+/// Body and chassis of a haul truck [m]: the yard simulation's (runtime/app/truck_scan), so the
+/// recogniser's tests and the excavator's scans see the same trucks.
+using TruckSpec = app::TruckBody;
 
 /// Representative bodies (rounded, not one manufacturer's data): a 3-axle road tipper of about
 /// 15 t payload, a 4-axle tipper of about 20 t and a 38 t articulated hauler without tailgate.
-TruckSpec Tipper15t();
-TruckSpec Tipper20t();
-TruckSpec Hauler38t();
+inline TruckSpec Tipper15t() { return app::TruckBodyOf(app::TruckClass::kTipper15t); }
+inline TruckSpec Tipper20t() { return app::TruckBodyOf(app::TruckClass::kTipper20t); }
+inline TruckSpec Hauler38t() { return app::TruckBodyOf(app::TruckClass::kHauler38t); }
 
 /// What the recogniser should report for a truck placed in a scene.
 struct TruckTruth {

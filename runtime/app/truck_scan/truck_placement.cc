@@ -106,6 +106,47 @@ TruckBody TruckBodyOf(TruckClass truck_class) {
   return s;
 }
 
+std::vector<TruckBodyBox> TruckBodyBoxes(const TruckBody& body) {
+  const double L = body.inner_length;
+  const double W = body.inner_width;
+  const double H = body.wall_height;
+  const double t = body.wall_thickness;
+  std::vector<TruckBodyBox> boxes;
+  const auto add = [&](std::string part, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    boxes.push_back({std::move(part), lo, hi});
+  };
+  const double rear_end = -L / 2 - (body.has_tailgate ? t : 0.0);
+  const double floor_top = -H;
+  const double ground = -body.rim_height();
+  add("floor", {-L / 2, -W / 2, floor_top - kFloorSlab}, {L / 2, W / 2, floor_top});
+  add("left_side", {rear_end, W / 2, floor_top - kSkirt}, {L / 2 + t, W / 2 + t, 0});
+  add("right_side", {rear_end, -W / 2 - t, floor_top - kSkirt}, {L / 2 + t, -W / 2, 0});
+  add("headboard", {L / 2, -W / 2 - t, floor_top - kFloorSlab},
+      {L / 2 + t, W / 2 + t, body.headboard_rise});
+  if (body.has_tailgate) {
+    add("tailgate", {-L / 2 - t, -W / 2, floor_top - kFloorSlab}, {-L / 2, W / 2, 0});
+  }
+  const double cab_start = L / 2 + t + body.cab_gap;
+  const double cab_end = cab_start + body.cab_length;
+  add("cab", {cab_start, -body.cab_width / 2, ground + 0.9},
+      {cab_end, body.cab_width / 2, ground + body.cab_height});
+  const double wr = body.wheel_radius;
+  add("chassis", {rear_end + 0.2, -0.5, ground + 2 * wr - 0.3},
+      {cab_end - 0.2, 0.5, floor_top - kFloorSlab});
+  const double wheel_outer = W / 2 + t - 0.02;
+  int wheel = 0;
+  for (const double axle_x :
+       {-L / 2 + 0.9, -L / 2 + 0.9 + 2.4 * wr, cab_start + 0.5 * body.cab_length}) {
+    for (const double side : {-1.0, 1.0}) {
+      const double y_in = side * (wheel_outer - 0.45);
+      const double y_out = side * wheel_outer;
+      add("wheel_" + std::to_string(wheel++), {axle_x - wr, std::min(y_in, y_out), ground},
+          {axle_x + wr, std::max(y_in, y_out), ground + 2 * wr});
+    }
+  }
+  return boxes;
+}
+
 Eigen::Isometry3d TruckPlacement::T_world_bed_corner() const {
   Eigen::Isometry3d T_bed_corner = Eigen::Isometry3d::Identity();
   T_bed_corner.translation() = Eigen::Vector3d(-0.5 * inner_length, -0.5 * inner_width, 0.0);
@@ -135,7 +176,6 @@ TruckPlacement PlaceTruck(const TruckBody& body, const TruckPose& pose, plant::W
   const double L = body.inner_length;
   const double W = body.inner_width;
   const double H = body.wall_height;
-  const double t = body.wall_thickness;
 
   TruckPlacement placement;
   placement.body = body;
@@ -230,46 +270,15 @@ TruckPlacement PlaceTruck(const TruckBody& body, const TruckPose& pose, plant::W
     terrain.SetFloor(i % grid.nx, i / grid.nx, placement.rim_z);
   }
 
-  // --- Boxes, given by bed-frame corners (x along the bed, y left, z up from the rim). ---
-  const auto add = [&](const std::string& part, const Eigen::Vector3d& lo_bed,
-                       const Eigen::Vector3d& hi_bed) {
+  for (const TruckBodyBox& part : TruckBodyBoxes(body)) {
     plant::OrientedBox box;
-    box.name = options.name + "_" + part;
-    box.center = T_world_bed * (0.5 * (lo_bed + hi_bed));
-    box.half_extents = 0.5 * (hi_bed - lo_bed);
+    box.name = options.name + "_" + part.part;
+    box.center = T_world_bed * (0.5 * (part.lo_bed + part.hi_bed));
+    box.half_extents = 0.5 * (part.hi_bed - part.lo_bed);
     box.yaw = pose.yaw;
     box.semantic_class = core::SemanticClass::kOtherLoader;
     box.reflectivity = body.reflectivity;
     placement.boxes.push_back(box);
-  };
-  const double rear_end = -L / 2 - (body.has_tailgate ? t : 0.0);
-  const double floor_top = -H;
-  const double ground = -body.rim_height();
-  add("floor", {-L / 2, -W / 2, floor_top - kFloorSlab}, {L / 2, W / 2, floor_top});
-  add("left_side", {rear_end, W / 2, floor_top - kSkirt}, {L / 2 + t, W / 2 + t, 0});
-  add("right_side", {rear_end, -W / 2 - t, floor_top - kSkirt}, {L / 2 + t, -W / 2, 0});
-  add("headboard", {L / 2, -W / 2 - t, floor_top - kFloorSlab},
-      {L / 2 + t, W / 2 + t, body.headboard_rise});
-  if (body.has_tailgate) {
-    add("tailgate", {-L / 2 - t, -W / 2, floor_top - kFloorSlab}, {-L / 2, W / 2, 0});
-  }
-  const double cab_start = L / 2 + t + body.cab_gap;
-  const double cab_end = cab_start + body.cab_length;
-  add("cab", {cab_start, -body.cab_width / 2, ground + 0.9},
-      {cab_end, body.cab_width / 2, ground + body.cab_height});
-  const double wr = body.wheel_radius;
-  add("chassis", {rear_end + 0.2, -0.5, ground + 2 * wr - 0.3},
-      {cab_end - 0.2, 0.5, floor_top - kFloorSlab});
-  const double wheel_outer = W / 2 + t - 0.02;
-  int wheel = 0;
-  for (const double axle_x :
-       {-L / 2 + 0.9, -L / 2 + 0.9 + 2.4 * wr, cab_start + 0.5 * body.cab_length}) {
-    for (const double side : {-1.0, 1.0}) {
-      const double y_in = side * (wheel_outer - 0.45);
-      const double y_out = side * wheel_outer;
-      add("wheel_" + std::to_string(wheel++), {axle_x - wr, std::min(y_in, y_out), ground},
-          {axle_x + wr, std::max(y_in, y_out), ground + 2 * wr});
-    }
   }
   world->obstacles.insert(world->obstacles.end(), placement.boxes.begin(), placement.boxes.end());
   return placement;

@@ -67,6 +67,19 @@ struct TruckBody {
   double struck_volume() const { return inner_length * inner_width * wall_height; }
 };
 
+/// One solid part of a body, by its corners in the bed frame (origin at the centre of the
+/// opening on the rim plane, x along the bed towards the cab, y to its left, z up).
+struct TruckBodyBox {
+  std::string part;  ///< "floor", "left_side", …, "cab", "chassis", "wheel_0" …
+  Eigen::Vector3d lo_bed = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hi_bed = Eigen::Vector3d::Zero();
+};
+
+/// The body's parts: floor slab, side walls, headboard (cab guard), tailgate, cab, chassis
+/// rails, six wheels. The one geometry of a truck that PlaceTruck and the recognition tests'
+/// scenes build from.
+std::vector<TruckBodyBox> TruckBodyBoxes(const TruckBody& body);
+
 enum class TruckClass { kTipper15t, kTipper20t, kHauler38t };
 
 /// "15 t tipper", "20 t tipper", "38 t articulated hauler".

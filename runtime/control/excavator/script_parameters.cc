@@ -127,32 +127,24 @@ LoadingScript BuildLoadingScript(const ScriptParameters& p, const ScriptSettings
         {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
         p.swing_dig},
        {"stop and execute dig", {Near(J::kSwing, p.swing_dig, eps)}, p.swing_dig}}};
+  // The boom leaves the dig by rising to φ_clear (Fig. 14) or, when the dig left it above that
+  // carrying angle, by holding over the face while the swing leaves it and lowering on the way
+  // to the truck; both then hold while leaving the truck and lower to dig.
+  std::vector<ScriptRule> boom;
   if (std::isnan(p.swing_boom_lower)) {
-    scripts[JointIndex(J::kBoom)] = {
-        J::kBoom,
-        {{"raise", {}, p.boom_clear},
-         {"hold while leaving the truck",
-          {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
-          p.boom_clear},
-         {"lower to dig",
-          {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)},
-          p.boom_dig}}};
+    boom = {{"raise", {}, p.boom_clear}};
   } else {
-    // The dig left the boom above the carrying angle: hold it while the swing leaves the face,
-    // lower it on the way to the truck.
-    scripts[JointIndex(J::kBoom)] = {
-        J::kBoom,
-        {{"hold over the face", {}, p.boom_start},
-         {"lower to carry",
-          {Past(J::kSwing, p.swing_start, p.swing_dump, p.swing_boom_lower)},
-          p.boom_clear},
-         {"hold while leaving the truck",
-          {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
-          p.boom_clear},
-         {"lower to dig",
-          {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)},
-          p.boom_dig}}};
+    boom = {{"hold over the face", {}, p.boom_start},
+            {"lower to carry",
+             {Past(J::kSwing, p.swing_start, p.swing_dump, p.swing_boom_lower)},
+             p.boom_clear}};
   }
+  boom.push_back({"hold while leaving the truck",
+                  {Past(J::kBucket, p.bucket_carry, p.bucket_open, p.bucket_dumped)},
+                  p.boom_clear});
+  boom.push_back(
+      {"lower to dig", {Past(J::kSwing, p.swing_dump, p.swing_dig, p.swing_return)}, p.boom_dig});
+  scripts[JointIndex(J::kBoom)] = {J::kBoom, std::move(boom)};
   scripts[JointIndex(J::kStick)] = {
       J::kStick,
       {{"wait", {}, p.stick_start},

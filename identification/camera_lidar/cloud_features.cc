@@ -12,6 +12,7 @@
 #include <pcl/segmentation/sac_segmentation.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 namespace autoshovel::identification {
@@ -92,8 +93,41 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
       normal = refit.cast<float>();
       offset = static_cast<float>(-refit.dot(mean));
     }
+    std::vector<float> heights(n);
+    for (std::size_t i = 0; i < n; ++i) heights[i] = normal.dot(points[i]) + offset;
+    // The floor's own noise, robustly: σ = 1.4826 · median |h| over the points near the plane.
+    std::vector<float> near_plane;
+    for (const float h : heights) {
+      if (std::abs(h) < 0.5 * options.ground_threshold) near_plane.push_back(std::abs(h));
+    }
+    if (!near_plane.empty()) {
+      const auto middle = near_plane.begin() + static_cast<std::ptrdiff_t>(near_plane.size() / 2);
+      std::nth_element(near_plane.begin(), middle, near_plane.end());
+      features.ground_noise = 1.4826 * *middle;
+    }
+    // Average k neighbours so that ground_noise_sigmas · σ / √k fits in the ground band
+    // (header: an unsmoothed noisy floor splits asymmetrically; a smoothed noise-free one pulls
+    // the floor next to an object into it, so no more smoothing than the noise asks for).
+    const double ratio =
+        options.ground_noise_sigmas * features.ground_noise / options.ground_class_threshold;
+    features.ground_smoothing_neighbours =
+        static_cast<int>(std::clamp(std::ceil(ratio * ratio), 1.0,
+                                    static_cast<double>(options.max_ground_smoothing_neighbours)));
+    std::vector<float> smoothed = heights;
+    if (features.ground_smoothing_neighbours > 1) {
+      std::vector<int> neighbours;
+      std::vector<float> distances;
+      for (std::size_t i = 0; i < n; ++i) {
+        tree->nearestKSearch(static_cast<int>(i), features.ground_smoothing_neighbours, neighbours,
+                             distances);
+        if (neighbours.empty()) continue;
+        double sum = 0;
+        for (const int j : neighbours) sum += heights[static_cast<std::size_t>(j)];
+        smoothed[i] = static_cast<float>(sum / static_cast<double>(neighbours.size()));
+      }
+    }
     for (std::size_t i = 0; i < n; ++i) {
-      const float height = normal.dot(points[i]) + offset;
+      const float height = smoothed[i];
       if (std::abs(height) < options.ground_class_threshold) {
         is_ground[i] = 1;
         ++features.ground_points;

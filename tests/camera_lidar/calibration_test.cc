@@ -142,31 +142,34 @@ void ExpectRecovered(const Eigen::Vector3d& w, const Eigen::Vector3d& t, Lock lo
   const AutoCalibrationResult r = AutoCalibrate(s.frames, T0, options);
   const PoseError before = ComparePoses(T0, s.T_lidar_camera);
   const PoseError after = ComparePoses(r.T_lidar_camera, s.T_lidar_camera);
+  // The camera's position error in the LiDAR frame (x forward, z up on the simulated mount).
+  const Eigen::Vector3d error_lidar =
+      1e3 * (r.T_lidar_camera.translation() - s.T_lidar_camera.translation());
   std::printf(
-      "auto-calibration: %.2f deg %.1f mm -> %.3f deg %.1f mm, rho %.4f -> %.4f, "
-      "%d evaluations, %d runs, %.1f s\n",
+      "auto-calibration: %.2f deg %.1f mm -> %.3f deg %.1f mm (xyz %+.1f %+.1f %+.1f mm), "
+      "rho %.4f -> %.4f, %d evaluations, %d runs, %.1f s\n",
       before.rotation / kDeg, 1e3 * before.translation, after.rotation / kDeg,
-      1e3 * after.translation, r.initial.rho, r.final.rho, r.evaluations, r.runs, r.seconds);
+      1e3 * after.translation, error_lidar.x(), error_lidar.y(), error_lidar.z(), r.initial.rho,
+      r.final.rho, r.evaluations, r.runs, r.seconds);
   EXPECT_LT(after.rotation, max_rotation);
   EXPECT_LT(after.translation, max_translation);
   EXPECT_GE(r.final.rho, r.initial.rho);
 }
 
-// Issue 5 asks for 0.3° and 2 cm. The rotation meets it; the translation does NOT yet: with the
-// area lookup ρ is continuous and every start tried (six directions) reaches the same maximum,
-// but that maximum is 21–28 mm from the truth (z up ≈ 2 cm, x back ≈ 1 cm; the F_S, F_N and
-// F_R optima alone lie 4–10 cm away in different directions; docs/camera_lidar_calibration.md,
-// "Limits"). Measured here: 0.13°, 22.6 mm; the bound records that with a margin, not the 2 cm.
+// Issue 5: from 2° / 5 cm back to within 0.3° and 2 cm. Measured here: 0.141°, 10.1 mm (every
+// start of the Explore test below: 0.14–0.18°, 10–15 mm; before the floor's noise-adaptive
+// height smoothing, cloud_features.h, 22–28 mm).
 TEST(AutoCalibration, TwoDegreesFiveCentimetresRotationBackWithinSpec) {
   const Eigen::Vector3d axis = Eigen::Vector3d(1, -2, 1.5).normalized();
   const Eigen::Vector3d shift = Eigen::Vector3d(-1, 1, 0.5).normalized();
-  ExpectRecovered(2 * kDeg * axis, 0.05 * shift, Lock::kNone, 0.3 * kDeg, 0.03);
+  ExpectRecovered(2 * kDeg * axis, 0.05 * shift, Lock::kNone, 0.3 * kDeg, 0.02);
 }
 
-// Measured: 0.13°, 21.6 mm.
+// Issue 5: from 3° per axis back to within 0.5° (and the translation within 2 cm all the same).
+// Measured: 0.146°, 10.5 mm.
 TEST(AutoCalibration, ThreeDegreesPerAxisBackWithinHalfADegree) {
   ExpectRecovered(Eigen::Vector3d(3, -3, 3) * kDeg, Eigen::Vector3d::Zero(), Lock::kNone,
-                  0.5 * kDeg, 0.03);
+                  0.5 * kDeg, 0.02);
 }
 
 TEST(AutoCalibration, ThreeDegreesPerAxisTranslationLocked) {
@@ -197,7 +200,7 @@ TEST(AutoCalibration, LockedRotationKeepsIt) {
 }
 
 // Opt-in (AUTOSHOVEL_CALIBRATION_EXPLORE=1): other start directions than the tests', printed,
-// for docs/camera_lidar_calibration.md's table. The bounds are the 3° tests' (0.5°, 3 cm).
+// for docs/camera_lidar_calibration.md's table. The bounds are the 3° test's (0.5°, 2 cm).
 TEST(AutoCalibration, Explore) {
   if (std::getenv("AUTOSHOVEL_CALIBRATION_EXPLORE") == nullptr) GTEST_SKIP();
   const std::pair<Eigen::Vector3d, Eigen::Vector3d> twos[] = {{{1, -2, 1.5}, {-1, 1, 0.5}},
@@ -206,10 +209,10 @@ TEST(AutoCalibration, Explore) {
                                                               {{0, 1, 0.3}, {0, 0, 1}}};
   for (const auto& [a, b] : twos) {
     ExpectRecovered(2 * kDeg * a.normalized(), 0.05 * b.normalized(), Lock::kNone, 0.5 * kDeg,
-                    0.03);
+                    0.02);
   }
   for (const Eigen::Vector3d& w : {Eigen::Vector3d(3, -3, 3), Eigen::Vector3d(-3, 3, 3)}) {
-    ExpectRecovered(w * kDeg, Eigen::Vector3d::Zero(), Lock::kNone, 0.5 * kDeg, 0.03);
+    ExpectRecovered(w * kDeg, Eigen::Vector3d::Zero(), Lock::kNone, 0.5 * kDeg, 0.02);
   }
 }
 

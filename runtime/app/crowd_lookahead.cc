@@ -11,7 +11,8 @@
 
 namespace autoshovel::app {
 
-std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, double margin) {
+std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, double margin,
+                                               int growth_cells) {
   const Eigen::MatrixXf& cls = map["class"];
   const Eigen::MatrixXf& obstacle_confidence = map["obstacle_confidence"];
   const Eigen::MatrixXf& pile_confidence = map["pile_confidence"];
@@ -31,8 +32,8 @@ std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, d
   for (int iy = 0; iy < ny; ++iy) {
     for (int ix = 0; ix < nx; ++ix) {
       bool take = sure(ix, iy);
-      for (int dy = -2; dy <= 2 && !take && confident(ix, iy); ++dy) {
-        for (int dx = -2; dx <= 2 && !take; ++dx) {
+      for (int dy = -growth_cells; dy <= growth_cells && !take && confident(ix, iy); ++dy) {
+        for (int dx = -growth_cells; dx <= growth_cells && !take; ++dx) {
           const int jx = ix + dx, jy = iy + dy;
           take = jx >= 0 && jy >= 0 && jx < nx && jy < ny && sure(jx, jy);
         }

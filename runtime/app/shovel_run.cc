@@ -134,6 +134,11 @@ ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<
                                 "' is not a wheel loader");
   }
   if (options.cycles < 1) throw std::invalid_argument("autoshovel run: --cycles must be >= 1");
+  if (options.sure_obstacle_growth_cells < 0 || options.sure_obstacle_growth_cells > 10) {
+    throw std::invalid_argument(
+        "autoshovel run: sure_obstacle_growth_cells must be in [0, 10], got " +
+        std::to_string(options.sure_obstacle_growth_cells));
+  }
   const double rates[] = {options.map_rate, options.decision_rate, options.control_rate};
   for (double r : rates) {
     if (!(r > 0) || !std::isfinite(r)) throw std::invalid_argument("autoshovel run: bad rate");
@@ -237,6 +242,8 @@ std::string ShovelJob::ConfigYaml() const {
     << "safety_distance_m: " << o.safety_distance << "\n"
     << "d_res_m: " << o.d_res << "\n"
     << "planning_margin_m: " << o.planning_margin << "\n"
+    << "clear_obstacle_margin: " << o.clear_obstacle_margin << "\n"
+    << "sure_obstacle_growth_cells: " << o.sure_obstacle_growth_cells << "\n"
     << "handover_distance_m: " << o.handover_distance << "\n"
     << "max_cycle_time_s: " << o.max_cycle_time << "\n"
     << "rates_hz: {control: " << o.control_rate << ", decisions: " << o.decision_rate
@@ -555,7 +562,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         trigger = std::make_unique<control::BoomPressureTrigger>(o.pressure_threshold);
       }
       pre_contact = HeightGridOf(st.map->map());
-      sure_obstacles = SureObstacleCells(st.map->map(), o.clear_obstacle_margin);
+      sure_obstacles =
+          SureObstacleCells(st.map->map(), o.clear_obstacle_margin, o.sure_obstacle_growth_cells);
       obstacle_resolution = st.map->map().resolution();
       scoop =
           std::make_unique<control::ScoopCycle>(machine, *st.setup.functions, pre_contact,

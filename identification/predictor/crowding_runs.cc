@@ -170,6 +170,7 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
         if (v1 >= spec.trigger_volume || stalled || t - contact_time > options.max_crowd_time) {
           triggered = true;
           trigger_time = t;
+          run.trigger_cause = v1 >= spec.trigger_volume ? "volume" : stalled ? "stall" : "time_out";
           const Eigen::Vector3d tip = run.past_path.back();
           run.features.speed = s.speed;
           run.features.shoveled_volume = v1;

@@ -67,6 +67,7 @@ struct CrowdingRun {
   prediction::PenetrationFeatures features;  ///< at the trigger
   double penetration = 0;                    ///< travel from trigger to stop [m] (the target)
   double contact_to_trigger = 0;             ///< travel from first contact to the trigger [m]
+  std::string trigger_cause;                 ///< volume (V1 reached the spec's), stall or time_out
   double payload = 0;             ///< bucket volume at the end of the run [m³] (plant truth)
   double payload_at_trigger = 0;  ///< [m³]
   prediction::HeightGrid map;     ///< pre-contact heights around the path (cropped)

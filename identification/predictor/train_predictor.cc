@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -90,21 +91,6 @@ int main(int argc, char** argv) {
       train.y.push_back(run.penetration);
       train_runs.push_back(&run);
     }
-    if (!samples_csv.empty()) {
-      std::ofstream csv(samples_csv);
-      csv << "run,set,shape,material,height,v0,trigger_volume,speed,V1,h1,h2,h3,h4,h5,h6,"
-             "penetration,payload\n";
-      for (const predictor::CrowdingRun& run : all) {
-        if (!run.ok) continue;
-        csv << run.spec.index << "," << (run.spec.index % 5 == 4 ? "test" : "train") << ","
-            << run.spec.shape << "," << run.spec.material << "," << run.spec.height << ","
-            << run.spec.approach_speed << "," << run.spec.trigger_volume << ","
-            << run.features.speed << "," << run.features.shoveled_volume;
-        for (double h : run.features.heights) csv << "," << h;
-        csv << "," << run.penetration << "," << run.payload << "\n";
-      }
-    }
-
     prediction::FeatureScaling scaling;
     scaling.machine = machine.name;
     scaling.materials = materials;
@@ -122,6 +108,25 @@ int main(int argc, char** argv) {
     const double training_time = elapsed() - generation_time;
 
     const prediction::PenetrationPredictor model = prediction::PenetrationPredictor::Load(out);
+    if (!samples_csv.empty()) {
+      // Every completed run with the final model's prediction beside its target, so the error
+      // tail can be read by cause (test set: runs i mod 5 = 4).
+      std::ofstream csv(samples_csv);
+      csv << "run,set,shape,material,height,v0,trigger_volume,trigger_cause,speed,V1,h1,h2,h3,h4,"
+             "h5,h6,penetration,predicted_penetration,payload\n";
+      for (const predictor::CrowdingRun& run : all) {
+        if (!run.ok) continue;
+        csv << run.spec.index << "," << (run.spec.index % 5 == 4 ? "test" : "train") << ","
+            << run.spec.shape << "," << run.spec.material << "," << run.spec.height << ","
+            << run.spec.approach_speed << "," << run.spec.trigger_volume << "," << run.trigger_cause
+            << "," << run.features.speed << "," << run.features.shoveled_volume;
+        for (double h : run.features.heights) csv << "," << h;
+        const prediction::PenetrationPrediction predicted = model.Predict(run.features);
+        csv << "," << run.penetration << ","
+            << (predicted.ok ? predicted.penetration : std::nan("")) << "," << run.payload << "\n";
+      }
+      if (!csv) throw std::runtime_error("cannot write " + samples_csv);
+    }
     double capacity = 0;  // what the bucket holds full and racked back (evaluation.h)
     for (const predictor::CrowdingRun* run : train_runs)
       capacity = std::max(capacity, run->payload);

@@ -290,6 +290,11 @@ int main(int argc, char** argv) {
                    "Never closer to an obstacle (footprint with 0.3 m margins) [m]")
       ->capture_default_str();
   run_cmd->add_option("--d-res", run.d_res, "d_res of Eq. (14) [m]")->capture_default_str();
+  run_cmd
+      ->add_option("--sure-obstacle-growth", run.sure_obstacle_growth_cells,
+                   "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
+      ->check(CLI::Range(0, 10))
+      ->capture_default_str();
   bool run_no_figures = false;
   run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
   autoshovel::app::TruckLoadingOptions truck_loading;

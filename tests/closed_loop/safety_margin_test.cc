@@ -3,10 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "runtime/app/crowd_lookahead.h"
+#include "runtime/perception/semantic_map.h"
 
 namespace autoshovel::app {
 namespace {
@@ -57,6 +59,44 @@ TEST(CrowdLookahead, DistanceAheadCountsOnlyTheCorridorAhead) {
   EXPECT_NEAR(DistanceAhead(cells, {0, 0}, 0.0, 2.0, 6.0, 0.3), 3.85, 1e-12);
   // Heading north, the same cells are all outside the corridor or behind.
   EXPECT_TRUE(std::isinf(DistanceAhead(cells, {0, 0}, std::numbers::pi / 2, 0.4, 6.0, 0.3)));
+}
+
+// A wall's row of sure cells (obstacle 1.0, pile 0.1) with, in front of it, the blurred crest:
+// a row of confident obstacle cells that carry pile evidence too (obstacle 0.97, pile 0.8), and a
+// pile top seen obliquely (obstacle 0.7). Growth takes the confident cells within `growth`
+// cells of a sure one, never the oblique top.
+TEST(CrowdLookahead, SureObstacleCellsGrowByTheGivenCellsOnly) {
+  perception::GridMap map(0.3, Eigen::Vector2d(3.0, 3.0), Eigen::Vector2d(0, 0));  // 10 × 10
+  map.Add("class", static_cast<float>(perception::CellClass::kGround));
+  map.Add("obstacle_confidence", 0.0f);
+  map.Add("pile_confidence", 0.0f);
+  auto set = [&](int ix, float obstacle, float pile) {
+    for (int iy = 0; iy < 10; ++iy) {
+      const perception::Index i(ix, iy);
+      map.at("class", i) = static_cast<float>(perception::CellClass::kObstacle);
+      map.at("obstacle_confidence", i) = obstacle;
+      map.at("pile_confidence", i) = pile;
+    }
+  };
+  set(9, 1.0f, 0.1f);   // the wall: sure
+  set(8, 0.97f, 0.8f);  // the crest against it: confident, not sure (0.97 − 0.8 < 0.5)
+  set(7, 0.97f, 0.8f);
+  set(6, 0.7f, 0.6f);  // an obliquely seen top: not even confident
+  auto columns = [&](int growth) {
+    std::vector<int> xs;
+    for (const Eigen::Vector2d& p : SureObstacleCells(map, 0.5, growth)) {
+      perception::Index i;
+      EXPECT_TRUE(map.IndexOf(p, i));
+      if (std::find(xs.begin(), xs.end(), i.x()) == xs.end()) xs.push_back(i.x());
+    }
+    std::sort(xs.begin(), xs.end());
+    return xs;
+  };
+  EXPECT_EQ(columns(0), std::vector<int>({9}));
+  EXPECT_EQ(columns(1), std::vector<int>({8, 9}));
+  EXPECT_EQ(columns(2), std::vector<int>({7, 8, 9}));
+  EXPECT_EQ(columns(5), std::vector<int>({7, 8, 9}));
+  EXPECT_EQ(SureObstacleCells(map, 0.5, 1).size(), 20u);
 }
 
 }  // namespace

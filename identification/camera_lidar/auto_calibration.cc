@@ -74,6 +74,8 @@ ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& ma
   frame.normals = features.normals;
   frame.segment = features.segment;
   frame.num_segments = features.num_segments;
+  frame.ground_noise = features.ground_noise;
+  frame.ground_smoothing_neighbours = features.ground_smoothing_neighbours;
   return frame;
 }
 

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
@@ -356,6 +357,23 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
         << frames.size() << " frames, masks: " << loaded.front().mask_source
         << (loaded.size() > 1 ? ", ..." : "") << "\n";
     out << "  start: " << start << "\n";
+    {
+      // The floor's noise decides how the ground class is made (cloud_features.h); a user with
+      // a noisy or a very clean LiDAR sees it here.
+      double noise_lo = INFINITY, noise_hi = 0;
+      int k_lo = std::numeric_limits<int>::max(), k_hi = 0;
+      for (const ScoreFrame& f : score_frames) {
+        noise_lo = std::min(noise_lo, f.ground_noise),
+        noise_hi = std::max(noise_hi, f.ground_noise);
+        k_lo = std::min(k_lo, f.ground_smoothing_neighbours);
+        k_hi = std::max(k_hi, f.ground_smoothing_neighbours);
+      }
+      std::snprintf(line, sizeof line,
+                    "  floor noise sigma %.1f-%.1f mm: ground class on heights averaged over "
+                    "%d-%d neighbours\n",
+                    1e3 * noise_lo, 1e3 * noise_hi, k_lo, k_hi);
+      out << line;
+    }
     out << "  T_lidar_camera start " << PoseText(T0) << "\n";
     out << "  T_lidar_camera final " << PoseText(result.T_lidar_camera) << "\n";
     std::snprintf(line, sizeof line,

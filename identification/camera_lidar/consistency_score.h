@@ -86,7 +86,9 @@ struct ScoreFrame {
   std::vector<Eigen::Vector3f> normals;  ///< unit, LiDAR frame
   std::vector<int> segment;              ///< class per point, in [0, num_segments)
   int num_segments = 2;
-  double reflectivity_variance = 1;  ///< over the whole cloud
+  double reflectivity_variance = 1;     ///< over the whole cloud
+  double ground_noise = 0;              ///< floor height σ the classes were made with [m]
+  int ground_smoothing_neighbours = 1;  ///< k of the ground smoothing (cloud_features.h) [-]
   /// Per mask: no LiDAR support (MarkUnsupportedMasks); empty: none flagged.
   std::vector<char> unsupported;
 };

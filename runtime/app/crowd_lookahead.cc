@@ -60,13 +60,19 @@ double ScoopReach(const model::MachineDescription& machine, double q_boom, doubl
 }
 
 double DistanceAhead(const std::vector<Eigen::Vector2d>& cells, const Eigen::Vector2d& hinge_xy,
-                     double heading, double half_width, double front_length, double cell_size) {
+                     double heading, double half_width, double front_length, double cell_size,
+                     int* nearest) {
   const Eigen::Vector2d u(std::cos(heading), std::sin(heading)), lateral(-u.y(), u.x());
   double ahead = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector2d& p : cells) {
-    const Eigen::Vector2d d = p - hinge_xy;
+  if (nearest != nullptr) *nearest = -1;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const Eigen::Vector2d d = cells[k] - hinge_xy;
     if (d.dot(u) <= 0 || std::abs(d.dot(lateral)) > half_width) continue;
-    ahead = std::min(ahead, d.dot(u) - front_length - 0.5 * cell_size);
+    const double distance = d.dot(u) - front_length - 0.5 * cell_size;
+    if (distance < ahead) {
+      ahead = distance;
+      if (nearest != nullptr) *nearest = static_cast<int>(k);
+    }
   }
   return ahead;
 }

@@ -30,8 +30,10 @@ double ScoopReach(const model::MachineDescription& machine, double q_boom, doubl
 
 /// Distance from the front edge (`front_length` ahead of the hinge along `heading`) to the
 /// nearest of `cells` in the corridor of ±`half_width` ahead, less half a cell (the cells are
-/// centres) [m]; +inf when none is ahead.
+/// centres) [m]; +inf when none is ahead. `nearest`, if given, receives the index in `cells` of
+/// that nearest cell (−1 when none).
 double DistanceAhead(const std::vector<Eigen::Vector2d>& cells, const Eigen::Vector2d& hinge_xy,
-                     double heading, double half_width, double front_length, double cell_size);
+                     double heading, double half_width, double front_length, double cell_size,
+                     int* nearest = nullptr);
 
 }  // namespace autoshovel::app

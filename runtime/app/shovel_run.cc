@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <ostream>
@@ -97,6 +98,29 @@ bool InsideBin(const plant::Bin& bin, const Eigen::Vector2d& p) {
 std::string Fixed(double value, int digits) {
   char text[64];
   std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
+// What the look-ahead stopped for, for the log: the map's view of the nearest sure obstacle cell
+// and, from the simulation's truth, how far that cell lies from the nearest real obstacle (the
+// map's blur at a wall; docs/main_job.md).
+std::string SureCellReport(const perception::GridMap& map, const Eigen::Vector2d& cell,
+                           const std::vector<plant::OrientedBox>& obstacles) {
+  perception::Index index;
+  if (!map.IndexOf(cell, index)) return "nearest sure cell off the map";
+  std::string text = "nearest sure cell (" + Fixed(cell.x(), 2) + ", " + Fixed(cell.y(), 2) +
+                     "): height " + Fixed(map.at("elevation", index), 2) + " m, obstacle " +
+                     Fixed(map.at("obstacle_confidence", index), 2) + ", pile " +
+                     Fixed(map.at("pile_confidence", index), 2);
+  double truth = std::numeric_limits<double>::infinity();
+  const plant::OrientedBox* nearest = nullptr;
+  for (const plant::OrientedBox& box : obstacles) {
+    const double d = QuadDistance(Quad{cell, cell, cell, cell}, BoxQuad(box));
+    if (d < truth) truth = d, nearest = &box;
+  }
+  if (nearest != nullptr) {
+    text += "; simulation truth: " + Fixed(truth, 2) + " m from " + nearest->name;
+  }
   return text;
 }
 
@@ -517,8 +541,9 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       sweep.front_length =
           std::max(footprint.front_length,
                    ScoopReach(machine, s.q[0], s.q[1], scoop_options.strategy) + 0.3);
+      int nearest = -1;
       const double ahead = DistanceAhead(sure_obstacles, s.hinge_xy, s.heading, sweep.half_width,
-                                         sweep.front_length, obstacle_resolution);
+                                         sweep.front_length, obstacle_resolution, &nearest);
       // Stopping takes the decision latency (one 20 Hz period) plus v² / 2 a_dec of the speed
       // profile; in a pile the resistance shortens it, on the floor it does not.
       const double v = std::max(0.0, s.speed);
@@ -530,7 +555,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         stop_requested = true;
         say("obstacle " + Fixed(ahead, 2) + " m ahead on the map (scoop " + scoop_phase +
             ", sweep reach " + Fixed(sweep.front_length, 2) + " m, stopping " + Fixed(stopping, 2) +
-            " m): crowding ends");
+            " m): crowding ends; " +
+            SureCellReport(st.map->map(), sure_obstacles[nearest], scenario.world.obstacles));
       }
     }
     if (stage == Stage::kNavigate && remaining <= o.handover_distance) {

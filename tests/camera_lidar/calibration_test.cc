@@ -30,6 +30,24 @@ struct SimulatedData {
   std::vector<ScoreFrame> frames;
 };
 
+// The ground-class settings (cloud_features.h), overridable from the environment so that the
+// variants docs/camera_lidar_calibration.md compares ("Limits" 10) can be rerun with the Explore
+// and noise-free tests: AUTOSHOVEL_CALIBRATION_GROUND_SIGMAS, _GROUND_MAX_K and _GROUND_BAND
+// (the ground band's half-width, also the no-class band's top) [m].
+CloudFeatureOptions GroundOptionsFromEnvironment() {
+  CloudFeatureOptions options;
+  if (const char* v = std::getenv("AUTOSHOVEL_CALIBRATION_GROUND_SIGMAS")) {
+    options.ground_noise_sigmas = std::atof(v);
+  }
+  if (const char* v = std::getenv("AUTOSHOVEL_CALIBRATION_GROUND_MAX_K")) {
+    options.max_ground_smoothing_neighbours = std::atoi(v);
+  }
+  if (const char* v = std::getenv("AUTOSHOVEL_CALIBRATION_GROUND_BAND")) {
+    options.ground_class_threshold = options.object_min_height = std::atof(v);
+  }
+  return options;
+}
+
 SimulatedData Simulate(double range_noise) {
   SimulatedData s;
   const std::string models = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
@@ -44,7 +62,8 @@ SimulatedData Simulate(double range_noise) {
   s.up_lidar = T_base_lidar.linear().transpose() * Eigen::Vector3d::UnitZ();
   const CameraIntrinsics intrinsics = IntrinsicsFromDescription(s.machine.sensors.camera);
   for (const YardFrame& f : SimulateYardFrames(s.machine, s.lidar, s.T_lidar_camera, models)) {
-    s.frames.push_back(PrepareScoreFrame(f.cloud, f.masks, intrinsics, s.up_lidar, 40000));
+    s.frames.push_back(PrepareScoreFrame(f.cloud, f.masks, intrinsics, s.up_lidar, 40000,
+                                         GroundOptionsFromEnvironment()));
   }
   return s;
 }

@@ -363,7 +363,7 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
       double noise_lo = INFINITY, noise_hi = 0;
       int k_lo = std::numeric_limits<int>::max(), k_hi = 0;
       for (const ScoreFrame& f : score_frames) {
-        noise_lo = std::min(noise_lo, f.ground_noise),
+        noise_lo = std::min(noise_lo, f.ground_noise);
         noise_hi = std::max(noise_hi, f.ground_noise);
         k_lo = std::min(k_lo, f.ground_smoothing_neighbours);
         k_hi = std::max(k_hi, f.ground_smoothing_neighbours);

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <numbers>
 #include <optional>
 #include <ostream>
@@ -112,14 +111,13 @@ std::string SureCellReport(const perception::GridMap& map, const Eigen::Vector2d
                      "): height " + Fixed(map.at("elevation", index), 2) + " m, obstacle " +
                      Fixed(map.at("obstacle_confidence", index), 2) + ", pile " +
                      Fixed(map.at("pile_confidence", index), 2);
-  double truth = std::numeric_limits<double>::infinity();
-  const plant::OrientedBox* nearest = nullptr;
-  for (const plant::OrientedBox& box : obstacles) {
-    const double d = QuadDistance(Quad{cell, cell, cell, cell}, BoxQuad(box));
-    if (d < truth) truth = d, nearest = &box;
-  }
-  if (nearest != nullptr) {
-    text += "; simulation truth: " + Fixed(truth, 2) + " m from " + nearest->name;
+  // A footprint shrunk to the cell's centre: FootprintClearance gives the nearest box.
+  perception::MachineFootprint point;
+  point.hinge_xy = cell;
+  const Clearance truth = FootprintClearance(point, obstacles);
+  if (truth.obstacle >= 0) {
+    text += "; simulation truth: " + Fixed(truth.distance, 2) + " m from " +
+            obstacles[static_cast<std::size_t>(truth.obstacle)].name;
   }
   return text;
 }

@@ -170,9 +170,12 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
     const float near = nearest[(pv / kBlock) * bw + pu / kBlock];
     if (hit.depth > near + config_.occlusion_tolerance + 0.03f * near) continue;
     // The cell covers a few pixels: the confidences are their mean, except that a machine,
-    // person or wall anywhere in the cell's image footprint counts in full, so that a cell on
-    // such an obstacle's silhouette is an obstacle (the seed's safety rule of Eq. 11 applied to
-    // the whole footprint). "Other" (debris, and the sky above a pile's crest) is averaged.
+    // person or wall in the footprint's rows at or below the cell's own centre row counts in
+    // full, so that a cell on such an obstacle's silhouette is an obstacle (the seed's safety
+    // rule of Eq. 11 applied to the footprint). The rows above the centre show what stands
+    // behind the cell: a wall seen over a pile's surface is averaged, not handed to the pile in
+    // front of it (docs/main_job.md: that put the look-ahead's sure cells 1.15 m before a bin's
+    // back wall, 2.5 m up its 3 m face). "Other" (debris, the sky over a crest) is averaged.
     const int radius = std::clamp(
         static_cast<int>(camera.fx * sx * 0.5 * map_.map().resolution() / hit.depth), 1, 4);
     // Rows: the square of the cell's width, widened to the rows its surface covers (at most
@@ -198,7 +201,7 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
         const Confidences p = Collapse(probabilities, v * w + u);
         if (std::isnan(p.ground)) continue;
         c.ground += p.ground, c.pile += p.pile, c.obstacle += p.obstacle;
-        hard_max = std::max(hard_max, p.hard);
+        if (v >= pv) hard_max = std::max(hard_max, p.hard);
         ++samples;
       }
     }

@@ -12,6 +12,7 @@
 #include "identification/calibration/calibrate_arm_command.h"
 #include "identification/camera_lidar/calibrate_camera_lidar_command.h"
 #include "identification/hydraulics/identify_hydraulics_command.h"
+#include "identification/weights/train_weights_command.h"
 #include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
@@ -226,6 +227,28 @@ int main(int argc, char** argv) {
   hydraulics_cmd->add_option("--seed", hydraulics.seed, "Seed of --simulate")
       ->capture_default_str();
 
+  autoshovel::identification::TrainWeightsOptions train_weights;
+  CLI::App* train_cmd = app.add_subcommand("train", "Fit learned parts of the system to data");
+  train_cmd->require_subcommand(1);
+  CLI::App* weights_cmd = train_cmd->add_subcommand(
+      "weights", "Tune the Eq. (18) shovel-point weights by CMA-ES on expert demonstrations");
+  weights_cmd->add_option("--machine", train_weights.machine, "Wheel loader name or description")
+      ->capture_default_str();
+  weights_cmd->add_option("--demos", train_weights.demos, "Demonstrations database (SQLite)")
+      ->capture_default_str();
+  weights_cmd->add_option("--generate", train_weights.generate,
+                          "First write this many simulated expert demonstrations to --demos "
+                          "(the seed used 482)");
+  weights_cmd->add_option("--seed", train_weights.seed, "Seed of the scenes and of CMA-ES")
+      ->capture_default_str();
+  weights_cmd
+      ->add_option("-o,--out", train_weights.out, "Weights YAML to write (never overwritten)")
+      ->capture_default_str();
+  weights_cmd->add_option("--evaluations", train_weights.evaluations, "CMA-ES budget")
+      ->capture_default_str();
+  weights_cmd->add_option("--threads", train_weights.threads, "Worker threads (0: every core)")
+      ->capture_default_str();
+
   autoshovel::planning::SelectOptions select;
   CLI::App* select_cmd = app.add_subcommand(
       "select", "Shovel point selection (Algorithm 2) on a yard: ranked candidates and a PNG");
@@ -295,6 +318,8 @@ int main(int argc, char** argv) {
                    "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
       ->check(CLI::Range(0, 10))
       ->capture_default_str();
+  run_cmd->add_option("--shovel-weights", run.shovel_weights,
+                      "Eq. (18) weights YAML from `autoshovel train weights` (default: Table 1)");
   bool run_no_figures = false;
   run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
   autoshovel::app::TruckLoadingOptions truck_loading;
@@ -386,6 +411,10 @@ int main(int argc, char** argv) {
       return 2;
     }
     return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
+  }
+  if (*weights_cmd) {
+    train_weights.models_dir = models_dir;
+    return autoshovel::identification::RunTrainWeights(train_weights, std::cout, std::cerr);
   }
   if (*select_cmd) {
     select.models_dir = models_dir;

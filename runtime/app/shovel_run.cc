@@ -28,6 +28,7 @@
 #include "runtime/planning/candidate_render.h"
 #include "runtime/planning/chen2024_baseline.h"
 #include "runtime/planning/shovel_point_selection.h"
+#include "runtime/planning/shovel_weights_file.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
@@ -136,6 +137,7 @@ struct ShovelJob::State {
   std::unique_ptr<perception::SemanticMap> semantic;
   sensors::Rng rng;
   std::string segmenter;
+  planning::ShovelPointConfig selection;  ///< Eq. (18) weights: Table 1 or --shovel-weights
   double cycle_clock = 0;  ///< each cycle's plant starts where the last one ended [s]
   int next_site = 0;
 
@@ -144,7 +146,9 @@ struct ShovelJob::State {
         setup(plant::LoadScenarioWithMachine(o.scenario, o.models_dir, o.machine)),
         predictor(prediction::PenetrationPredictor::Load(
             o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor)),
-        rng(o.seed) {}
+        rng(o.seed) {
+    if (!o.shovel_weights.empty()) planning::ReadShovelWeights(o.shovel_weights, selection);
+  }
 };
 
 ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<State>(options)) {
@@ -256,6 +260,10 @@ std::string ShovelJob::ConfigYaml() const {
     << "predictor: "
     << (o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor) << "\n"
     << "selection: " << ToString(o.selection) << "\n"
+    << "shovel_weights: {k_t: " << state_->selection.k_t << ", k_s: " << state_->selection.k_s
+    << ", k_c: " << state_->selection.k_c << ", k_e: " << state_->selection.k_e
+    << ", k_a: " << state_->selection.k_a << "}"
+    << (o.shovel_weights.empty() ? "  # Table 1" : "  # from " + o.shovel_weights) << "\n"
     << "trigger: " << ToString(o.trigger) << "\n"
     << "policy: " << control::ToString(o.policy) << "\n"
     << "pressure_threshold_bar: " << o.pressure_threshold / 1e5 << "\n"
@@ -342,7 +350,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   perceive.truth_labels = o.truth_labels;
   perceive.segmenter = st.segmenter;
 
-  planning::ShovelPointConfig select_config;
+  planning::ShovelPointConfig select_config = st.selection;
   // Eq. (14) scores clearance but, as the seed writes it, only penalises a path that comes
   // closer than d_res (s_s = d_min / d_res). The run holds every cycle to the safety distance,
   // so our selection takes the best candidate whose planned clearance is at least the safety

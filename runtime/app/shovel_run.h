@@ -61,10 +61,12 @@ struct ShovelRunOptions {
   /// pile confidence by this much [-].
   double clear_obstacle_margin = 0.5;
   /// ... plus the confident obstacle cells within this many cells of those (crowd_lookahead.h).
-  /// 1, measured (docs/main_job.md): 0 let the footprint come 0.33 m from the wall on
-  /// pile_against_wall (seeds 2, 3); 2 kept every yard at least as far from its obstacles as 1
-  /// but stopped sand in the mixing station's bin_4 1.8 m short of its back wall [cells].
+  /// 1, measured (docs/main_job.md): with the old Eq. (5) projection 0 let the footprint come
+  /// 0.33 m from the wall on pile_against_wall (seeds 2, 3); since the rows rule 0, 1 and 2 are
+  /// equally safe in the yards, and 1 keeps a cell of margin for a map a frame late [cells].
   int sure_obstacle_growth_cells = 1;
+  /// Eq. (18) weights from this YAML file (`autoshovel train weights`); empty: Table 1's.
+  std::string shovel_weights;
   double curvature_reserve = 0.9;  ///< paths are planned at most at this fraction of κmax
   double handover_distance = 2.0;  ///< path left when the scoop cycle takes over [m]
   double max_cycle_time = 120.0;   ///< a cycle running longer is aborted [s]

@@ -13,6 +13,7 @@
 #include "identification/camera_lidar/calibrate_camera_lidar_command.h"
 #include "identification/hydraulics/identify_hydraulics_command.h"
 #include "identification/weights/train_weights_command.h"
+#include "runtime/app/campaign/campaign_command.h"
 #include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
@@ -249,6 +250,21 @@ int main(int argc, char** argv) {
   weights_cmd->add_option("--threads", train_weights.threads, "Worker threads (0: every core)")
       ->capture_default_str();
 
+  autoshovel::app::CampaignOptions campaign;
+  std::string campaign_out;
+  CLI::App* campaign_cmd = app.add_subcommand(
+      "campaign",
+      "Run a production campaign (weeks of shifts x policies) over every core, or over MPI "
+      "ranks under mpirun; resumable");
+  campaign_cmd->add_option("spec", campaign.spec, "Campaign YAML (docs/campaigns.md)")->required();
+  campaign_cmd->add_option("-o,--out", campaign_out, "Campaign folder (default: runs/campaign_<name>)");
+  campaign_cmd->add_option("--workers", campaign.workers, "Worker processes (0: every core)")
+      ->capture_default_str();
+  campaign_cmd->add_flag("--resume", campaign.resume,
+                         "Continue the campaign in the folder: merge, then run what is missing");
+  campaign_cmd->add_option("--worker-index", campaign.worker_index)->group("");
+  campaign_cmd->add_option("--worker-count", campaign.worker_count)->group("");
+
   autoshovel::planning::SelectOptions select;
   CLI::App* select_cmd = app.add_subcommand(
       "select", "Shovel point selection (Algorithm 2) on a yard: ranked candidates and a PNG");
@@ -411,6 +427,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
+  }
+  if (*campaign_cmd) {
+    campaign.models_dir = models_dir;
+    campaign.out_dir = campaign_out;
+    return autoshovel::app::RunCampaign(campaign, std::cout, std::cerr);
   }
   if (*weights_cmd) {
     train_weights.models_dir = models_dir;

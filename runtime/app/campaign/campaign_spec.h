@@ -1,0 +1,63 @@
+// A production campaign (issue 8; wheel-loader seed §7.5, Tables 6–7): weeks of a yard's work,
+// shift after shift, each shift once per scooping policy so that the policies meet the same
+// piles. Read strictly from YAML; every problem is reported as `file:line:column: key: what`.
+//
+//   name: mixing_station_production   # names the runs: <name>/w01s03/<policy>
+//   scenario: mixing_station          # yard (models/scenarios) and its machine
+//   machine: xcmg_968ev               # optional: another wheel loader
+//   seed: 1                           # each shift's seed derives from it
+//   weeks: 4
+//   shifts_per_week: 21
+//   cycles_per_shift: 12              # the yard persists across a shift's cycles (piles dug);
+//                                     # each shift starts from the scenario's yard (restocked)
+//   policies: [auto, stairway_fixed]  # auto | just_in_out | stairway | stairway_fixed
+//   stairway_steps: 3                 # N of "Stairway #N" (stairway_fixed)
+//   trigger: predicted                # predicted | perception | pressure
+//   truth_labels: true                # simulator labels instead of the network (faster)
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "runtime/control/scoop_cycle.h"
+
+namespace autoshovel::app {
+
+struct CampaignSpec {
+  std::string source_file;
+  std::string name;
+  std::string scenario;
+  std::string machine;  ///< empty: the scenario's
+  std::uint64_t seed = 1;
+  int weeks = 1;
+  int shifts_per_week = 1;
+  int cycles_per_shift = 1;
+  std::vector<std::string> policies;  ///< as written: auto, just_in_out, stairway, stairway_fixed
+  int stairway_steps = 3;
+  std::string trigger = "predicted";
+  bool truth_labels = true;
+
+  int shifts() const { return weeks * shifts_per_week; }
+  int jobs() const { return shifts() * static_cast<int>(policies.size()); }
+  long long cycles() const { return static_cast<long long>(jobs()) * cycles_per_shift; }
+};
+
+/// Reads and validates a campaign file. Throws core::InputError with every problem found.
+CampaignSpec LoadCampaignSpec(const std::string& path);
+
+control::ScoopPolicy ParseScoopPolicy(const std::string& name);
+
+/// One unit of work: a shift under one policy, `cycles_per_shift` cycles in one yard.
+struct CampaignJob {
+  int index = 0;  ///< 0 … jobs − 1, shift-major
+  int week = 0;   ///< 1-based
+  int shift = 0;  ///< 1-based within the week
+  std::string policy;
+  std::string run_id;   ///< <name>/wWWsSS/<policy>
+  std::uint64_t seed = 0;  ///< the shift's seed: the same for every policy of the shift
+};
+
+std::vector<CampaignJob> CampaignJobs(const CampaignSpec& spec);
+
+}  // namespace autoshovel::app

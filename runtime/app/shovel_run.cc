@@ -32,6 +32,7 @@
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
+#include "runtime/plant/scenario_builder.h"
 #include "runtime/prediction/penetration_predictor.h"
 #include "runtime/prediction/volume_estimation.h"
 #include "runtime/results/plots.h"
@@ -148,6 +149,7 @@ struct ShovelJob::State {
             o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor)),
         rng(o.seed) {
     if (!o.shovel_weights.empty()) planning::ReadShovelWeights(o.shovel_weights, selection);
+    plant::VaryPiles(setup.scenario, o.seed, o.yard_variation);
   }
 };
 
@@ -274,6 +276,7 @@ std::string ShovelJob::ConfigYaml() const {
     << "planning_margin_m: " << o.planning_margin << "\n"
     << "clear_obstacle_margin: " << o.clear_obstacle_margin << "\n"
     << "sure_obstacle_growth_cells: " << o.sure_obstacle_growth_cells << "\n"
+    << "yard_variation: " << o.yard_variation << "\n"
     << "handover_distance_m: " << o.handover_distance << "\n"
     << "max_cycle_time_s: " << o.max_cycle_time << "\n"
     << "rates_hz: {control: " << o.control_rate << ", decisions: " << o.decision_rate

@@ -67,6 +67,9 @@ struct ShovelRunOptions {
   int sure_obstacle_growth_cells = 1;
   /// Eq. (18) weights from this YAML file (`autoshovel train weights`); empty: Table 1's.
   std::string shovel_weights;
+  /// Vary the scenario's piles as a restocked yard (plant::VaryPiles, seeded by `seed`): each
+  /// pile's height scaled by up to this fraction down; 0: the scenario as written [-].
+  double yard_variation = 0;
   double curvature_reserve = 0.9;  ///< paths are planned at most at this fraction of κmax
   double handover_distance = 2.0;  ///< path left when the scoop cycle takes over [m]
   double max_cycle_time = 120.0;   ///< a cycle running longer is aborted [s]

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace autoshovel::plant {
@@ -296,6 +298,25 @@ TerrainBuildReport BuildTerrain(World& world, std::vector<Pile>& piles,
     if (piles[i].cells == 0) report.hidden.push_back(static_cast<int>(i));
   }
   return report;
+}
+
+void VaryPiles(Scenario& scenario, std::uint64_t seed, double fraction) {
+  if (!(fraction >= 0 && fraction <= 0.9)) {
+    throw std::invalid_argument("yard variation must be in [0, 0.9], got " +
+                                std::to_string(fraction));
+  }
+  if (fraction == 0) return;
+  Random random(seed);
+  for (Pile& pile : scenario.piles) {
+    pile.height *= 1.0 - fraction * random.Uniform();
+    if (pile.shape == PileShape::kIrregular) pile.seed ^= seed;
+    if (pile.shape == PileShape::kCone || pile.shape == PileShape::kIrregular) {
+      pile.base_radius = pile.height / pile.slope;
+    }
+  }
+  Terrain& terrain = scenario.world.terrain;
+  terrain = Terrain(terrain.geometry(), terrain.floor(0, 0));
+  BuildTerrain(scenario.world, scenario.piles, scenario.bins);
 }
 
 }  // namespace autoshovel::plant

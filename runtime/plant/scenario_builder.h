@@ -2,6 +2,7 @@
 // rules). Kept apart from the YAML reading so that the geometry can be read on its own.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "runtime/plant/scenario.h"
@@ -20,5 +21,12 @@ struct TerrainBuildReport {
 /// specified bit for bit.
 TerrainBuildReport BuildTerrain(World& world, std::vector<Pile>& piles,
                                 const std::vector<Bin>& bins);
+
+/// A restocked yard, as a campaign's shifts meet it: every pile's height scaled by a factor
+/// drawn in [1 − fraction, 1] (deliveries top a pile up to at most its nominal height), an
+/// irregular pile's lobes and bumps re-seeded, and the terrain rebuilt. Drawn from `seed`,
+/// bit-exact; fraction 0 leaves the scenario as it is. Throws std::invalid_argument for a
+/// fraction outside [0, 0.9].
+void VaryPiles(Scenario& scenario, std::uint64_t seed, double fraction);
 
 }  // namespace autoshovel::plant

@@ -24,8 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("autoshovel_campaign_" + std::to_string(::getpid()) + "_" + name);
+  const fs::path dir = fs::temp_directory_path() /
+                       ("autoshovel_campaign_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -151,8 +151,9 @@ TEST(Campaign, KilledWithSigkillAndResumedLosesAndDuplicatesNothing) {
   const fs::path spec = WriteSpec(dir, kResumeSpec);
   const std::string models = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
   auto command = [&](const fs::path& out, bool resume) {
-    std::vector<std::string> args = {"autoshovel", "--models", models, "campaign", spec.string(),
-                                     "-o", out.string(), "--workers", "2"};
+    std::vector<std::string> args = {"autoshovel", "--models",    models,
+                                     "campaign",   spec.string(), "-o",
+                                     out.string(), "--workers",   "2"};
     if (resume) args.push_back("--resume");
     return args;
   };

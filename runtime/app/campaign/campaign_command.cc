@@ -69,6 +69,7 @@ ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
               : spec.trigger == "pressure" ? TriggerChoice::kPressure
                                            : TriggerChoice::kPredicted;
   o.figures = false;
+  o.yard_variation = spec.yard_variation;
   return o;
 }
 
@@ -107,8 +108,8 @@ int RunWorker(const CampaignSpec& spec, const std::vector<CampaignJob>& jobs,
         const results::CycleRecord& r = outcome.record;
         char line[300];
         std::snprintf(line, sizeof line, "%s cycle %d: %s %s %s fill %.1f %% %.1f s %.0f kJ%s\n",
-                      job.run_id.c_str(), c, r.bin.c_str(), r.material.c_str(),
-                      r.strategy.c_str(), 100 * r.fill_rate, r.time_s.total, r.energy_kj.total,
+                      job.run_id.c_str(), c, r.bin.c_str(), r.material.c_str(), r.strategy.c_str(),
+                      100 * r.fill_rate, r.time_s.total, r.energy_kj.total,
                       r.completed ? "" : (" FAILED: " + outcome.failure).c_str());
         log << line << std::flush;
         if (after_cycle) after_cycle();
@@ -133,8 +134,8 @@ bool PrepareFolder(const CampaignOptions& o, const CampaignSpec& spec,
       return false;
     }
     if (ReadFile(stored_spec) != ReadFile(o.spec)) {
-      err << kCommand << ": " << o.spec << " differs from the campaign in " << dir.string()
-          << " (" << stored_spec.string()
+      err << kCommand << ": " << o.spec << " differs from the campaign in " << dir.string() << " ("
+          << stored_spec.string()
           << "); a resumed campaign must keep its spec, or its rows would not be comparable\n";
       return false;
     }
@@ -167,8 +168,9 @@ void PrintProgress(std::ostream& out, long long done, long long total, long long
   const double rate = seconds > 0 ? fresh / seconds : 0;
   const double eta = rate > 0 ? (total - done) / rate : 0;
   char line[200];
-  std::snprintf(line, sizeof line, "\r[%lld/%lld cycles] %.2f cycles/s, %.0f s elapsed, ETA %.0f s   ",
-                done, total, rate, seconds, eta);
+  std::snprintf(line, sizeof line,
+                "\r[%lld/%lld cycles] %.2f cycles/s, %.0f s elapsed, ETA %.0f s   ", done, total,
+                rate, seconds, eta);
   out << line << (final ? "\n" : "") << std::flush;
 }
 
@@ -191,14 +193,13 @@ void PrintSummary(const std::filesystem::path& merged, std::ostream& out) {
   if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) == SQLITE_OK) {
     while (sqlite3_step(s) == SQLITE_ROW) {
       char line[300];
-      std::snprintf(line, sizeof line,
-                    "| %s | %lld | %lld | %.1f %% | %.2f | %.1f | %.1f | %.0f | %lld | %.2f |\n",
-                    reinterpret_cast<const char*>(sqlite3_column_text(s, 0)),
-                    sqlite3_column_int64(s, 1), sqlite3_column_int64(s, 2),
-                    100 * sqlite3_column_double(s, 3), sqlite3_column_double(s, 4),
-                    sqlite3_column_double(s, 5), sqlite3_column_double(s, 6),
-                    sqlite3_column_double(s, 7), sqlite3_column_int64(s, 8),
-                    sqlite3_column_double(s, 9));
+      std::snprintf(
+          line, sizeof line,
+          "| %s | %lld | %lld | %.1f %% | %.2f | %.1f | %.1f | %.0f | %lld | %.2f |\n",
+          reinterpret_cast<const char*>(sqlite3_column_text(s, 0)), sqlite3_column_int64(s, 1),
+          sqlite3_column_int64(s, 2), 100 * sqlite3_column_double(s, 3),
+          sqlite3_column_double(s, 4), sqlite3_column_double(s, 5), sqlite3_column_double(s, 6),
+          sqlite3_column_double(s, 7), sqlite3_column_int64(s, 8), sqlite3_column_double(s, 9));
       out << line;
     }
   }
@@ -219,11 +220,10 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
   }
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const int workers = std::clamp(o.workers > 0 ? o.workers : cores, 1, spec.jobs());
-  out << kCommand << ": " << spec.name << ", " << spec.jobs() << " jobs ("
-      << spec.shifts() << " shifts x " << spec.policies.size() << " policies) of "
-      << spec.cycles_per_shift << " cycles, " << workers << " worker process(es) -> "
-      << dir.string() << (base > 0 ? ", resuming with " + std::to_string(base) + " stored" : "")
-      << "\n";
+  out << kCommand << ": " << spec.name << ", " << spec.jobs() << " jobs (" << spec.shifts()
+      << " shifts x " << spec.policies.size() << " policies) of " << spec.cycles_per_shift
+      << " cycles, " << workers << " worker process(es) -> " << dir.string()
+      << (base > 0 ? ", resuming with " + std::to_string(base) + " stored" : "") << "\n";
   const long long shard_rows_before = ShardRows(dir);
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
   std::vector<pid_t> pids;
@@ -271,7 +271,8 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
         --alive;
         if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
           ++failed_workers;
-          err << "\n" << kCommand << ": worker " << k << " ended with "
+          err << "\n"
+              << kCommand << ": worker " << k << " ended with "
               << (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
                                       : "status " + std::to_string(WEXITSTATUS(status)))
               << " (log: " << (dir / ("worker-" + std::to_string(k) + ".log")).string() << ")\n";
@@ -301,9 +302,8 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
 
 // Under mpirun: rank 0 prepares and merges, every rank works; progress from rank 0's view of
 // the shards (the campaign folder must be on a filesystem every rank sees).
-int RunMpi(const CampaignOptions& o, const CampaignSpec& spec,
-           const std::vector<CampaignJob>& jobs, const std::filesystem::path& dir,
-           std::ostream& out, std::ostream& err) {
+int RunMpi(const CampaignOptions& o, const CampaignSpec& spec, const std::vector<CampaignJob>& jobs,
+           const std::filesystem::path& dir, std::ostream& out, std::ostream& err) {
   MPI_Init(nullptr, nullptr);
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -336,9 +336,9 @@ int RunMpi(const CampaignOptions& o, const CampaignSpec& spec,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     PrintProgress(out, base + fresh, spec.cycles(), fresh, seconds, final);
   };
-  const int failed = RunWorker(spec, jobs, dir, o.models_dir, rank, size, log,
-                               rank == 0 ? std::function<void()>([&] { progress(false); })
-                                         : std::function<void()>());
+  const int failed = RunWorker(
+      spec, jobs, dir, o.models_dir, rank, size, log,
+      rank == 0 ? std::function<void()>([&] { progress(false); }) : std::function<void()>());
   // Rank 0 keeps reporting from the shards until every rank is done (a non-blocking barrier:
   // collectives must match in kind on every rank).
   MPI_Request done;
@@ -382,9 +382,8 @@ int RunCampaign(const CampaignOptions& o, std::ostream& out, std::ostream& err) 
       o.out_dir.empty() ? std::filesystem::path("runs") / ("campaign_" + spec.name) : o.out_dir;
   try {
     if (o.worker_index >= 0) {  // a worker process of a local campaign
-      return RunWorker(spec, jobs, dir, o.models_dir, o.worker_index, o.worker_count, out) == 0
-                 ? 0
-                 : 1;
+      return RunWorker(spec, jobs, dir, o.models_dir, o.worker_index, o.worker_count, out) == 0 ? 0
+                                                                                                : 1;
     }
     if (StartedByMpirun()) return RunMpi(o, spec, jobs, dir, out, err);
     // Check that the jobs can be set up (scenario, machine, models) before starting workers.

@@ -65,8 +65,13 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
       }
     }
     spec.stairway_steps = root.Integer("stairway_steps", 1, 10, 3);
-    if (root.Has("trigger")) spec.trigger = root.Enum("trigger", {"predicted", "perception", "pressure"});
-    if (root.Has("truth_labels")) spec.truth_labels = root.Enum("truth_labels", {"true", "false"}) == "true";
+    if (root.Has("trigger"))
+      spec.trigger = root.Enum("trigger", {"predicted", "perception", "pressure"});
+    if (root.Has("truth_labels"))
+      spec.truth_labels = root.Enum("truth_labels", {"true", "false"}) == "true";
+    if (root.Has("yard_variation")) {
+      spec.yard_variation = root.Number("yard_variation", core::NumberRule::Closed(0.0, 0.9, ""));
+    }
     root.Finish();
     if (sink.empty() && spec.cycles() > 10'000'000) {
       root.Error("cycles_per_shift", "the campaign would run " + std::to_string(spec.cycles()) +

@@ -14,6 +14,8 @@
 //   stairway_steps: 3                 # N of "Stairway #N" (stairway_fixed)
 //   trigger: predicted                # predicted | perception | pressure
 //   truth_labels: true                # simulator labels instead of the network (faster)
+//   yard_variation: 0.25              # each shift's piles up to 25 % lower than written, and
+//                                     # irregular heaps re-seeded (plant::VaryPiles); default 0
 #pragma once
 
 #include <cstdint>
@@ -37,6 +39,7 @@ struct CampaignSpec {
   int stairway_steps = 3;
   std::string trigger = "predicted";
   bool truth_labels = true;
+  double yard_variation = 0;
 
   int shifts() const { return weeks * shifts_per_week; }
   int jobs() const { return shifts() * static_cast<int>(policies.size()); }
@@ -54,7 +57,7 @@ struct CampaignJob {
   int week = 0;   ///< 1-based
   int shift = 0;  ///< 1-based within the week
   std::string policy;
-  std::string run_id;   ///< <name>/wWWsSS/<policy>
+  std::string run_id;      ///< <name>/wWWsSS/<policy>
   std::uint64_t seed = 0;  ///< the shift's seed: the same for every policy of the shift
 };
 

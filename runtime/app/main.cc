@@ -257,7 +257,8 @@ int main(int argc, char** argv) {
       "Run a production campaign (weeks of shifts x policies) over every core, or over MPI "
       "ranks under mpirun; resumable");
   campaign_cmd->add_option("spec", campaign.spec, "Campaign YAML (docs/campaigns.md)")->required();
-  campaign_cmd->add_option("-o,--out", campaign_out, "Campaign folder (default: runs/campaign_<name>)");
+  campaign_cmd->add_option("-o,--out", campaign_out,
+                           "Campaign folder (default: runs/campaign_<name>)");
   campaign_cmd->add_option("--workers", campaign.workers, "Worker processes (0: every core)")
       ->capture_default_str();
   campaign_cmd->add_flag("--resume", campaign.resume,

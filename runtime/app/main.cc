@@ -14,6 +14,7 @@
 #include "identification/hydraulics/identify_hydraulics_command.h"
 #include "identification/weights/train_weights_command.h"
 #include "runtime/app/campaign/campaign_command.h"
+#include "runtime/app/campaign/production_report.h"
 #include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
@@ -266,6 +267,21 @@ int main(int argc, char** argv) {
   campaign_cmd->add_option("--worker-index", campaign.worker_index)->group("");
   campaign_cmd->add_option("--worker-count", campaign.worker_count)->group("");
 
+  autoshovel::app::ProductionReportOptions production;
+  std::string production_db, production_png;
+  CLI::App* report_cmd = app.add_subcommand("report", "Reports from results databases");
+  report_cmd->require_subcommand(1);
+  CLI::App* production_cmd = report_cmd->add_subcommand(
+      "production",
+      "The seed's Tables 6-7 and Fig. 22 from a campaign database (adaptive vs Stairway #3)");
+  production_cmd->add_option("database", production_db, "results.sqlite of a campaign")->required();
+  production_cmd->add_option("--png", production_png,
+                             "Fig. 22 box plots (default: production_fig22.png beside it)");
+  production_cmd->add_option("--adaptive", production.adaptive_policy, "Adaptive policy's name")
+      ->capture_default_str();
+  production_cmd->add_option("--baseline", production.baseline_policy, "Baseline policy's name")
+      ->capture_default_str();
+
   autoshovel::planning::SelectOptions select;
   CLI::App* select_cmd = app.add_subcommand(
       "select", "Shovel point selection (Algorithm 2) on a yard: ranked candidates and a PNG");
@@ -428,6 +444,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
+  }
+  if (*production_cmd) {
+    production.database = production_db;
+    production.png = production_png;
+    return autoshovel::app::RunProductionReport(production, std::cout, std::cerr);
   }
   if (*campaign_cmd) {
     campaign.models_dir = models_dir;

@@ -580,7 +580,16 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
   result.ranked = std::move(candidates);
   if (result.feasible == 0) {
     result.status = SelectionStatus::kNoFeasibleCandidate;
-    result.message = std::to_string(result.ranked.size()) + " candidates, none feasible";
+    // Why, tallied: a user needs to know whether the pile is too lopsided, boxed in, or in
+    // the way of every path.
+    std::map<std::string, int> reasons;
+    for (const ShovelCandidate& c : result.ranked) ++reasons[c.infeasible];
+    std::string why;
+    for (const auto& [reason, count] : reasons) {
+      why += (why.empty() ? "" : ", ") + reason + ": " + std::to_string(count);
+    }
+    result.message =
+        std::to_string(result.ranked.size()) + " candidates, none feasible (" + why + ")";
   } else {
     result.status = SelectionStatus::kSelected;
     result.message = std::to_string(result.feasible) + " of " +

@@ -12,6 +12,7 @@
 #include "identification/calibration/calibrate_arm_command.h"
 #include "identification/camera_lidar/calibrate_camera_lidar_command.h"
 #include "identification/hydraulics/identify_hydraulics_command.h"
+#include "identification/predictor/retrain_command.h"
 #include "identification/weights/train_weights_command.h"
 #include "runtime/app/campaign/campaign_command.h"
 #include "runtime/app/campaign/production_report.h"
@@ -251,6 +252,19 @@ int main(int argc, char** argv) {
   weights_cmd->add_option("--threads", train_weights.threads, "Worker threads (0: every core)")
       ->capture_default_str();
 
+  autoshovel::predictor::RetrainOptions retrain;
+  CLI::App* retrain_cmd = train_cmd->add_subcommand(
+      "predictor", "Retrain the penetration predictor from a campaign's crowding samples");
+  retrain_cmd->add_option("database", retrain.database, "results.sqlite of a campaign or a run")
+      ->required();
+  retrain_cmd->add_option("-o,--out", retrain.out, "Path stem of the new model")->required();
+  retrain_cmd->add_option("--machine", retrain.machine, "Wheel loader")->capture_default_str();
+  retrain_cmd->add_option("--base", retrain.base,
+                          "Model to compare with (default: the shipped penetration_svr)");
+  retrain_cmd->add_option("--strategy", retrain.strategy, "Samples of this scoop only, or all")
+      ->capture_default_str();
+  retrain_cmd->add_option("--threads", retrain.threads, "0: every core")->capture_default_str();
+
   autoshovel::app::CampaignOptions campaign;
   std::string campaign_out;
   CLI::App* campaign_cmd = app.add_subcommand(
@@ -454,6 +468,10 @@ int main(int argc, char** argv) {
     campaign.models_dir = models_dir;
     campaign.out_dir = campaign_out;
     return autoshovel::app::RunCampaign(campaign, std::cout, std::cerr);
+  }
+  if (*retrain_cmd) {
+    retrain.models_dir = models_dir;
+    return autoshovel::predictor::RunRetrainPredictor(retrain, std::cout, std::cerr);
   }
   if (*weights_cmd) {
     train_weights.models_dir = models_dir;

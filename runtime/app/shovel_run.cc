@@ -674,6 +674,18 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   std::string actions;
   for (const std::string& a : r.action_names) actions += (actions.empty() ? "" : ",") + a;
   rec.atomic_actions = actions;
+  if (scoop && r.has_features_at_trigger && rec.completed &&
+      std::isfinite(r.travel_after_trigger)) {
+    results::CrowdingSample& c = rec.crowding;
+    c.present = true;
+    c.strategy = rec.strategy;
+    c.trigger = r.trigger_reason;
+    c.material = r.features_at_trigger.material;
+    c.speed = r.features_at_trigger.speed;
+    c.v1 = r.features_at_trigger.shoveled_volume;
+    for (int k = 0; k < 6; ++k) c.heights[k] = r.features_at_trigger.heights[k];
+    c.penetration = r.travel_after_trigger;
+  }
   rec.trigger_time_s = std::isnan(r.trigger_time) ? NAN : r.trigger_time - t0;
   rec.payload_m3 = machine_io.PayloadVolume();
   rec.fill_rate = rec.payload_m3 / machine.bucket.rated_capacity;

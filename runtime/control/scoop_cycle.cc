@@ -115,8 +115,11 @@ struct ScoopCycle::Runtime {
   double hold_attitude = NAN;
   std::string stop_request;  ///< RequestStop's reason: crowding ends at the next decision
   bool drive_held = false;   ///< after a stop request the scoop does not crowd on
-  std::vector<Eigen::Vector3d> last_predicted_path;  ///< of the last V2 [m]
-  double last_v2 = NAN;                              ///< [m³]
+  std::vector<Eigen::Vector3d> last_predicted_path;              ///< of the last V2 [m]
+  double last_v2 = NAN;                                          ///< [m³]
+  std::optional<prediction::PenetrationFeatures> last_features;  ///< of the last V2
+  Eigen::Vector2d trigger_hinge = Eigen::Vector2d::Zero();
+  double trigger_heading = 0;
   std::optional<JointPid> boom_pid, bucket_pid;
   std::optional<SpeedPid> speed_pid;
   core::ActuatorCommand command;
@@ -193,6 +196,7 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
         return std::isfinite(h) ? std::max(h, 0.0) : 0.0;
       },
       rt.tip_path.back().head<2>(), s.heading, machine_.bucket.width);
+  rt.last_features = features;
   const prediction::PenetrationPrediction d = predictor_->Predict(features);
   if (!d.ok) {
     ++rt.result.prediction_failures;
@@ -252,6 +256,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       in.boom_pressure = s.boom_pressure;
       const bool predict =
           trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
+      rt.last_features.reset();
       in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
       rt.last_v2 = predict ? in.v2 : NAN;
       const bool fired = trigger_.Fire(in);
@@ -284,6 +289,11 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         r.v2_at_trigger = in.v2;
         r.predicted_tip_path = rt.last_predicted_path;
         r.boom_pressure_at_trigger = s.boom_pressure;
+        r.has_features_at_trigger = rt.last_features.has_value();
+        if (rt.last_features) r.features_at_trigger = *rt.last_features;
+        rt.trigger_hinge = s.hinge_xy;
+        rt.trigger_heading = s.heading;
+        r.travel_after_trigger = 0;
         rt.q_bucket_at_trigger = s.q_bucket;
         rt.q_boom_at_trigger = s.q_boom;
         rt.sequencer.emplace(*strategy, options_.strategy, limits_);
@@ -296,6 +306,10 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       return;
     }
     case Phase::kScoop: {
+      rt.result.travel_after_trigger = std::max(
+          rt.result.travel_after_trigger,
+          (s.hinge_xy - rt.trigger_hinge)
+              .dot(Eigen::Vector2d(std::cos(rt.trigger_heading), std::sin(rt.trigger_heading))));
       // The running action is over once arrived and paused, or timed out.
       if (rt.action) {
         const bool bucket = rt.action->kind == AtomicKind::kRetractBucket;

@@ -162,6 +162,13 @@ struct ScoopResult {
   std::vector<ScoopSample> samples;                 ///< every decision while digging
   std::vector<Eigen::Vector3d> tip_path;            ///< actual tip, approach to scoop end, world
   std::vector<Eigen::Vector3d> predicted_tip_path;  ///< V2's predicted path at the trigger
+  /// The penetration predictor's inputs at the trigger (when V2 was computed there) and the
+  /// machine's forward travel from the trigger to the end of the scoop phase, along its heading
+  /// at the trigger: the (features, target) pair the predictor is trained on, logged by
+  /// campaigns for retraining at a new site (seed §7.6).
+  bool has_features_at_trigger = false;
+  prediction::PenetrationFeatures features_at_trigger;
+  double travel_after_trigger = NAN;  ///< [m]
 
   const PhaseRecord* Phase(const std::string& name) const;
   /// Contact to the end of the scoop phase (the seed's Table 6/7 "time"): crowd + scoop.

@@ -82,6 +82,23 @@ CREATE TABLE samples (
 ) WITHOUT ROWID;
 )sql";
 
+// Added after schema version 1 without changing it: created where missing when a database is
+// opened (an older file gains an empty table; nothing else changes).
+constexpr const char* kCrowdingSamplesSchema = R"sql(
+CREATE TABLE IF NOT EXISTS crowding_samples (
+  run_id         TEXT NOT NULL,
+  cycle          INTEGER NOT NULL,
+  strategy       TEXT NOT NULL,
+  trigger_cause  TEXT NOT NULL,
+  material       TEXT NOT NULL,
+  speed_mps      REAL,
+  v1_m3          REAL,
+  h1_m REAL, h2_m REAL, h3_m REAL, h4_m REAL, h5_m REAL, h6_m REAL,
+  penetration_m  REAL,
+  PRIMARY KEY (run_id, cycle)
+) WITHOUT ROWID;
+)sql";
+
 double ColumnDouble(sqlite3_stmt* statement, int column) {
   if (sqlite3_column_type(statement, column) == SQLITE_NULL) return kNotMeasured;
   return sqlite3_column_double(statement, column);
@@ -226,6 +243,7 @@ void ResultsDb::CreateOrCheckSchema() {
       again.Step();
       if (sqlite3_column_int(again.get(), 0) == 0) {
         Execute(kSchema);
+        Execute(kCrowdingSamplesSchema);
         Statement version(*this, "INSERT INTO schema_version (version) VALUES (?)");
         version.Bind(1, static_cast<std::int64_t>(kSchemaVersion));
         if (version.Run() != SQLITE_OK) Fail("cannot write the schema version");
@@ -253,6 +271,7 @@ void ResultsDb::CreateOrCheckSchema() {
                          " (written by another autoshovel version)");
   }
   Execute("PRAGMA journal_mode = WAL");
+  Execute(kCrowdingSamplesSchema);
 }
 
 bool ResultsDb::BeginRun(const RunInfo& run) {
@@ -376,11 +395,50 @@ void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record)
              std::to_string(record.cycle));
       }
     }
+    if (record.crowding.present) {
+      const CrowdingSample& c = record.crowding;
+      Statement crowding(*this,
+                         "INSERT INTO crowding_samples VALUES "
+                         "(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      crowding.Bind(1, run_id).Bind(2, static_cast<std::int64_t>(record.cycle));
+      crowding.Bind(3, c.strategy).Bind(4, c.trigger).Bind(5, c.material);
+      crowding.Bind(6, c.speed).Bind(7, c.v1);
+      for (int k = 0; k < 6; ++k) crowding.Bind(8 + k, c.heights[k]);
+      crowding.Bind(14, c.penetration);
+      if (crowding.Run() != SQLITE_OK) {
+        Fail("cannot write the crowding sample of cycle " + std::to_string(record.cycle));
+      }
+    }
     Execute("COMMIT");
   } catch (...) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     throw;
   }
+}
+
+std::vector<ResultsDb::StoredCrowdingSample> ResultsDb::CrowdingSamples() const {
+  std::vector<StoredCrowdingSample> out;
+  Statement select(
+      *this,
+      "SELECT run_id, cycle, strategy, trigger_cause, material, speed_mps, v1_m3, h1_m, "
+      "h2_m, h3_m, h4_m, h5_m, h6_m, penetration_m FROM crowding_samples "
+      "ORDER BY run_id, cycle");
+  while (select.Step()) {
+    StoredCrowdingSample s;
+    sqlite3_stmt* r = select.get();
+    s.run_id = ColumnText(r, 0);
+    s.cycle = sqlite3_column_int(r, 1);
+    s.sample.present = true;
+    s.sample.strategy = ColumnText(r, 2);
+    s.sample.trigger = ColumnText(r, 3);
+    s.sample.material = ColumnText(r, 4);
+    s.sample.speed = ColumnDouble(r, 5);
+    s.sample.v1 = ColumnDouble(r, 6);
+    for (int k = 0; k < 6; ++k) s.sample.heights[k] = ColumnDouble(r, 7 + k);
+    s.sample.penetration = ColumnDouble(r, 13);
+    out.push_back(std::move(s));
+  }
+  return out;
 }
 
 std::vector<int> ResultsDb::CompletedCycles(const std::string& run_id) const {

@@ -13,6 +13,7 @@
 // Schema, units and example queries: docs/results_and_reports.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -74,6 +75,19 @@ struct CycleSample {
   double actual_tip_z = kNotMeasured;     ///< [m]
 };
 
+/// The penetration predictor's inputs at the scoop trigger and the travel that followed: a row
+/// of `crowding_samples`, the data `autoshovel train predictor DB` retrains on (seed §7.6).
+struct CrowdingSample {
+  bool present = false;  ///< false: the cycle computed no prediction at its trigger
+  std::string strategy;  ///< the scoop that followed, e.g. "just_in_out"
+  std::string trigger;   ///< what fired, e.g. "prediction", "stopped"
+  std::string material;
+  double speed = kNotMeasured;        ///< v at the trigger [m/s]
+  double v1 = kNotMeasured;           ///< V1 at the trigger [m³]
+  std::array<double, 6> heights{};    ///< h1..h6 ahead of the tip [m]
+  double penetration = kNotMeasured;  ///< forward travel from the trigger to the scoop's end [m]
+};
+
 /// One shoveling cycle: a row of `cycles` and its `samples`.
 struct CycleRecord {
   int cycle = 0;  ///< index within the run, 0-based; unique per run
@@ -92,6 +106,7 @@ struct CycleRecord {
   int safety_violations = 0;              ///< safety-rule violations in the cycle (must be 0)
   bool completed = true;  ///< ran to the end; false: aborted (safety stop, timeout), row whole
   std::vector<CycleSample> samples;
+  CrowdingSample crowding;
 };
 
 class ResultsDb {
@@ -129,6 +144,13 @@ class ResultsDb {
   std::vector<CycleRecord> Cycles(const std::string& run_id, bool with_samples = false) const;
   std::optional<CycleRecord> Cycle(const std::string& run_id, int cycle) const;
   std::vector<CycleSample> Samples(const std::string& run_id, int cycle) const;
+  /// Every stored crowding sample, with its run and cycle.
+  struct StoredCrowdingSample {
+    std::string run_id;
+    int cycle = 0;
+    CrowdingSample sample;
+  };
+  std::vector<StoredCrowdingSample> CrowdingSamples() const;
 
  private:
   class Statement;

@@ -76,7 +76,7 @@ void MergeShard(const std::filesystem::path& merged, const std::filesystem::path
   Execute(db.get(), "ATTACH DATABASE " + Quote(shard.string()) + " AS shard", where);
   try {
     Execute(db.get(), "BEGIN IMMEDIATE", where);
-    for (const char* table : {"runs", "cycles", "samples"}) {
+    for (const char* table : {"runs", "cycles", "samples", "crowding_samples"}) {
       Execute(db.get(),
               std::string("INSERT OR IGNORE INTO main.") + table + " SELECT * FROM shard." + table,
               where);

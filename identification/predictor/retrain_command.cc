@@ -1,0 +1,173 @@
+#include "identification/predictor/retrain_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <thread>
+
+#include "identification/predictor/svr_training.h"
+#include "runtime/model/description.h"
+#include "runtime/prediction/penetration_predictor.h"
+#include "runtime/results/results_db.h"
+
+namespace autoshovel::predictor {
+namespace {
+
+constexpr const char* kCommand = "autoshovel train predictor";
+constexpr int kMinTrainingSamples = 20;
+
+// FNV-1a of run and cycle: a split that does not move when rows are added.
+bool HeldOut(const std::string& run_id, int cycle) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const char c : run_id + "#" + std::to_string(cycle)) {
+    h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
+  }
+  return h % 5 == 4;
+}
+
+prediction::PenetrationFeatures FeaturesOf(const results::CrowdingSample& s) {
+  prediction::PenetrationFeatures f;
+  f.speed = s.speed;
+  f.shoveled_volume = s.v1;
+  f.material = s.material;
+  for (int k = 0; k < prediction::kNumHeights; ++k) f.heights[k] = s.heights[k];
+  return f;
+}
+
+struct Score {
+  int samples = 0, refused = 0;
+  double within_010 = 0, within_015 = 0, within_020 = 0, rmse = 0;
+};
+
+Score ScoreModel(const prediction::PenetrationPredictor& model,
+                 const std::vector<results::CrowdingSample>& set) {
+  Score s;
+  s.samples = static_cast<int>(set.size());
+  double sq = 0;
+  int n = 0;
+  for (const results::CrowdingSample& c : set) {
+    const prediction::PenetrationPrediction p = model.Predict(FeaturesOf(c));
+    if (!p.ok) {
+      ++s.refused;  // counted as a miss in every bucket
+      continue;
+    }
+    const double e = std::abs(p.penetration - c.penetration);
+    s.within_010 += e <= 0.10, s.within_015 += e <= 0.15, s.within_020 += e <= 0.20;
+    sq += e * e, ++n;
+  }
+  if (s.samples > 0) {
+    s.within_010 /= s.samples, s.within_015 /= s.samples, s.within_020 /= s.samples;
+  }
+  s.rmse = n > 0 ? std::sqrt(sq / n) : NAN;
+  return s;
+}
+
+void PrintScore(std::ostream& out, const char* name, const Score& s) {
+  char line[200];
+  std::snprintf(line, sizeof line, "| %s | %d | %.1f %% | %.1f %% | %.1f %% | %.3f | %d |\n", name,
+                s.samples, 100 * s.within_010, 100 * s.within_015, 100 * s.within_020, s.rmse,
+                s.refused);
+  out << line;
+}
+
+}  // namespace
+
+int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream& err) {
+  try {
+    if (o.out.empty()) {
+      err << kCommand << ": give --out STEM for the new model (.model and .scale)\n";
+      return 2;
+    }
+    const std::string base = o.base.empty() ? o.models_dir + "/prediction/penetration_svr" : o.base;
+    for (const char* ext : {".model", ".scale"}) {
+      if (std::filesystem::exists(o.out + ext)) {
+        err << kCommand << ": " << o.out << ext
+            << " already exists; a model is never overwritten (choose another --out)\n";
+        return 2;
+      }
+    }
+    if (std::filesystem::weakly_canonical(o.out + ".model") ==
+        std::filesystem::weakly_canonical(base + ".model")) {
+      err << kCommand << ": --out is the base model\n";
+      return 2;
+    }
+    if (!std::filesystem::is_regular_file(o.database)) {
+      err << kCommand << ": " << o.database << ": no such file\n";
+      return 2;
+    }
+    const model::MachineDescription machine =
+        model::LoadMachineDescription(model::ResolveMachineDescription(o.machine, o.models_dir));
+    const prediction::PenetrationPredictor shipped = prediction::PenetrationPredictor::Load(base);
+
+    std::vector<results::CrowdingSample> training, held_out;
+    int skipped = 0;
+    {
+      const results::ResultsDb db(o.database);
+      for (const results::ResultsDb::StoredCrowdingSample& s : db.CrowdingSamples()) {
+        if (o.strategy != "all" && s.sample.strategy != o.strategy) {
+          ++skipped;
+          continue;
+        }
+        (HeldOut(s.run_id, s.cycle) ? held_out : training).push_back(s.sample);
+      }
+    }
+    out << o.database << ": " << training.size() + held_out.size() << " crowding samples ("
+        << (o.strategy == "all" ? "every strategy" : o.strategy) << "; " << skipped
+        << " of other strategies left out): " << training.size() << " to train, " << held_out.size()
+        << " held out\n";
+    if (static_cast<int>(training.size()) < kMinTrainingSamples || held_out.empty()) {
+      err << kCommand << ": too few samples to train (" << training.size() << "; at least "
+          << kMinTrainingSamples << " and one held out): run a longer campaign first\n";
+      return 1;
+    }
+
+    std::vector<std::string> materials;
+    for (const model::Material& m : machine.materials) materials.push_back(m.name);
+    SvrDataset train;
+    for (const results::CrowdingSample& s : training) {
+      std::string why;
+      const std::vector<double> x =
+          prediction::PenetrationPredictor::Encode(FeaturesOf(s), materials, &why);
+      if (x.empty() || !std::isfinite(s.penetration)) continue;  // refused, as the model would
+      train.x.push_back(x);
+      train.y.push_back(s.penetration);
+    }
+    prediction::FeatureScaling scaling;
+    scaling.machine = machine.name;
+    scaling.materials = materials;
+    scaling.notes.push_back("retrained by: autoshovel train predictor " + o.database + " --out " +
+                            o.out + " (" + std::to_string(train.x.size()) + " samples of " +
+                            o.strategy + ")");
+    const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    const int threads = o.threads > 0
+                            ? o.threads
+                            : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    SvrGrid grid;
+    grid.folds = std::min(grid.folds, static_cast<int>(train.x.size()));
+    const SvrTrainingResult fit = TrainPenetrationSvr(train, grid, threads, scaling, o.out);
+    const prediction::PenetrationPredictor retrained =
+        prediction::PenetrationPredictor::Load(o.out);
+
+    char line[300];
+    std::snprintf(line, sizeof line,
+                  "SVR: C %g, gamma %g, epsilon %g, CV MSE %.4f m^2, %d support vectors, %d "
+                  "settings tried\n\n",
+                  fit.c, fit.gamma, fit.epsilon, fit.cv_mse, fit.support_vectors,
+                  fit.settings_tried);
+    out << line;
+    out << "| held-out samples | n | |error| <= 0.10 m | <= 0.15 m | <= 0.20 m | RMSE m | refused "
+           "|\n| --- | --- | --- | --- | --- | --- | --- |\n";
+    PrintScore(out, ("shipped " + base).c_str(), ScoreModel(shipped, held_out));
+    PrintScore(out, ("retrained " + o.out).c_str(), ScoreModel(retrained, held_out));
+    out << "\nmodel: " << o.out << ".model, " << o.out << ".scale\n";
+    return 0;
+  } catch (const std::exception& e) {
+    err << kCommand << ": " << e.what() << "\n";
+    return 2;
+  }
+}
+
+}  // namespace autoshovel::predictor

@@ -365,6 +365,11 @@ int main(int argc, char** argv) {
                    "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
       ->check(CLI::Range(0, 10))
       ->capture_default_str();
+  run_cmd
+      ->add_option("--yard-variation", run.yard_variation,
+                   "Restock the piles up to this fraction lower (a campaign's yard_variation)")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
   run_cmd->add_option("--shovel-weights", run.shovel_weights,
                       "Eq. (18) weights YAML from `autoshovel train weights` (default: Table 1)");
   bool run_no_figures = false;

@@ -5,6 +5,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "identification/weights/expert_model.h"
 #include "runtime/plant/scenario_builder.h"
 
 namespace autoshovel::identification {
@@ -174,11 +175,7 @@ DemoScene RandomDemoScene(const model::MachineDescription& machine, std::uint64_
   // the hinge) clear of every obstacle: drawn again until it is (a few tries at most).
   const auto clear_of_obstacles = [&](const Eigen::Vector2d& xy) {
     for (const plant::OrientedBox& box : s.world.obstacles) {
-      const Eigen::Vector2d d = xy - box.center.head<2>();
-      const double c = std::cos(box.yaw), sn = std::sin(box.yaw);
-      const double along = std::max(std::abs(c * d.x() + sn * d.y()) - box.half_extents.x(), 0.0);
-      const double across = std::max(std::abs(-sn * d.x() + c * d.y()) - box.half_extents.y(), 0.0);
-      if (std::hypot(along, across) < 5.0) return false;
+      if (FootprintDistance(box, xy) < 5.0) return false;
     }
     return true;
   };

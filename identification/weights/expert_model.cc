@@ -14,18 +14,10 @@ constexpr double kSampleStep = 0.1;  // bite and corridor sampling [m]
 
 double Wrap(double angle) { return std::remainder(angle, 2 * kPi); }
 
-double DistanceToBox(const plant::OrientedBox& box, const Eigen::Vector2d& xy) {
-  const Eigen::Vector2d d = xy - box.center.head<2>();
-  const double c = std::cos(box.yaw), s = std::sin(box.yaw);
-  const double along = std::max(std::abs(c * d.x() + s * d.y()) - box.half_extents.x(), 0.0);
-  const double across = std::max(std::abs(-s * d.x() + c * d.y()) - box.half_extents.y(), 0.0);
-  return std::hypot(along, across);
-}
-
 double NearestObstacle(const plant::World& world, const Eigen::Vector2d& xy) {
   double nearest = std::numeric_limits<double>::infinity();
   for (const plant::OrientedBox& box : world.obstacles) {
-    nearest = std::min(nearest, DistanceToBox(box, xy));
+    nearest = std::min(nearest, FootprintDistance(box, xy));
   }
   return nearest;
 }
@@ -37,6 +29,14 @@ double DepthAt(const plant::Terrain& terrain, const Eigen::Vector2d& xy) {
 }
 
 }  // namespace
+
+double FootprintDistance(const plant::OrientedBox& box, const Eigen::Vector2d& xy) {
+  const Eigen::Vector2d d = xy - box.center.head<2>();
+  const double c = std::cos(box.yaw), s = std::sin(box.yaw);
+  const double along = std::max(std::abs(c * d.x() + s * d.y()) - box.half_extents.x(), 0.0);
+  const double across = std::max(std::abs(-s * d.x() + c * d.y()) - box.half_extents.y(), 0.0);
+  return std::hypot(along, across);
+}
 
 ExpertTerms ExpertView(const plant::World& world, const planning::CandidatePose& candidate,
                        const planning::Pose2& start, double bucket_width,

@@ -47,6 +47,9 @@ struct ExpertTerms {
   double squareness = 0;
 };
 
+/// Distance from `xy` to the footprint (xy rectangle) of `box`, 0 inside [m].
+double FootprintDistance(const plant::OrientedBox& box, const Eigen::Vector2d& xy);
+
 ExpertTerms ExpertView(const plant::World& world, const planning::CandidatePose& candidate,
                        const planning::Pose2& start, double bucket_width, const ExpertModel& model);
 

@@ -61,13 +61,6 @@ std::filesystem::path TempFile(const std::string& name) {
   return path;
 }
 
-double BoxDistance(const plant::OrientedBox& box, const Eigen::Vector2d& xy) {
-  const Eigen::Vector2d d = xy - box.center.head<2>();
-  const double c = std::cos(box.yaw), s = std::sin(box.yaw);
-  return std::hypot(std::max(std::abs(c * d.x() + s * d.y()) - box.half_extents.x(), 0.0),
-                    std::max(std::abs(-s * d.x() + c * d.y()) - box.half_extents.y(), 0.0));
-}
-
 TEST(DemoScenes, SameSeedSameSceneOtherSeedOtherScene) {
   const DemoScene a = RandomDemoScene(TheLoader().machine, 42);
   const DemoScene b = RandomDemoScene(TheLoader().machine, 42);
@@ -81,7 +74,7 @@ TEST(DemoScenes, SameSeedSameSceneOtherSeedOtherScene) {
     const DemoScene s = RandomDemoScene(TheLoader().machine, seed);
     EXPECT_GT(s.scenario.world.terrain.MaterialVolume(), 2.0) << s.kind;
     for (const plant::OrientedBox& box : s.scenario.world.obstacles) {
-      EXPECT_GT(BoxDistance(box, s.start.xy), 3.0) << "seed " << seed << ", " << box.name;
+      EXPECT_GT(FootprintDistance(box, s.start.xy), 3.0) << "seed " << seed << ", " << box.name;
     }
   }
 }
@@ -131,7 +124,7 @@ TEST(Demonstrations, TheExpertPicksPileFrontPointsAwayFromObstacles) {
                                      TheLoader().geometry.bucket_width, expert);
     EXPECT_GE(t.clearance, expert.veto_distance) << seed;
     for (const plant::OrientedBox& box : s.scenario.world.obstacles) {
-      EXPECT_GE(BoxDistance(box, candidates[chosen].xy), expert.veto_distance) << seed;
+      EXPECT_GE(FootprintDistance(box, candidates[chosen].xy), expert.veto_distance) << seed;
     }
   }
 }

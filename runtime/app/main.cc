@@ -279,6 +279,7 @@ int main(int argc, char** argv) {
   campaign_cmd->add_flag("--resume", campaign.resume,
                          "Continue the campaign in the folder: merge, then run what is missing");
   campaign_cmd->add_option("--worker-index", campaign.worker_index)->group("");
+  campaign_cmd->add_option("--coordinator-pid", campaign.coordinator_pid)->group("");
   campaign_cmd->add_option("--worker-count", campaign.worker_count)->group("");
 
   autoshovel::app::ProductionReportOptions production;

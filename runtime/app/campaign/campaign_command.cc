@@ -4,6 +4,7 @@
 #include <mpi.h>
 #include <spawn.h>
 #include <sqlite3.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -104,7 +105,14 @@ int RunWorker(const CampaignSpec& spec, const std::vector<CampaignJob>& jobs,
       for (int c = 0; c <= last_missing; ++c) {
         const CycleOutcome outcome = shovel.RunCycle(c, {}, nullptr);
         if (stored.count(c)) continue;
-        shard.WriteCycle(job.run_id, outcome.record);
+        try {
+          shard.WriteCycle(job.run_id, outcome.record);
+        } catch (const results::DuplicateCycleError& e) {
+          // Stored meanwhile by another process (same seed, same cycle): the row is there, which
+          // is all the campaign needs; the job goes on to its next cycle.
+          log << job.run_id << " cycle " << c << ": already stored (" << e.what() << ")\n";
+          continue;
+        }
         const results::CycleRecord& r = outcome.record;
         char line[300];
         std::snprintf(line, sizeof line, "%s cycle %d: %s %s %s fill %.1f %% %.1f s %.0f kJ%s\n",
@@ -239,7 +247,9 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
                                      "--worker-index",
                                      std::to_string(k),
                                      "--worker-count",
-                                     std::to_string(workers)};
+                                     std::to_string(workers),
+                                     "--coordinator-pid",
+                                     std::to_string(getpid())};
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -382,6 +392,15 @@ int RunCampaign(const CampaignOptions& o, std::ostream& out, std::ostream& err) 
       o.out_dir.empty() ? std::filesystem::path("runs") / ("campaign_" + spec.name) : o.out_dir;
   try {
     if (o.worker_index >= 0) {  // a worker process of a local campaign
+      // A worker dies with its coordinator: an orphan would go on writing its shard while the
+      // resumed campaign's new worker writes the same one. The parent may have gone before
+      // prctl took effect, hence the check after it.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (o.coordinator_pid > 0 && getppid() != o.coordinator_pid) {
+        err << kCommand << ": worker " << o.worker_index << ": the coordinator (pid "
+            << o.coordinator_pid << ") is gone\n";
+        return 1;
+      }
       return RunWorker(spec, jobs, dir, o.models_dir, o.worker_index, o.worker_count, out) == 0 ? 0
                                                                                                 : 1;
     }

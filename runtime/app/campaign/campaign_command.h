@@ -8,9 +8,10 @@
 // policy. `autoshovel report production results.sqlite` reads it.
 //
 // Local workers are processes (this executable again, with hidden --worker options), so that a
-// crash of one cycle takes down one worker, not the campaign. Each worker runs the jobs
-// k, k + N, k + 2N, …; jobs are shifts × policies, and within a job the cycles run in order
-// because the yard evolves as it is dug.
+// crash of one cycle takes down one worker, not the campaign; a worker dies with the
+// coordinator (PR_SET_PDEATHSIG), so no orphan races a resumed campaign for its shard. Each worker
+// runs the jobs k, k + N, k + 2N, …; jobs are shifts × policies, and within a job the cycles run in
+// order because the yard evolves as it is dug.
 //
 // Crash safety and resume: a worker commits each cycle in one transaction to its own shard. A
 // campaign killed at any point (SIGKILL included, or a rank lost under mpirun) is continued by
@@ -35,6 +36,7 @@ struct CampaignOptions {
   // Internal (a worker process started by the coordinator):
   int worker_index = -1;
   int worker_count = 0;
+  int coordinator_pid = 0;  ///< the worker exits when its parent is no longer this process
 };
 
 /// 0 when every cycle of the campaign is stored, 1 when some are missing (a worker failed:

@@ -106,12 +106,14 @@ std::string Fixed(double value, int digits) {
 // and, from the simulation's truth, how far that cell lies from the nearest real obstacle (the
 // map's blur at a wall; docs/main_job.md).
 std::string SureCellReport(const perception::GridMap& map, const Eigen::Vector2d& cell,
-                           const std::vector<plant::OrientedBox>& obstacles) {
+                           const plant::World& world) {
+  const std::vector<plant::OrientedBox>& obstacles = world.obstacles;
   perception::Index index;
   if (!map.IndexOf(cell, index)) return "nearest sure cell off the map";
   std::string text = "nearest sure cell (" + Fixed(cell.x(), 2) + ", " + Fixed(cell.y(), 2) +
                      "): height " + Fixed(map.at("elevation", index), 2) + " m, obstacle " +
-                     Fixed(map.at("obstacle_confidence", index), 2) + ", pile " +
+                     Fixed(map.at("obstacle_confidence", index), 2) + " (steep " +
+                     Fixed(map.at("steep_obstacle_confidence", index), 2) + "), pile " +
                      Fixed(map.at("pile_confidence", index), 2);
   // A footprint shrunk to the cell's centre: FootprintClearance gives the nearest box.
   perception::MachineFootprint point;
@@ -119,7 +121,8 @@ std::string SureCellReport(const perception::GridMap& map, const Eigen::Vector2d
   const Clearance truth = FootprintClearance(point, obstacles);
   if (truth.obstacle >= 0) {
     text += "; simulation truth: " + Fixed(truth.distance, 2) + " m from " +
-            obstacles[static_cast<std::size_t>(truth.obstacle)].name;
+            obstacles[static_cast<std::size_t>(truth.obstacle)].name + ", ground " +
+            Fixed(world.terrain.HeightAt(cell.x(), cell.y()), 2) + " m";
   }
   return text;
 }
@@ -274,6 +277,7 @@ std::string ShovelJob::ConfigYaml() const {
     << "safety_distance_m: " << o.safety_distance << "\n"
     << "d_res_m: " << o.d_res << "\n"
     << "planning_margin_m: " << o.planning_margin << "\n"
+    << "selection_margin_m: " << o.selection_margin << "\n"
     << "clear_obstacle_margin: " << o.clear_obstacle_margin << "\n"
     << "sure_obstacle_growth_cells: " << o.sure_obstacle_growth_cells << "\n"
     << "yard_variation: " << o.yard_variation << "\n"
@@ -357,13 +361,22 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   // Eq. (14) scores clearance but, as the seed writes it, only penalises a path that comes
   // closer than d_res (s_s = d_min / d_res). The run holds every cycle to the safety distance,
   // so our selection takes the best candidate whose planned clearance is at least the safety
-  // distance plus `planning_margin` (the map's obstacle cells are 0.3 m wide; the path follower
-  // cuts corners and lags curvature steps by some centimetres).
+  // distance plus `selection_margin` (the path follower cuts corners and lags curvature steps
+  // by some centimetres; the planned clearance already leaves out half a map cell and half
+  // its outline sampling, shovel_point_selection.h).
   select_config.safety_distance = o.d_res;
-  const double min_planned_clearance = o.safety_distance + o.planning_margin;
+  const double min_planned_clearance = o.safety_distance + o.selection_margin;
   // Paths are planned at most at `curvature_reserve` of κmax: the follower keeps articulation
   // in hand to pull back onto a path whose curvature steps it can only follow at a finite rate.
   select_config.max_curvature = o.curvature_reserve * st.loader.MaxCurvature();
+  // Eq. (14)'s area A runs on past the contact as far as the machine drives in, with the front
+  // edge as far as the bucket reaches while it scoops (the boom lifted: beyond the tip on the
+  // floor that the selection's body outline assumes).
+  select_config.scoop_advance =
+      o.scoop_drive_in +
+      std::max(0.0, ScoopReach(machine, scoop_options.attack_pose.boom,
+                               scoop_options.attack_pose.bucket, scoop_options.strategy) -
+                        st.loader.tip_reach);
 
   enum class Stage { kSelect, kNavigate, kScoop, kDone } stage = Stage::kSelect;
   std::optional<planning::ShovelCandidate> goal;
@@ -380,6 +393,9 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   double remaining = INFINITY;
   double max_cross_track = 0;  ///< largest distance of the front axle from its path [m]
   double min_clearance = INFINITY;
+  /// Farthest the front axle went past the planned contact pose along the entry heading [m]:
+  /// what the selection's scoop_advance must cover.
+  double scoop_advance = 0;
   int violations = 0;
   bool in_violation = false;
   bool stop_requested = false;
@@ -415,12 +431,19 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     last_selection =
         planning::SelectShovelPoints(grid, in_bin, plane, T_world_hinge, st.loader, select_config);
     last_piles = in_bin;
+    // The best candidate whose approach and whole scoop keep the planned clearance; failing
+    // that, the best whose approach does (its crowd will be ended early by the look-ahead).
     const planning::ShovelCandidate* best = nullptr;
-    for (const planning::ShovelCandidate& k : last_selection.ranked) {
-      if (k.feasible && k.scores.min_obstacle_distance >= min_planned_clearance) {
-        best = &k;
-        break;
+    for (const bool whole_scoop : {true, false}) {
+      for (const planning::ShovelCandidate& k : last_selection.ranked) {
+        const double d =
+            whole_scoop ? k.scores.min_obstacle_distance : k.scores.approach_obstacle_distance;
+        if (k.feasible && d >= min_planned_clearance) {
+          best = &k;
+          break;
+        }
       }
+      if (best != nullptr) break;
     }
     if (o.selection == SelectionMethod::kChen2024) {
       last_baseline = planning::RankChen2024(
@@ -479,8 +502,19 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       const planning::ShovelCandidate* best = select();
       if (stage == Stage::kSelect) {
         if (best == nullptr) {
+          double best_approach = -INFINITY;
+          for (const planning::ShovelCandidate& k : last_selection.ranked) {
+            if (k.feasible) {
+              best_approach = std::max(best_approach, k.scores.approach_obstacle_distance);
+            }
+          }
           out.failure =
-              "no feasible shovel point in " + site.name + " (" + last_selection.message + ")";
+              "no feasible shovel point in " + site.name + " (" + last_selection.message +
+              (std::isfinite(best_approach)
+                   ? "; none planned " + Fixed(min_planned_clearance, 2) +
+                         " m clear of obstacles, the clearest " + Fixed(best_approach, 2) + " m"
+                   : std::string()) +
+              ")";
           out.no_shovel_point = true;
           stage = Stage::kDone;
           return;
@@ -490,7 +524,9 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         say("selected point (" + Fixed(best->pose.xy.x(), 2) + ", " + Fixed(best->pose.xy.y(), 2) +
             ") heading " + Fixed(best->pose.entry_heading / kDeg, 1) + " deg, F " +
             Fixed(best->score, 3) + ", path " + Fixed(best->path.length(), 1) + " m, d_min " +
-            Fixed(best->scores.min_obstacle_distance, 2) + " m");
+            Fixed(best->scores.min_obstacle_distance, 2) + " m (approach " +
+            Fixed(best->scores.approach_obstacle_distance, 2) + " m, scoop " +
+            Fixed(best->scores.scoop_advance, 1) + " m in)");
       } else if (best != nullptr) {
         // The goal being driven to, as seen on the new map and planned from where the machine
         // is now: infeasible (an obstacle came into view) → take the best; beaten by 0.05 in F
@@ -506,7 +542,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         }
         if (current == nullptr || !current->feasible ||
             (o.selection == SelectionMethod::kOurs &&
-             current->scores.min_obstacle_distance < min_planned_clearance)) {
+             current->scores.approach_obstacle_distance < min_planned_clearance)) {
           start_path(*best);
           say("re-selected (goal no longer feasible): F " + Fixed(best->score, 3));
         } else if (o.selection == SelectionMethod::kOurs && best->score > current->score + 0.05) {
@@ -536,6 +572,15 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
           " m");
     }
     in_violation = violating;
+    if (stage == Stage::kScoop && goal) {
+      const Eigen::Vector2d front_axle =
+          s.hinge_xy + machine.chassis.hinge_to_front_axle *
+                           Eigen::Vector2d(std::cos(s.heading), std::sin(s.heading));
+      const double entry = goal->front_axle_goal.heading;
+      scoop_advance =
+          std::max(scoop_advance, (front_axle - goal->front_axle_goal.xy)
+                                      .dot(Eigen::Vector2d(std::cos(entry), std::sin(entry))));
+    }
     // Look-ahead on the map (the machine's own knowledge, not the truth above; crowd_lookahead.h):
     // while the scoop cycle drives in, the front edge of what the scoop will sweep must keep the
     // safety distance plus the planning margin plus the stopping distance from the map's sure
@@ -565,7 +610,22 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         say("obstacle " + Fixed(ahead, 2) + " m ahead on the map (scoop " + scoop_phase +
             ", sweep reach " + Fixed(sweep.front_length, 2) + " m, stopping " + Fixed(stopping, 2) +
             " m): crowding ends; " +
-            SureCellReport(st.map->map(), sure_obstacles[nearest], scenario.world.obstacles));
+            SureCellReport(st.map->map(), sure_obstacles[nearest], plant.world()));
+      } else {
+        // Beside: the whole machine where it will stand once stopped. Entered at an angle to a
+        // wall, the body closes on the wall sideways while the corridor ahead stays clear
+        // (seed §5.2: the safety distance holds for the area covered during the process).
+        perception::MachineFootprint stopped = sweep;
+        stopped.hinge_xy += stopping * Eigen::Vector2d(std::cos(s.heading), std::sin(s.heading));
+        const double beside =
+            FootprintDistanceToCells(stopped, sure_obstacles, obstacle_resolution, &nearest);
+        if (beside < o.safety_distance + o.planning_margin) {
+          scoop->RequestStop("obstacle_beside");
+          stop_requested = true;
+          say("obstacle " + Fixed(beside, 2) + " m beside on the map (scoop " + scoop_phase +
+              ", stopping " + Fixed(stopping, 2) + " m): crowding ends; " +
+              SureCellReport(st.map->map(), sure_obstacles[nearest], plant.world()));
+        }
       }
     }
     if (stage == Stage::kNavigate && remaining <= o.handover_distance) {
@@ -770,9 +830,11 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       ", " + rec.material + ", " + rec.strategy + " (" + rec.atomic_actions + "), fill " +
       Fixed(100 * rec.fill_rate, 1) + " %, trigger " + Fixed(r.trigger_after_contact, 2) +
       " s after contact, cycle " + Fixed(rec.time_s.total, 1) + " s, " +
-      Fixed(rec.energy_kj.total, 0) + " kJ, clearance " + Fixed(min_clearance, 2) + " m; map " +
-      std::to_string(perception_calls) + "× (" + Fixed(perception_seconds, 1) + " s), selection " +
-      std::to_string(selections) + "× (" + Fixed(selection_seconds, 1) + " s)");
+      Fixed(rec.energy_kj.total, 0) + " kJ, clearance " + Fixed(min_clearance, 2) +
+      " m, path error " + Fixed(max_cross_track, 2) + " m, drove in " + Fixed(scoop_advance, 2) +
+      " m past the planned contact; map " + std::to_string(perception_calls) + "× (" +
+      Fixed(perception_seconds, 1) + " s), selection " + std::to_string(selections) + "× (" +
+      Fixed(selection_seconds, 1) + " s)");
   return out;
 }
 

@@ -53,9 +53,20 @@ struct ShovelRunOptions {
   /// behind the rear axle: perception/machine_footprint.h) never comes closer than this to an
   /// obstacle, so the body itself keeps 0.8 m by default [m].
   double safety_distance = 0.5;
-  /// Our selection only takes candidates planned with at least safety_distance + this much
-  /// clearance: path tracking error and the map's 0.3 m cells [m].
+  /// The crowd look-ahead stops the scoop this much before the safety distance: the map's
+  /// 0.3 m cells and a frame's latency [m].
   double planning_margin = 0.15;
+  /// Our selection only takes candidates planned with at least safety_distance + this much
+  /// clearance. The planned clearance is already conservative: half a map cell and half the
+  /// outline sampling are left out (0.2 m, shovel_point_selection.h) and obstacle cells cover
+  /// more than the obstacle. That has covered the path follower's error (each cycle's done line
+  /// logs it: 0.03–0.31 m): on pile_behind_loader a path planned 0.52 m clear, followed with
+  /// 0.31 m of error, kept 0.70 m in truth. A margin of 0.15 m there left no candidate [m].
+  double selection_margin = 0.0;
+  /// How far the front axle drives on past the planned contact while scooping [m], for the
+  /// selection's clearance over the whole scoop (Eq. 14's A). The main job logs the measured
+  /// value per cycle ("drove in … m past the planned contact"): 1.5–3.2 m on the mixing station.
+  double scoop_drive_in = 3.0;
   double d_res = 1.0;  ///< Eq. (14)'s safety distance: clearance below it lowers s_s [m]
   /// The crowd look-ahead stops for map obstacle cells whose obstacle confidence exceeds their
   /// pile confidence by this much [-].

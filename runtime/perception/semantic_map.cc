@@ -71,13 +71,14 @@ SemanticMap::SemanticMap(ElevationMap& map, const SemanticMapConfig& config)
     : map_(map), config_(config) {
   GridMap& g = map_.map();
   for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
-                            "height_ground_confidence", "class"}) {
+                            "steep_obstacle_confidence", "height_ground_confidence", "class"}) {
     if (!g.Exists(layer)) g.Add(layer, kNaN);
   }
   if (!g.Exists("semantic_frames")) g.Add("semantic_frames", 0.0f);
   // A hole takes its nearest observed cell's class evidence with its height (Eq. 9's
   // continuity assumption): a hole behind a person is not pile by its height alone.
-  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence"}) {
+  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
+                            "steep_obstacle_confidence"}) {
     map_.FillAlso(layer);
   }
 }
@@ -163,6 +164,7 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
   Eigen::MatrixXf& ground = g["ground_confidence"];
   Eigen::MatrixXf& pile = g["pile_confidence"];
   Eigen::MatrixXf& obstacle = g["obstacle_confidence"];
+  Eigen::MatrixXf& steep_obstacle_layer = g["steep_obstacle_confidence"];
   Eigen::MatrixXf& frames = g["semantic_frames"];
   long updated = 0;
   for (const Hit& hit : hits) {
@@ -191,6 +193,13 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
                                    static_cast<float>(config_.occlusion_tolerance))) {
       continue;
     }
+    // Seen at a grazing angle (its surface a row or two high) a cell's own pixels are not
+    // surely its own: a centimetre of height error moves the ray's hit decimetres along, onto
+    // whatever stands behind (the in-full rule put a bin's back wall on pile tops seen from
+    // 19 m). The class keeps the in-full rule (an obstacle is never pile), but the evidence
+    // that an obstacle is *there* ("steep_obstacle_confidence", what the crowd look-ahead
+    // stops for) takes the hard pixels in full only from steeper views.
+    const bool steep = hit.v_max - hit.v_min >= config_.min_rows_for_hard;
     Confidences c{0, 0, 0, 0};
     float hard_max = 0;
     int samples = 0;
@@ -207,6 +216,7 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
     }
     if (samples == 0) continue;
     c.ground /= samples, c.pile /= samples, c.obstacle /= samples;
+    const float steep_obstacle = steep ? std::max(c.obstacle, hard_max) : c.obstacle;
     c.obstacle = std::max(c.obstacle, hard_max);
     const int ix = hit.cell % nx, iy = hit.cell / nx;
     float& n = frames(ix, iy);
@@ -218,6 +228,7 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
     blend(ground(ix, iy), c.ground);
     blend(pile(ix, iy), c.pile);
     blend(obstacle(ix, iy), c.obstacle);
+    blend(steep_obstacle_layer(ix, iy), steep_obstacle);
     ++updated;
   }
   return updated;

@@ -8,8 +8,10 @@
 //
 // Layers added to the map: "ground_confidence", "pile_confidence", "obstacle_confidence"
 // (p̂1..p̂3, averaged over the frames that saw the cell), "semantic_frames" (how many),
-// "height_ground_confidence" (p1) and "class" (a CellClass value, NaN where the height is
-// unknown).
+// "height_ground_confidence" (p1), "class" (a CellClass value, NaN where the height is
+// unknown) and "steep_obstacle_confidence" (p̂3 with a machine, person or wall in the footprint
+// counted in full only from views that are not grazing: the evidence that an obstacle stands
+// in the cell, which the crowd look-ahead uses).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -43,6 +45,10 @@ struct SemanticMapConfig {
   /// fraction of its depth (less `occlusion_tolerance`) sits beside an occluding contour and
   /// takes no class evidence from that frame [-].
   double contour_depth_ratio = 0.8;
+  /// For "steep_obstacle_confidence", a machine, person or wall pixel in a cell's footprint
+  /// counts in full only when the cell's surface spans more than this many image rows; seen
+  /// flatter, its pixels are averaged like the rest [rows].
+  int min_rows_for_hard = 2;
   double ground_z0 = 0.3;          ///< z0: cells at or below this height fit the ground [m]
   double ransac_threshold = 0.05;  ///< inlier distance of the plane fit [m]
   int ransac_iterations = 200;

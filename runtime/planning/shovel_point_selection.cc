@@ -262,6 +262,9 @@ std::string ShovelPointConfig::Validate() const {
   }
   if (!(normal_radius > 0)) return "normal_radius must be > 0 m";
   if (!(penetration_length > 0)) return "penetration_length must be > 0 m";
+  if (!(scoop_advance >= 0) || !std::isfinite(scoop_advance)) {
+    return "scoop_advance must be a finite length >= 0 m, got " + std::to_string(scoop_advance);
+  }
   if (!(entry_window > 0)) return "entry_window must be > 0 m";
   if (!(path_spacing > 0)) return "path_spacing must be > 0 m";
   if (!(max_drive_over_height >= 0)) return "max_drive_over_height must be >= 0 m";
@@ -401,29 +404,105 @@ Eigen::MatrixXf ObstacleDistanceField(const GridMap& map) {
 }
 
 double SweptObstacleDistance(const GridMap& map, const Eigen::MatrixXf& field,
-                             const std::vector<PathSample>& samples, const LoaderGeometry& loader) {
-  // The body's two rectangles are covered by discs on their centre lines, 1 m apart, each of
-  // radius √(hw² + 0.5²): the discs contain the rectangles and overshoot by < 0.1 m. A disc's
-  // distance to the obstacle cells is the distance field at its centre less its radius, less
-  // half a cell (the field is between cell centres; an obstacle fills its cell).
-  const double hw = loader.HalfWidth(), spacing = 1.0;
-  const double radius = std::sqrt(hw * hw + spacing * spacing / 4);
-  const double front = loader.tip_reach + loader.body_margin - hw;  // last disc centre
-  const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin - hw;
-  double d_min = kInf;
+                             const std::vector<PathSample>& samples, const LoaderGeometry& loader,
+                             double cap) {
+  // The distance from a rectangle to the obstacle cells outside it is the least distance field
+  // on its outline; the field is sampled on the outline every `step`, so the least sample
+  // overestimates it by at most step / 2, which is taken off, and half a cell more (the field is
+  // between cell centres; an obstacle fills its cell). An obstacle inside a rectangle crossed its
+  // outline at an earlier pose of the sweep (poses a path spacing apart, outline samples a
+  // fraction of a cell apart): the swept minimum sees it there. (Discs along the centre line,
+  // the usual shortcut, either miss the corners or reach far beyond the ends: at a bin's mouth
+  // both errors matter.)
+  const double hw = loader.HalfWidth();
+  const double step = std::min(0.1, map.resolution());
+  const double front = loader.tip_reach + loader.body_margin;
+  const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin;
+  // Work in the field's units (before the corrections below): exact below the cap, and a
+  // collision (≤ 0) ends the search.
+  const double correction = step / 2 + map.resolution() / 2;
+  double d_min = std::isfinite(cap) ? cap + correction : kInf;
+  auto outline = [&](const Eigen::Vector2d& hinge, const Eigen::Vector2d& u, double from,
+                     double to) {
+    // The field changes by at most the distance moved (plus a cell's interpolation slack): a
+    // rectangle whose centre lies farther than its half diagonal beyond the least distance so
+    // far cannot lower it. Most poses of a path are skipped so.
+    const double half_diagonal = std::hypot((to - from) / 2, hw);
+    if (Interpolate(map, field, hinge + (from + to) / 2 * u) - half_diagonal - map.resolution() >
+        d_min) {
+      return;
+    }
+    const Eigen::Vector2d n(-u.y(), u.x());
+    const Eigen::Vector2d corners[4] = {hinge + from * u - hw * n, hinge + to * u - hw * n,
+                                        hinge + to * u + hw * n, hinge + from * u + hw * n};
+    // Each edge in pieces of at most 1 m, each piece in sub-pieces of at most `step`, sampled at
+    // their middles (every point of the outline within step / 2 of a sample). A piece whose
+    // middle lies farther than half its length (and a cell) beyond the least distance so far is
+    // skipped whole, by the same bound as above.
+    for (int e = 0; e < 4; ++e) {
+      const Eigen::Vector2d& a = corners[e];
+      const Eigen::Vector2d& b = corners[(e + 1) % 4];
+      const double length = (b - a).norm();
+      const int pieces = std::max(1, static_cast<int>(std::ceil(length / 1.0)));
+      const int subs = std::max(1, static_cast<int>(std::ceil(length / pieces / step)));
+      for (int p = 0; p < pieces; ++p) {
+        const double mid = (p + 0.5) / pieces;
+        if (Interpolate(map, field, a + (b - a) * mid) - length / pieces / 2 - map.resolution() >
+            d_min) {
+          continue;
+        }
+        for (int k = 0; k < subs; ++k) {
+          const double t = (p + (k + 0.5) / subs) / pieces;
+          d_min = std::min(d_min, Interpolate(map, field, a + (b - a) * t));
+        }
+      }
+    }
+  };
   for (const PathSample& p : samples) {
     const double gamma = loader.ArticulationFor(p.curvature);
     const Eigen::Vector2d u_front = Direction(p.heading), u_rear = Direction(p.heading - gamma);
     const Eigen::Vector2d hinge = p.xy - loader.hinge_to_front_axle * u_front;
-    auto disc = [&](const Eigen::Vector2d& c) {
-      d_min = std::min(d_min, Interpolate(map, field, c) - radius - map.resolution() / 2);
-    };
-    const int n_front = static_cast<int>(std::ceil(front / spacing));
-    for (int k = 0; k <= n_front; ++k) disc(hinge + std::min(k * spacing, front) * u_front);
-    const int n_rear = static_cast<int>(std::ceil(rear / spacing));
-    for (int k = 1; k <= n_rear; ++k) disc(hinge - std::min(k * spacing, rear) * u_rear);
+    outline(hinge, u_front, 0.0, front);
+    outline(hinge, u_rear, -rear, 0.0);
+    if (d_min <= correction) break;  // touching: the path collides, however much more
   }
-  return d_min;
+  return d_min - correction;
+}
+
+double RoomAhead(const GridMap& map, const Pose2& front_axle, const LoaderGeometry& loader,
+                 double range) {
+  // March the bucket's corridor (±half the body width) cell by cell from the front edge at
+  // this pose; the first obstacle cell ends it. Half-cell steps: no cell is stepped over.
+  const Eigen::Vector2d u = Direction(front_axle.heading), n(-u.y(), u.x());
+  const Eigen::Vector2d front_edge =
+      front_axle.xy + (loader.tip_reach - loader.hinge_to_front_axle + loader.body_margin) * u;
+  const double step = map.resolution() / 2, hw = loader.HalfWidth();
+  for (double along = 0; along <= range; along += step) {
+    for (double across = -hw; across <= hw + 1e-9; across += step) {
+      Index i;
+      if (map.IndexOf(front_edge + along * u + across * n, i) &&
+          IsClass(map, i, CellClass::kObstacle)) {
+        return std::max(0.0, along - map.resolution() / 2);
+      }
+    }
+  }
+  return kInf;
+}
+
+std::vector<PathSample> WithScoopAdvance(std::vector<PathSample> samples, double advance,
+                                         double spacing) {
+  if (samples.empty() || !(advance > 0)) return samples;
+  // The scoop drives straight on: the main job's path follower steers on along the entry
+  // heading while crowding and holds the articulation once it scoops, so the extension carries
+  // the last heading with no curvature.
+  const PathSample last = samples.back();
+  const Eigen::Vector2d u = Direction(last.heading);
+  const int n = static_cast<int>(std::ceil(advance / spacing));
+  for (int k = 1; k <= n; ++k) {
+    const double ds = std::min(k * spacing, advance);
+    samples.push_back({last.s + ds, last.xy + ds * u, last.heading, 0.0});
+  }
+  return samples;
 }
 
 // --- Candidates ---
@@ -502,6 +581,9 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
   const Pose2 start{T_world_hinge.xy + lf * Direction(T_world_hinge.heading),
                     T_world_hinge.heading};
   const double axle_to_tip = loader.tip_reach - lf;
+  // Eq. (14) needs d_min exactly only below d_res (s_s = 1 above it); 1 m beyond is kept for
+  // the logs and figures, farther is reported as that much.
+  const double clearance_cap = config.safety_distance + 1.0;
 
   std::vector<ShovelCandidate> candidates;
   candidates.reserve(poses.size());
@@ -515,6 +597,21 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
     // with d_min > 0; failing that the shortest (scored, and vetoed by s_s or the pile check).
     const std::vector<DubinsPath> words =
         AllDubinsPaths(start, c.front_axle_goal, result.max_curvature);
+    // Eq. (14)'s A goes on past the contact: the scoop drives straight in, up to scoop_advance
+    // or until an obstacle straight ahead (less d_res) ends it (the main job's look-ahead ends
+    // crowding there); what it passes beside counts. The same for every word to this pose.
+    const double room =
+        RoomAhead(map, c.front_axle_goal, loader, config.scoop_advance + config.safety_distance);
+    const double advance = std::clamp(room - config.safety_distance, 0.0, config.scoop_advance);
+    const double d_scoop =
+        advance > 0
+            ? SweptObstacleDistance(
+                  map, distance_field,
+                  WithScoopAdvance({{0.0, c.front_axle_goal.xy, c.front_axle_goal.heading, 0.0}},
+                                   advance, config.path_spacing),
+                  loader, clearance_cap)
+            : kInf;
+    s.scoop_advance = advance;
     int chosen = -1, rank = 3;  // 0: clear of d_res, 1: not touching, 2: neither
     double chosen_d_min = 0;
     std::vector<PathSample> chosen_samples;
@@ -523,7 +620,8 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
       std::vector<PathSample> samples = SamplePath(words[w], config.path_spacing);
       const bool over_pile =
           DrivesOverPile(map, pile_height, samples, loader, config.max_drive_over_height);
-      const double d_min = SweptObstacleDistance(map, distance_field, samples, loader);
+      const double d_min =
+          SweptObstacleDistance(map, distance_field, samples, loader, clearance_cap);
       const int r = over_pile ? 2 : d_min > config.safety_distance ? 0 : d_min > 0 ? 1 : 2;
       if (r < rank) {
         chosen = w, rank = r, chosen_d_min = d_min, chosen_over_pile = over_pile;
@@ -532,7 +630,8 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
     }
     c.path = words[chosen];
     s.path_length = c.path.length();
-    s.min_obstacle_distance = chosen_d_min;
+    s.approach_obstacle_distance = chosen_d_min;
+    s.min_obstacle_distance = std::min(chosen_d_min, d_scoop);
     s.end_curvature = chosen_samples.back().curvature;
     s.entry_curvature = EntryCurvature(chosen_samples, config.entry_window);
     s.entry_articulation = loader.ArticulationFor(s.entry_curvature);

@@ -94,7 +94,12 @@ struct ShovelPointConfig {
   double normal_radius = 1.5;  ///< cells within this of a point give its inward normal [m]
   // Scores.
   double penetration_length = 2.0;  ///< Ω's depth into the pile along the heading [m]
-  double entry_window = 3.0;        ///< the end of the path whose mean |κ| is κ_im [m]
+  /// Eq. (14)'s A is "the area covered by the loader during the process": the approach path and
+  /// then the scoop, which drives the machine on along the entry heading after the bucket meets
+  /// the pile. d_min is taken over the path extended straight by this much [m], less where an
+  /// obstacle straight ahead (less d_res) ends the crowd first.
+  double scoop_advance = 2.0;
+  double entry_window = 3.0;  ///< the end of the path whose mean |κ| is κ_im [m]
   // Paths.
   double path_spacing = 0.25;  ///< sampling of the planned path [m]
   /// The tyres may roll onto the pile's toe up to this height; higher pile cells under the
@@ -109,8 +114,10 @@ struct ShovelPointConfig {
 /// The five scores of one candidate and the quantities behind them.
 struct ScoreBreakdown {
   double s_t = 0, s_s = 0, s_c = 0, s_e = 0, s_a = 0;
-  double torque = 0;                          ///< T_c, Eq. (12) [m⁴], left heavy positive
-  double min_obstacle_distance = 0;           ///< d_min, Eq. (14) [m] (+inf: no obstacle)
+  double torque = 0;                      ///< T_c, Eq. (12) [m⁴], left heavy positive
+  double min_obstacle_distance = 0;       ///< d_min, Eq. (14): approach and scoop [m] (+inf: none)
+  double approach_obstacle_distance = 0;  ///< d_min of the approach path alone [m]
+  double scoop_advance = 0;  ///< how far past contact A runs: ≤ scoop_advance, room ahead [m]
   double volume_left = 0, volume_middle = 0;  ///< V_l, V_m, Eq. (15) [m³]
   double volume_right = 0;
   double path_length = 0;         ///< l_im, Eq. (16) [m]
@@ -218,9 +225,23 @@ Eigen::MatrixXf ObstacleDistanceField(const perception::GridMap& map);
 /// d_min of Eq. (14) for a path: the least distance between the area the loader's body sweeps
 /// along `samples` (front frame from the hinge to the tip, rear frame to the counterweight,
 /// rear turned by the articulation that holds each sample's curvature) and the obstacle cells,
-/// from `distance_field` (ObstacleDistanceField) [m]. Conservative to about half a cell.
+/// from `distance_field` (ObstacleDistanceField) [m]. Conservative by at most a cell. Exact
+/// below `cap`; a clearance beyond it is returned as `cap` (the search stops refining there),
+/// and the search ends at the first contact (the result then ≤ 0 but not the deepest).
 double SweptObstacleDistance(const perception::GridMap& map, const Eigen::MatrixXf& distance_field,
-                             const std::vector<PathSample>& samples, const LoaderGeometry& loader);
+                             const std::vector<PathSample>& samples, const LoaderGeometry& loader,
+                             double cap = std::numeric_limits<double>::infinity());
+
+/// `samples` extended straight on from the last one by `advance` [m] at `spacing`, with the last
+/// heading and zero curvature: the scoop's drive into the pile that Eq. (14)'s area A includes.
+std::vector<PathSample> WithScoopAdvance(std::vector<PathSample> samples, double advance,
+                                         double spacing);
+
+/// Distance from the bucket's front edge (tip_reach + body_margin ahead of the hinge), with the
+/// front axle at `front_axle`, straight ahead to the first obstacle cell in the corridor of the
+/// body's width [m]; +inf when none lies within `range`.
+double RoomAhead(const perception::GridMap& map, const Pose2& front_axle,
+                 const LoaderGeometry& loader, double range);
 
 const char* ToString(SelectionStatus status);
 

@@ -61,6 +61,30 @@ TEST(CrowdLookahead, DistanceAheadCountsOnlyTheCorridorAhead) {
   EXPECT_TRUE(std::isinf(DistanceAhead(cells, {0, 0}, std::numbers::pi / 2, 0.4, 6.0, 0.3)));
 }
 
+TEST(CrowdLookahead, FootprintDistanceToCellsSeesBothFrames) {
+  perception::MachineFootprint f;
+  f.hinge_xy = {0, 0};
+  f.heading_front = 0;
+  f.articulation = 0;
+  f.front_length = 6.0;
+  f.rear_length = 4.0;
+  f.half_width = 1.5;
+  // Beside the front frame: 3 − 1.5 − 0.15; beyond its corner: hypot(2, 1) − 0.15.
+  EXPECT_NEAR(FootprintDistanceToCells(f, {{3.0, 3.0}}, 0.3), 1.35, 1e-12);
+  EXPECT_NEAR(FootprintDistanceToCells(f, {{8.0, 2.5}}, 0.3), std::hypot(2.0, 1.0) - 0.15, 1e-12);
+  // Behind: the rear frame turned by the articulation. With γ = 90° the rear frame points
+  // along +y from the hinge (heading 0 − 90°: its backwards axis is +y), so a cell at (0, 5)
+  // lies 1 m past its end; with γ = 0 the same cell is 3.5 m beside it.
+  int nearest = -2;
+  EXPECT_NEAR(FootprintDistanceToCells(f, {{-9, 0}, {0.0, 5.0}}, 0.3, &nearest), 3.35, 1e-12);
+  EXPECT_EQ(nearest, 1);
+  f.articulation = std::numbers::pi / 2;
+  EXPECT_NEAR(FootprintDistanceToCells(f, {{0.0, 5.0}}, 0.3), 0.85, 1e-12);
+  // Inside: negative by the half cell; no cells: +inf.
+  EXPECT_NEAR(FootprintDistanceToCells(f, {{1.0, 0.0}}, 0.3), -0.15, 1e-12);
+  EXPECT_TRUE(std::isinf(FootprintDistanceToCells(f, {}, 0.3)));
+}
+
 // A wall's row of sure cells (obstacle 1.0, pile 0.1) with, in front of it, the blurred crest:
 // a row of confident obstacle cells that carry pile evidence too (obstacle 0.97, pile 0.8), and a
 // pile top seen obliquely (obstacle 0.7). Growth takes the confident cells within `growth`

@@ -66,10 +66,9 @@ TEST(ShovelCycle, GravelConeIsJustInAndOutAndFull) {
 }
 
 // River sand in the mixing station's bin_4 (a difficult material, γ ∈ 𝒴): "Stairway". The
-// ridge lies against the bin's back wall, and the crowd look-ahead ends crowding while the
-// footprint is still 1.66 m from it (the map puts the wall's evidence on the crest in front of
-// it; docs/main_job.md): fill measured 0.923, held at 0.9 (0.999 without the look-ahead, which
-// brought the footprint 0.34 m from the wall on pile_against_wall).
+// ridge lies against the bin's back wall, and the crowd look-ahead ends crowding before it:
+// fill measured 0.974 (0.923 while the look-ahead still stopped for the wall's labels seen over
+// the crest at a grazing angle; semantic_map.h), held at 0.9; clearance 1.34 m.
 TEST(ShovelCycle, SandInABinIsStairwayAndFull) {
   ShovelRunOptions options = Options("mixing_station");
   options.bins = {"bin_4"};

@@ -185,16 +185,19 @@ void ExpectClearOfObstacles(const Yard& yard, const ShovelPointResult& result,
     if (!c.feasible) break;
     EXPECT_GT(TrueClearance(yard, c), 0.0) << name << " rank " << k + 1;
   }
-  // The best keeps the safety distance d_res from every true obstacle box (its body outline
-  // bare; the planner's carries a 0.3 m margin, so s_s slightly below 1 still means clear).
-  EXPECT_GT(best.scores.s_s, 0.7) << name;
+  // The best's approach keeps the safety distance d_res from every true obstacle box (its body
+  // outline bare; the planner's carries a 0.3 m margin, so slightly below d_res still means
+  // clear). Its s_s also counts the scoop beyond the contact (Eq. 14's A), which the true
+  // clearance below does not.
+  EXPECT_GT(best.scores.approach_obstacle_distance, 0.7) << name;
+  EXPECT_LE(best.scores.min_obstacle_distance, best.scores.approach_obstacle_distance) << name;
   const double clearance = TrueClearance(yard, best);
   std::printf(
       "%s: %s; best (%.2f, %.2f) heading %.1f deg F %.3f, path %.1f m, clearance %.2f "
-      "m (planner d_min %.2f m)\n",
+      "m (planner d_min %.2f m, approach %.2f m)\n",
       name.c_str(), result.message.c_str(), best.pose.xy.x(), best.pose.xy.y(),
       best.pose.entry_heading * 180 / std::numbers::pi, best.score, best.scores.path_length,
-      clearance, best.scores.min_obstacle_distance);
+      clearance, best.scores.min_obstacle_distance, best.scores.approach_obstacle_distance);
   EXPECT_GE(clearance, 1.0) << name;  // d_res
 }
 

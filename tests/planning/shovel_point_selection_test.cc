@@ -173,6 +173,63 @@ TEST(ShovelScores, ObstacleDistanceFieldAndSweptDistance) {
   EXPECT_TRUE(std::isinf(ObstacleDistanceField(empty)(3, 3)));
 }
 
+// Eq. (14)'s A covers the scoop too: a path that stops short of an obstacle beside the pile's
+// front keeps its distance, but driving on into the pile brings the body alongside it.
+TEST(ShovelScores, ScoopAdvanceExtendsTheSweptArea) {
+  GridMap map = FlatMap(0.3, 39, {0.15, 0.15});
+  Index obstacle;
+  ASSERT_TRUE(map.IndexOf({8.1, 3.0}, obstacle));
+  ASSERT_NEAR(map.PositionOf(obstacle).y(), 3.0, 1e-9);
+  map.at("class", obstacle) = static_cast<float>(CellClass::kObstacle);
+  const Eigen::MatrixXf field = ObstacleDistanceField(map);
+  LoaderGeometry loader;
+  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
+  loader.max_articulation = 38 * kPi / 180;
+  loader.track_width = 2.25;
+  loader.bucket_width = 3.0;
+  loader.tip_reach = 4.5;
+  const std::vector<PathSample> approach =
+      SamplePath(ShortestDubinsPath({{-10, 0}, 0}, {{0, 0}, 0}, 0.2), 0.25);
+  const std::vector<PathSample> with_scoop = WithScoopAdvance(approach, 6.0, 0.25);
+  ASSERT_EQ(with_scoop.size(), approach.size() + 24);
+  EXPECT_NEAR(with_scoop.back().xy.x(), 6.0, 1e-9);
+  EXPECT_NEAR(with_scoop.back().s, approach.back().s + 6.0, 1e-9);
+  EXPECT_EQ(with_scoop.back().curvature, 0.0);
+  // Without the advance the front (hinge at x = −1.6, reach 4.5 + 0.3 m) ends 4.8 m short of
+  // the cell's near face; with it the side passes 3 m − hw from the cell's centre.
+  const double exact_beside = 3.0 - loader.HalfWidth() - 0.15;
+  EXPECT_GT(SweptObstacleDistance(map, field, approach, loader), exact_beside + 1.0);
+  const double d = SweptObstacleDistance(map, field, with_scoop, loader);
+  EXPECT_LE(d, exact_beside + 1e-6);
+  EXPECT_GT(d, exact_beside - 0.15);
+  EXPECT_EQ(WithScoopAdvance(approach, 0.0, 0.25).size(), approach.size());
+}
+
+// The body is a rectangle up to its corners: an obstacle off the front corner, diagonally
+// ahead, is as far as the corner, not as far as a rounded nose would be.
+TEST(ShovelScores, SweptDistanceCoversTheFrontCorners) {
+  GridMap map = FlatMap(0.1, 30, {0.05, 0.05});
+  LoaderGeometry loader;
+  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
+  loader.max_articulation = 38 * kPi / 180;
+  loader.track_width = 2.25;
+  loader.bucket_width = 3.0;
+  loader.tip_reach = 4.5;
+  const double hw = loader.HalfWidth();
+  // One pose: front axle at the origin heading +x, so the hinge is at x = −1.6 and the front
+  // corner at (−1.6 + 4.5 + 0.3, hw). A cell 0.6 m beyond the corner on both axes.
+  const Eigen::Vector2d corner(-1.6 + loader.tip_reach + loader.body_margin, hw);
+  Index obstacle;
+  ASSERT_TRUE(map.IndexOf(corner + Eigen::Vector2d(0.6, 0.6), obstacle));
+  map.at("class", obstacle) = static_cast<float>(CellClass::kObstacle);
+  const Eigen::MatrixXf field = ObstacleDistanceField(map);
+  const std::vector<PathSample> pose = {{0.0, {0, 0}, 0.0, 0.0}};
+  const double exact = (map.PositionOf(obstacle) - corner).norm() - 0.05;
+  const double d = SweptObstacleDistance(map, field, pose, loader);
+  EXPECT_LE(d, exact + 1e-6);  // never beyond the true clearance of the corner
+  EXPECT_GT(d, exact - 0.2);   // conservative by less than the discs' overshoot and a cell
+}
+
 // Chen et al. (2024) baseline: a plane rising 0.5 m per metre towards +x.
 TEST(Chen2024Baseline, IndicatorsOnAPlaneAndARidge) {
   GridMap map = FlatMap(0.25, 20, {0, 0});
@@ -210,6 +267,9 @@ TEST(ShovelPointConfig, ValidateNamesTheProblem) {
   config = {};
   config.entry_angle_offsets = {2.0};
   EXPECT_NE(config.Validate().find("entry_angle_offsets"), std::string::npos);
+  config = {};
+  config.scoop_advance = std::nan("");
+  EXPECT_NE(config.Validate().find("scoop_advance"), std::string::npos);
 }
 
 }  // namespace

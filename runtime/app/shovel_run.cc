@@ -526,7 +526,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
             Fixed(best->score, 3) + ", path " + Fixed(best->path.length(), 1) + " m, d_min " +
             Fixed(best->scores.min_obstacle_distance, 2) + " m (approach " +
             Fixed(best->scores.approach_obstacle_distance, 2) + " m, scoop " +
-            Fixed(best->scores.scoop_advance, 1) + " m in)");
+            Fixed(select_config.scoop_advance, 1) + " m in)");
       } else if (best != nullptr) {
         // The goal being driven to, as seen on the new map and planned from where the machine
         // is now: infeasible (an obstacle came into view) → take the best; beaten by 0.05 in F

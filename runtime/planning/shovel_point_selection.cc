@@ -403,106 +403,112 @@ Eigen::MatrixXf ObstacleDistanceField(const GridMap& map) {
   return out;
 }
 
-double SweptObstacleDistance(const GridMap& map, const Eigen::MatrixXf& field,
-                             const std::vector<PathSample>& samples, const LoaderGeometry& loader,
-                             double cap) {
-  // The distance from a rectangle to the obstacle cells outside it is the least distance field
-  // on its outline; the field is sampled on the outline every `step`, so the least sample
-  // overestimates it by at most step / 2, which is taken off, and half a cell more (the field is
-  // between cell centres; an obstacle fills its cell). An obstacle inside a rectangle crossed its
-  // outline at an earlier pose of the sweep (poses a path spacing apart, outline samples a
-  // fraction of a cell apart): the swept minimum sees it there. (Discs along the centre line,
-  // the usual shortcut, either miss the corners or reach far beyond the ends: at a bin's mouth
-  // both errors matter.)
-  const double hw = loader.HalfWidth();
-  const double step = std::min(0.1, map.resolution());
-  const double front = loader.tip_reach + loader.body_margin;
-  const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin;
-  // Work in the field's units (before the corrections below): exact below the cap, and a
-  // collision (≤ 0) ends the search.
-  const double correction = step / 2 + map.resolution() / 2;
-  double d_min = std::isfinite(cap) ? cap + correction : kInf;
-  auto outline = [&](const Eigen::Vector2d& hinge, const Eigen::Vector2d& u, double from,
-                     double to) {
+namespace {
+
+// The least distance field along segments of the loader's outline. The distance from a
+// rectangle to the obstacle cells outside it is the least distance field on its outline; the
+// field is sampled every `step`, so the least sample overestimates it by at most step / 2, which
+// `correction` takes off, and half a cell more (the field is between cell centres; an obstacle
+// fills its cell). An obstacle inside a rectangle crossed its outline at an earlier pose of the
+// sweep (poses a path spacing apart, outline samples a fraction of a cell apart): the swept
+// minimum sees it there. (Discs along the centre line, the usual shortcut, either miss the
+// corners or reach far beyond the ends: at a bin's mouth both errors matter.)
+class OutlineProbe {
+ public:
+  OutlineProbe(const GridMap& map, const Eigen::MatrixXf& field, double cap)
+      : map_(map), field_(field), step_(std::min(0.1, map.resolution())) {
+    correction_ = step_ / 2 + map.resolution() / 2;
+    // Work in the field's units: exact below the cap.
+    d_min_ = std::isfinite(cap) ? cap + correction_ : kInf;
+  }
+
+  /// The rectangle [from, to] × [−hw, hw] in the axes (u, n) at `origin`, whole.
+  void Rectangle(const Eigen::Vector2d& origin, const Eigen::Vector2d& u, double from, double to,
+                 double hw) {
     // The field changes by at most the distance moved (plus a cell's interpolation slack): a
     // rectangle whose centre lies farther than its half diagonal beyond the least distance so
     // far cannot lower it. Most poses of a path are skipped so.
-    const double half_diagonal = std::hypot((to - from) / 2, hw);
-    if (Interpolate(map, field, hinge + (from + to) / 2 * u) - half_diagonal - map.resolution() >
-        d_min) {
-      return;
-    }
+    if (Far(origin + (from + to) / 2 * u, std::hypot((to - from) / 2, hw))) return;
     const Eigen::Vector2d n(-u.y(), u.x());
-    const Eigen::Vector2d corners[4] = {hinge + from * u - hw * n, hinge + to * u - hw * n,
-                                        hinge + to * u + hw * n, hinge + from * u + hw * n};
-    // Each edge in pieces of at most 1 m, each piece in sub-pieces of at most `step`, sampled at
-    // their middles (every point of the outline within step / 2 of a sample). A piece whose
-    // middle lies farther than half its length (and a cell) beyond the least distance so far is
-    // skipped whole, by the same bound as above.
-    for (int e = 0; e < 4; ++e) {
-      const Eigen::Vector2d& a = corners[e];
-      const Eigen::Vector2d& b = corners[(e + 1) % 4];
-      const double length = (b - a).norm();
-      const int pieces = std::max(1, static_cast<int>(std::ceil(length / 1.0)));
-      const int subs = std::max(1, static_cast<int>(std::ceil(length / pieces / step)));
-      for (int p = 0; p < pieces; ++p) {
-        const double mid = (p + 0.5) / pieces;
-        if (Interpolate(map, field, a + (b - a) * mid) - length / pieces / 2 - map.resolution() >
-            d_min) {
-          continue;
-        }
-        for (int k = 0; k < subs; ++k) {
-          const double t = (p + (k + 0.5) / subs) / pieces;
-          d_min = std::min(d_min, Interpolate(map, field, a + (b - a) * t));
-        }
+    const Eigen::Vector2d corners[4] = {origin + from * u - hw * n, origin + to * u - hw * n,
+                                        origin + to * u + hw * n, origin + from * u + hw * n};
+    for (int e = 0; e < 4; ++e) Segment(corners[e], corners[(e + 1) % 4]);
+  }
+
+  /// One straight piece of outline.
+  void Segment(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    // In pieces of at most 1 m, each in sub-pieces of at most `step`, sampled at their middles
+    // (every point within step / 2 of a sample). A piece whose middle lies farther than half
+    // its length beyond the least distance so far is skipped whole, by the bound above.
+    const double length = (b - a).norm();
+    const int pieces = std::max(1, static_cast<int>(std::ceil(length / 1.0)));
+    const int subs = std::max(1, static_cast<int>(std::ceil(length / pieces / step_)));
+    for (int p = 0; p < pieces; ++p) {
+      if (Far(a + (b - a) * ((p + 0.5) / pieces), length / pieces / 2)) continue;
+      for (int k = 0; k < subs; ++k) {
+        const double t = (p + (k + 0.5) / subs) / pieces;
+        d_min_ = std::min(d_min_, Interpolate(map_, field_, a + (b - a) * t));
       }
     }
-  };
+  }
+
+  bool Touching() const { return d_min_ <= correction_; }
+  double Distance() const { return d_min_ - correction_; }
+
+ private:
+  bool Far(const Eigen::Vector2d& centre, double radius) const {
+    return Interpolate(map_, field_, centre) - radius - map_.resolution() > d_min_;
+  }
+
+  const GridMap& map_;
+  const Eigen::MatrixXf& field_;
+  double step_, correction_, d_min_;
+};
+
+}  // namespace
+
+double SweptObstacleDistance(const GridMap& map, const Eigen::MatrixXf& field,
+                             const std::vector<PathSample>& samples, const LoaderGeometry& loader,
+                             double cap) {
+  const double hw = loader.HalfWidth();
+  const double front = loader.tip_reach + loader.body_margin;
+  const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin;
+  OutlineProbe probe(map, field, cap);
   for (const PathSample& p : samples) {
     const double gamma = loader.ArticulationFor(p.curvature);
     const Eigen::Vector2d u_front = Direction(p.heading), u_rear = Direction(p.heading - gamma);
     const Eigen::Vector2d hinge = p.xy - loader.hinge_to_front_axle * u_front;
-    outline(hinge, u_front, 0.0, front);
-    outline(hinge, u_rear, -rear, 0.0);
-    if (d_min <= correction) break;  // touching: the path collides, however much more
+    probe.Rectangle(hinge, u_front, 0.0, front, hw);
+    probe.Rectangle(hinge, u_rear, -rear, 0.0, hw);
+    if (probe.Touching()) break;  // the path collides, however much more
   }
-  return d_min - correction;
+  return probe.Distance();
 }
 
-double RoomAhead(const GridMap& map, const Pose2& front_axle, const LoaderGeometry& loader,
-                 double range) {
-  // March the bucket's corridor (±half the body width) cell by cell from the front edge at
-  // this pose; the first obstacle cell ends it. Half-cell steps: no cell is stepped over.
-  const Eigen::Vector2d u = Direction(front_axle.heading), n(-u.y(), u.x());
-  const Eigen::Vector2d front_edge =
-      front_axle.xy + (loader.tip_reach - loader.hinge_to_front_axle + loader.body_margin) * u;
-  const double step = map.resolution() / 2, hw = loader.HalfWidth();
-  for (double along = 0; along <= range; along += step) {
-    for (double across = -hw; across <= hw + 1e-9; across += step) {
-      Index i;
-      if (map.IndexOf(front_edge + along * u + across * n, i) &&
-          IsClass(map, i, CellClass::kObstacle)) {
-        return std::max(0.0, along - map.resolution() / 2);
-      }
+double ScoopSideClearance(const GridMap& map, const Eigen::MatrixXf& field,
+                          const Pose2& front_axle_goal, const LoaderGeometry& loader,
+                          double advance, double spacing, double cap) {
+  const double hw = loader.HalfWidth();
+  const double front = loader.tip_reach + loader.body_margin;
+  const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin;
+  const Eigen::Vector2d u = Direction(front_axle_goal.heading), n(-u.y(), u.x());
+  const Eigen::Vector2d hinge0 = front_axle_goal.xy - loader.hinge_to_front_axle * u;
+  OutlineProbe probe(map, field, cap);
+  const int steps = std::max(1, static_cast<int>(std::ceil(advance / spacing)));
+  for (int k = 0; k <= steps && advance > 0; ++k) {
+    const double s = std::min(k * spacing, advance);
+    const Eigen::Vector2d hinge = hinge0 + s * u;
+    // The front frame's sides, as far as the front edge at contact: beyond it lies what the
+    // crowd meets head on, which the look-ahead ends the crowd for. The rear frame whole.
+    const double side_end = front - s;
+    if (side_end > 0) {
+      probe.Segment(hinge - hw * n, hinge + side_end * u - hw * n);
+      probe.Segment(hinge + hw * n, hinge + side_end * u + hw * n);
     }
+    probe.Rectangle(hinge, u, -rear, 0.0, hw);
+    if (probe.Touching()) break;
   }
-  return kInf;
-}
-
-std::vector<PathSample> WithScoopAdvance(std::vector<PathSample> samples, double advance,
-                                         double spacing) {
-  if (samples.empty() || !(advance > 0)) return samples;
-  // The scoop drives straight on: the main job's path follower steers on along the entry
-  // heading while crowding and holds the articulation once it scoops, so the extension carries
-  // the last heading with no curvature.
-  const PathSample last = samples.back();
-  const Eigen::Vector2d u = Direction(last.heading);
-  const int n = static_cast<int>(std::ceil(advance / spacing));
-  for (int k = 1; k <= n; ++k) {
-    const double ds = std::min(k * spacing, advance);
-    samples.push_back({last.s + ds, last.xy + ds * u, last.heading, 0.0});
-  }
-  return samples;
+  return probe.Distance();
 }
 
 // --- Candidates ---
@@ -597,21 +603,12 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
     // with d_min > 0; failing that the shortest (scored, and vetoed by s_s or the pile check).
     const std::vector<DubinsPath> words =
         AllDubinsPaths(start, c.front_axle_goal, result.max_curvature);
-    // Eq. (14)'s A goes on past the contact: the scoop drives straight in, up to scoop_advance
-    // or until an obstacle straight ahead (less d_res) ends it (the main job's look-ahead ends
-    // crowding there); what it passes beside counts. The same for every word to this pose.
-    const double room =
-        RoomAhead(map, c.front_axle_goal, loader, config.scoop_advance + config.safety_distance);
-    const double advance = std::clamp(room - config.safety_distance, 0.0, config.scoop_advance);
+    // Eq. (14)'s A goes on past the contact: the scoop drives straight in by scoop_advance.
+    // What it passes beside counts; what it meets head on (the pile's far side, a wall behind
+    // a pile) ends the crowd first (the main job's look-ahead). The same for every word here.
     const double d_scoop =
-        advance > 0
-            ? SweptObstacleDistance(
-                  map, distance_field,
-                  WithScoopAdvance({{0.0, c.front_axle_goal.xy, c.front_axle_goal.heading, 0.0}},
-                                   advance, config.path_spacing),
-                  loader, clearance_cap)
-            : kInf;
-    s.scoop_advance = advance;
+        ScoopSideClearance(map, distance_field, c.front_axle_goal, loader, config.scoop_advance,
+                           config.path_spacing, clearance_cap);
     int chosen = -1, rank = 3;  // 0: clear of d_res, 1: not touching, 2: neither
     double chosen_d_min = 0;
     std::vector<PathSample> chosen_samples;

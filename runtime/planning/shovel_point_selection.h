@@ -96,8 +96,8 @@ struct ShovelPointConfig {
   double penetration_length = 2.0;  ///< Ω's depth into the pile along the heading [m]
   /// Eq. (14)'s A is "the area covered by the loader during the process": the approach path and
   /// then the scoop, which drives the machine on along the entry heading after the bucket meets
-  /// the pile. d_min is taken over the path extended straight by this much [m], less where an
-  /// obstacle straight ahead (less d_res) ends the crowd first.
+  /// the pile. d_min also covers the body's sides and rear driven straight on this much [m]
+  /// (ScoopSideClearance).
   double scoop_advance = 2.0;
   double entry_window = 3.0;  ///< the end of the path whose mean |κ| is κ_im [m]
   // Paths.
@@ -117,7 +117,6 @@ struct ScoreBreakdown {
   double torque = 0;                      ///< T_c, Eq. (12) [m⁴], left heavy positive
   double min_obstacle_distance = 0;       ///< d_min, Eq. (14): approach and scoop [m] (+inf: none)
   double approach_obstacle_distance = 0;  ///< d_min of the approach path alone [m]
-  double scoop_advance = 0;  ///< how far past contact A runs: ≤ scoop_advance, room ahead [m]
   double volume_left = 0, volume_middle = 0;  ///< V_l, V_m, Eq. (15) [m³]
   double volume_right = 0;
   double path_length = 0;         ///< l_im, Eq. (16) [m]
@@ -232,16 +231,15 @@ double SweptObstacleDistance(const perception::GridMap& map, const Eigen::Matrix
                              const std::vector<PathSample>& samples, const LoaderGeometry& loader,
                              double cap = std::numeric_limits<double>::infinity());
 
-/// `samples` extended straight on from the last one by `advance` [m] at `spacing`, with the last
-/// heading and zero curvature: the scoop's drive into the pile that Eq. (14)'s area A includes.
-std::vector<PathSample> WithScoopAdvance(std::vector<PathSample> samples, double advance,
-                                         double spacing);
-
-/// Distance from the bucket's front edge (tip_reach + body_margin ahead of the hinge), with the
-/// front axle at `front_axle`, straight ahead to the first obstacle cell in the corridor of the
-/// body's width [m]; +inf when none lies within `range`.
-double RoomAhead(const perception::GridMap& map, const Pose2& front_axle,
-                 const LoaderGeometry& loader, double range);
+/// The scoop's part of Eq. (14)'s A: the least distance from the obstacle cells to the loader
+/// driving straight on from the contact pose (front axle at `front_axle_goal`) by `advance`
+/// [m], sampled every `spacing`: the front frame's sides up to where its front edge was at
+/// contact, and the rear frame whole. What lies straight ahead of the bucket is left out: the
+/// crowd ends before it (the main job's look-ahead). Exact below `cap`, as SweptObstacleDistance.
+double ScoopSideClearance(const perception::GridMap& map, const Eigen::MatrixXf& distance_field,
+                          const Pose2& front_axle_goal, const LoaderGeometry& loader,
+                          double advance, double spacing,
+                          double cap = std::numeric_limits<double>::infinity());
 
 const char* ToString(SelectionStatus status);
 

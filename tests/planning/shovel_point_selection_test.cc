@@ -173,36 +173,49 @@ TEST(ShovelScores, ObstacleDistanceFieldAndSweptDistance) {
   EXPECT_TRUE(std::isinf(ObstacleDistanceField(empty)(3, 3)));
 }
 
-// Eq. (14)'s A covers the scoop too: a path that stops short of an obstacle beside the pile's
-// front keeps its distance, but driving on into the pile brings the body alongside it.
-TEST(ShovelScores, ScoopAdvanceExtendsTheSweptArea) {
+// Eq. (14)'s A covers the scoop too: driving on into the pile brings the body alongside an
+// obstacle beside the pile's front, while one straight ahead is left to the crowd look-ahead.
+TEST(ShovelScores, ScoopSideClearanceSeesBesideNotAhead) {
   GridMap map = FlatMap(0.3, 39, {0.15, 0.15});
-  Index obstacle;
-  ASSERT_TRUE(map.IndexOf({8.1, 3.0}, obstacle));
-  ASSERT_NEAR(map.PositionOf(obstacle).y(), 3.0, 1e-9);
-  map.at("class", obstacle) = static_cast<float>(CellClass::kObstacle);
-  const Eigen::MatrixXf field = ObstacleDistanceField(map);
+  Index beside, ahead;
+  ASSERT_TRUE(map.IndexOf({8.1, 3.0}, beside));
+  ASSERT_NEAR(map.PositionOf(beside).y(), 3.0, 1e-9);
+  map.at("class", beside) = static_cast<float>(CellClass::kObstacle);
   LoaderGeometry loader;
   loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
   loader.max_articulation = 38 * kPi / 180;
   loader.track_width = 2.25;
   loader.bucket_width = 3.0;
   loader.tip_reach = 4.5;
-  const std::vector<PathSample> approach =
-      SamplePath(ShortestDubinsPath({{-10, 0}, 0}, {{0, 0}, 0}, 0.2), 0.25);
-  const std::vector<PathSample> with_scoop = WithScoopAdvance(approach, 6.0, 0.25);
-  ASSERT_EQ(with_scoop.size(), approach.size() + 24);
-  EXPECT_NEAR(with_scoop.back().xy.x(), 6.0, 1e-9);
-  EXPECT_NEAR(with_scoop.back().s, approach.back().s + 6.0, 1e-9);
-  EXPECT_EQ(with_scoop.back().curvature, 0.0);
-  // Without the advance the front (hinge at x = −1.6, reach 4.5 + 0.3 m) ends 4.8 m short of
-  // the cell's near face; with it the side passes 3 m − hw from the cell's centre.
+  const Eigen::MatrixXf field = ObstacleDistanceField(map);
+  // Contact with the front axle at the origin heading +x: hinge at −1.6, front edge at 3.2.
+  const Pose2 contact{{0, 0}, 0};
   const double exact_beside = 3.0 - loader.HalfWidth() - 0.15;
-  EXPECT_GT(SweptObstacleDistance(map, field, approach, loader), exact_beside + 1.0);
-  const double d = SweptObstacleDistance(map, field, with_scoop, loader);
+  // Without driving on, the obstacle is 4.8 m ahead of the front edge's end, far beyond d_res.
+  EXPECT_TRUE(std::isinf(ScoopSideClearance(map, field, contact, loader, 0.0, 0.25)));
+  // Driving 6 m on: the sides count only up to the contact's front edge (x ≤ 3.2) and the rear
+  // frame reaches x ≤ 4.4, so a cell at x = 8.1 (met head on, by the bucket) stays far.
+  const double d6 = ScoopSideClearance(map, field, contact, loader, 6.0, 0.25);
+  EXPECT_GT(d6, exact_beside + 1.0);
+  // A cell beside the front axle's contact position instead, (2.1, 3.0): the sides pass it.
+  map.at("class", beside) = static_cast<float>(CellClass::kGround);
+  ASSERT_TRUE(map.IndexOf({2.1, 3.0}, beside));
+  map.at("class", beside) = static_cast<float>(CellClass::kObstacle);
+  // And a wall straight ahead, 1 m beyond the front edge, across the corridor.
+  for (double y = -1.5; y <= 1.5; y += 0.3) {
+    ASSERT_TRUE(map.IndexOf({4.35, y}, ahead));
+    map.at("class", ahead) = static_cast<float>(CellClass::kObstacle);
+  }
+  const Eigen::MatrixXf field2 = ObstacleDistanceField(map);
+  const double d = ScoopSideClearance(map, field2, contact, loader, 3.0, 0.25);
+  // The side edge runs along y = hw, 3 − hw from the beside cell's centre; the wall's cells
+  // (x = 4.35) lie at least 1.15 m beyond the sides' ends (x ≤ 3.2): the beside cell decides.
   EXPECT_LE(d, exact_beside + 1e-6);
   EXPECT_GT(d, exact_beside - 0.15);
-  EXPECT_EQ(WithScoopAdvance(approach, 0.0, 0.25).size(), approach.size());
+  // The whole body driven 3 m on would run into that wall: SweptObstacleDistance says so.
+  std::vector<PathSample> straight;
+  for (int k = 0; k <= 12; ++k) straight.push_back({0.25 * k, {0.25 * k, 0.0}, 0.0, 0.0});
+  EXPECT_LE(SweptObstacleDistance(map, field2, straight, loader), 0.0);
 }
 
 // The body is a rectangle up to its corners: an obstacle off the front corner, diagonally

@@ -51,6 +51,10 @@ ArmCalibrationData ReadArmCalibrationCsv(const std::string& path,
     header_row = row;
     break;
   }
+  if (header.empty()) {
+    sink.Add({path, 0, 0}, "", "no header row (the file is empty or only comments)");
+    sink.ThrowIfAny();
+  }
   // Find each wanted column with its unit.
   const double deg = std::numbers::pi / 180.0;
   auto find = [&](const std::string& stem,
@@ -85,6 +89,12 @@ ArmCalibrationData ReadArmCalibrationCsv(const std::string& path,
     ++row;
     if (line.empty() || line[0] == '#') continue;
     const std::vector<std::string> cells = SplitCsv(line);
+    if (cells.size() != header.size()) {  // a cell lost or added shifts every column after it
+      sink.Add({path, row, 1}, "",
+               std::to_string(cells.size()) + " cells, expected " + std::to_string(header.size()) +
+                   " like the header (row " + std::to_string(header_row) + ")");
+      continue;
+    }
     auto number = [&](const Column& c, const std::string& name, bool optional, bool& present) {
       present = false;
       if (c.index >= static_cast<int>(cells.size()) || cells[c.index].empty()) {
@@ -115,6 +125,9 @@ ArmCalibrationData ReadArmCalibrationCsv(const std::string& path,
     data.angles.push_back(pose);
     rows.push_back(row);
     displacement.push_back({has_dx && has_dz, Eigen::Vector2d(x, z)});
+  }
+  if (rows.empty() && sink.empty()) {
+    sink.Add({path, header_row, 1}, "", "no pose rows after the header");
   }
   // Every pose but the last needs its displacement to the next one.
   for (std::size_t i = 0; i + 1 < displacement.size(); ++i) {

@@ -22,6 +22,8 @@ namespace autoshovel::identification {
 
 namespace {
 
+constexpr float kMaxRange = 10000.0f;  // [m], far beyond any LiDAR's range
+
 [[noreturn]] void Fail(const std::string& file, int line, const std::string& key,
                        const std::string& message) {
   core::DiagnosticSink sink;
@@ -211,7 +213,26 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
     }
     return;
   }
+  // pcl::io's header parser does not stop at DATA: it reads on, skipping empty lines, comments
+  // and VERSION, and takes a line that starts with a header keyword for more header. Binary data
+  // that begins like that redefines the fields under the decoder, which then reads out of
+  // bounds (found by tests/fuzz: data starting with "COLUMNS", PCL's old name for FIELDS).
   const std::streamoff start = in.tellg();
+  for (int at = line_no + 1; std::getline(in, line); ++at) {
+    const std::vector<std::string> w = Split(line);
+    if (line.empty() || (!w.empty() && (w[0][0] == '#' || w[0].starts_with("VERSION")))) continue;
+    for (const char* header_key : {"FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT",
+                                   "VIEWPOINT", "POINTS", "DATA"}) {
+      if (!w.empty() && w[0].starts_with(header_key)) {
+        Fail(path, at, "DATA",
+             "the " + data + " data begins with '" + header_key +
+                 "', which pcl::io would read as another header line");
+      }
+    }
+    break;
+  }
+  in.clear();
+  in.seekg(start);
   in.seekg(0, std::ios::end);
   const long remaining = static_cast<long>(in.tellg() - start);
   if (data == "binary") {
@@ -288,10 +309,21 @@ sensors::PointCloud ReadKittiBin(const std::string& path, std::size_t max_points
   sensors::PointCloud cloud;
   cloud.sensor = std::filesystem::path(path).stem().string();
   std::mt19937_64 rng(0x5eed);
-  long seen = 0;
+  long seen = 0, offset = 0;
   float v[4];
-  while (in.read(reinterpret_cast<char*>(v), sizeof v)) {
+  for (; in.read(reinterpret_cast<char*>(v), sizeof v); offset += sizeof v) {
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
+    // No LiDAR sees 10 km: such a coordinate is a file that is not float32 x y z i (text, a PCD
+    // renamed .bin, float64), which would otherwise decode to a cloud of nonsense.
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(v[k]) > kMaxRange) {
+        std::ostringstream message;
+        message << "byte " << offset + 4 * k << " (point " << offset / 16 << ", "
+                << "xyz"[k] << "): " << v[k] << " m is no LiDAR return (|"
+                << "xyz"[k] << "| > " << kMaxRange << " m): not float32 x, y, z, intensity?";
+        Fail(path, 0, "", message.str());
+      }
+    }
     sensors::LidarPoint q;
     q.p_sensor = Eigen::Vector3f(v[0], v[1], v[2]);
     q.intensity = std::isfinite(v[3]) ? v[3] : 0.0f;

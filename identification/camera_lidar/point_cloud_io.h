@@ -7,6 +7,7 @@
 //   cloud.pcd:12:1: expected 4 values (x y z intensity), got 3
 //   cloud.pcd:11:1: DATA: truncated: the header promises 100 points (1600 bytes), 1000 follow
 //   cloud.bin: size 1234 bytes is not a multiple of 16 (float32 x, y, z, intensity per point)
+//   cloud.bin: byte 36 (point 2, y): 1e+30 m is no LiDAR return (|y| > 10000 m): ...
 // The header is checked here, line by line; the data is then decoded by pcl::io (PCDReader),
 // which also handles binary_compressed (LZF). Points with a non-finite coordinate (an
 // organised cloud's "no return") are dropped.

@@ -138,8 +138,16 @@ std::vector<Demonstration> ReadDemonstrations(const std::filesystem::path& file,
   {
     Statement s = Prepare(file, db.get(), "SELECT key, value FROM meta");
     while (sqlite3_step(s.get()) == SQLITE_ROW) {
-      values[reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 0))] =
-          reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1));
+      const unsigned char* key = sqlite3_column_text(s.get(), 0);
+      const unsigned char* value = sqlite3_column_text(s.get(), 1);
+      if (key == nullptr || value == nullptr) {
+        throw std::runtime_error(
+            file.string() + ": meta: a NULL " +
+            (key == nullptr
+                 ? "key"
+                 : "value of '" + std::string(reinterpret_cast<const char*>(key)) + "'"));
+      }
+      values[reinterpret_cast<const char*>(key)] = reinterpret_cast<const char*>(value);
     }
   }
   if (values["format"] != kDemonstrationFormat) {
@@ -160,6 +168,15 @@ std::vector<Demonstration> ReadDemonstrations(const std::filesystem::path& file,
     const std::string where = file.string() + ": demonstration " + std::to_string(d.id) + ": ";
     const unsigned char* kind = sqlite3_column_text(r, 1);
     d.kind = kind != nullptr ? reinterpret_cast<const char*>(kind) : "";
+    // A NULL or text where a number belongs would read as 0: refuse it, naming the column.
+    for (int c = 2; c < 16; ++c) {
+      const int type = sqlite3_column_type(r, c);
+      if (type != SQLITE_FLOAT && type != SQLITE_INTEGER) {
+        throw std::runtime_error(where + sqlite3_column_name(r, c) + " is " +
+                                 (type == SQLITE_NULL ? std::string("NULL") : "not a number") +
+                                 ", expected a number");
+      }
+    }
     const double resolution = sqlite3_column_double(r, 2);
     const int nx = sqlite3_column_int(r, 3), ny = sqlite3_column_int(r, 4);
     double v[11];
@@ -188,6 +205,12 @@ std::vector<Demonstration> ReadDemonstrations(const std::filesystem::path& file,
       throw std::runtime_error(where + "the map's size does not match its cells");
     }
     std::memcpy(elevation.data(), sqlite3_column_blob(r, 16), cells * sizeof(float));
+    for (std::size_t i = 0; i < cells; ++i) {  // NaN is "unknown"; an infinity is corrupt
+      if (std::isinf(elevation.data()[i])) {
+        throw std::runtime_error(where + "elevation at cell " + std::to_string(i) +
+                                 " is infinite (NaN marks an unknown cell)");
+      }
+    }
     const auto* bytes = static_cast<const std::uint8_t*>(sqlite3_column_blob(r, 17));
     for (std::size_t i = 0; i < cells; ++i) {
       if (bytes[i] == kUnknownClass) {

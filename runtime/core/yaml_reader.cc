@@ -331,6 +331,13 @@ void MapReader::Finish() {
   const std::vector<std::string> known(known_keys_.begin(), known_keys_.end());
   std::set<std::string> explained;  // missing keys that an unknown key probably misspells
   for (auto it = node_.begin(); it != node_.end(); ++it) {
+    // YAML allows any node as a key (`? [a, b]`, `{[1, 2]: x}`, an empty `?`); converting one
+    // that is not a scalar to a string throws YAML::BadConversion (found by tests/fuzz).
+    if (!it->first.IsScalar()) {
+      file_->sink().Add(core::LocationOf(file_->file(), it->first), key_path_,
+                        "a key must be a name, got " + Describe(it->first));
+      continue;
+    }
     const std::string key = it->first.as<std::string>();
     if (known_keys_.count(key) > 0) continue;
     std::string message = "unknown key '" + key + "'";

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -24,6 +25,104 @@ constexpr int kFormatVersion = 1;
   sink.Add(core::SourceLocation{file, line, line > 0 ? 1 : 0}, "", message);
   sink.ThrowIfAny();
   throw std::logic_error("unreachable");
+}
+
+bool ParseFinite(const std::string& word, double& value) {
+  char* end = nullptr;
+  value = std::strtod(word.c_str(), &end);
+  return !word.empty() && end == word.c_str() + word.size() && std::isfinite(value);
+}
+
+// libsvm's svm_load_model reports nothing but failure, takes "nan" for a number and, when the
+// file ends before `total_sv` support vectors, repeats the last line read. So the text is checked
+// here first, line by line: a header of known keys with finite numbers, "SV", then exactly
+// total_sv lines `coefficient index:value ...` with increasing indices and finite numbers.
+void CheckLibsvmModel(const std::string& path, int features) {
+  std::ifstream file(path);
+  if (!file) Refuse(path, 0, "cannot open the libsvm model file (written by train_predictor)");
+  std::string text;
+  int line = 0;
+  long total_sv = -1, seen = 0;
+  bool in_vectors = false;
+  while (std::getline(file, text)) {
+    ++line;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    std::istringstream in(text);
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    if (!in_vectors) {
+      if (words.empty()) Refuse(path, line, "empty line in the header");
+      const std::string& key = words[0];
+      if (key == "SV" && words.size() == 1) {
+        in_vectors = true;
+        continue;
+      }
+      static const std::vector<std::string> kNumeric = {"degree",   "gamma", "coef0", "nr_class",
+                                                        "total_sv", "rho",   "label", "probA",
+                                                        "probB",    "nr_sv"};
+      if (key == "svm_type" || key == "kernel_type") {
+        const std::string expected = key == "svm_type" ? "epsilon_svr" : "rbf";
+        if (words.size() != 2 || words[1] != expected) {
+          Refuse(path, line,
+                 key + ": expected " + expected +
+                     " (the predictor is an epsilon-SVR with an RBF kernel), got '" +
+                     text.substr(std::min(text.size(), key.size() + 1)) + "'");
+        }
+        continue;
+      }
+      if (std::find(kNumeric.begin(), kNumeric.end(), key) == kNumeric.end()) {
+        Refuse(path, line,
+               "'" + key +
+                   "' is not a libsvm model header key (svm_type, kernel_type, "
+                   "gamma, nr_class, total_sv, rho, ..., then SV)");
+      }
+      if (words.size() < 2) Refuse(path, line, key + ": no value");
+      for (std::size_t i = 1; i < words.size(); ++i) {
+        double v = 0;
+        if (!ParseFinite(words[i], v)) {
+          Refuse(
+              path, line,
+              key + ": value " + std::to_string(i) + " '" + words[i] + "' is not a finite number");
+        }
+        if (key == "total_sv") total_sv = v >= 0 && v == std::floor(v) ? static_cast<long>(v) : -1;
+      }
+      if (key == "total_sv" && total_sv < 0) Refuse(path, line, "total_sv: expected a count");
+      continue;
+    }
+    if (words.empty()) continue;
+    if (++seen > total_sv) {
+      Refuse(path, line, "more support vectors than total_sv " + std::to_string(total_sv));
+    }
+    double v = 0;
+    if (!ParseFinite(words[0], v)) {
+      Refuse(path, line, "coefficient '" + words[0] + "' is not a finite number");
+    }
+    long last_index = 0;
+    for (std::size_t i = 1; i < words.size(); ++i) {
+      const std::size_t colon = words[i].find(':');
+      char* end = nullptr;
+      const long index = colon == std::string::npos ? 0 : std::strtol(words[i].c_str(), &end, 10);
+      if (colon == std::string::npos || end != words[i].c_str() + colon || index <= last_index ||
+          !ParseFinite(words[i].substr(colon + 1), v)) {
+        Refuse(path, line,
+               "'" + words[i] + "' is not index:value (increasing index >= 1, finite value)");
+      }
+      if (index > features) {
+        Refuse(path, line,
+               "support vector " + std::to_string(seen) + " uses feature index " +
+                   std::to_string(index) + ", the scaling file has " + std::to_string(features) +
+                   " features");
+      }
+      last_index = index;
+    }
+  }
+  if (!in_vectors) Refuse(path, line, "no 'SV' line: not a libsvm model file");
+  if (total_sv < 0) Refuse(path, line, "no total_sv in the header");
+  if (seen < total_sv) {
+    Refuse(path, line + 1,
+           "truncated: total_sv " + std::to_string(total_sv) + ", " + std::to_string(seen) +
+               " support vectors follow");
+  }
 }
 
 }  // namespace
@@ -188,6 +287,7 @@ PenetrationPredictor PenetrationPredictor::Load(const std::string& path_stem) {
   if (!std::filesystem::is_regular_file(path)) {
     Refuse(path, 0, "cannot open the libsvm model file (written by train_predictor)");
   }
+  CheckLibsvmModel(path, static_cast<int>(scaling.names.size()));
   auto model = std::make_unique<Model>();
   model->svm = svm_load_model(path.c_str());
   if (model->svm == nullptr) {

@@ -1,0 +1,130 @@
+// The fuzz targets' inputs as ordinary tests, in the normal build (no clang, no libFuzzer): every
+// seed of tests/fuzz/corpus/<target>/ and every input kept in tests/fuzz/regressions/<target>/
+// (a fuzzing finding, since fixed) goes through the reader that target fuzzes, read the same way.
+// Seeds named `valid_*` must be read; every other input must be refused with core::InputError,
+// located (refusal.h: every diagnostic names the file and a line of it, or 0 for the whole file).
+// Any other exception fails the test; a crash fails the whole executable.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "identification/calibration/arm_calibration_csv.h"
+#include "identification/camera_lidar/point_cloud_io.h"
+#include "identification/hydraulics/log_reader.h"
+#include "runtime/core/diagnostics.h"
+#include "runtime/model/description.h"
+#include "tests/fuzz/hydraulic_log_formats.h"
+#include "tests/fuzz/refusal.h"
+
+namespace autoshovel::fuzz {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kFuzzDir = fs::path(AUTOSHOVEL_SOURCE_DIR) / "tests" / "fuzz";
+
+std::vector<fs::path> FilesIn(const fs::path& dir) {
+  std::vector<fs::path> files;
+  if (!fs::is_directory(dir)) return files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.is_regular_file()) files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+int LinesOf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return CountLines(std::string(std::istreambuf_iterator<char>(in), {}));
+}
+
+// Reads `path` as the fuzz target does; returns its refusal, if any. Throws whatever else the
+// reader throws (a finding).
+using Read = std::function<std::optional<core::InputError>(const std::string& path)>;
+
+template <typename F>
+std::optional<core::InputError> Refusal(F&& read) {
+  try {
+    read();
+  } catch (const core::InputError& e) {
+    return e;
+  }
+  return std::nullopt;
+}
+
+struct Counts {
+  int valid = 0, refused = 0;
+};
+
+Counts CheckTarget(const std::string& target, const Read& read) {
+  Counts counts;
+  for (const char* kind : {"corpus", "regressions"}) {
+    for (const fs::path& file : FilesIn(kFuzzDir / kind / target)) {
+      const std::string path = file.string();
+      const bool valid =
+          std::string(kind) == "corpus" && file.filename().string().starts_with("valid_");
+      SCOPED_TRACE(path);
+      const std::optional<core::InputError> refusal = read(path);
+      if (valid) {
+        EXPECT_FALSE(refusal) << "a valid seed was refused:\n" << refusal->what();
+        ++counts.valid;
+      } else if (!refusal) {
+        ADD_FAILURE() << "a malformed input was accepted";
+      } else {
+        EXPECT_EQ(RefusalProblem(*refusal, path, LinesOf(path)), "");
+        ++counts.refused;
+      }
+    }
+  }
+  return counts;
+}
+
+// Each target has valid and malformed seeds: an empty or misnamed corpus must not pass quietly.
+void ExpectBothKinds(const Counts& counts) {
+  EXPECT_GE(counts.valid, 2);
+  EXPECT_GE(counts.refused, 2);
+}
+
+TEST(FuzzRegressions, Description) {
+  model::LoadOptions options;
+  options.materials_dir = AUTOSHOVEL_SOURCE_DIR "/models/materials";
+  ExpectBothKinds(CheckTarget("description", [&](const std::string& path) {
+    return Refusal([&] { model::LoadMachineDescription(path, options); });
+  }));
+}
+
+TEST(FuzzRegressions, ArmCalibrationCsv) {
+  ExpectBothKinds(CheckTarget("arm_calibration_csv", [](const std::string& path) {
+    return Refusal([&] { identification::ReadArmCalibrationCsv(path, {"boom", "bucket"}); });
+  }));
+}
+
+// Read in both formats, like the fuzz target: every refusal must be located, and an input counts
+// as refused when either format refuses it.
+TEST(FuzzRegressions, HydraulicLog) {
+  ExpectBothKinds(CheckTarget("hydraulic_log", [](const std::string& path) {
+    std::optional<core::InputError> first;
+    for (const identification::LogFormat& format : HydraulicLogFormats()) {
+      auto refusal = Refusal([&] { identification::ReadHydraulicLog(path, format); });
+      if (refusal && !first) first = refusal;
+      if (refusal) EXPECT_EQ(RefusalProblem(*refusal, path, LinesOf(path)), "");
+    }
+    return first;
+  }));
+}
+
+TEST(FuzzRegressions, Pcd) {
+  ExpectBothKinds(CheckTarget("pcd", [](const std::string& path) {
+    return Refusal([&] { identification::ReadPointCloud(path, /*max_points=*/64); });
+  }));
+}
+
+}  // namespace
+}  // namespace autoshovel::fuzz

@@ -1,0 +1,2 @@
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT);
+INSERT INTO meta VALUES ('format', 'autoshovel-demonstrations-1');

@@ -114,7 +114,9 @@ TEST(FuzzRegressions, HydraulicLog) {
     for (const identification::LogFormat& format : HydraulicLogFormats()) {
       auto refusal = Refusal([&] { identification::ReadHydraulicLog(path, format); });
       if (refusal && !first) first = refusal;
-      if (refusal) EXPECT_EQ(RefusalProblem(*refusal, path, LinesOf(path)), "");
+      if (refusal) {
+        EXPECT_EQ(RefusalProblem(*refusal, path, LinesOf(path)), "");
+      }
     }
     return first;
   }));

@@ -79,6 +79,15 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
   int next_key = 0;
   while (data.empty() && std::getline(in, line)) {
     ++line_no;
+    // pcl::io skips empty lines but ends the header at one of only blanks (" ", a lone "\r"),
+    // then decodes without fields: a null dereference (found by tests/fuzz). It splits on space,
+    // tab and CR only, so a vertical tab or form feed would split the line differently there.
+    if (!line.empty() && line.find_first_not_of(" \t\r\v\f") == std::string::npos) {
+      Fail(path, line_no, "", "a header line of only blanks (pcl::io would end the header here)");
+    }
+    if (line.find_first_of("\v\f") != std::string::npos) {
+      Fail(path, line_no, "", "a vertical tab or form feed in the header");
+    }
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty() || line[0] == '#') continue;
     const std::vector<std::string> w = Split(line);

@@ -12,7 +12,7 @@
 namespace autoshovel::app {
 
 std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, double margin,
-                                               int growth_cells) {
+                                               int growth_cells, double min_confidence) {
   const Eigen::MatrixXf& cls = map["class"];
   // The evidence that an obstacle stands in the cell (semantic_map.h): a wall seen over a pile
   // top at a grazing angle does not make the pile top a place to stop before.
@@ -23,7 +23,7 @@ std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, d
   const float obstacle = static_cast<float>(perception::CellClass::kObstacle);
   const int nx = static_cast<int>(cls.rows()), ny = static_cast<int>(cls.cols());
   auto confident = [&](int ix, int iy) {
-    return cls(ix, iy) == obstacle && obstacle_confidence(ix, iy) >= 0.95;
+    return cls(ix, iy) == obstacle && obstacle_confidence(ix, iy) >= min_confidence;
   };
   Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> sure(nx, ny);
   for (int iy = 0; iy < ny; ++iy) {

@@ -15,14 +15,15 @@
 namespace autoshovel::app {
 
 /// Centres of the map's *sure* obstacle cells [m, world]: class obstacle with obstacle
-/// confidence ("steep_obstacle_confidence" where the map has it, semantic_map.h) ≥ 0.95 and ≥ the
+/// confidence ("steep_obstacle_confidence" where the map has it, semantic_map.h) ≥
+/// `min_confidence` and ≥ the
 /// pile confidence + `margin`, plus the cells of confidence ≥ 0.95 within `growth_cells` cells of
 /// those. A pile's top the camera saw only obliquely comes out of Eq. (11) as obstacle by its
 /// height with both confidences middling (obstacle 0.6–0.8, pile 0.4–0.9): the bucket already in
 /// the pile must not stop for it. A wall's face next to a pile's crest carries pile evidence too
 /// (the boundary is blurred), hence the growth.
 std::vector<Eigen::Vector2d> SureObstacleCells(const perception::GridMap& map, double margin,
-                                               int growth_cells);
+                                               int growth_cells, double min_confidence = 0.95);
 
 /// The farthest horizontal reach of a loader's bucket tip from the hinge while scooping from
 /// (q_boom, q_bucket): the boom raised by every Stairway lift and the exit lift, the bucket as

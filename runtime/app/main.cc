@@ -325,6 +325,7 @@ int main(int argc, char** argv) {
   select_cmd->add_flag("--no-baseline", no_baseline, "Skip the Chen et al. (2024) ranking");
 
   autoshovel::app::ShovelRunOptions run;
+  std::string run_faults;
   std::string run_out, run_policy = "auto", run_trigger = "predicted", run_selection = "ours";
   double run_pressure_bar = run.pressure_threshold / 1e5;
   CLI::App* run_cmd = app.add_subcommand(
@@ -366,6 +367,10 @@ int main(int argc, char** argv) {
                    "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
       ->check(CLI::Range(0, 10))
       ->capture_default_str();
+  run_cmd
+      ->add_option("--faults", run_faults,
+                   "YAML file with a 'faults' list injected into every cycle (docs/faults.md)")
+      ->check(CLI::ExistingFile);
   run_cmd
       ->add_option("--yard-variation", run.yard_variation,
                    "Restock the piles up to this fraction lower (a campaign's yard_variation)")
@@ -450,6 +455,14 @@ int main(int argc, char** argv) {
                                                 : TriggerChoice::kPressure;
     run.selection = run_selection == "ours" ? autoshovel::app::SelectionMethod::kOurs
                                             : autoshovel::app::SelectionMethod::kChen2024;
+    if (!run_faults.empty()) {
+      try {
+        run.faults = autoshovel::plant::LoadFaults(run_faults);
+      } catch (const std::exception& e) {
+        std::cerr << "autoshovel run: " << e.what() << "\n";
+        return 2;
+      }
+    }
     return autoshovel::app::RunShovelCommand(run, run_out, std::cout, std::cerr);
   }
 

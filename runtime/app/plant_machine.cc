@@ -1,7 +1,9 @@
 // The plant as a ScoopMachine (plant_machine.h).
 #include "runtime/app/plant_machine.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace autoshovel::app {
 
@@ -14,8 +16,8 @@ control::Proprioception PlantMachine::Sense() const {
   const plant::MachineState& s = plant_.state();
   control::Proprioception p;
   p.time = s.time;
-  p.hinge_xy = s.hinge_xy;
-  p.heading = s.heading;
+  p.hinge_xy = s.hinge_xy + pose_offset_;
+  p.heading = std::remainder(s.heading + heading_offset_, 2 * std::numbers::pi);
   p.articulation = s.articulation;
   p.speed = s.speed;
   p.q_boom = s.q[0], p.q_bucket = s.q[1];
@@ -25,8 +27,16 @@ control::Proprioception PlantMachine::Sense() const {
 }
 
 bool PlantMachine::Command(const core::ActuatorCommand& command, std::string* why) {
+  last_command_ = command;
   core::ActuatorCommand sent = command;
   if (std::isfinite(steering_override_)) sent.articulation_rate = steering_override_;
+  if (stuck_actuator_ >= 0 && stuck_actuator_ < static_cast<int>(sent.valve.size())) {
+    sent.valve[static_cast<std::size_t>(stuck_actuator_)] = 0.0;
+  }
+  if (hold_stop_) {
+    sent.drive = 0, sent.brake = 1, sent.articulation_rate = 0;
+    std::fill(sent.valve.begin(), sent.valve.end(), 0.0);
+  }
   for (double u : sent.valve) all_finite_ = all_finite_ && std::isfinite(u);
   all_finite_ = all_finite_ && std::isfinite(sent.drive) && std::isfinite(sent.brake) &&
                 std::isfinite(sent.articulation_rate);

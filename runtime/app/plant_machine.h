@@ -29,6 +29,20 @@ class PlantMachine : public control::ScoopMachine {
   /// caller gives; NaN: the caller's.
   void SetSteeringOverride(double articulation_rate) { steering_override_ = articulation_rate; }
 
+  // Faults (plant/fault_spec.h) and the safety interlock.
+  /// The localisation's error: Sense() reports the hinge this far off and the heading turned.
+  void SetPoseError(const Eigen::Vector2d& offset, double heading) {
+    pose_offset_ = offset, heading_offset_ = heading;
+  }
+  /// The valve of `actuator` stays at neutral whatever is commanded (−1: none).
+  void SetStuckValve(int actuator) { stuck_actuator_ = actuator; }
+  /// While held, every command is replaced by a stop: brake on, drive off, valves and steering
+  /// at rest (the supervisor's interlock; it holds whatever the caller commands).
+  void HoldStop(bool hold) { hold_stop_ = hold; }
+  bool holding_stop() const { return hold_stop_; }
+  /// The last command as the caller gave it (before faults and the interlock).
+  const core::ActuatorCommand& last_command() const { return last_command_; }
+
   bool all_commands_finite() const { return all_finite_; }
   long commands() const { return commands_; }
   plant::Plant& plant() { return plant_; }
@@ -39,6 +53,11 @@ class PlantMachine : public control::ScoopMachine {
   double steering_override_;
   bool all_finite_ = true;
   long commands_ = 0;
+  Eigen::Vector2d pose_offset_ = Eigen::Vector2d::Zero();
+  double heading_offset_ = 0;
+  int stuck_actuator_ = -1;
+  bool hold_stop_ = false;
+  core::ActuatorCommand last_command_;
 };
 
 }  // namespace autoshovel::app

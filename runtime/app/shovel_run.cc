@@ -378,7 +378,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
                                scoop_options.attack_pose.bucket, scoop_options.strategy) -
                         st.loader.tip_reach);
 
-  enum class Stage { kSelect, kNavigate, kScoop, kDone } stage = Stage::kSelect;
+  // kSafeStop: the supervisor abandoned the cycle; the machine brakes to rest, then kDone.
+  enum class Stage { kSelect, kNavigate, kScoop, kSafeStop, kDone } stage = Stage::kSelect;
   std::optional<planning::ShovelCandidate> goal;
   std::optional<control::PathFollower> follower;
   std::unique_ptr<control::ScoopTrigger> trigger;
@@ -403,6 +404,35 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   double perception_seconds = 0, selection_seconds = 0;
   const double t0 = plant.time();
 
+  // Faults this cycle meets (plant/fault_spec.h): the scenario's and the run's own; and the
+  // supervisor that answers them (safety_supervisor.h).
+  std::vector<plant::FaultSpec> faults = scenario.faults;
+  faults.insert(faults.end(), o.faults.begin(), o.faults.end());
+  auto active = [&](plant::FaultKind kind) -> const plant::FaultSpec* {
+    for (const plant::FaultSpec& f : faults) {
+      if (f.kind == kind && f.ActiveAt(index, plant.time() - t0)) return &f;
+    }
+    return nullptr;
+  };
+  SafetySupervisor supervisor(o.supervisor);
+  std::vector<plant::OrientedBox> fault_obstacles;  ///< people a fault put in the yard
+  bool person_placed = false;
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> planned_obstacles;  ///< see start_path
+  double last_reason_seen = -1e9;         ///< when the supervisor last saw a reason to hold [s]
+  std::vector<Eigen::Vector2d> nav_sure;  ///< the current map's sure obstacle cells
+  double stop_speed = 0, stop_xy_travel = 0;
+  Eigen::Vector2d stop_xy = Eigen::Vector2d::Zero();
+  // Abandons the cycle: the interlock holds the machine stopped until it rests.
+  auto safe_stop = [&](const std::string& reason) {
+    supervisor.Stop(reason);
+    machine_io.HoldStop(true);
+    stop_xy = plant.state().hinge_xy;
+    stop_speed = std::abs(plant.state().speed);
+    out.failure = "safe stop: " + reason;
+    stage = Stage::kSafeStop;
+    say("SAFE STOP at t = " + Fixed(plant.time() - t0, 2) + " s: " + reason);
+  };
+
   control::JointPid boom_pid(
       scoop_options.boom_gains,
       machine.hydraulics.actuators[machine.ActuatorOfJoint(0)].valve.dead_zone);
@@ -426,7 +456,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     for (auto& p : piles) {
       if (in_site(p.centroid)) in_bin.push_back(std::move(p));
     }
-    const plant::MachineState& s = plant.state();
+    // From the localisation (a jump moves where the machine believes it stands).
+    const control::Proprioception s = machine_io.Sense();
     const planning::Pose2 T_world_hinge{s.hinge_xy, s.heading};
     last_selection =
         planning::SelectShovelPoints(grid, in_bin, plane, T_world_hinge, st.loader, select_config);
@@ -470,9 +501,30 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   };
   auto update_map = [&]() {
     const auto w0 = std::chrono::steady_clock::now();
-    st.scene->SetExtraBoxes(plant.OwnBodies());
-    perceive.lidar_frames = perception_calls == 0 ? 5 : 1;
+    std::vector<plant::OrientedBox> extra = plant.OwnBodies();
+    extra.insert(extra.end(), fault_obstacles.begin(), fault_obstacles.end());
+    st.scene->SetExtraBoxes(std::move(extra));
+    const bool lidar = active(plant::FaultKind::kLidarDropout) == nullptr;
+    perceive.lidar_frames = !lidar ? 0 : perception_calls == 0 ? 5 : 1;
+    perceive.camera_frame = active(plant::FaultKind::kCameraBlackout) == nullptr;
     perception::PerceiveFromPlant(plant, *st.scene, st.rng, perceive, *st.map, *st.semantic);
+    if (lidar) supervisor.LidarFrame(plant.time());
+    if (perceive.camera_frame) supervisor.CameraFrame(plant.time());
+    // The look-ahead along the path stops for less: a person who stepped in is in the
+    // obstacle evidence at 0.5 two frames later (blended at 0.3 a frame), at 0.95 only after
+    // nine (1.3 s at 7 Hz, beyond a loader's stopping distance at 1.5 m/s).
+    // Only what stands at least `path_obstacle_height` above the ground plane: a low cell's
+    // middling obstacle evidence is a shadow or a label's blur on the floor, not a person.
+    nav_sure.clear();
+    const Eigen::Vector3d plane = st.semantic->ground_plane();
+    for (const Eigen::Vector2d& c :
+         SureObstacleCells(st.map->map(), o.path_obstacle_margin, 0, o.path_obstacle_confidence)) {
+      perception::Index i;
+      if (!st.map->map().IndexOf(c, i)) continue;
+      const double height =
+          st.map->map().at("elevation", i) - (plane.x() * c.x() + plane.y() * c.y() + plane.z());
+      if (height >= o.path_obstacle_height) nav_sure.push_back(c);
+    }
     ++perception_calls;
     perception_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
@@ -486,9 +538,14 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     if (new_goal) {
       goal_selection = last_selection;
       goal_baseline = last_baseline;
-      goal_from = {plant.state().hinge_xy, plant.state().heading};
+      const control::Proprioception now = machine_io.Sense();
+      goal_from = {now.hinge_xy, now.heading};
     }
     follower.emplace(planning::SamplePath(c.path, 0.1), st.loader);
+    // The obstacles this path was planned round: the look-ahead along the path stops only for
+    // the others (those that came after).
+    const Eigen::MatrixXf& cls = st.map->map()["class"];
+    planned_obstacles = (cls.array() == static_cast<float>(perception::CellClass::kObstacle));
   };
 
   MultiRateExecutive executive(1.0 / o.control_rate, plant.time());
@@ -554,24 +611,161 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       }
     }
   });
+  // The supervisor's 20 Hz checks (safety_supervisor.h): faults that put a person in the way,
+  // the sensor watchdog and the look-ahead along the path while driving, the actuators.
+  auto SuperviseAt20Hz = [&]() {
+    const plant::MachineState& truth = plant.state();
+    const control::Proprioception sensed = machine_io.Sense();
+    const plant::FaultSpec* person = active(plant::FaultKind::kPersonEntersPath);
+    if (person != nullptr && !person_placed && stage == Stage::kNavigate && goal) {
+      // On the planned path, `ahead_m` beyond the point of it nearest the front axle now.
+      const std::vector<planning::PathSample> path = planning::SamplePath(goal->path, 0.1);
+      const Eigen::Vector2d front_axle =
+          truth.hinge_xy + machine.chassis.hinge_to_front_axle *
+                               Eigen::Vector2d(std::cos(truth.heading), std::sin(truth.heading));
+      std::size_t nearest = 0;
+      for (std::size_t k = 0; k < path.size(); ++k) {
+        if ((path[k].xy - front_axle).norm() < (path[nearest].xy - front_axle).norm()) nearest = k;
+      }
+      std::size_t at = nearest;
+      while (at + 1 < path.size() && path[at].s - path[nearest].s < person->ahead_m) ++at;
+      plant::OrientedBox box;
+      box.name = "person (fault " + person->where + ")";
+      box.center = {path[at].xy.x(), path[at].xy.y(), 0.9};
+      box.half_extents = {0.3, 0.3, 0.9};
+      box.semantic_class = core::SemanticClass::kPerson;
+      fault_obstacles.push_back(box);
+      person_placed = true;
+      say("a person steps onto the path at t = " + Fixed(plant.time() - t0, 2) + " s at (" +
+          Fixed(box.center.x(), 2) + ", " + Fixed(box.center.y(), 2) + "), " +
+          Fixed(path[at].s - path[nearest].s, 1) + " m ahead along it (fault)");
+    }
+    if (stage == Stage::kNavigate) {
+      const double t = plant.time();
+      // Watchdog: no motion on a stale map.
+      const std::string stale = supervisor.StaleSensors(t);
+      // Look-ahead along the path: a tube of the body's half width plus half the safety
+      // distance round the rest of the planned path, for obstacles the path was not planned
+      // round (a person who stepped onto it; one beside it makes the 7 Hz re-selection plan
+      // round them). The distance is from the bucket's front edge along the path.
+      const double v = std::max(0.0, sensed.speed);
+      const double stopping =
+          v / o.decision_rate + v * v / (2 * scoop_options.speed_gains.max_deceleration);
+      const double reach = prediction::TipInBase(machine, sensed.q_boom, sensed.q_bucket).x();
+      const double lf = machine.chassis.hinge_to_front_axle;
+      const double front_beyond_axle = reach + 0.3 - lf;
+      const perception::MachineFootprint body = perception::LoaderFootprint(
+          machine, sensed.hinge_xy, sensed.heading, sensed.articulation, reach);
+      const double tube = body.half_width + o.safety_distance / 2;
+      const double needed = o.safety_distance + o.planning_margin + stopping +
+                            st.map->map().resolution() +
+                            (supervisor.stopped() ? o.resume_clearance : 0.0);
+      double ahead = INFINITY;
+      Eigen::Vector2d blocking_cell = Eigen::Vector2d::Zero();
+      if (goal && !nav_sure.empty()) {
+        const std::vector<planning::PathSample> path = planning::SamplePath(goal->path, 0.2);
+        const Eigen::Vector2d axle =
+            sensed.hinge_xy +
+            lf * Eigen::Vector2d(std::cos(sensed.heading), std::sin(sensed.heading));
+        std::size_t k0 = 0;
+        for (std::size_t k = 0; k < path.size(); ++k) {
+          if ((path[k].xy - axle).norm() < (path[k0].xy - axle).norm()) k0 = k;
+        }
+        const double horizon = front_beyond_axle + needed + 1.0;
+        std::vector<Eigen::Vector2d> near;
+        for (const Eigen::Vector2d& c : nav_sure) {
+          // Within two cells of one it was planned round: more of that obstacle, come into
+          // view as the machine drove on (a parked loader's far side), not a newcomer.
+          perception::Index i;
+          bool planned_round = false;
+          if (st.map->map().IndexOf(c, i)) {
+            for (int dx = -2; dx <= 2 && !planned_round; ++dx) {
+              for (int dy = -2; dy <= 2 && !planned_round; ++dy) {
+                const int x = i.x() + dx, y = i.y() + dy;
+                planned_round = x >= 0 && y >= 0 && x < planned_obstacles.rows() &&
+                                y < planned_obstacles.cols() && planned_obstacles(x, y);
+              }
+            }
+          }
+          if (!planned_round && (c - axle).norm() < horizon + tube) near.push_back(c);
+        }
+        for (std::size_t k = k0; k < path.size() && std::isinf(ahead); ++k) {
+          const double along = path[k].s - path[k0].s;
+          if (along > horizon) break;
+          // From the bucket's front edge on: beside the body lie its own returns' fringe (the
+          // map's cells straddle the self-filter's outline) and what the planner kept clear.
+          if (along < front_beyond_axle - 0.3) continue;
+          for (const Eigen::Vector2d& c : near) {
+            if ((c - path[k].xy).norm() < tube) {
+              ahead = along - front_beyond_axle;
+              blocking_cell = c;
+              break;
+            }
+          }
+        }
+      }
+      const bool blocked = ahead < needed;
+      const std::string why = !stale.empty() ? "sensor watchdog: " + stale
+                              : blocked
+                                  ? "obstacle " + Fixed(ahead, 2) + " m ahead on the path; " +
+                                        SureCellReport(st.map->map(), blocking_cell, plant.world())
+                                  : "";
+      if (!why.empty() && !supervisor.stopped()) {
+        supervisor.Stop(why);
+        machine_io.HoldStop(true);
+        stop_xy = truth.hinge_xy;
+        stop_speed = std::abs(truth.speed);
+        say("stop at t = " + Fixed(t - t0, 2) + " s: " + why);
+      }
+      if (!why.empty()) last_reason_seen = t;
+      if (why.empty() && supervisor.stopped() && t - last_reason_seen >= o.resume_after) {
+        say("drives on at t = " + Fixed(t - t0, 2) + " s (was: " + supervisor.reason() + ")");
+        supervisor.Resume();
+        machine_io.HoldStop(false);
+        speed_pid.Reset(sensed.speed);  // its integral wound up against the brake
+      }
+      if (supervisor.stopped()) {
+        stop_xy_travel = std::max(stop_xy_travel, (truth.hinge_xy - stop_xy).norm());
+      }
+    }
+    if (stage == Stage::kNavigate || stage == Stage::kScoop) {
+      for (int j = 0; j < 2; ++j) {
+        const int actuator = machine.ActuatorOfJoint(j);
+        const double valve =
+            actuator >= 0 && actuator < static_cast<int>(machine_io.last_command().valve.size())
+                ? machine_io.last_command().valve[actuator]
+                : 0.0;
+        const std::string unanswered = supervisor.CheckJoint(
+            j, j == 0 ? "boom" : "bucket", plant.time(), valve,
+            j == 0 ? sensed.q_boom : sensed.q_bucket, j == 0 ? sensed.qd_boom : sensed.qd_bucket,
+            machine.links[j].joint_min, machine.links[j].joint_max);
+        if (!unanswered.empty()) {
+          safe_stop(unanswered);
+          return;
+        }
+      }
+    }
+  };
   executive.Add("state_machine_and_safety", 1.0 / o.decision_rate, [&](double) {
     const plant::MachineState& s = plant.state();
     const double reach = prediction::TipInBase(machine, s.q[0], s.q[1]).x();
     const perception::MachineFootprint footprint =
         perception::LoaderFootprint(machine, s.hinge_xy, s.heading, s.articulation, reach);
-    const Clearance c = FootprintClearance(footprint, scenario.world.obstacles);
+    std::vector<plant::OrientedBox> truth_obstacles = scenario.world.obstacles;
+    truth_obstacles.insert(truth_obstacles.end(), fault_obstacles.begin(), fault_obstacles.end());
+    const Clearance c = FootprintClearance(footprint, truth_obstacles);
     min_clearance = std::min(min_clearance, c.distance);
     const bool violating = c.distance < o.safety_distance;
     if (violating && !in_violation) {
       ++violations;
-      say("SAFETY: " + Fixed(c.distance, 2) + " m from " +
-          scenario.world.obstacles[c.obstacle].name + " at t = " + Fixed(plant.time() - t0, 2) +
-          " s, hinge (" + Fixed(s.hinge_xy.x(), 2) + ", " + Fixed(s.hinge_xy.y(), 2) +
-          "), heading " + Fixed(s.heading / kDeg, 1) + " deg, articulation " +
-          Fixed(s.articulation / kDeg, 1) + " deg, path error so far " + Fixed(max_cross_track, 2) +
-          " m");
+      say("SAFETY: " + Fixed(c.distance, 2) + " m from " + truth_obstacles[c.obstacle].name +
+          " at t = " + Fixed(plant.time() - t0, 2) + " s, hinge (" + Fixed(s.hinge_xy.x(), 2) +
+          ", " + Fixed(s.hinge_xy.y(), 2) + "), heading " + Fixed(s.heading / kDeg, 1) +
+          " deg, articulation " + Fixed(s.articulation / kDeg, 1) + " deg, path error so far " +
+          Fixed(max_cross_track, 2) + " m");
     }
     in_violation = violating;
+    SuperviseAt20Hz();
     if (stage == Stage::kScoop && goal) {
       const Eigen::Vector2d front_axle =
           s.hinge_xy + machine.chassis.hinge_to_front_axle *
@@ -628,7 +822,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         }
       }
     }
-    if (stage == Stage::kNavigate && remaining <= o.handover_distance) {
+    if (stage == Stage::kNavigate && remaining <= o.handover_distance && !supervisor.stopped()) {
       // Hand over to the scoop cycle with the map as it stands before contact. The material is
       // that of the site's pile nearest the shovel point: the yard's inventory (which material
       // lies in which bin) is known to the station; the map's classes do not tell materials.
@@ -642,9 +836,17 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         stage = Stage::kDone;
         return;
       }
-      const model::Material* material = machine.FindMaterial(pile->material);
+      std::string material_name = pile->material;
+      for (const plant::FaultSpec& f : faults) {
+        if (f.kind == plant::FaultKind::kMaterialMistyped && f.InCycle(index)) {
+          say("inventory reports " + f.reported + " for " + pile->material + " (fault, " + f.where +
+              ")");
+          material_name = f.reported;
+        }
+      }
+      const model::Material* material = machine.FindMaterial(material_name);
       if (material == nullptr) {
-        out.failure = "machine '" + machine.name + "' has no material '" + pile->material + "'";
+        out.failure = "machine '" + machine.name + "' has no material '" + material_name + "'";
         stage = Stage::kDone;
         return;
       }
@@ -670,7 +872,26 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     }
   });
   executive.Add("control", 1.0 / o.control_rate, [&](double) {
+    // Localisation and actuator faults, then what the machine senses.
+    const plant::FaultSpec* jump = active(plant::FaultKind::kLocalisationJump);
+    machine_io.SetPoseError(jump ? jump->offset_m : Eigen::Vector2d::Zero(),
+                            jump ? jump->heading_rad : 0.0);
+    const plant::FaultSpec* stuck = active(plant::FaultKind::kStuckValve);
+    machine_io.SetStuckValve(stuck ? machine.ActuatorOfJoint(stuck->joint == "boom" ? 0 : 1) : -1);
     const control::Proprioception s = machine_io.Sense();
+    if (stage == Stage::kSafeStop) {
+      stop_xy_travel = std::max(stop_xy_travel, (plant.state().hinge_xy - stop_xy).norm());
+      command.drive = 0, command.brake = 1, command.articulation_rate = 0;
+      std::string why;
+      machine_io.Command(command, &why);
+      if (std::abs(plant.state().speed) < 0.01) stage = Stage::kDone;
+      return;
+    }
+    const std::string pose_jump = supervisor.CheckPose(s.time, s.hinge_xy, s.heading, s.speed);
+    if (!pose_jump.empty()) {
+      safe_stop(pose_jump);
+      return;
+    }
     if (stage == Stage::kNavigate || (stage == Stage::kScoop && follower)) {
       const control::SteeringCommand steer =
           follower->Update(s.hinge_xy, s.heading, s.articulation);
@@ -723,6 +944,10 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     }
   }
   const double nav_time = scoop ? 0.0 : plant.time() - t0;
+  out.safe_stops = supervisor.safe_stops();
+  out.recoveries = supervisor.recoveries();
+  out.stop_travel_m = stop_xy_travel;
+  out.speed_at_stop = stop_speed;
   if (scoop) out.scoop = scoop->Finish(machine_io);
   st.cycle_clock = plant.time();
 

@@ -20,7 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "runtime/app/safety_supervisor.h"
 #include "runtime/control/scoop_cycle.h"
+#include "runtime/plant/fault_spec.h"
 #include "runtime/results/results_db.h"
 
 namespace autoshovel::app {
@@ -56,6 +58,22 @@ struct ShovelRunOptions {
   /// The crowd look-ahead stops the scoop this much before the safety distance: the map's
   /// 0.3 m cells and a frame's latency [m].
   double planning_margin = 0.15;
+  /// Faults injected on top of the scenario's own (plant/fault_spec.h), and the supervisor
+  /// that answers them.
+  std::vector<plant::FaultSpec> faults;
+  SupervisorConfig supervisor;
+  /// While driving to a shovel point, the machine holds a stop for obstacle cells in the
+  /// corridor ahead whose (steep) obstacle evidence reaches this and beats their pile evidence
+  /// by `path_obstacle_margin` (a person who stepped in: docs/faults.md) [-].
+  double path_obstacle_confidence = 0.5;
+  double path_obstacle_margin = 0.3;
+  double path_obstacle_height = 0.5;  ///< ... standing this high above the ground plane [m]
+  /// A hold for the watchdog or an obstacle on the path ends once its cause has been gone
+  /// this long [s].
+  double resume_after = 1.0;
+  /// ... and, for an obstacle on the path, once it is this much farther than the distance it
+  /// stopped for [m].
+  double resume_clearance = 1.0;
   /// Our selection only takes candidates planned with at least safety_distance + this much
   /// clearance. The planned clearance is already conservative: half a map cell and half the
   /// outline sampling are left out (0.2 m, shovel_point_selection.h) and obstacle cells cover
@@ -99,6 +117,11 @@ struct CycleOutcome {
   double target_volume = 0;
   std::vector<std::filesystem::path> figures;  ///< written for this cycle
   std::vector<std::string> figure_titles;
+  // The safety supervisor's answers to faults (safety_supervisor.h).
+  int safe_stops = 0;        ///< stops it held (watchdog, obstacle on the path, abandons)
+  int recoveries = 0;        ///< of those, the ones it drove on from
+  double stop_travel_m = 0;  ///< farthest the hinge moved after a stop began [m]
+  double speed_at_stop = 0;  ///< speed when the last stop began [m/s]
 };
 
 /// The yard, the machine, the map and the models of one run; cycles are run one after another.

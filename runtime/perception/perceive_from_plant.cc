@@ -45,6 +45,11 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
       stats.returns_on_machine += update.on_machine;
     }
   }
+  if (!options.camera_frame) {
+    stats.holes_filled = map.FillHoles();
+    stats.ground_plane_found = semantic.Fuse();
+    return stats;
+  }
   const Eigen::Isometry3d T_world_camera = sensors::SensorInWorld(s, machine.sensors.camera.pose);
   sensors::CameraOptions camera_options;
   camera_options.lighting = options.lighting;

@@ -19,7 +19,8 @@
 namespace autoshovel::perception {
 
 struct PerceptionFromPlantOptions {
-  int lidar_frames = 5;  ///< per LiDAR, 0.1 s apart
+  int lidar_frames = 5;      ///< per LiDAR, 0.1 s apart; 0: none arrives (a dropout)
+  bool camera_frame = true;  ///< false: no usable camera frame arrives (a blackout)
   plant::Lighting lighting = plant::Lighting::kNormal;
   bool truth_labels = false;  ///< the simulator's per-pixel labels instead of the network
   std::string segmenter;      ///< ONNX network (needed unless truth_labels)

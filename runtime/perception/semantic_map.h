@@ -11,7 +11,7 @@
 // "height_ground_confidence" (p1), "class" (a CellClass value, NaN where the height is
 // unknown) and "steep_obstacle_confidence" (p̂3 with a machine, person or wall in the footprint
 // counted in full only from views that are not grazing: the evidence that an obstacle stands
-// in the cell, which the crowd look-ahead uses).
+// in the cell, which the look-aheads use).
 #pragma once
 
 #include <Eigen/Geometry>

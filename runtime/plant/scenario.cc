@@ -14,6 +14,7 @@
 #include "runtime/core/sha256.h"
 #include "runtime/core/strings.h"
 #include "runtime/core/yaml_reader.h"
+#include "runtime/plant/fault_spec.h"
 #include "runtime/plant/scenario_builder.h"
 
 namespace autoshovel::plant {
@@ -153,6 +154,7 @@ class ScenarioReader {
     for (auto& map : root.MapList("obstacles", /*required=*/false)) {
       ReadObstacle(map, yard_frame, s);
     }
+    s.faults = ReadFaults(root);
     root.Finish();
     CheckStartPose(s);
     sink_.ThrowIfAny();

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/plant/fault_spec.h"
 #include "runtime/plant/world.h"
 
 namespace autoshovel::plant {
@@ -80,6 +81,7 @@ struct Scenario {
   std::uint32_t seed = 0;
   std::vector<Bin> bins;
   std::vector<Pile> piles;
+  std::vector<FaultSpec> faults;  ///< injected by the simulator (fault_spec.h); usually none
 
   /// The pile of that name, or nullptr.
   const Pile* FindPile(const std::string& pile_name) const;

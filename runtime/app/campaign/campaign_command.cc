@@ -71,6 +71,7 @@ ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
                                            : TriggerChoice::kPredicted;
   o.figures = false;
   o.yard_variation = spec.yard_variation;
+  o.faults = spec.faults;
   return o;
 }
 

@@ -72,6 +72,7 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
     if (root.Has("yard_variation")) {
       spec.yard_variation = root.Number("yard_variation", core::NumberRule::Closed(0.0, 0.9, ""));
     }
+    spec.faults = plant::ReadFaults(root);
     root.Finish();
     if (sink.empty() && spec.cycles() > 10'000'000) {
       root.Error("cycles_per_shift", "the campaign would run " + std::to_string(spec.cycles()) +

@@ -16,6 +16,7 @@
 //   truth_labels: true                # simulator labels instead of the network (faster)
 //   yard_variation: 0.25              # each shift's piles up to 25 % lower than written, and
 //                                     # irregular heaps re-seeded (plant::VaryPiles); default 0
+//   faults: [...]                     # injected faults, as in a scenario (plant/fault_spec.h)
 #pragma once
 
 #include <cstdint>
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "runtime/control/scoop_cycle.h"
+#include "runtime/plant/fault_spec.h"
 
 namespace autoshovel::app {
 
@@ -40,6 +42,8 @@ struct CampaignSpec {
   std::string trigger = "predicted";
   bool truth_labels = true;
   double yard_variation = 0;
+  /// Faults every shift's cycles meet (plant/fault_spec.h), on top of the scenario's own.
+  std::vector<plant::FaultSpec> faults;
 
   int shifts() const { return weeks * shifts_per_week; }
   int jobs() const { return shifts() * static_cast<int>(policies.size()); }

@@ -39,6 +39,19 @@ void SetPile(GridMap& map, const Eigen::Vector2d& xy, double height) {
 
 const Eigen::Vector3d kLevel(0, 0, 0);
 
+// A loader of the XCMG's proportions, written out so the tests' numbers can be checked by hand.
+LoaderGeometry XcmgLikeLoader() {
+  LoaderGeometry loader;
+  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
+  loader.max_articulation = 38 * kPi / 180;
+  loader.track_width = 2.25;
+  loader.wheel_radius = 0.8;
+  loader.bucket_width = 3.0;
+  loader.rated_capacity = 3.5;
+  loader.tip_reach = 4.5;
+  return loader;
+}
+
 TEST(LoaderGeometry, MaxCurvatureFromTheArticulationLimit) {
   const model::MachineDescription machine =
       model::LoadMachineDescription(model::ResolveMachineDescription("xcmg_968ev", kModels));
@@ -155,14 +168,7 @@ TEST(ShovelScores, ObstacleDistanceFieldAndSweptDistance) {
   EXPECT_NEAR(field(i.x(), i.y()), (map.PositionOf(i) - map.PositionOf(obstacle)).norm(), 1e-5);
   // A loader driving along y = 0 past it: the body's side (half width hw) passes 3 m − hw from
   // the obstacle cell's centre, less the half cell the obstacle fills.
-  LoaderGeometry loader;
-  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
-  loader.max_articulation = 38 * kPi / 180;
-  loader.track_width = 2.25;
-  loader.wheel_radius = 0.8;
-  loader.bucket_width = 3.0;
-  loader.rated_capacity = 3.5;
-  loader.tip_reach = 4.5;
+  const LoaderGeometry loader = XcmgLikeLoader();
   DubinsPath straight = ShortestDubinsPath({{-10, 0}, 0}, {{20, 0}, 0}, 0.2);
   const double d = SweptObstacleDistance(map, field, SamplePath(straight, 0.25), loader);
   const double exact = 3.0 - loader.HalfWidth() - 0.15;
@@ -181,12 +187,7 @@ TEST(ShovelScores, ScoopSideClearanceSeesBesideNotAhead) {
   ASSERT_TRUE(map.IndexOf({8.1, 3.0}, beside));
   ASSERT_NEAR(map.PositionOf(beside).y(), 3.0, 1e-9);
   map.at("class", beside) = static_cast<float>(CellClass::kObstacle);
-  LoaderGeometry loader;
-  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
-  loader.max_articulation = 38 * kPi / 180;
-  loader.track_width = 2.25;
-  loader.bucket_width = 3.0;
-  loader.tip_reach = 4.5;
+  const LoaderGeometry loader = XcmgLikeLoader();
   const Eigen::MatrixXf field = ObstacleDistanceField(map);
   // Contact with the front axle at the origin heading +x: hinge at −1.6, front edge at 3.2.
   const Pose2 contact{{0, 0}, 0};
@@ -222,12 +223,7 @@ TEST(ShovelScores, ScoopSideClearanceSeesBesideNotAhead) {
 // ahead, is as far as the corner, not as far as a rounded nose would be.
 TEST(ShovelScores, SweptDistanceCoversTheFrontCorners) {
   GridMap map = FlatMap(0.1, 30, {0.05, 0.05});
-  LoaderGeometry loader;
-  loader.hinge_to_front_axle = loader.hinge_to_rear_axle = 1.6;
-  loader.max_articulation = 38 * kPi / 180;
-  loader.track_width = 2.25;
-  loader.bucket_width = 3.0;
-  loader.tip_reach = 4.5;
+  const LoaderGeometry loader = XcmgLikeLoader();
   const double hw = loader.HalfWidth();
   // One pose: front axle at the origin heading +x, so the hinge is at x = −1.6 and the front
   // corner at (−1.6 + 4.5 + 0.3, hw). A cell 0.6 m beyond the corner on both axes.

@@ -613,7 +613,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   });
   // The supervisor's 20 Hz checks (safety_supervisor.h): faults that put a person in the way,
   // the sensor watchdog and the look-ahead along the path while driving, the actuators.
-  auto SuperviseAt20Hz = [&]() {
+  auto supervise_at_20hz = [&]() {
     const plant::MachineState& truth = plant.state();
     const control::Proprioception sensed = machine_io.Sense();
     const plant::FaultSpec* person = active(plant::FaultKind::kPersonEntersPath);
@@ -765,7 +765,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
           Fixed(max_cross_track, 2) + " m");
     }
     in_violation = violating;
-    SuperviseAt20Hz();
+    supervise_at_20hz();
     if (stage == Stage::kScoop && goal) {
       const Eigen::Vector2d front_axle =
           s.hinge_xy + machine.chassis.hinge_to_front_axle *

@@ -13,6 +13,7 @@
 #include "runtime/app/shovel_run.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/plant/fault_spec.h"
+#include "tests/closed_loop/cycle_runner.h"
 
 namespace autoshovel::app {
 namespace {
@@ -21,28 +22,12 @@ using plant::FaultKind;
 using plant::FaultSpec;
 
 ShovelRunOptions Options(const std::string& bin) {
-  ShovelRunOptions o;
-  o.scenario = "mixing_station";
-  o.models_dir = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
-  o.truth_labels = true;
-  o.cycles = 1;
-  o.figures = false;
+  ShovelRunOptions o = TestCycleOptions("mixing_station");
   o.bins = {bin};
   return o;
 }
 
-CycleOutcome RunOne(const ShovelRunOptions& options) {
-  ShovelJob job(options);
-  CycleOutcome out = job.RunCycle(0, {}, nullptr);
-  const results::CycleRecord& r = out.record;
-  std::printf(
-      "[fault cycle] %s: %s, fill %.3f, clearance %.2f m, %d violation(s), %d safe stop(s), "
-      "%d recover(ies), travel after a stop %.2f m from %.2f m/s\n",
-      r.bin.c_str(), r.completed ? "completed" : out.failure.c_str(), r.fill_rate,
-      r.safety_margin_m, r.safety_violations, out.safe_stops, out.recoveries, out.stop_travel_m,
-      out.speed_at_stop);
-  return out;
-}
+CycleOutcome RunOne(const ShovelRunOptions& options) { return RunTestCycle(options); }
 
 // Every faulty cycle: no safety violation, and a stop that began at speed v ends within the
 // braking distance v² / 2a of the speed profile (1 m/s²) plus a 20 Hz period's travel.

@@ -8,33 +8,14 @@
 #include <string>
 
 #include "runtime/app/shovel_run.h"
+#include "tests/closed_loop/cycle_runner.h"
 
 namespace autoshovel::app {
 namespace {
 
-ShovelRunOptions Options(const std::string& scenario) {
-  ShovelRunOptions o;
-  o.scenario = scenario;
-  o.models_dir = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
-  o.truth_labels = true;
-  o.cycles = 1;
-  o.figures = false;
-  return o;
-}
+ShovelRunOptions Options(const std::string& scenario) { return TestCycleOptions(scenario); }
 
-CycleOutcome RunOne(const ShovelRunOptions& options) {
-  ShovelJob job(options);
-  CycleOutcome out = job.RunCycle(0, {}, nullptr);
-  const results::CycleRecord& r = out.record;
-  std::printf(
-      "[cycle] %s/%s: %s %s, %s (%s), fill %.3f, trigger %.2f s after contact, "
-      "clearance %.2f m, %d violation(s), cycle %.1f s, %.0f kJ\n",
-      r.scenario.c_str(), r.bin.c_str(), r.completed ? "completed" : out.failure.c_str(),
-      r.material.c_str(), r.strategy.c_str(), r.atomic_actions.c_str(), r.fill_rate,
-      out.scoop.trigger_after_contact, r.safety_margin_m, r.safety_violations, r.time_s.total,
-      r.energy_kj.total);
-  return out;
-}
+CycleOutcome RunOne(const ShovelRunOptions& options) { return RunTestCycle(options); }
 
 // What every cycle must show.
 void ExpectSafeAndWhole(const ShovelRunOptions& options, const CycleOutcome& out) {

@@ -23,7 +23,36 @@ control::Proprioception PlantMachine::Sense() const {
   p.q_boom = s.q[0], p.q_bucket = s.q[1];
   p.qd_boom = s.qd[0], p.qd_bucket = s.qd[1];
   p.boom_pressure = boom_actuator_ >= 0 ? plant_.ActuatorPressure(boom_actuator_, true) : 0.0;
+  if (faulty_joint_ >= 0) {
+    double& q = faulty_joint_ == 0 ? p.q_boom : p.q_bucket;
+    double& qd = faulty_joint_ == 0 ? p.qd_boom : p.qd_bucket;
+    if (joint_frozen_) {
+      q = frozen_q_, qd = 0;
+    } else {
+      q += joint_bias_;
+    }
+  }
+  if (angle_noise_ > 0) {
+    std::normal_distribution<double> n(0.0, angle_noise_);
+    p.articulation += n(noise_rng_);
+    p.q_boom += n(noise_rng_);
+    p.q_bucket += n(noise_rng_);
+  }
   return p;
+}
+
+void PlantMachine::SetJointReadingFault(int joint, double bias, bool frozen) {
+  if (frozen && (!joint_frozen_ || joint != faulty_joint_) && (joint == 0 || joint == 1)) {
+    frozen_q_ = plant_.state().q[joint];  // the reading it had when the freeze began
+  }
+  faulty_joint_ = joint == 0 || joint == 1 ? joint : -1;
+  joint_bias_ = bias;
+  joint_frozen_ = frozen && faulty_joint_ >= 0;
+}
+
+void PlantMachine::SetAngleNoise(double sigma, std::uint64_t seed) {
+  if (sigma > 0 && angle_noise_ <= 0) noise_rng_.seed(seed);
+  angle_noise_ = sigma;
 }
 
 bool PlantMachine::Command(const core::ActuatorCommand& command, std::string* why) {

@@ -3,6 +3,8 @@
 // and tests wire the plant to control.
 #pragma once
 
+#include <cstdint>
+#include <random>
 #include <string>
 
 #include "runtime/control/scoop_cycle.h"
@@ -36,6 +38,12 @@ class PlantMachine : public control::ScoopMachine {
   }
   /// The valve of `actuator` stays at neutral whatever is commanded (−1: none).
   void SetStuckValve(int actuator) { stuck_actuator_ = actuator; }
+  /// Arm IMU faults on joint `joint` (0 boom, 1 bucket; −1: none): Sense() reports its angle
+  /// `bias` too high, or, when `frozen`, the angle it had when the freeze began and a rate of 0.
+  void SetJointReadingFault(int joint, double bias, bool frozen);
+  /// White noise of 1σ `sigma` [rad] on the reported articulation and arm angles (0: none),
+  /// drawn from a generator seeded with `seed` when the noise is switched on.
+  void SetAngleNoise(double sigma, std::uint64_t seed);
   /// While held, every command is replaced by a stop: brake on, drive off, valves and steering
   /// at rest (the supervisor's interlock; it holds whatever the caller commands).
   void HoldStop(bool hold) { hold_stop_ = hold; }
@@ -56,6 +64,12 @@ class PlantMachine : public control::ScoopMachine {
   Eigen::Vector2d pose_offset_ = Eigen::Vector2d::Zero();
   double heading_offset_ = 0;
   int stuck_actuator_ = -1;
+  int faulty_joint_ = -1;
+  double joint_bias_ = 0;
+  bool joint_frozen_ = false;
+  double frozen_q_ = 0;
+  double angle_noise_ = 0;
+  mutable std::mt19937_64 noise_rng_;
   bool hold_stop_ = false;
   core::ActuatorCommand last_command_;
 };

@@ -31,6 +31,16 @@ std::string SafetySupervisor::StaleSensors(double t) const {
   return stale;
 }
 
+bool SafetySupervisor::AcceptFrame(SensorStream stream, double stamp, double now) {
+  double& newest = stream == SensorStream::kLidar ? last_lidar_ : last_camera_;
+  if (!std::isfinite(stamp) || stamp <= newest || now - stamp > config_.max_sensor_age) {
+    ++refused_frames_;
+    return false;
+  }
+  newest = stamp;
+  return true;
+}
+
 std::string SafetySupervisor::CheckPose(double t, const Eigen::Vector2d& hinge_xy, double heading,
                                         double speed) {
   std::string jump;

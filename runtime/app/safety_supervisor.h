@@ -14,6 +14,14 @@
 // - Actuators: a joint whose valve is commanded open by at least `stuck_command` for
 //   `stuck_time` while it neither moves nor rests at a limit does not answer its valve (a stuck
 //   spool, a dead IMU): the machine stops and the cycle is abandoned.
+// - Frame order: a frame is used only when it is newer than the newest already used from that
+//   sensor and younger than `max_sensor_age` (AcceptFrame). A late frame fused at the pose of
+//   its arrival would put old returns where the machine is now, and could overwrite newer
+//   evidence (a person who just stepped in) with older; it is dropped and counted, and only
+//   used frames feed the watchdog.
+// - Degraded sensors (docs/faults.md): a LiDAR blind in a sector that faces the direction of
+//   travel (within `blind_sector_cone`), or a camera whose view is masked for dirt beyond
+//   `max_masked_fraction`, holds the machine like a silent sensor while driving.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,14 +30,18 @@
 namespace autoshovel::app {
 
 struct SupervisorConfig {
-  double max_sensor_age = 0.5;  ///< [s]
-  double jump_distance = 0.3;   ///< beyond the motion the speed explains, per tick [m]
-  double jump_heading = 0.05;   ///< per tick [rad] (the XCMG yaws at most ~0.5 rad/s)
-  double stuck_command = 0.3;   ///< valve opening that must move the joint [-]
-  double stuck_time = 2.0;      ///< [s]
-  double stuck_rate = 0.005;    ///< joint speed below which it counts as not moving [rad/s]
-  double limit_margin = 0.05;   ///< a joint this close to a limit may rest [rad]
+  double max_sensor_age = 0.5;        ///< [s]
+  double jump_distance = 0.3;         ///< beyond the motion the speed explains, per tick [m]
+  double jump_heading = 0.05;         ///< per tick [rad] (the XCMG yaws at most ~0.5 rad/s)
+  double stuck_command = 0.3;         ///< valve opening that must move the joint [-]
+  double stuck_time = 2.0;            ///< [s]
+  double stuck_rate = 0.005;          ///< joint speed below which it counts as not moving [rad/s]
+  double limit_margin = 0.05;         ///< a joint this close to a limit may rest [rad]
+  double blind_sector_cone = 1.0472;  ///< half-angle about the travel direction [rad] (60°)
+  double max_masked_fraction = 0.25;  ///< of the camera image masked for dirt [-]
 };
+
+enum class SensorStream { kLidar, kCamera };
 
 class SafetySupervisor {
  public:
@@ -37,6 +49,11 @@ class SafetySupervisor {
 
   void LidarFrame(double t) { last_lidar_ = t; }
   void CameraFrame(double t) { last_camera_ = t; }
+  /// A frame of `stream` stamped `stamp` arrives at `now`. Returns whether it may be used (see
+  /// above); a used frame counts for the watchdog as LidarFrame/CameraFrame(stamp).
+  bool AcceptFrame(SensorStream stream, double stamp, double now);
+  /// Frames refused by AcceptFrame as late or out of order.
+  long refused_frames() const { return refused_frames_; }
   /// "" when both sensors delivered within the age limit at `t`, else what is stale.
   std::string StaleSensors(double t) const;
 
@@ -58,6 +75,7 @@ class SafetySupervisor {
  private:
   SupervisorConfig config_;
   double last_lidar_ = -1e9, last_camera_ = -1e9;
+  long refused_frames_ = 0;
   bool have_pose_ = false;
   double last_t_ = 0, last_heading_ = 0;
   Eigen::Vector2d last_xy_ = Eigen::Vector2d::Zero();

@@ -141,6 +141,8 @@ struct ShovelJob::State {
   std::unique_ptr<perception::SemanticMap> semantic;
   sensors::Rng rng;
   std::string segmenter;
+  /// Dirt on the lens stays from cycle to cycle, and so does what the monitor learnt of it.
+  perception::LensDirtMonitor lens_dirt;
   planning::ShovelPointConfig selection;  ///< Eq. (18) weights: Table 1 or --shovel-weights
   double cycle_clock = 0;  ///< each cycle's plant starts where the last one ended [s]
   int next_site = 0;
@@ -176,6 +178,22 @@ ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<
   }
   if (options.map_rate > options.control_rate || options.decision_rate > options.control_rate) {
     throw std::invalid_argument("autoshovel run: control must be the fastest rate");
+  }
+  // A fault that names a sensor must name one this machine has (else it would never strike).
+  std::vector<plant::FaultSpec> all_faults = scenario.faults;
+  all_faults.insert(all_faults.end(), options.faults.begin(), options.faults.end());
+  for (const plant::FaultSpec& f : all_faults) {
+    if (f.kind != plant::FaultKind::kLidarDeadSector) continue;
+    std::string names;
+    bool known = false;
+    for (const model::Lidar& l : machine.sensors.lidars) {
+      known = known || l.name == f.lidar;
+      names += (names.empty() ? "" : ", ") + l.name;
+    }
+    if (!known) {
+      throw std::invalid_argument(f.where + ": lidar_dead_sector: machine '" + machine.name +
+                                  "' has no LiDAR '" + f.lidar + "' (it has: " + names + ")");
+    }
   }
   // Sites: the bins asked for, else every bin holding a pile and the open yard if piles lie
   // outside bins. A bin is entered from `approach_distance` out of its open front, facing in;
@@ -414,11 +432,19 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     }
     return nullptr;
   };
+  auto has_fault = [&](plant::FaultKind kind) {
+    return std::any_of(faults.begin(), faults.end(), [&](const plant::FaultSpec& f) {
+      return f.kind == kind && f.InCycle(index);
+    });
+  };
   SafetySupervisor supervisor(o.supervisor);
   std::vector<plant::OrientedBox> fault_obstacles;  ///< people a fault put in the yard
   bool person_placed = false;
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> planned_obstacles;  ///< see start_path
-  double last_reason_seen = -1e9;         ///< when the supervisor last saw a reason to hold [s]
+  double last_reason_seen = -1e9;  ///< when the supervisor last saw a reason to hold [s]
+  long frames_arrived = 0;         ///< perception ticks (every second one lags in a fault)
+  std::string degraded;            ///< degraded sensors as the last map update found them
+  bool dirt_reported = false;
   std::vector<Eigen::Vector2d> nav_sure;  ///< the current map's sure obstacle cells
   double stop_speed = 0, stop_xy_travel = 0;
   Eigen::Vector2d stop_xy = Eigen::Vector2d::Zero();
@@ -504,12 +530,55 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     std::vector<plant::OrientedBox> extra = plant.OwnBodies();
     extra.insert(extra.end(), fault_obstacles.begin(), fault_obstacles.end());
     st.scene->SetExtraBoxes(std::move(extra));
-    const bool lidar = active(plant::FaultKind::kLidarDropout) == nullptr;
+    // Frames that arrive: none in a dropout or a blackout; late ones (stamped `lag_s` before
+    // now, every second frame) refused by the supervisor's order check, never fused.
+    const double now = plant.time();
+    const plant::FaultSpec* late = active(plant::FaultKind::kTimestampsOutOfOrder);
+    auto stamp_of = [&](const char* sensor) {
+      const bool lagging = late != nullptr && late->sensor == sensor && frames_arrived % 2 == 1;
+      return lagging ? now - late->lag_s : now;
+    };
+    const bool lidar = active(plant::FaultKind::kLidarDropout) == nullptr &&
+                       supervisor.AcceptFrame(SensorStream::kLidar, stamp_of("lidar"), now);
+    const bool camera = active(plant::FaultKind::kCameraBlackout) == nullptr &&
+                        supervisor.AcceptFrame(SensorStream::kCamera, stamp_of("camera"), now);
+    ++frames_arrived;
     perceive.lidar_frames = !lidar ? 0 : perception_calls == 0 ? 5 : 1;
-    perceive.camera_frame = active(plant::FaultKind::kCameraBlackout) == nullptr;
-    perception::PerceiveFromPlant(plant, *st.scene, st.rng, perceive, *st.map, *st.semantic);
-    if (lidar) supervisor.LidarFrame(plant.time());
-    if (perceive.camera_frame) supervisor.CameraFrame(plant.time());
+    perceive.camera_frame = camera;
+    const plant::FaultSpec* blind = active(plant::FaultKind::kLidarDeadSector);
+    perceive.dead_lidar = blind != nullptr ? blind->lidar : "";
+    perceive.dead_sector = blind != nullptr ? blind->sector_rad : Eigen::Vector2d::Zero();
+    const plant::FaultSpec* dirt = active(plant::FaultKind::kCameraLensDirt);
+    const model::Camera& camera_model = machine.sensors.camera;
+    perceive.lens_dirt_center_px = dirt != nullptr
+                                       ? Eigen::Vector2d(dirt->center.x() * camera_model.width_px,
+                                                         dirt->center.y() * camera_model.height_px)
+                                       : Eigen::Vector2d::Zero();
+    perceive.lens_dirt_radius_px = dirt != nullptr ? dirt->radius * camera_model.width_px : 0.0;
+    perceive.check_lidar_health = true;
+    perceive.lens_dirt = &st.lens_dirt;
+    const perception::PerceptionFromPlantStats seen =
+        perception::PerceiveFromPlant(plant, *st.scene, st.rng, perceive, *st.map, *st.semantic);
+    // Degraded sensors: a blind sector facing the way the machine goes, a view masked for dirt.
+    out.masked_fraction = std::max(out.masked_fraction, seen.camera_masked_fraction);
+    out.blind_sector = out.blind_sector || !seen.blind_sectors.empty();
+    degraded.clear();
+    const double travel = target_speed < 0 ? std::numbers::pi : 0.0;
+    for (const auto& [name, sector] : seen.blind_sectors) {
+      if (!perception::SectorFaces(sector, travel, o.supervisor.blind_sector_cone)) continue;
+      degraded += (degraded.empty() ? "" : ", ") + std::string("LiDAR ") + name + " blind from " +
+                  Fixed(sector.from * 180 / std::numbers::pi, 0) + " to " +
+                  Fixed(sector.to * 180 / std::numbers::pi, 0) + " deg";
+    }
+    if (perceive.camera_frame && seen.camera_masked_fraction > o.supervisor.max_masked_fraction) {
+      degraded += (degraded.empty() ? "" : ", ") + std::string("camera view ") +
+                  Fixed(100 * seen.camera_masked_fraction, 0) + " % masked for lens dirt";
+    }
+    if (seen.camera_masked_fraction > 0 && !dirt_reported) {
+      say("lens dirt found: " + Fixed(100 * seen.camera_masked_fraction, 1) +
+          " % of the image masked at t = " + Fixed(now - t0, 2) + " s");
+      dirt_reported = true;
+    }
     // The look-ahead along the path stops for less: a person who stepped in is in the
     // obstacle evidence at 0.5 two frames later (blended at 0.3 a frame), at 0.95 only after
     // nine (1.3 s at 7 Hz, beyond a loader's stopping distance at 1.5 m/s).
@@ -642,8 +711,9 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     }
     if (stage == Stage::kNavigate) {
       const double t = plant.time();
-      // Watchdog: no motion on a stale map.
-      const std::string stale = supervisor.StaleSensors(t);
+      // Watchdog: no motion on a stale map, nor on one from a degraded sensor.
+      std::string stale = supervisor.StaleSensors(t);
+      if (!degraded.empty()) stale += (stale.empty() ? "" : ", ") + degraded;
       // Look-ahead along the path: a tube of the body's half width plus half the safety
       // distance round the rest of the planned path, for obstacles the path was not planned
       // round (a person who stepped onto it; one beside it makes the 7 Hz re-selection plan
@@ -878,6 +948,29 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
                             jump ? jump->heading_rad : 0.0);
     const plant::FaultSpec* stuck = active(plant::FaultKind::kStuckValve);
     machine_io.SetStuckValve(stuck ? machine.ActuatorOfJoint(stuck->joint == "boom" ? 0 : 1) : -1);
+    // Arm IMU faults: a bias growing from the fault's start, or a reading frozen there.
+    const plant::FaultSpec* drift = active(plant::FaultKind::kImuBiasDrift);
+    const plant::FaultSpec* frozen = active(plant::FaultKind::kImuStuck);
+    if (frozen != nullptr) {
+      machine_io.SetJointReadingFault(frozen->joint == "boom" ? 0 : 1, 0.0, true);
+    } else if (drift != nullptr) {
+      machine_io.SetJointReadingFault(drift->joint == "boom" ? 0 : 1,
+                                      drift->rate_rad_s * (plant.time() - t0 - drift->start_s),
+                                      false);
+    } else {
+      machine_io.SetJointReadingFault(-1, 0.0, false);
+    }
+    const plant::FaultSpec* noise = active(plant::FaultKind::kEncoderNoise);
+    machine_io.SetAngleNoise(noise != nullptr ? noise->sigma_rad : 0.0,
+                             0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(index + 1));
+    if (has_fault(plant::FaultKind::kHydraulicDelayDrift)) {
+      const plant::FaultSpec* slow = active(plant::FaultKind::kHydraulicDelayDrift);
+      for (std::size_t k = 0; k < machine.hydraulics.actuators.size(); ++k) {
+        plant.SetTransportDelay(static_cast<int>(k),
+                                machine.hydraulics.actuators[k].valve.transport_delay *
+                                    (slow != nullptr ? slow->factor : 1.0));
+      }
+    }
     const control::Proprioception s = machine_io.Sense();
     if (stage == Stage::kSafeStop) {
       stop_xy_travel = std::max(stop_xy_travel, (plant.state().hinge_xy - stop_xy).norm());
@@ -947,6 +1040,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   out.safe_stops = supervisor.safe_stops();
   out.recoveries = supervisor.recoveries();
   out.stop_travel_m = stop_xy_travel;
+  out.refused_frames = supervisor.refused_frames();
   out.speed_at_stop = stop_speed;
   if (scoop) out.scoop = scoop->Finish(machine_io);
   st.cycle_clock = plant.time();
@@ -1059,7 +1153,16 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       " m, path error " + Fixed(max_cross_track, 2) + " m, drove in " + Fixed(scoop_advance, 2) +
       " m past the planned contact; map " + std::to_string(perception_calls) + "× (" +
       Fixed(perception_seconds, 1) + " s), selection " + std::to_string(selections) + "× (" +
-      Fixed(selection_seconds, 1) + " s)");
+      Fixed(selection_seconds, 1) + " s)" +
+      (out.safe_stops + out.refused_frames > 0 || out.blind_sector || out.masked_fraction > 0
+           ? "; supervisor: " + std::to_string(out.safe_stops) + " stop(s), " +
+                 std::to_string(out.recoveries) + " recover(ies), " +
+                 std::to_string(out.refused_frames) + " late frame(s) refused" +
+                 (out.blind_sector ? ", a LiDAR blind sector" : "") +
+                 (out.masked_fraction > 0
+                      ? ", up to " + Fixed(100 * out.masked_fraction, 0) + " % of the image masked"
+                      : "")
+           : ""));
   return out;
 }
 

@@ -118,10 +118,13 @@ struct CycleOutcome {
   std::vector<std::filesystem::path> figures;  ///< written for this cycle
   std::vector<std::string> figure_titles;
   // The safety supervisor's answers to faults (safety_supervisor.h).
-  int safe_stops = 0;        ///< stops it held (watchdog, obstacle on the path, abandons)
-  int recoveries = 0;        ///< of those, the ones it drove on from
-  double stop_travel_m = 0;  ///< farthest the hinge moved after a stop began [m]
-  double speed_at_stop = 0;  ///< speed when the last stop began [m/s]
+  int safe_stops = 0;          ///< stops it held (watchdog, obstacle on the path, abandons)
+  int recoveries = 0;          ///< of those, the ones it drove on from
+  double stop_travel_m = 0;    ///< farthest the hinge moved after a stop began [m]
+  double speed_at_stop = 0;    ///< speed when the last stop began [m/s]
+  long refused_frames = 0;     ///< late or out-of-order sensor frames not used
+  double masked_fraction = 0;  ///< most of the camera image masked for lens dirt [-]
+  bool blind_sector = false;   ///< a LiDAR was found blind in some sector
 };
 
 /// The yard, the machine, the map and the models of one run; cycles are run one after another.

@@ -1,5 +1,7 @@
 #include "runtime/perception/perceive_from_plant.h"
 
+#include <cmath>
+#include <limits>
 #include <memory>
 
 #include "runtime/perception/machine_footprint.h"
@@ -36,11 +38,28 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
                       (plant.TipInWorld().head<2>() - s.hinge_xy).norm());
   for (const model::Lidar& lidar : machine.sensors.lidars) {
     const Eigen::Isometry3d T_world_lidar = sensors::SensorInWorld(s, lidar.pose);
+    const bool dead = !options.dead_lidar.empty() && lidar.name == options.dead_lidar;
     for (int k = 0; k < options.lidar_frames; ++k) {
       const double t = s.time + 0.1 * k;
-      const MapUpdateStats update =
-          map.Update(sensors::SimulateLidarFrame(lidar, scene, T_world_lidar, t, rng),
-                     T_world_lidar, t, &footprint);
+      sensors::PointCloud cloud = sensors::SimulateLidarFrame(lidar, scene, T_world_lidar, t, rng);
+      if (dead) {
+        std::erase_if(cloud.points, [&](const sensors::LidarPoint& p) {
+          const double azimuth = std::atan2(p.p_sensor.y(), p.p_sensor.x());
+          return azimuth >= options.dead_sector.x() && azimuth <= options.dead_sector.y();
+        });
+      }
+      if (options.check_lidar_health && k + 1 == options.lidar_frames) {
+        std::vector<Eigen::Vector3d> rays;
+        for (const sensors::LidarRay& ray : sensors::LidarScanPattern(lidar, t)) {
+          rays.push_back(ray.direction);
+        }
+        const Eigen::Isometry3d T_cab_lidar = sensors::PoseToIsometry(lidar.pose);
+        for (const AzimuthSector& sector :
+             BlindSectors(rays, cloud, T_cab_lidar.linear(), T_world_lidar.linear())) {
+          stats.blind_sectors.emplace_back(lidar.name, sector);
+        }
+      }
+      const MapUpdateStats update = map.Update(cloud, T_world_lidar, t, &footprint);
       stats.returns_fused += update.fused;
       stats.returns_on_machine += update.on_machine;
     }
@@ -53,8 +72,14 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
   const Eigen::Isometry3d T_world_camera = sensors::SensorInWorld(s, machine.sensors.camera.pose);
   sensors::CameraOptions camera_options;
   camera_options.lighting = options.lighting;
+  camera_options.lens_dirt_center_px = options.lens_dirt_center_px;
+  camera_options.lens_dirt_radius_px = options.lens_dirt_radius_px;
   const sensors::CameraFrame image = sensors::SimulateCameraFrame(
       machine.sensors.camera, scene, T_world_camera, s.time, camera_options, rng);
+  if (options.lens_dirt != nullptr) {
+    options.lens_dirt->Observe(image, T_world_camera);
+    stats.camera_masked_fraction = options.lens_dirt->masked_fraction();
+  }
   ClassProbabilities probabilities;
   if (options.truth_labels) {
     probabilities = FromLabels(image.labels, image.width, image.height);
@@ -65,6 +90,23 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
     probabilities.height = result.height;
     probabilities.planes = std::move(result.probabilities);
     stats.semantics = "network " + options.segmenter;
+  }
+  if (options.lens_dirt != nullptr && stats.camera_masked_fraction > 0) {
+    // Masked pixels give no evidence (SemanticMap::Project skips NaN probabilities).
+    const std::size_t plane = static_cast<std::size_t>(probabilities.width) * probabilities.height;
+    const double su = static_cast<double>(image.width) / probabilities.width;
+    const double sv = static_cast<double>(image.height) / probabilities.height;
+    for (int v = 0; v < probabilities.height; ++v) {
+      for (int u = 0; u < probabilities.width; ++u) {
+        if (!options.lens_dirt->Masked(static_cast<int>(u * su), static_cast<int>(v * sv))) {
+          continue;
+        }
+        for (int c = 0; c < core::kNumSemanticClasses; ++c) {
+          probabilities.planes[c * plane + static_cast<std::size_t>(v) * probabilities.width + u] =
+              std::numeric_limits<float>::quiet_NaN();
+        }
+      }
+    }
   }
   semantic.Project(probabilities, machine.sensors.camera, T_world_camera);
   stats.holes_filled = map.FillHoles();

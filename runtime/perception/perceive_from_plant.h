@@ -8,8 +8,12 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "runtime/perception/elevation_map.h"
+#include "runtime/perception/lens_dirt_monitor.h"
+#include "runtime/perception/lidar_health.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/world.h"
@@ -24,6 +28,15 @@ struct PerceptionFromPlantOptions {
   plant::Lighting lighting = plant::Lighting::kNormal;
   bool truth_labels = false;  ///< the simulator's per-pixel labels instead of the network
   std::string segmenter;      ///< ONNX network (needed unless truth_labels)
+
+  // Faults (plant/fault_spec.h) and the health checks that find them.
+  std::string dead_lidar;  ///< this LiDAR returns nothing within `dead_sector` ("": none)
+  Eigen::Vector2d dead_sector = Eigen::Vector2d::Zero();          ///< sensor-frame azimuths [rad]
+  Eigen::Vector2d lens_dirt_center_px = Eigen::Vector2d::Zero();  ///< see CameraOptions
+  double lens_dirt_radius_px = 0;                                 ///< 0: a clean lens
+  bool check_lidar_health = false;  ///< look for blind sectors in every LiDAR's last frame
+  /// When given, judges each camera frame for dirt; pixels it masks give the map no evidence.
+  LensDirtMonitor* lens_dirt = nullptr;
 };
 
 struct PerceptionFromPlantStats {
@@ -32,6 +45,9 @@ struct PerceptionFromPlantStats {
   long holes_filled = 0;
   bool ground_plane_found = false;  ///< false: too few ground cells; classes not fused
   std::string semantics;            ///< "simulator labels" or "network <file>"
+  /// Blind sectors found (check_lidar_health), with the LiDAR's name.
+  std::vector<std::pair<std::string, AzimuthSector>> blind_sectors;
+  double camera_masked_fraction = 0;  ///< of the last image, masked for dirt
 };
 
 /// Updates `map` and `semantic` (built on `map`) with what the machine of `plant` senses in

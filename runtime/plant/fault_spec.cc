@@ -1,6 +1,7 @@
 #include "runtime/plant/fault_spec.h"
 
 #include <algorithm>
+#include <numbers>
 
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/yaml_reader.h"
@@ -21,6 +22,20 @@ const char* ToString(FaultKind kind) {
       return "material_mistyped";
     case FaultKind::kPersonEntersPath:
       return "person_enters_path";
+    case FaultKind::kLidarDeadSector:
+      return "lidar_dead_sector";
+    case FaultKind::kCameraLensDirt:
+      return "camera_lens_dirt";
+    case FaultKind::kImuBiasDrift:
+      return "imu_bias_drift";
+    case FaultKind::kImuStuck:
+      return "imu_stuck";
+    case FaultKind::kEncoderNoise:
+      return "encoder_noise";
+    case FaultKind::kHydraulicDelayDrift:
+      return "hydraulic_delay_drift";
+    case FaultKind::kTimestampsOutOfOrder:
+      return "timestamps_out_of_order";
   }
   return "?";
 }
@@ -35,9 +50,12 @@ bool FaultSpec::ActiveAt(int cycle, double t) const {
 
 std::vector<FaultSpec> ReadFaults(core::MapReader& root) {
   std::vector<FaultSpec> faults;
-  const std::vector<std::string> kinds = {"lidar_dropout",     "camera_blackout",
-                                          "localisation_jump", "stuck_valve",
-                                          "material_mistyped", "person_enters_path"};
+  // In FaultKind order.
+  const std::vector<std::string> kinds = {
+      "lidar_dropout",          "camera_blackout",    "localisation_jump", "stuck_valve",
+      "material_mistyped",      "person_enters_path", "lidar_dead_sector", "camera_lens_dirt",
+      "imu_bias_drift",         "imu_stuck",          "encoder_noise",     "hydraulic_delay_drift",
+      "timestamps_out_of_order"};
   for (core::MapReader& entry : root.MapList("faults", /*required=*/false)) {
     FaultSpec f;
     const core::SourceLocation at = entry.location();
@@ -83,6 +101,38 @@ std::vector<FaultSpec> ReadFaults(core::MapReader& root) {
         break;
       case FaultKind::kPersonEntersPath:
         f.ahead_m = entry.Number("ahead_m", core::NumberRule::Positive("m"));
+        break;
+      case FaultKind::kLidarDeadSector: {
+        f.lidar = entry.String("lidar");
+        const auto sector =
+            entry.Numbers<2>("sector_deg", core::NumberRule::Closed(-180, 180, "deg"));
+        f.sector_rad = {sector[0] * std::numbers::pi / 180, sector[1] * std::numbers::pi / 180};
+        if (!(sector[0] < sector[1]))
+          entry.Error("sector_deg", "must be [from, to] with from < to");
+        break;
+      }
+      case FaultKind::kCameraLensDirt: {
+        const auto center = entry.Numbers<2>("center", core::NumberRule::Closed(0, 1, "-"));
+        f.center = {center[0], center[1]};
+        f.radius = entry.Number("radius", core::NumberRule::Closed(0, 1, "-"));
+        break;
+      }
+      case FaultKind::kImuBiasDrift:
+        f.joint = entry.Enum("joint", {"boom", "bucket"});
+        f.rate_rad_s = entry.AngleDeg("rate_deg_s", core::NumberRule::Closed(-10, 10, "deg/s"));
+        break;
+      case FaultKind::kImuStuck:
+        f.joint = entry.Enum("joint", {"boom", "bucket"});
+        break;
+      case FaultKind::kEncoderNoise:
+        f.sigma_rad = entry.AngleDeg("sigma_deg", core::NumberRule::Closed(0, 10, "deg"));
+        break;
+      case FaultKind::kHydraulicDelayDrift:
+        f.factor = entry.Number("factor", core::NumberRule::Closed(0.1, 10, "-"));
+        break;
+      case FaultKind::kTimestampsOutOfOrder:
+        f.sensor = entry.Enum("sensor", {"lidar", "camera"});
+        f.lag_s = entry.Number("lag_s", core::NumberRule::Positive("s"));
         break;
       case FaultKind::kLidarDropout:
       case FaultKind::kCameraBlackout:

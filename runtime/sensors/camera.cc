@@ -136,8 +136,22 @@ CameraFrame SimulateCameraFrame(const model::Camera& camera, const RaycastScene&
     for (int u = 0; u < frame.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * frame.width + u;
       const Eigen::Vector3d d = R * PixelRay(camera, u, v);
-      const RayHit hit = scene.Cast(origin, d, options.max_range);
       Rgb radiance;
+      if (options.lens_dirt_radius_px > 0 &&
+          (Eigen::Vector2d(u, v) - options.lens_dirt_center_px).norm() <=
+              options.lens_dirt_radius_px) {
+        frame.labels[i] = static_cast<std::uint8_t>(SemanticClass::kGround);
+        radiance = Rgb::Constant(0.02);
+        const Rgb exposed = (ex.gain * radiance + ex.flare).min(1.0).max(0.0);
+        for (int c = 0; c < 3; ++c) {
+          const double dn = 255.0 * std::pow(exposed[c], 1.0 / 2.2);
+          const double sigma = std::sqrt(ex.read_noise * ex.read_noise + ex.shot_noise * dn);
+          frame.bgr[3 * i + (2 - c)] = static_cast<std::uint8_t>(
+              std::clamp(std::round(dn + sigma * gauss(rng)), 0.0, 255.0));
+        }
+        continue;
+      }
+      const RayHit hit = scene.Cast(origin, d, options.max_range);
       if (!hit.hit) {
         frame.labels[i] = static_cast<std::uint8_t>(SemanticClass::kOther);
         radiance = Sky(d);

@@ -56,6 +56,12 @@ struct CameraOptions {
   Eigen::Vector3d sun_direction = Eigen::Vector3d(-0.5, -0.5, 0.70710678118654757);
   bool shadows = true;     ///< cast shadow rays (kDim never has hard shadows)
   double max_range = 400;  ///< beyond this a pixel sees sky [m]
+  /// Dirt on the lens (fault injection): pixels within `lens_dirt_radius_px` of
+  /// `lens_dirt_center_px` see a dark, even blot (radiance 0.02, sensor noise still on top),
+  /// and the simulator's labels there are ground, what a segmenter would make of a featureless
+  /// brown patch low in the image. Radius 0: a clean lens.
+  Eigen::Vector2d lens_dirt_center_px = Eigen::Vector2d::Zero();
+  double lens_dirt_radius_px = 0;
 };
 
 /// Body (x forward, y left, z up) ← optical (x right, y down, z forward).

@@ -130,7 +130,176 @@ TEST(Faults, PersonOnThePathStopsTheMachineShortOfThem) {
   EXPECT_LT(out.record.safety_margin_m, 4.0);  // it did come towards them
 }
 
+// The front LiDAR blind straight ahead for 2 s while driving: held like a silent sensor, then
+// on again when the sector returns.
+TEST(Faults, LidarBlindAheadHoldsTheMachine) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec blind = Fault(FaultKind::kLidarDeadSector, 2.0, 2.0);
+  blind.lidar = "front_solid_state";
+  blind.sector_rad = {-20 * M_PI / 180, 20 * M_PI / 180};
+  o.faults = {blind};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_TRUE(out.blind_sector);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  EXPECT_EQ(out.safe_stops, 1);
+  EXPECT_EQ(out.recoveries, 1);
+}
+
+// The top LiDAR blind behind the cab while the machine drives forward: seen, logged, and no
+// reason to stop.
+TEST(Faults, LidarBlindBehindLetsAForwardDriveGoOn) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec blind = Fault(FaultKind::kLidarDeadSector, 0.0, INFINITY);
+  blind.lidar = "top_16";
+  blind.sector_rad = {150 * M_PI / 180, 180 * M_PI / 180};
+  o.faults = {blind};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_TRUE(out.blind_sector);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  EXPECT_EQ(out.safe_stops, 0);
+}
+
+// A small blot of dirt on the lens: found, masked, the cycle goes on. A large one masks more
+// than a quarter of the view: held until the lens is clean again.
+TEST(Faults, SmallLensDirtIsMaskedAndTheCycleGoesOn) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec dirt = Fault(FaultKind::kCameraLensDirt, 0.0, INFINITY);
+  dirt.center = {0.5, 0.8};
+  dirt.radius = 0.08;
+  o.faults = {dirt};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_GT(out.masked_fraction, 0.02);  // the blot covers π·38² px = 1.6 % of the image
+  EXPECT_LT(out.masked_fraction, 0.25);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  EXPECT_EQ(out.safe_stops, 0);
+}
+
+TEST(Faults, LargeLensDirtHoldsTheMachineUntilWiped) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec dirt = Fault(FaultKind::kCameraLensDirt, 1.0, 4.0);
+  dirt.center = {0.5, 0.6};
+  dirt.radius = 0.25;
+  o.faults = {dirt};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_GT(out.masked_fraction, 0.25);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  EXPECT_EQ(out.safe_stops, 1);
+  EXPECT_EQ(out.recoveries, 1);
+}
+
+// The bucket IMU repeats one reading: the bucket looks as if it did not answer its valve; the
+// cycle is abandoned with the machine at rest.
+TEST(Faults, StuckBucketImuAbandonsTheCycle) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec stuck = Fault(FaultKind::kImuStuck, 0.0, INFINITY);
+  stuck.joint = "bucket";
+  o.faults = {stuck};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_FALSE(out.record.completed);
+  EXPECT_NE(out.failure.find("bucket does not answer its valve"), std::string::npos) << out.failure;
+}
+
+// The boom IMU's bias walks off. Nothing on board measures the boom twice, so a slow drift
+// (0.1°/s, 2° by the end of the cycle) is not seen: the bucket rides a few centimetres off
+// and the cycle completes. A fast one (1°/s) has the joint PID press the bucket into the floor
+// to reach the angle it reads: the boom stops answering its valve, and the cycle is abandoned.
+TEST(Faults, SlowBoomImuDriftCompletesAFastOneIsStopped) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec drift = Fault(FaultKind::kImuBiasDrift, 0.0, INFINITY);
+  drift.joint = "boom";
+  drift.rate_rad_s = 0.1 * M_PI / 180;
+  o.faults = {drift};
+  const CycleOutcome slow = RunOne(o);
+  ExpectSafe(o, slow);
+  EXPECT_TRUE(slow.record.completed) << slow.failure;
+  EXPECT_GE(slow.record.fill_rate, 0.9);
+
+  o.faults[0].rate_rad_s = 1.0 * M_PI / 180;
+  const CycleOutcome fast = RunOne(o);
+  ExpectSafe(o, fast);
+  EXPECT_FALSE(fast.record.completed);
+  EXPECT_NE(fast.failure.find("boom does not answer its valve"), std::string::npos) << fast.failure;
+}
+
+// Noise of 0.5° on the articulation encoder and the arm angles (five times the encoder's
+// rating): the PIDs and the path follower ride it out.
+TEST(Faults, EncoderNoiseIsRiddenOut) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec noise = Fault(FaultKind::kEncoderNoise, 0.0, INFINITY);
+  noise.sigma_rad = 0.5 * M_PI / 180;
+  o.faults = {noise};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  EXPECT_GE(out.record.fill_rate, 0.9);
+}
+
+// Every valve 50 % slower to answer than identified: the cycle completes; the volume trigger,
+// which predicts with the identified delay, fires late and the fill may overshoot.
+TEST(Faults, HydraulicDelayDriftStillCompletes) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec slow = Fault(FaultKind::kHydraulicDelayDrift, 0.0, INFINITY);
+  slow.factor = 1.5;
+  o.faults = {slow};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  EXPECT_GE(out.record.fill_rate, 0.9);
+}
+
+// Every second LiDAR frame arrives 0.3 s late: refused (never fused at the wrong pose), and
+// the frames in order keep the watchdog fed (0.29 s apart < 0.5 s): no stop.
+TEST(Faults, LateLidarFramesAreRefusedWithoutAStop) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec late = Fault(FaultKind::kTimestampsOutOfOrder, 0.0, INFINITY);
+  late.sensor = "lidar";
+  late.lag_s = 0.3;
+  o.faults = {late};
+  const CycleOutcome out = RunOne(o);
+  ExpectSafe(o, out);
+  EXPECT_TRUE(out.record.completed) << out.failure;
+  // Half the 7 Hz frames of ≈ 5 s of selecting and driving (the map is not updated while the
+  // bucket is in the pile).
+  EXPECT_GE(out.refused_frames, 12);
+  EXPECT_EQ(out.safe_stops, 0);
+}
+
+TEST(Faults, ADeadSectorOfAnUnknownLidarIsRefused) {
+  ShovelRunOptions o = Options("bin_1");
+  FaultSpec blind = Fault(FaultKind::kLidarDeadSector, 0.0, INFINITY);
+  blind.lidar = "roof_lidar";
+  blind.where = "faults.yaml:3";
+  o.faults = {blind};
+  try {
+    ShovelJob job(o);
+    FAIL() << "accepted a LiDAR the machine does not have";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("faults.yaml:3: lidar_dead_sector"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("top_16, front_solid_state"), std::string::npos)
+        << e.what();
+  }
+}
+
 // --- The supervisor's rules on their own ---
+
+TEST(SafetySupervisor, FramesOutOfOrderOrTooOldAreRefused) {
+  SafetySupervisor s;
+  EXPECT_TRUE(s.AcceptFrame(SensorStream::kLidar, 1.0, 1.0));
+  EXPECT_FALSE(s.AcceptFrame(SensorStream::kLidar, 0.9, 1.1));  // older than the newest used
+  EXPECT_FALSE(s.AcceptFrame(SensorStream::kLidar, 1.0, 1.1));  // the same frame again
+  EXPECT_TRUE(s.AcceptFrame(SensorStream::kCamera, 0.9, 1.1));  // each sensor has its own order
+  EXPECT_FALSE(s.AcceptFrame(SensorStream::kLidar, 1.2, 1.8));  // in order, but 0.6 s old
+  EXPECT_FALSE(s.AcceptFrame(SensorStream::kLidar, std::nan(""), 1.8));
+  EXPECT_EQ(s.refused_frames(), 4);
+  // Refused frames do not feed the watchdog: the LiDAR's newest used frame is still t = 1.0.
+  EXPECT_NE(s.StaleSensors(1.8).find("LiDAR silent for 0.80 s"), std::string::npos);
+}
 
 TEST(SafetySupervisor, WatchdogNamesTheSilentSensor) {
   SafetySupervisor s;
@@ -229,7 +398,53 @@ void ExpectError(const std::string& yaml, const std::string& expected) {
   }
 }
 
+TEST(FaultSpecFile, ReadsTheSensorAndActuatorKinds) {
+  const std::string path = Write("faults_sensors.yaml", R"(faults:
+  - kind: lidar_dead_sector
+    lidar: top_16
+    sector_deg: [-10, 20]
+  - kind: camera_lens_dirt
+    center: [0.5, 0.7]
+    radius: 0.15
+  - kind: imu_bias_drift
+    joint: boom
+    rate_deg_s: 0.5
+  - kind: imu_stuck
+    joint: bucket
+  - kind: encoder_noise
+    sigma_deg: 1.0
+  - kind: hydraulic_delay_drift
+    factor: 1.5
+  - kind: timestamps_out_of_order
+    sensor: camera
+    lag_s: 0.3
+)");
+  const std::vector<FaultSpec> f = plant::LoadFaults(path);
+  ASSERT_EQ(f.size(), 7u);
+  EXPECT_EQ(f[0].kind, FaultKind::kLidarDeadSector);
+  EXPECT_EQ(f[0].lidar, "top_16");
+  EXPECT_NEAR(f[0].sector_rad.x(), -10 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(f[0].sector_rad.y(), 20 * M_PI / 180, 1e-12);
+  EXPECT_EQ(f[1].center, Eigen::Vector2d(0.5, 0.7));
+  EXPECT_EQ(f[1].radius, 0.15);
+  EXPECT_NEAR(f[2].rate_rad_s, 0.5 * M_PI / 180, 1e-12);
+  EXPECT_EQ(f[3].kind, FaultKind::kImuStuck);
+  EXPECT_EQ(f[3].joint, "bucket");
+  EXPECT_NEAR(f[4].sigma_rad, M_PI / 180, 1e-12);
+  EXPECT_EQ(f[5].factor, 1.5);
+  EXPECT_EQ(f[6].sensor, "camera");
+  EXPECT_EQ(f[6].lag_s, 0.3);
+  EXPECT_STREQ(plant::ToString(f[6].kind), "timestamps_out_of_order");
+}
+
 TEST(FaultSpecFile, BadEntriesAreLocated) {
+  ExpectError("faults:\n  - kind: lidar_dead_sector\n    lidar: a\n    sector_deg: [20, 10]\n",
+              ":4:");
+  ExpectError("faults:\n  - kind: camera_lens_dirt\n    center: [0.5, 1.5]\n    radius: 0.1\n",
+              ":3:");
+  ExpectError("faults:\n  - kind: hydraulic_delay_drift\n    factor: 0\n", ":3:");
+  ExpectError("faults:\n  - kind: timestamps_out_of_order\n    sensor: radar\n    lag_s: 1\n",
+              ":3:");
   ExpectError("faults:\n  - kind: lidar_drop\n", ":2:");
   ExpectError("faults:\n  - kind: lidar_drop\n", "lidar_dropout");
   ExpectError("faults:\n  - kind: lidar_dropout\n    start_s: -1\n", ":3:");

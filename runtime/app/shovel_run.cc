@@ -709,6 +709,12 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
           Fixed(box.center.x(), 2) + ", " + Fixed(box.center.y(), 2) + "), " +
           Fixed(path[at].s - path[nearest].s, 1) + " m ahead along it (fault)");
     }
+    if (person_placed && person == nullptr && !fault_obstacles.empty()) {
+      // The fault's window ended: the person walks off (the map forgets them as it sees the
+      // ground there again).
+      fault_obstacles.clear();
+      say("the person leaves at t = " + Fixed(plant.time() - t0, 2) + " s (fault)");
+    }
     if (stage == Stage::kNavigate) {
       const double t = plant.time();
       // Watchdog: no motion on a stale map, nor on one from a degraded sensor.
@@ -1049,6 +1055,16 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   const control::ScoopResult& r = out.scoop;
   if (out.failure.empty() && scoop && !r.ok) out.failure = r.failure;
   rec.completed = out.failure.empty() && r.ok;
+  rec.failure = rec.completed ? "" : out.failure;
+  rec.safe_stops = out.safe_stops;
+  rec.recoveries = out.recoveries;
+  rec.refused_frames = static_cast<int>(out.refused_frames);
+  for (const plant::FaultSpec& f : faults) {
+    const std::string kind = plant::ToString(f.kind);
+    if (f.InCycle(index) && rec.faults.find(kind) == std::string::npos) {
+      rec.faults += (rec.faults.empty() ? "" : ",") + kind;
+    }
+  }
   rec.strategy = scoop ? control::ToString(r.strategy) : "";
   std::string actions;
   for (const std::string& a : r.action_names) actions += (actions.empty() ? "" : ",") + a;

@@ -17,7 +17,8 @@ constexpr const char* kCycleColumns =
     "payload_m3, "
     "time_approach_s, time_crowd_s, time_scoop_s, time_level_s, time_retreat_s, time_total_s, "
     "energy_approach_kj, energy_crowd_kj, energy_scoop_kj, energy_level_kj, energy_retreat_kj, "
-    "energy_total_kj, safety_margin_m, safety_violations, completed";
+    "energy_total_kj, safety_margin_m, safety_violations, completed, safe_stops, recoveries, "
+    "refused_frames, faults, failure";
 
 constexpr const char* kSampleColumns =
     "t_s, v1_m3, v1v2_m3, triggered, predicted_tip_x_m, predicted_tip_z_m, actual_tip_x_m, "
@@ -63,6 +64,11 @@ CREATE TABLE cycles (
   safety_margin_m     REAL,
   safety_violations   INTEGER NOT NULL,
   completed           INTEGER NOT NULL CHECK (completed IN (0, 1)),
+  safe_stops          INTEGER,
+  recoveries          INTEGER,
+  refused_frames      INTEGER,
+  faults              TEXT,
+  failure             TEXT,
   UNIQUE (run_id, cycle)
 );
 CREATE TABLE samples (
@@ -80,6 +86,19 @@ CREATE TABLE samples (
   PRIMARY KEY (run_id, cycle, k),
   FOREIGN KEY (run_id, cycle) REFERENCES cycles(run_id, cycle)
 ) WITHOUT ROWID;
+)sql";
+
+// Version 1 → 2: the safety supervisor's counts, the faults a cycle was declared to meet and
+// why it did not complete (issue 9). Columns are appended, so that a migrated file and a new one
+// have the same column order (the campaign merges shards with INSERT … SELECT *); rows written
+// before the migration hold NULL there ("not recorded").
+constexpr const char* kMigrateV1ToV2 = R"sql(
+ALTER TABLE cycles ADD COLUMN safe_stops INTEGER;
+ALTER TABLE cycles ADD COLUMN recoveries INTEGER;
+ALTER TABLE cycles ADD COLUMN refused_frames INTEGER;
+ALTER TABLE cycles ADD COLUMN faults TEXT;
+ALTER TABLE cycles ADD COLUMN failure TEXT;
+UPDATE schema_version SET version = 2;
 )sql";
 
 // Added after schema version 1 without changing it: created where missing when a database is
@@ -260,11 +279,28 @@ void ResultsDb::CreateOrCheckSchema() {
                          ": not an autoshovel results database (a SQLite file with " +
                          std::to_string(tables) + " table(s) but no schema_version table)");
   }
-  Statement version(*this, "SELECT version FROM schema_version");
-  if (!version.Step() || sqlite3_column_type(version.get(), 0) != SQLITE_INTEGER) {
-    throw ResultsDbError(file_.string() + ": results database without a schema version row");
+  int found = 0;
+  {
+    Statement version(*this, "SELECT version FROM schema_version");
+    if (!version.Step() || sqlite3_column_type(version.get(), 0) != SQLITE_INTEGER) {
+      throw ResultsDbError(file_.string() + ": results database without a schema version row");
+    }
+    found = sqlite3_column_int(version.get(), 0);
   }
-  const int found = sqlite3_column_int(version.get(), 0);
+  if (found == 1) {
+    // Migrated in one transaction; a concurrent opener that migrated first is seen again here.
+    Execute("BEGIN IMMEDIATE");
+    try {
+      Statement again(*this, "SELECT version FROM schema_version");
+      again.Step();
+      if (sqlite3_column_int(again.get(), 0) == 1) Execute(kMigrateV1ToV2);
+      Execute("COMMIT");
+    } catch (...) {
+      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      throw;
+    }
+    found = 2;
+  }
   if (found != kSchemaVersion) {
     throw ResultsDbError(file_.string() + ": results schema version " + std::to_string(found) +
                          ", this build reads version " + std::to_string(kSchemaVersion) +
@@ -343,7 +379,7 @@ void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record)
     {
       Statement insert(*this, std::string("INSERT INTO cycles (run_id, cycle, ") + kCycleColumns +
                                   ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, "
-                                  "?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                                  "?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
       // One Bind per statement: chained `Bind(i++, ...).Bind(i++, ...)` is sequenced in C++17
       // but GCC's -Wsequence-point still flags it.
       int i = 0;
@@ -369,6 +405,19 @@ void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record)
       real(record.safety_margin_m);
       integer(record.safety_violations);
       integer(record.completed ? 1 : 0);
+      for (const int count : {record.safe_stops, record.recoveries, record.refused_frames}) {
+        if (count < 0) {
+          insert.BindNull(++i);
+        } else {
+          integer(count);
+        }
+      }
+      text(record.faults);
+      if (record.completed) {
+        insert.BindNull(++i);
+      } else {
+        text(record.failure);
+      }
       const int rc = insert.Run();
       if (rc == SQLITE_CONSTRAINT_UNIQUE || rc == SQLITE_CONSTRAINT_PRIMARYKEY) {
         throw DuplicateCycleError(file_.string() + ": run '" + run_id + "' already holds cycle " +
@@ -491,6 +540,12 @@ std::vector<CycleRecord> ResultsDb::Cycles(const std::string& run_id, bool with_
       r.safety_margin_m = ColumnDouble(s, i++);
       r.safety_violations = sqlite3_column_int(s, i++);
       r.completed = sqlite3_column_int(s, i++) != 0;
+      for (int* count : {&r.safe_stops, &r.recoveries, &r.refused_frames}) {
+        *count = sqlite3_column_type(s, i) == SQLITE_NULL ? -1 : sqlite3_column_int(s, i);
+        ++i;
+      }
+      r.faults = ColumnText(s, i++);
+      r.failure = ColumnText(s, i++);
       records.push_back(std::move(r));
     }
   }

@@ -105,18 +105,25 @@ struct CycleRecord {
   double safety_margin_m = kNotMeasured;  ///< smallest clearance to obstacles/people [m]
   int safety_violations = 0;              ///< safety-rule violations in the cycle (must be 0)
   bool completed = true;  ///< ran to the end; false: aborted (safety stop, timeout), row whole
+  // Schema version 2 (issue 9). −1: not recorded (a row written before version 2; NULL).
+  int safe_stops = 0;      ///< stops the safety supervisor held
+  int recoveries = 0;      ///< of those, the ones the machine drove on from
+  int refused_frames = 0;  ///< late or out-of-order sensor frames not used
+  std::string faults;      ///< the fault kinds declared for the cycle, comma-separated; "" none
+  std::string failure;     ///< why it did not complete ("" when it did; stored as NULL)
   std::vector<CycleSample> samples;
   CrowdingSample crowding;
 };
 
 class ResultsDb {
  public:
-  static constexpr int kSchemaVersion = 1;
+  static constexpr int kSchemaVersion = 2;
 
-  /// Opens `file`, creating it and the schema when it does not exist or is empty. Throws
-  /// ResultsDbError naming the file when it is not a SQLite database, is a SQLite database
-  /// without our schema_version table, or has another schema version. A foreign file is not
-  /// modified.
+  /// Opens `file`, creating it and the schema when it does not exist or is empty, and migrating
+  /// a version-1 file to version 2 in place (one transaction; its rows keep their values and
+  /// read −1 / "" for the new fields). Throws ResultsDbError naming the file when it is not a
+  /// SQLite database, is a SQLite database without our schema_version table, or has another
+  /// schema version. A foreign file is not modified.
   explicit ResultsDb(const std::filesystem::path& file);
   ~ResultsDb();
   ResultsDb(const ResultsDb&) = delete;

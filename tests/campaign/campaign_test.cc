@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "runtime/app/campaign/campaign_spec.h"
@@ -103,6 +104,50 @@ TEST(CampaignJobs, PairPoliciesOnTheShiftSeed) {
   EXPECT_EQ(jobs[7].run_id, "resume_test/w02s01/stairway_fixed");
   EXPECT_EQ(jobs[7].week, 2);
   EXPECT_EQ(jobs[7].shift, 1);
+}
+
+const char* kFaultSpec =
+    "name: faults\nscenarios: [cone_pile, mixing_station]\nseed: 3\nweeks: 1\n"
+    "shifts_per_week: 1\ncycles_per_shift: 1\npolicies: [auto]\n"
+    "fault_cases:\n"
+    "  - name: none\n"
+    "  - name: lidar_dropout\n"
+    "    faults:\n"
+    "      - {kind: lidar_dropout, start_s: 2.0, duration_s: 1.5}\n";
+
+TEST(CampaignSpec, FaultCasesTimesScenarios) {
+  const fs::path dir = TempDir("fault_spec");
+  const CampaignSpec spec = LoadCampaignSpec(WriteSpec(dir, kFaultSpec).string());
+  EXPECT_EQ(spec.scenarios, (std::vector<std::string>{"cone_pile", "mixing_station"}));
+  ASSERT_EQ(spec.fault_cases.size(), 2u);
+  EXPECT_TRUE(spec.fault_cases[0].faults.empty());
+  ASSERT_EQ(spec.fault_cases[1].faults.size(), 1u);
+  EXPECT_EQ(spec.fault_cases[1].faults[0].kind, plant::FaultKind::kLidarDropout);
+  EXPECT_EQ(spec.jobs(), 4);
+  const std::vector<CampaignJob> jobs = CampaignJobs(spec);
+  ASSERT_EQ(jobs.size(), 4u);
+  // Case-major; every case meets the same yards with the same seed.
+  EXPECT_EQ(jobs[0].run_id, "faults/cone_pile/none/w01s01/auto");
+  EXPECT_EQ(jobs[1].run_id, "faults/mixing_station/none/w01s01/auto");
+  EXPECT_EQ(jobs[2].run_id, "faults/cone_pile/lidar_dropout/w01s01/auto");
+  EXPECT_EQ(jobs[2].scenario, "cone_pile");
+  EXPECT_EQ(jobs[2].faults.size(), 1u);
+  EXPECT_TRUE(jobs[0].faults.empty());
+  for (const CampaignJob& job : jobs) EXPECT_EQ(job.seed, jobs[0].seed);
+
+  const std::string both = SpecError(
+      "name: a\nscenario: cone_pile\nscenarios: [low_pile]\nweeks: 1\nshifts_per_week: 1\n"
+      "cycles_per_shift: 1\npolicies: [auto]\n");
+  EXPECT_NE(both.find("either 'scenario' or 'scenarios'"), std::string::npos) << both;
+  const std::string twice = SpecError(
+      "name: a\nscenarios: [low_pile]\nweeks: 1\nshifts_per_week: 1\ncycles_per_shift: 1\n"
+      "policies: [auto]\nfault_cases:\n  - name: x\n  - name: x\n");
+  EXPECT_NE(twice.find("spec.yaml:9:"), std::string::npos) << twice;
+  EXPECT_NE(twice.find("fault case 'x' is listed twice"), std::string::npos) << twice;
+  const std::string bad_fault = SpecError(
+      "name: a\nscenarios: [low_pile]\nweeks: 1\nshifts_per_week: 1\ncycles_per_shift: 1\n"
+      "policies: [auto]\nfault_cases:\n  - name: x\n    faults:\n      - kind: lidar_drop\n");
+  EXPECT_NE(bad_fault.find("spec.yaml:10:"), std::string::npos) << bad_fault;
 }
 
 // Starts `autoshovel campaign` in its own process group; returns its pid.
@@ -206,6 +251,51 @@ TEST(Campaign, KilledWithSigkillAndResumedLosesAndDuplicatesNothing) {
   // Resuming a complete campaign runs nothing and changes nothing.
   ASSERT_EQ(Wait(StartCampaign(command(dir / "killed", true), dir / "again.log")), 0);
   EXPECT_EQ(CountCycles(dir / "killed" / "results.sqlite"), 4);
+  fs::remove_all(dir);
+}
+
+// A fault campaign of 2 yards x 2 fault cases, one cycle each: the table is printed and stored
+// (view fault_summary), counted from the cycles' own rows.
+TEST(Campaign, FaultCampaignPrintsAndStoresTheFaultTable) {
+  const fs::path dir = TempDir("fault_campaign");
+  const fs::path spec = WriteSpec(dir, kFaultSpec);
+  const std::string models = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
+  const fs::path out = dir / "out";
+  ASSERT_EQ(Wait(StartCampaign({"autoshovel", "--models", models, "campaign", spec.string(), "-o",
+                                out.string(), "--workers", "2"},
+                               dir / "campaign.log")),
+            0);
+  std::ifstream log_file(dir / "campaign.log");
+  const std::string log((std::istreambuf_iterator<char>(log_file)), {});
+  EXPECT_NE(log.find("| fault | scenario | cycles | completed |"), std::string::npos) << log;
+  EXPECT_NE(log.find("| none | cone_pile | 1 | 1 |"), std::string::npos) << log;
+  EXPECT_NE(log.find("| lidar_dropout | mixing_station | 1 |"), std::string::npos) << log;
+
+  const results::ResultsDb db(out / "results.sqlite");
+  int dropout_stops = 0, none_stops = 0;
+  for (const results::RunInfo& run : db.Runs()) {
+    for (const results::CycleRecord& c : db.Cycles(run.run_id)) {
+      EXPECT_EQ(c.safety_violations, 0) << run.run_id;
+      if (run.run_id.find("/lidar_dropout/") != std::string::npos) {
+        EXPECT_EQ(c.faults, "lidar_dropout");
+        dropout_stops += c.safe_stops;
+      } else {
+        EXPECT_EQ(c.faults, "");
+        none_stops += c.safe_stops;
+      }
+    }
+  }
+  EXPECT_EQ(none_stops, 0);
+  EXPECT_GE(dropout_stops, 2);  // the watchdog held each yard's machine once
+  std::ostringstream table;
+  ASSERT_TRUE(PrintFaultTable(out / "results.sqlite", table));
+  std::istringstream lines(table.str());
+  std::string line;
+  int rows = 0;
+  while (std::getline(lines, line))
+    rows += line.starts_with("| none") || line.starts_with("| lidar");
+  EXPECT_EQ(rows, 4);
+  EXPECT_LT(table.str().find("| none"), table.str().find("| lidar_dropout"));  // spec order
   fs::remove_all(dir);
 }
 

@@ -260,6 +260,74 @@ TEST(ResultsDb, OtherSchemaVersionIsRefusedNamingBoth) {
   }
 }
 
+// Schema version 2: the supervisor's counts, the declared faults and the failure round-trip.
+TEST(ResultsDb, SafetyFieldsRoundTrip) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  ResultsDb db(file);
+  db.BeginRun(TestRun());
+  CycleRecord failed = TestRecord(0, 3);
+  failed.completed = false;
+  failed.safe_stops = 2;
+  failed.recoveries = 1;
+  failed.refused_frames = 17;
+  failed.faults = "lidar_dropout,person_enters_path";
+  failed.failure = "safe stop: localisation jumped";
+  db.WriteCycle("run-1", failed);
+  CycleRecord fine = TestRecord(1, 3);
+  fine.failure = "ignored when completed";
+  db.WriteCycle("run-1", fine);
+  const std::vector<CycleRecord> back = db.Cycles("run-1");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].safe_stops, 2);
+  EXPECT_EQ(back[0].recoveries, 1);
+  EXPECT_EQ(back[0].refused_frames, 17);
+  EXPECT_EQ(back[0].faults, "lidar_dropout,person_enters_path");
+  EXPECT_EQ(back[0].failure, "safe stop: localisation jumped");
+  EXPECT_EQ(back[1].safe_stops, 0);
+  EXPECT_EQ(back[1].faults, "");
+  EXPECT_EQ(Query(file, "SELECT failure IS NULL FROM cycles WHERE cycle = 1"), "1");
+}
+
+// A version-1 file (as the last build before version 2 wrote it) is migrated in place: its rows
+// keep every value and read "not recorded" for the new fields; new rows store them; the column
+// order is a new file's (campaign shards merge with INSERT … SELECT *).
+TEST(ResultsDb, VersionOneFileIsMigrated) {
+  const auto dir = ScratchDir("");
+  const auto file = dir / "v1.sqlite";
+  {
+    ResultsDb db(file);
+    db.BeginRun(TestRun());
+    db.WriteCycle("run-1", TestRecord(0, 3));
+  }
+  Exec(file,
+       "ALTER TABLE cycles DROP COLUMN safe_stops; ALTER TABLE cycles DROP COLUMN recoveries; "
+       "ALTER TABLE cycles DROP COLUMN refused_frames; ALTER TABLE cycles DROP COLUMN faults; "
+       "ALTER TABLE cycles DROP COLUMN failure; UPDATE schema_version SET version = 1");
+  ASSERT_EQ(Query(file, "SELECT count(*) FROM pragma_table_info('cycles')"), "26");
+  const CycleRecord before = TestRecord(0, 3);
+  {
+    ResultsDb db(file);
+    std::vector<CycleRecord> rows = db.Cycles("run-1");
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_EQ(rows[0].fill_rate, before.fill_rate);
+    EXPECT_EQ(rows[0].energy_kj.total, before.energy_kj.total);
+    EXPECT_EQ(rows[0].safe_stops, -1);
+    EXPECT_EQ(rows[0].recoveries, -1);
+    EXPECT_EQ(rows[0].refused_frames, -1);
+    CycleRecord next = TestRecord(1, 3);
+    next.safe_stops = 1;
+    db.WriteCycle("run-1", next);
+    EXPECT_EQ(db.Cycles("run-1")[1].safe_stops, 1);
+  }
+  EXPECT_EQ(Query(file, "SELECT version FROM schema_version"), "2");
+  const auto fresh = dir / "v2.sqlite";
+  { ResultsDb db(fresh); }
+  EXPECT_EQ(Query(file, "SELECT group_concat(name) FROM pragma_table_info('cycles')"),
+            Query(fresh, "SELECT group_concat(name) FROM pragma_table_info('cycles')"));
+  { ResultsDb again(file); }  // opening a migrated file again changes nothing
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM cycles"), "2");
+}
+
 TEST(ResultsDb, CorruptedPagesAreReportedNamingTheFile) {
   const auto file = ScratchDir("") / "results.sqlite";
   {

@@ -58,7 +58,7 @@ std::string ReadFile(const std::filesystem::path& file) {
 ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
                             const std::string& models_dir) {
   ShovelRunOptions o;
-  o.scenario = spec.scenario;
+  o.scenario = job.scenario;
   o.models_dir = models_dir;
   o.machine = spec.machine;
   o.cycles = spec.cycles_per_shift;
@@ -71,7 +71,8 @@ ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
                                            : TriggerChoice::kPredicted;
   o.figures = false;
   o.yard_variation = spec.yard_variation;
-  o.faults = spec.faults;
+  o.faults = job.faults;
+  o.max_cycle_time = spec.max_cycle_time_s;
   return o;
 }
 
@@ -175,11 +176,12 @@ long long ShardRows(const std::filesystem::path& dir) {
 void PrintProgress(std::ostream& out, long long done, long long total, long long fresh,
                    double seconds, bool final) {
   const double rate = seconds > 0 ? fresh / seconds : 0;
-  const double eta = rate > 0 ? (total - done) / rate : 0;
+  // No ETA before the first cycle of this session is stored (the rate is not known yet).
+  char eta[32] = "?";
+  if (rate > 0) std::snprintf(eta, sizeof eta, "%.0f s", (total - done) / rate);
   char line[200];
-  std::snprintf(line, sizeof line,
-                "\r[%lld/%lld cycles] %.2f cycles/s, %.0f s elapsed, ETA %.0f s   ", done, total,
-                rate, seconds, eta);
+  std::snprintf(line, sizeof line, "\r[%lld/%lld cycles] %.2f cycles/s, %.0f s elapsed, ETA %s   ",
+                done, total, rate, seconds, eta);
   out << line << (final ? "\n" : "") << std::flush;
 }
 
@@ -213,7 +215,19 @@ void PrintSummary(const std::filesystem::path& merged, std::ostream& out) {
     }
   }
   sqlite3_finalize(s);
+  // A fault campaign: the fault × scenario table too.
+  bool fault_campaign = false;
+  if (sqlite3_prepare_v2(db, "SELECT count(*) FROM campaign_runs WHERE fault_case <> ''", -1, &s,
+                         nullptr) == SQLITE_OK &&
+      sqlite3_step(s) == SQLITE_ROW) {
+    fault_campaign = sqlite3_column_int64(s, 0) > 0;
+  }
+  sqlite3_finalize(s);
   sqlite3_close(db);
+  if (fault_campaign) {
+    out << "\nFaults x scenarios (view fault_summary):\n";
+    PrintFaultTable(merged, out);
+  }
 }
 
 // Local: worker processes of this executable, progress from their shards.
@@ -230,8 +244,12 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const int workers = std::clamp(o.workers > 0 ? o.workers : cores, 1, spec.jobs());
   out << kCommand << ": " << spec.name << ", " << spec.jobs() << " jobs (" << spec.shifts()
-      << " shifts x " << spec.policies.size() << " policies) of " << spec.cycles_per_shift
-      << " cycles, " << workers << " worker process(es) -> " << dir.string()
+      << " shifts x "
+      << (spec.matrix() ? std::to_string(spec.scenarios.size()) + " scenarios x " +
+                              std::to_string(spec.cases()) + " fault cases x "
+                        : std::string())
+      << spec.policies.size() << " policies) of " << spec.cycles_per_shift << " cycles, " << workers
+      << " worker process(es) -> " << dir.string()
       << (base > 0 ? ", resuming with " + std::to_string(base) + " stored" : "") << "\n";
   const long long shard_rows_before = ShardRows(dir);
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
@@ -407,7 +425,11 @@ int RunCampaign(const CampaignOptions& o, std::ostream& out, std::ostream& err) 
     }
     if (StartedByMpirun()) return RunMpi(o, spec, jobs, dir, out, err);
     // Check that the jobs can be set up (scenario, machine, models) before starting workers.
-    { ShovelJob probe(JobOptions(spec, jobs.front(), o.models_dir)); }
+    // Each yard under each fault case once (a fault may name a sensor the machine lacks).
+    for (const CampaignJob& job : jobs) {
+      if (job.week != 1 || job.shift != 1 || job.policy != spec.policies.front()) continue;
+      ShovelJob probe(JobOptions(spec, job, o.models_dir));
+    }
     if (!PrepareFolder(o, spec, jobs, dir, err)) return 2;
     return RunLocal(o, spec, dir, out, err);
   } catch (const std::exception& e) {

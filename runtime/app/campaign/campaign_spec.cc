@@ -1,5 +1,6 @@
 #include "runtime/app/campaign/campaign_spec.h"
 
+#include <cctype>
 #include <cstdio>
 #include <stdexcept>
 
@@ -45,7 +46,20 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
         break;
       }
     }
-    spec.scenario = root.String("scenario");
+    if (root.Has("scenarios")) {
+      if (root.Has("scenario")) root.Error("scenario", "give either 'scenario' or 'scenarios'");
+      spec.scenarios = root.Strings("scenarios", true);
+      for (std::size_t i = 0; i < spec.scenarios.size(); ++i) {
+        for (std::size_t j = 0; j < i; ++j) {
+          if (spec.scenarios[j] == spec.scenarios[i]) {
+            root.Error("scenarios", "scenario '" + spec.scenarios[i] + "' is listed twice");
+          }
+        }
+      }
+    } else {
+      spec.scenarios = {root.String("scenario")};
+    }
+    if (!spec.scenarios.empty()) spec.scenario = spec.scenarios.front();
     if (root.Has("machine")) spec.machine = root.String("machine");
     spec.seed = static_cast<std::uint64_t>(root.Integer("seed", 0, 2147483647, 1));
     spec.weeks = root.Integer("weeks", 1, 520);
@@ -72,7 +86,30 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
     if (root.Has("yard_variation")) {
       spec.yard_variation = root.Number("yard_variation", core::NumberRule::Closed(0.0, 0.9, ""));
     }
+    if (root.Has("max_cycle_time_s")) {
+      spec.max_cycle_time_s =
+          root.Number("max_cycle_time_s", core::NumberRule::Closed(5.0, 3600.0, "s"));
+    }
     spec.faults = plant::ReadFaults(root);
+    for (core::MapReader& entry : root.MapList("fault_cases", /*required=*/false)) {
+      FaultCase c;
+      c.name = entry.String("name");
+      bool bad_name = c.name.empty();
+      for (const char ch : c.name) {
+        bad_name |= !(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-');
+      }
+      if (bad_name) {
+        entry.Error("name", "use letters, digits, '_' and '-' only (it names the runs), got '" +
+                                c.name + "'");
+      }
+      for (const FaultCase& earlier : spec.fault_cases) {
+        if (earlier.name == c.name)
+          entry.Error("name", "fault case '" + c.name + "' is listed twice");
+      }
+      c.faults = plant::ReadFaults(entry);
+      entry.Finish();
+      spec.fault_cases.push_back(std::move(c));
+    }
     root.Finish();
     if (sink.empty() && spec.cycles() > 10'000'000) {
       root.Error("cycles_per_shift", "the campaign would run " + std::to_string(spec.cycles()) +
@@ -89,15 +126,32 @@ std::vector<CampaignJob> CampaignJobs(const CampaignSpec& spec) {
     const int week = s / spec.shifts_per_week + 1, shift = s % spec.shifts_per_week + 1;
     char label[32];
     std::snprintf(label, sizeof label, "w%02ds%02d", week, shift);
-    for (const std::string& policy : spec.policies) {
-      CampaignJob job;
-      job.index = static_cast<int>(jobs.size());
-      job.week = week;
-      job.shift = shift;
-      job.policy = policy;
-      job.run_id = spec.name + "/" + label + "/" + policy;
-      job.seed = Mix(spec.seed * 0x100000001b3ULL + static_cast<std::uint64_t>(s));
-      jobs.push_back(job);
+    const std::vector<FaultCase> cases =
+        spec.fault_cases.empty() ? std::vector<FaultCase>{FaultCase{}} : spec.fault_cases;
+    // A spec built in code may give `scenario` alone.
+    const std::vector<std::string> scenarios =
+        spec.scenarios.empty() ? std::vector<std::string>{spec.scenario} : spec.scenarios;
+    // Case-major, so that the fault table (campaign_store.h) lists cases in the spec's order.
+    for (const FaultCase& fault_case : cases) {
+      for (const std::string& scenario : scenarios) {
+        for (const std::string& policy : spec.policies) {
+          CampaignJob job;
+          job.index = static_cast<int>(jobs.size());
+          job.week = week;
+          job.shift = shift;
+          job.policy = policy;
+          job.scenario = scenario;
+          job.fault_case = fault_case.name;
+          job.faults = spec.faults;
+          job.faults.insert(job.faults.end(), fault_case.faults.begin(), fault_case.faults.end());
+          job.run_id = spec.matrix() ? spec.name + "/" + scenario + "/" +
+                                           (fault_case.name.empty() ? "-" : fault_case.name) + "/" +
+                                           label + "/" + policy
+                                     : spec.name + "/" + label + "/" + policy;
+          job.seed = Mix(spec.seed * 0x100000001b3ULL + static_cast<std::uint64_t>(s));
+          jobs.push_back(job);
+        }
+      }
     }
   }
   return jobs;

@@ -17,8 +17,24 @@
 //   yard_variation: 0.25              # each shift's piles up to 25 % lower than written, and
 //                                     # irregular heaps re-seeded (plant::VaryPiles); default 0
 //   faults: [...]                     # injected faults, as in a scenario (plant/fault_spec.h)
+//   max_cycle_time_s: 40              # a cycle not done by then ends incomplete; default 120
+//
+// A fault campaign (issue 9) runs every shift on several yards and under several fault cases,
+// each a named list of faults on top of `faults`; the summary is then a fault × scenario table
+// (also stored as the view `fault_summary` in results.sqlite):
+//
+//   scenarios: [mixing_station, pile_behind_loader]   # instead of `scenario`
+//   fault_cases:
+//     - name: none                    # no fault: the reference row
+//     - name: lidar_dropout
+//       faults:
+//         - {kind: lidar_dropout, start_s: 2.0, duration_s: 1.5}
+//
+// Runs are then named <name>/<scenario>/<case>/wWWsSS/<policy>; a shift's seed is the same on
+// every yard and under every case, so that each case meets the very yards of "none".
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -28,11 +44,18 @@
 
 namespace autoshovel::app {
 
+/// A named set of faults of a fault campaign.
+struct FaultCase {
+  std::string name;
+  std::vector<plant::FaultSpec> faults;
+};
+
 struct CampaignSpec {
   std::string source_file;
   std::string name;
-  std::string scenario;
-  std::string machine;  ///< empty: the scenario's
+  std::string scenario;                ///< the first of `scenarios`
+  std::vector<std::string> scenarios;  ///< `scenario`, or the `scenarios` list
+  std::string machine;                 ///< empty: the scenario's
   std::uint64_t seed = 1;
   int weeks = 1;
   int shifts_per_week = 1;
@@ -42,11 +65,19 @@ struct CampaignSpec {
   std::string trigger = "predicted";
   bool truth_labels = true;
   double yard_variation = 0;
+  double max_cycle_time_s = 120;
   /// Faults every shift's cycles meet (plant/fault_spec.h), on top of the scenario's own.
   std::vector<plant::FaultSpec> faults;
+  std::vector<FaultCase> fault_cases;  ///< empty: not a fault campaign
 
+  /// Run ids carry the scenario and the fault case (several yards, or fault cases).
+  bool matrix() const { return scenarios.size() > 1 || !fault_cases.empty(); }
+  int cases() const { return fault_cases.empty() ? 1 : static_cast<int>(fault_cases.size()); }
   int shifts() const { return weeks * shifts_per_week; }
-  int jobs() const { return shifts() * static_cast<int>(policies.size()); }
+  int jobs() const {
+    return shifts() * std::max<int>(1, static_cast<int>(scenarios.size())) * cases() *
+           static_cast<int>(policies.size());
+  }
   long long cycles() const { return static_cast<long long>(jobs()) * cycles_per_shift; }
 };
 
@@ -55,13 +86,17 @@ CampaignSpec LoadCampaignSpec(const std::string& path);
 
 control::ScoopPolicy ParseScoopPolicy(const std::string& name);
 
-/// One unit of work: a shift under one policy, `cycles_per_shift` cycles in one yard.
+/// One unit of work: a shift under one policy (on one yard, under one fault case),
+/// `cycles_per_shift` cycles in one yard.
 struct CampaignJob {
   int index = 0;  ///< 0 … jobs − 1, shift-major
   int week = 0;   ///< 1-based
   int shift = 0;  ///< 1-based within the week
   std::string policy;
-  std::string run_id;      ///< <name>/wWWsSS/<policy>
+  std::string scenario;
+  std::string fault_case;                ///< "" outside a fault campaign
+  std::vector<plant::FaultSpec> faults;  ///< the spec's and the case's
+  std::string run_id;      ///< <name>/wWWsSS/<policy>, or <name>/<scenario>/<case>/wWWsSS/<policy>
   std::uint64_t seed = 0;  ///< the shift's seed: the same for every policy of the shift
 };
 

@@ -10,6 +10,15 @@ if(AUTOSHOVEL_SANITIZE)
   set(AUTOSHOVEL_SANITIZER_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer
                                  -fno-sanitize-recover=undefined)
   add_compile_options(${AUTOSHOVEL_SANITIZER_FLAGS})
+  # Eigen stops trusting malloc's 16-byte alignment when it sees __SANITIZE_ADDRESS__ and then
+  # allocates with an offset of its own (handmade_aligned_malloc). Debian's PCL, Ceres and
+  # OpenCV were built without ASan and free Eigen storage with plain free(); when an
+  # Eigen::internal::aligned_malloc from our instrumented code is the one the dynamic linker
+  # binds (it is a weak symbol), PCL frees a pointer malloc never returned: ASan's "attempting
+  # free on address which was not malloc()-ed" in pcl::RandomSampleConsensus::computeModel.
+  # ASan's malloc does return 16-byte aligned memory on x86-64 (size classes of 16, power-of-two
+  # redzones), so our code may keep the assumption the prebuilt libraries make.
+  add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
   # GCC 12's -Wmaybe-uninitialized fires inside libstdc++'s <regex> (std::function moved in
   # _NFA::_M_insert_subexpr_end) once ASan instruments it, a known false positive; under
   # -Werror it would stop the build. The normal build keeps the warning.

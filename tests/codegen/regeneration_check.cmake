@@ -16,8 +16,19 @@ set(stale "")
 if(NOT expected STREQUAL actual)
   set(stale "file sets differ:\n  committed: ${expected}\n  regenerated: ${actual}\n")
 endif()
+# COMPARE_CONTENT=OFF (the sanitizer build): the file sets only. GiNaC's automatic evaluation
+# picks normal forms (which sign a sum takes, where a numeric factor goes) by hashes seeded
+# from the addresses of type-name strings, so a generator built with other flags (ASan's
+# RelWithDebInfo against the reference Release) writes −(b − a)·(−0.5) where the reference
+# writes (a − b)·0.5, and the temporaries and the canonical operand order of the printer
+# (codegen/expression_printer.cc) follow from those forms. Same mathematics, other text (1492
+# lines of diff on xcmg_968ev.cc). generated/ is the reference build's output, checked byte
+# for byte there (CI).
+if(NOT DEFINED COMPARE_CONTENT)
+  set(COMPARE_CONTENT ON)
+endif()
 foreach(file IN LISTS expected)
-  if(EXISTS "${WORK_DIR}/${file}")
+  if(COMPARE_CONTENT AND EXISTS "${WORK_DIR}/${file}")
     file(SHA256 "${SOURCE_DIR}/generated/${file}" a)
     file(SHA256 "${WORK_DIR}/${file}" b)
     if(NOT a STREQUAL b)

@@ -239,6 +239,7 @@ def pad16(x):
 @torch.no_grad()
 def confusion(model, images, labels, batch=4):
     """Confusion counts [truth, predicted] over full frames, padded as the runtime pads them."""
+    modes = [m.training for m in model.modules()]
     model.eval()
     counts = np.zeros((len(images), NUM_CLASSES, NUM_CLASSES), np.int64)
     h, w = labels.shape[1:]
@@ -249,7 +250,8 @@ def confusion(model, images, labels, batch=4):
             t = labels[s + k].astype(np.int64).ravel()
             counts[s + k] = np.bincount(t * NUM_CLASSES + pred[k].ravel(),
                                         minlength=NUM_CLASSES ** 2).reshape(NUM_CLASSES, -1)
-    model.train()
+    for m, training in zip(model.modules(), modes):  # as it was (frozen batch norm stays frozen)
+        m.training = training
     return counts
 
 
@@ -289,6 +291,54 @@ def dice_loss(logits, target):
     return 1 - dice[present].mean()
 
 
+def load_onnx(model, path):
+    """Starts `model` from a network that export() wrote, for fine-tuning on a new site
+    (`autoshovel train segmentation`). The exported graph has every batch norm folded into the
+    convolution before it; its Conv nodes, in graph order, are the model's Conv2d modules in
+    module order (forward() runs them in the order __init__ makes them). Each convolution takes
+    the folded weight; the batch norm after it becomes the identity plus the folded bias
+    (γ = 1, β = bias, mean 0, variance 1 − eps), so that the model computes what the file does.
+    The batch norms must then stay frozen (eval mode) while fine-tuning: batch statistics would
+    undo the folding at the first step."""
+    import onnx  # only needed here
+    from onnx import numpy_helper
+    graph = onnx.load(path).graph
+    weights = {i.name: numpy_helper.to_array(i) for i in graph.initializer}
+    nodes = [n for n in graph.node if n.op_type == "Conv"]
+    convs = [m for m in model.modules() if isinstance(m, nn.Conv2d)]
+    if len(nodes) != len(convs):
+        raise SystemExit(f"{path}: {len(nodes)} convolutions, the network has {len(convs)} "
+                         "(another architecture or --width?)")
+    after = {}
+    for seq in model.modules():
+        children = list(seq.children())
+        for a, b in zip(children, children[1:]):
+            if isinstance(a, nn.Conv2d) and isinstance(b, nn.BatchNorm2d):
+                after[a] = b
+    with torch.no_grad():
+        for k, (node, conv) in enumerate(zip(nodes, convs)):
+            w = weights.get(node.input[1])
+            b = weights.get(node.input[2]) if len(node.input) > 2 else None
+            if w is None or b is None or tuple(w.shape) != tuple(conv.weight.shape):
+                raise SystemExit(f"{path}: convolution {k} ({node.name}) does not match the "
+                                 f"network's {tuple(conv.weight.shape)}")
+            conv.weight.copy_(torch.from_numpy(w.copy()))
+            bn = after.get(conv)
+            if bn is None:
+                conv.bias.copy_(torch.from_numpy(b.copy()))
+            else:
+                bn.weight.fill_(1.0)
+                bn.bias.copy_(torch.from_numpy(b.copy()))
+                bn.running_mean.zero_()
+                bn.running_var.fill_(1.0 - bn.eps)
+
+
+def freeze_batch_norm(model):
+    for m in model.modules():
+        if isinstance(m, nn.BatchNorm2d):
+            m.eval()
+
+
 def export(model, path):
     model.eval()
     dummy = torch.zeros(1, 3, 384, 480)
@@ -319,6 +369,10 @@ def main():
     ap.add_argument("--init", default="",
                     help="start from the weights of a --checkpoint file with a fresh optimiser "
                          "and schedule (fine-tuning on new data)")
+    ap.add_argument("--init-onnx", default="",
+                    help="start from a network this script exported (batch norm folded; it is "
+                         "kept frozen), with a fresh optimiser and schedule: fine-tuning on a new "
+                         "site")
     ap.add_argument("--log", default="", help="write the final scores as JSON here")
     args = ap.parse_args()
 
@@ -353,6 +407,9 @@ def main():
     if args.init:
         model.load_state_dict(torch.load(args.init)["model"])
         print(f"initialised from {args.init}")
+    if args.init_onnx:
+        load_onnx(model, args.init_onnx)
+        print(f"initialised from {args.init_onnx} (batch norm folded, frozen)")
     if args.resume:
         state = torch.load(args.resume)
         model.load_state_dict(state["model"])
@@ -364,6 +421,11 @@ def main():
     sampler = CropSampler(train_x, train_y, crop, rng)
 
     model.train()
+    if args.init_onnx:
+        freeze_batch_norm(model)
+    if args.init_onnx and args.iters > 0:
+        text, _ = report(confusion(model, val_x, val_y), val_light)
+        print(f"val before fine-tuning\n{text}", flush=True)
     t_train, running = time.time(), []
     for it in range(start, args.iters):
         x, y = sampler.batch(args.batch)

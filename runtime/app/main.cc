@@ -22,6 +22,7 @@
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
 #include "runtime/app/shovel_run.h"
+#include "runtime/app/train_segmentation.h"
 #include "runtime/app/truck_loading/truck_loading_job.h"
 #include "runtime/planning/select_command.h"
 
@@ -265,6 +266,31 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   retrain_cmd->add_option("--threads", retrain.threads, "0: every core")->capture_default_str();
 
+  autoshovel::app::TrainSegmentationOptions segmentation;
+  CLI::App* segmentation_cmd = train_cmd->add_subcommand(
+      "segmentation",
+      "Fine-tune the segmentation network on views rendered in a new site's yard; scores before "
+      "and after on held-out views; never writes the shipped network");
+  segmentation_cmd->add_option("scenario", segmentation.scenario, "The new site's yard")
+      ->required();
+  segmentation_cmd->add_option("-o,--out", segmentation.out, "The new ONNX network")->required();
+  segmentation_cmd->add_option("--base", segmentation.base,
+                               "Network to start from (default: the shipped one)");
+  segmentation_cmd->add_option("--views", segmentation.views, "Training views to render")
+      ->capture_default_str();
+  segmentation_cmd->add_option("--heldout", segmentation.heldout, "Held-out views to render")
+      ->capture_default_str();
+  segmentation_cmd->add_option("--steps", segmentation.steps, "Fine-tuning steps (batch 8)")
+      ->capture_default_str();
+  segmentation_cmd->add_option("--lr", segmentation.learning_rate, "Peak learning rate")
+      ->capture_default_str();
+  segmentation_cmd
+      ->add_option("--seed", segmentation.seed, "Training views' seed (held-out: seed + 1000)")
+      ->capture_default_str();
+  segmentation_cmd->add_option("--jobs", segmentation.jobs, "Threads")->capture_default_str();
+  segmentation_cmd->add_option("--work", segmentation.work_dir,
+                               "Folder for the rendered views and logs (default: <out>.data)");
+
   autoshovel::app::CampaignOptions campaign;
   std::string campaign_out;
   CLI::App* campaign_cmd = app.add_subcommand(
@@ -487,6 +513,10 @@ int main(int argc, char** argv) {
     campaign.models_dir = models_dir;
     campaign.out_dir = campaign_out;
     return autoshovel::app::RunCampaign(campaign, std::cout, std::cerr);
+  }
+  if (*segmentation_cmd) {
+    segmentation.models_dir = models_dir;
+    return autoshovel::app::RunTrainSegmentation(segmentation, std::cout, std::cerr);
   }
   if (*retrain_cmd) {
     retrain.models_dir = models_dir;

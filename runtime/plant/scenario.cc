@@ -238,6 +238,13 @@ class ScenarioReader {
                      s.materials_dir + "'");
     }
     for (const auto& material : materials_) material_names_.push_back(material.name);
+    // Where the machine named by the scenario is looked for: beside the materials, unless the
+    // scenario names the models folder (a site's own materials with the shipped machines).
+    const auto machines = root.OptionalString("machines");
+    machines_dir_ =
+        machines ? (fs::path(*machines).is_relative() ? dir / *machines : fs::path(*machines))
+                       .lexically_normal()
+                 : (materials / "..").lexically_normal();
   }
 
   void ReadMachine(MapReader& machine, Scenario& s) {
@@ -251,7 +258,7 @@ class ScenarioReader {
     if (s.machine.empty() || materials_.empty()) return;
     // Machines live next to the materials: <models>/materials, <models>/loaders/<name>.yaml,
     // <models>/excavators/<name>.yaml (models/README.md). Only those two folders are searched.
-    fs::path models = (fs::path(s.materials_dir) / "..").lexically_normal();
+    fs::path models = machines_dir_;
     if (models.filename().empty()) models = models.parent_path();  // "models/" -> "models"
     std::vector<std::string> names;
     for (const char* kind : {"loaders", "excavators"}) {
@@ -660,6 +667,7 @@ class ScenarioReader {
   Yard yard_;
   std::vector<model::Material> materials_;
   std::vector<std::string> material_names_;
+  fs::path machines_dir_;  ///< holds loaders/ and excavators/ (see ReadMaterials)
   std::vector<std::string> pile_paths_;
   std::set<std::string> pile_names_, bin_names_, obstacle_names_;
 };

@@ -38,6 +38,7 @@ Rgb PileAlbedo(const plant::World& world, int material) {
     if (name.find("sand") != std::string::npos) return {0.62, 0.50, 0.33};
     if (name.find("big_gravel") != std::string::npos) return {0.40, 0.39, 0.37};
     if (name.find("gravel") != std::string::npos) return {0.48, 0.46, 0.42};
+    if (name.find("ore") != std::string::npos) return {0.36, 0.19, 0.13};  // haematite red-brown
   }
   return {0.45, 0.38, 0.30};
 }

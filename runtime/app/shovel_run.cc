@@ -560,7 +560,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     const perception::PerceptionFromPlantStats seen =
         perception::PerceiveFromPlant(plant, *st.scene, st.rng, perceive, *st.map, *st.semantic);
     // Degraded sensors: a blind sector facing the way the machine goes, a view masked for dirt.
-    out.masked_fraction = std::max(out.masked_fraction, seen.camera_masked_fraction);
+    out.masked_fraction = std::max(out.masked_fraction, seen.camera_dirty_fraction);
     out.blind_sector = out.blind_sector || !seen.blind_sectors.empty();
     degraded.clear();
     const double travel = target_speed < 0 ? std::numbers::pi : 0.0;
@@ -570,12 +570,12 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
                   Fixed(sector.from * 180 / std::numbers::pi, 0) + " to " +
                   Fixed(sector.to * 180 / std::numbers::pi, 0) + " deg";
     }
-    if (perceive.camera_frame && seen.camera_masked_fraction > o.supervisor.max_masked_fraction) {
+    if (perceive.camera_frame && seen.camera_dirty_fraction > o.supervisor.max_masked_fraction) {
       degraded += (degraded.empty() ? "" : ", ") + std::string("camera view ") +
-                  Fixed(100 * seen.camera_masked_fraction, 0) + " % masked for lens dirt";
+                  Fixed(100 * seen.camera_dirty_fraction, 0) + " % masked for lens dirt";
     }
-    if (seen.camera_masked_fraction > 0 && !dirt_reported) {
-      say("lens dirt found: " + Fixed(100 * seen.camera_masked_fraction, 1) +
+    if (seen.camera_dirty_fraction > 0 && !dirt_reported) {
+      say("lens dirt found: " + Fixed(100 * seen.camera_dirty_fraction, 1) +
           " % of the image masked at t = " + Fixed(now - t0, 2) + " s");
       dirt_reported = true;
     }

@@ -16,6 +16,10 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
     previous_mean_.assign(static_cast<std::size_t>(tiles_x_) * tiles_y_, 0.0);
     candidate_run_.assign(previous_mean_.size(), 0);
     masked_.assign(previous_mean_.size(), false);
+    suspect_.assign(previous_mean_.size(), false);
+    last_mean_.assign(previous_mean_.size(), 0.0);
+    last_spread_.assign(previous_mean_.size(), 0.0);
+    have_last_ = false;
     have_previous_ = false;
   }
   bool moved = true;
@@ -42,6 +46,10 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
     const double mean = sum[t] / count[t];
     const double spread = std::sqrt(std::max(0.0, sum_sq[t] / count[t] - mean * mean));
     const bool dark_and_even = mean < config_.max_mean && spread < config_.max_spread;
+    const bool onset = have_last_ && dark_and_even && last_spread_[t] > config_.onset_spread &&
+                       last_mean_[t] - mean > config_.onset_drop;
+    suspect_[t] = dark_and_even && (onset || suspect_[t] || candidate_run_[t] > 0);
+    last_mean_[t] = mean, last_spread_[t] = spread;
     if (!moved) {
       // The scene stood still: staying the same proves nothing, but a tile that shows texture
       // or light again is clean (the machine waits stopped for a wiper or a hand).
@@ -53,12 +61,13 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
     candidate_run_[t] = candidate ? candidate_run_[t] + 1 : 0;
     previous_mean_[t] = mean;
   }
+  have_last_ = true;
   if (moved) {
     have_previous_ = true;
     T_world_previous_ = T_world_camera;
   }
-  // The mask: dirty tiles and their eight neighbours.
-  long masked_pixels = 0;
+  // The mask: dirty tiles and their eight neighbours, and suspect tiles.
+  long masked_pixels = 0, dirty_pixels = 0;
   for (int ty = 0; ty < tiles_y_; ++ty) {
     for (int tx = 0; tx < tiles_x_; ++tx) {
       bool near_dirt = false;
@@ -70,14 +79,16 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
                           config_.frames_to_confirm;
         }
       }
-      masked_[static_cast<std::size_t>(ty * tiles_x_ + tx)] = near_dirt;
-      if (near_dirt) {
-        masked_pixels += static_cast<long>(std::min(config_.tile, w - tx * config_.tile)) *
-                         std::min(config_.tile, h - ty * config_.tile);
-      }
+      const std::size_t t = static_cast<std::size_t>(ty * tiles_x_ + tx);
+      masked_[t] = near_dirt || suspect_[t];
+      const long pixels = static_cast<long>(std::min(config_.tile, w - tx * config_.tile)) *
+                          std::min(config_.tile, h - ty * config_.tile);
+      if (masked_[t]) masked_pixels += pixels;
+      if (near_dirt) dirty_pixels += pixels;
     }
   }
   masked_fraction_ = static_cast<double>(masked_pixels) / (static_cast<double>(w) * h);
+  dirty_fraction_ = static_cast<double>(dirty_pixels) / (static_cast<double>(w) * h);
   return moved;
 }
 

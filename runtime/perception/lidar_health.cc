@@ -5,11 +5,11 @@
 
 namespace autoshovel::perception {
 
-std::vector<AzimuthSector> BlindSectors(const std::vector<Eigen::Vector3d>& ray_directions_sensor,
-                                        const sensors::PointCloud& cloud,
-                                        const Eigen::Matrix3d& R_body_sensor,
-                                        const Eigen::Matrix3d& R_world_sensor,
-                                        const LidarHealthConfig& config) {
+std::vector<AzimuthSector> BlindSectors(
+    const std::vector<Eigen::Vector3d>& ray_directions_sensor, const sensors::PointCloud& cloud,
+    const Eigen::Matrix3d& R_body_sensor, const Eigen::Matrix3d& R_world_sensor,
+    const LidarHealthConfig& config,
+    const std::function<bool(const Eigen::Vector3d&)>& ground_known) {
   const double pi = std::numbers::pi;
   const int bins = static_cast<int>(std::ceil(2 * pi / config.bin));
   auto bin_of = [&](const Eigen::Vector3d& d_body) {
@@ -20,7 +20,10 @@ std::vector<AzimuthSector> BlindSectors(const std::vector<Eigen::Vector3d>& ray_
   std::vector<int> returned(static_cast<std::size_t>(bins), 0);
   const double sin_depression = std::sin(config.min_depression);
   for (const Eigen::Vector3d& d : ray_directions_sensor) {
-    if ((R_world_sensor * d).z() <= -sin_depression) ++expected[bin_of(R_body_sensor * d)];
+    const Eigen::Vector3d d_world = R_world_sensor * d;
+    if (d_world.z() > -sin_depression) continue;
+    if (ground_known && !ground_known(d_world)) continue;
+    ++expected[bin_of(R_body_sensor * d)];
   }
   for (const sensors::LidarPoint& p : cloud.points) {
     const Eigen::Vector3d d = p.p_sensor.cast<double>();

@@ -54,8 +54,17 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
           rays.push_back(ray.direction);
         }
         const Eigen::Isometry3d T_cab_lidar = sensors::PoseToIsometry(lidar.pose);
-        for (const AzimuthSector& sector :
-             BlindSectors(rays, cloud, T_cab_lidar.linear(), T_world_lidar.linear())) {
+        // Floor the map has seen: where the ray meets the ground plane fitted so far (z = 0
+        // before the first fit), on a cell with a height.
+        const Eigen::Vector3d origin = T_world_lidar.translation();
+        const Eigen::Vector3d plane = semantic.ground_plane();
+        const double floor_z = plane.x() * origin.x() + plane.y() * origin.y() + plane.z();
+        auto ground_known = [&](const Eigen::Vector3d& d) {
+          const double along = (floor_z - origin.z()) / d.z();
+          return along > 0 && !std::isnan(map.HeightAt((origin + along * d).head<2>()));
+        };
+        for (const AzimuthSector& sector : BlindSectors(rays, cloud, T_cab_lidar.linear(),
+                                                        T_world_lidar.linear(), {}, ground_known)) {
           stats.blind_sectors.emplace_back(lidar.name, sector);
         }
       }
@@ -79,6 +88,7 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
   if (options.lens_dirt != nullptr) {
     options.lens_dirt->Observe(image, T_world_camera);
     stats.camera_masked_fraction = options.lens_dirt->masked_fraction();
+    stats.camera_dirty_fraction = options.lens_dirt->dirty_fraction();
   }
   ClassProbabilities probabilities;
   if (options.truth_labels) {

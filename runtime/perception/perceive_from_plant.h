@@ -47,7 +47,8 @@ struct PerceptionFromPlantStats {
   std::string semantics;            ///< "simulator labels" or "network <file>"
   /// Blind sectors found (check_lidar_health), with the LiDAR's name.
   std::vector<std::pair<std::string, AzimuthSector>> blind_sectors;
-  double camera_masked_fraction = 0;  ///< of the last image, masked for dirt
+  double camera_masked_fraction = 0;  ///< of the last image, masked for dirt (or suspect)
+  double camera_dirty_fraction = 0;   ///< of the last image, confirmed dirty (lens_dirt_monitor.h)
 };
 
 /// Updates `map` and `semantic` (built on `map`) with what the machine of `plant` senses in

@@ -129,14 +129,30 @@ TEST(LensDirtMonitor, FindsABlotThatStaysWhileTheSceneMoves) {
   std::mt19937 rng(1);
   LensDirtMonitor monitor;
   for (int k = 0; k < 3; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
-  // Two judged frames after the first: not yet confirmed (three are needed).
-  EXPECT_EQ(monitor.masked_fraction(), 0.0);
+  // Two judged frames after the first: suspect (masked) but not yet confirmed (three needed).
+  EXPECT_EQ(monitor.dirty_fraction(), 0.0);
+  EXPECT_TRUE(monitor.Masked(120, 120));
   monitor.Observe(Frame(3, true, rng), At(0.9));
   EXPECT_TRUE(monitor.Masked(120, 120));
   EXPECT_FALSE(monitor.Masked(10, 10));
   // The blot covers π·40² px = 11 % of the image; tiles round it are masked too.
-  EXPECT_GT(monitor.masked_fraction(), 0.109);
-  EXPECT_LT(monitor.masked_fraction(), 0.40);
+  EXPECT_GT(monitor.dirty_fraction(), 0.109);
+  EXPECT_LT(monitor.dirty_fraction(), 0.40);
+  EXPECT_GE(monitor.masked_fraction(), monitor.dirty_fraction());
+}
+
+// A blot thrown onto a clean lens is masked from the very frame it appears in, moving or not;
+// it counts as dirt only once confirmed.
+TEST(LensDirtMonitor, ASuddenBlotIsMaskedAtOnce) {
+  std::mt19937 rng(4);
+  LensDirtMonitor monitor;
+  monitor.Observe(Frame(0, false, rng), At(0.0));
+  monitor.Observe(Frame(0, true, rng), At(0.0));  // standing still
+  EXPECT_TRUE(monitor.Masked(120, 120));
+  EXPECT_EQ(monitor.dirty_fraction(), 0.0);
+  // The first moving frame compares the blot with the clean view; three more confirm it.
+  for (int k = 1; k <= 4; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
+  EXPECT_GT(monitor.dirty_fraction(), 0.109);
 }
 
 TEST(LensDirtMonitor, ACleanLensIsNeverMasked) {
@@ -144,6 +160,7 @@ TEST(LensDirtMonitor, ACleanLensIsNeverMasked) {
   LensDirtMonitor monitor;
   for (int k = 0; k < 10; ++k) monitor.Observe(Frame(k, false, rng), At(0.3 * k));
   EXPECT_EQ(monitor.masked_fraction(), 0.0);
+  EXPECT_EQ(monitor.dirty_fraction(), 0.0);
 }
 
 // A blot seen while the camera stands still is not confirmed (nothing moved behind it), but a
@@ -152,7 +169,7 @@ TEST(LensDirtMonitor, StillnessConfirmsNothingButAWipeClears) {
   std::mt19937 rng(3);
   LensDirtMonitor standing;
   for (int k = 0; k < 6; ++k) standing.Observe(Frame(0, true, rng), At(0.0));
-  EXPECT_EQ(standing.masked_fraction(), 0.0);
+  EXPECT_EQ(standing.dirty_fraction(), 0.0);
 
   LensDirtMonitor monitor;
   for (int k = 0; k < 4; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));

@@ -6,7 +6,8 @@
 namespace autoshovel::perception {
 
 bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
-                              const Eigen::Isometry3d& T_world_camera) {
+                              const Eigen::Isometry3d& T_world_camera,
+                              const std::vector<std::uint8_t>& own_machine) {
   const int w = frame.width, h = frame.height;
   if (w <= 0 || h <= 0 || frame.bgr.size() != static_cast<std::size_t>(3) * w * h) return false;
   if (w != width_ || h != height_) {  // first frame, or another camera: start over
@@ -17,9 +18,7 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
     candidate_run_.assign(previous_mean_.size(), 0);
     masked_.assign(previous_mean_.size(), false);
     suspect_.assign(previous_mean_.size(), false);
-    last_mean_.assign(previous_mean_.size(), 0.0);
-    last_spread_.assign(previous_mean_.size(), 0.0);
-    have_last_ = false;
+    last_clean_.assign(previous_mean_.size(), std::nan(""));
     have_previous_ = false;
   }
   bool moved = true;
@@ -32,36 +31,44 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
   // Grey level, sums per tile (Rec. 601 weights on BGR).
   const std::size_t tiles = previous_mean_.size();
   std::vector<double> sum(tiles, 0.0), sum_sq(tiles, 0.0);
-  std::vector<int> count(tiles, 0);
+  std::vector<int> count(tiles, 0), own(tiles, 0);
+  const bool have_own = own_machine.size() == static_cast<std::size_t>(w) * h;
   for (int v = 0; v < h; ++v) {
     const int row = (v / config_.tile) * tiles_x_;
     for (int u = 0; u < w; ++u) {
-      const std::uint8_t* p = &frame.bgr[3 * (static_cast<std::size_t>(v) * w + u)];
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      const std::uint8_t* p = &frame.bgr[3 * i];
       const double grey = 0.114 * p[0] + 0.587 * p[1] + 0.299 * p[2];
       const std::size_t t = static_cast<std::size_t>(row + u / config_.tile);
       sum[t] += grey, sum_sq[t] += grey * grey, ++count[t];
+      if (have_own && own_machine[i] != 0) ++own[t];
     }
   }
   for (std::size_t t = 0; t < tiles; ++t) {
     const double mean = sum[t] / count[t];
     const double spread = std::sqrt(std::max(0.0, sum_sq[t] / count[t] - mean * mean));
-    const bool dark_and_even = mean < config_.max_mean && spread < config_.max_spread;
-    const bool onset = have_last_ && dark_and_even && last_spread_[t] > config_.onset_spread &&
-                       last_mean_[t] - mean > config_.onset_drop;
-    suspect_[t] = dark_and_even && (onset || suspect_[t] || candidate_run_[t] > 0);
-    last_mean_[t] = mean, last_spread_[t] = spread;
+    // Dark: below max_mean, or below relative_dark of the tile's last clean look (in glare the
+    // blot itself reads ≈ 108, the lens flare over it).
+    const double clean = last_clean_[t];
+    const bool dark =
+        mean < config_.max_mean || (!std::isnan(clean) && mean < config_.relative_dark * clean);
+    const bool dark_and_even = 2 * own[t] < count[t] && dark && spread < config_.max_spread;
+    // Fallen: darker by onset_drop than the tile's last clean look. A tile never seen clean (a
+    // dim floor, dark from the start) never falls.
+    if (!dark_and_even) last_clean_[t] = mean;
+    const bool fallen = dark_and_even && !std::isnan(clean) && clean - mean > config_.onset_drop;
+    suspect_[t] = fallen;
     if (!moved) {
       // The scene stood still: staying the same proves nothing, but a tile that shows texture
       // or light again is clean (the machine waits stopped for a wiper or a hand).
-      if (!dark_and_even) candidate_run_[t] = 0;
+      if (!fallen) candidate_run_[t] = 0;
       continue;
     }
     const bool candidate =
-        have_previous_ && dark_and_even && std::abs(mean - previous_mean_[t]) < config_.max_change;
+        have_previous_ && fallen && std::abs(mean - previous_mean_[t]) < config_.max_change;
     candidate_run_[t] = candidate ? candidate_run_[t] + 1 : 0;
     previous_mean_[t] = mean;
   }
-  have_last_ = true;
   if (moved) {
     have_previous_ = true;
     T_world_previous_ = T_world_camera;
@@ -70,17 +77,18 @@ bool LensDirtMonitor::Observe(const sensors::CameraFrame& frame,
   long masked_pixels = 0, dirty_pixels = 0;
   for (int ty = 0; ty < tiles_y_; ++ty) {
     for (int tx = 0; tx < tiles_x_; ++tx) {
-      bool near_dirt = false;
-      for (int dy = -1; dy <= 1 && !near_dirt; ++dy) {
-        for (int dx = -1; dx <= 1 && !near_dirt; ++dx) {
+      bool near_dirt = false, near_suspect = false;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
           const int x = tx + dx, y = ty + dy;
-          near_dirt = x >= 0 && y >= 0 && x < tiles_x_ && y < tiles_y_ &&
-                      candidate_run_[static_cast<std::size_t>(y * tiles_x_ + x)] >=
-                          config_.frames_to_confirm;
+          if (x < 0 || y < 0 || x >= tiles_x_ || y >= tiles_y_) continue;
+          const std::size_t n = static_cast<std::size_t>(y * tiles_x_ + x);
+          near_dirt = near_dirt || candidate_run_[n] >= config_.frames_to_confirm;
+          near_suspect = near_suspect || suspect_[n];
         }
       }
       const std::size_t t = static_cast<std::size_t>(ty * tiles_x_ + tx);
-      masked_[t] = near_dirt || suspect_[t];
+      masked_[t] = near_dirt || near_suspect;
       const long pixels = static_cast<long>(std::min(config_.tile, w - tx * config_.tile)) *
                           std::min(config_.tile, h - ty * config_.tile);
       if (masked_[t]) masked_pixels += pixels;

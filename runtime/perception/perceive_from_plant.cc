@@ -1,5 +1,6 @@
 #include "runtime/perception/perceive_from_plant.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -85,11 +86,7 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
   camera_options.lens_dirt_radius_px = options.lens_dirt_radius_px;
   const sensors::CameraFrame image = sensors::SimulateCameraFrame(
       machine.sensors.camera, scene, T_world_camera, s.time, camera_options, rng);
-  if (options.lens_dirt != nullptr) {
-    options.lens_dirt->Observe(image, T_world_camera);
-    stats.camera_masked_fraction = options.lens_dirt->masked_fraction();
-    stats.camera_dirty_fraction = options.lens_dirt->dirty_fraction();
-  }
+
   ClassProbabilities probabilities;
   if (options.truth_labels) {
     probabilities = FromLabels(image.labels, image.width, image.height);
@@ -100,6 +97,27 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
     probabilities.height = result.height;
     probabilities.planes = std::move(result.probabilities);
     stats.semantics = "network " + options.segmenter;
+  }
+  if (options.lens_dirt != nullptr) {
+    // The machine's own pixels by the segmentation: they stand still in the image, not dirt.
+    std::vector<std::uint8_t> own(static_cast<std::size_t>(image.width) * image.height, 0);
+    const std::size_t plane = static_cast<std::size_t>(probabilities.width) * probabilities.height;
+    const std::size_t own_plane = static_cast<std::size_t>(core::SemanticClass::kOwnLoader);
+    if (plane > 0 && probabilities.planes.size() >= (own_plane + 1) * plane) {
+      for (int v = 0; v < image.height; ++v) {
+        for (int u = 0; u < image.width; ++u) {
+          const int pu = std::min(probabilities.width - 1, u * probabilities.width / image.width);
+          const int pv =
+              std::min(probabilities.height - 1, v * probabilities.height / image.height);
+          own[static_cast<std::size_t>(v) * image.width + u] =
+              probabilities.planes[own_plane * plane +
+                                   static_cast<std::size_t>(pv) * probabilities.width + pu] > 0.5f;
+        }
+      }
+    }
+    options.lens_dirt->Observe(image, T_world_camera, own);
+    stats.camera_masked_fraction = options.lens_dirt->masked_fraction();
+    stats.camera_dirty_fraction = options.lens_dirt->dirty_fraction();
   }
   if (options.lens_dirt != nullptr && stats.camera_masked_fraction > 0) {
     // Masked pixels give no evidence (SemanticMap::Project skips NaN probabilities).

@@ -165,7 +165,7 @@ TEST(Faults, LidarBlindBehindLetsAForwardDriveGoOn) {
 // than a quarter of the view: held until the lens is clean again.
 TEST(Faults, SmallLensDirtIsMaskedAndTheCycleGoesOn) {
   ShovelRunOptions o = Options("bin_1");
-  FaultSpec dirt = Fault(FaultKind::kCameraLensDirt, 0.0, INFINITY);
+  FaultSpec dirt = Fault(FaultKind::kCameraLensDirt, 1.0, INFINITY);  // a clean view first
   dirt.center = {0.5, 0.8};
   dirt.radius = 0.08;
   o.faults = {dirt};

@@ -128,17 +128,28 @@ Eigen::Isometry3d At(double x) {
 TEST(LensDirtMonitor, FindsABlotThatStaysWhileTheSceneMoves) {
   std::mt19937 rng(1);
   LensDirtMonitor monitor;
-  for (int k = 0; k < 3; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
-  // Two judged frames after the first: suspect (masked) but not yet confirmed (three needed).
+  monitor.Observe(Frame(0, false, rng), At(0.0));  // a clean look first
+  for (int k = 1; k <= 3; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
+  // Fallen (masked at once) but not yet confirmed: the first moving frame compares the blot
+  // with the clean view, the next two are candidates, three are needed.
   EXPECT_EQ(monitor.dirty_fraction(), 0.0);
   EXPECT_TRUE(monitor.Masked(120, 120));
-  monitor.Observe(Frame(3, true, rng), At(0.9));
+  monitor.Observe(Frame(4, true, rng), At(1.2));
   EXPECT_TRUE(monitor.Masked(120, 120));
   EXPECT_FALSE(monitor.Masked(10, 10));
   // The blot covers π·40² px = 11 % of the image; tiles round it are masked too.
   EXPECT_GT(monitor.dirty_fraction(), 0.109);
   EXPECT_LT(monitor.dirty_fraction(), 0.40);
   EXPECT_GE(monitor.masked_fraction(), monitor.dirty_fraction());
+}
+
+// A dark, even region that was never seen otherwise (a dim yard's floor, or a lens dirty before
+// the first frame) never falls: it is not dirt.
+TEST(LensDirtMonitor, DarkFromTheStartIsNotDirt) {
+  std::mt19937 rng(6);
+  LensDirtMonitor monitor;
+  for (int k = 0; k < 8; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
+  EXPECT_EQ(monitor.masked_fraction(), 0.0);
 }
 
 // A blot thrown onto a clean lens is masked from the very frame it appears in, moving or not;
@@ -153,6 +164,31 @@ TEST(LensDirtMonitor, ASuddenBlotIsMaskedAtOnce) {
   // The first moving frame compares the blot with the clean view; three more confirm it.
   for (int k = 1; k <= 4; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
   EXPECT_GT(monitor.dirty_fraction(), 0.109);
+}
+
+// The machine's own bucket, raised into view, stands still in the image as a blot does; where
+// the segmentation says it is the machine, it is never dirt.
+TEST(LensDirtMonitor, TheOwnMachineIsNotDirt) {
+  std::mt19937 rng(5);
+  auto with_bucket = [&](int k, bool bucket) {
+    sensors::CameraFrame f = Frame(k, false, rng);
+    if (!bucket) return f;
+    for (int v = 144; v < f.height; ++v) {
+      for (int u = 0; u < f.width; ++u) {
+        for (int c = 0; c < 3; ++c) f.bgr[3 * (static_cast<std::size_t>(v) * f.width + u) + c] = 40;
+      }
+    }
+    return f;
+  };
+  std::vector<std::uint8_t> bucket(240 * 192, 0);
+  std::fill(bucket.begin() + 144 * 240, bucket.end(), 1);
+  LensDirtMonitor told, untold;
+  for (int k = 0; k < 6; ++k) {
+    told.Observe(with_bucket(k, k > 0), At(0.3 * k), k > 0 ? bucket : std::vector<std::uint8_t>{});
+    untold.Observe(with_bucket(k, k > 0), At(0.3 * k));
+  }
+  EXPECT_EQ(told.masked_fraction(), 0.0);
+  EXPECT_GT(untold.dirty_fraction(), 0.2);  // the rule is what keeps the bucket out
 }
 
 TEST(LensDirtMonitor, ACleanLensIsNeverMasked) {
@@ -172,11 +208,13 @@ TEST(LensDirtMonitor, StillnessConfirmsNothingButAWipeClears) {
   EXPECT_EQ(standing.dirty_fraction(), 0.0);
 
   LensDirtMonitor monitor;
-  for (int k = 0; k < 4; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
-  ASSERT_TRUE(monitor.Masked(120, 120));
-  monitor.Observe(Frame(4, false, rng), At(0.9));  // stopped, lens wiped
+  monitor.Observe(Frame(0, false, rng), At(0.0));
+  for (int k = 1; k <= 4; ++k) monitor.Observe(Frame(k, true, rng), At(0.3 * k));
+  ASSERT_GT(monitor.dirty_fraction(), 0.1);
+  monitor.Observe(Frame(5, false, rng), At(1.2));  // stopped, lens wiped
   EXPECT_FALSE(monitor.Masked(120, 120));
   EXPECT_EQ(monitor.masked_fraction(), 0.0);
+  EXPECT_EQ(monitor.dirty_fraction(), 0.0);
 }
 
 }  // namespace

@@ -141,6 +141,8 @@ struct ShovelJob::State {
   std::unique_ptr<perception::SemanticMap> semantic;
   sensors::Rng rng;
   std::string segmenter;
+  /// The scenario's faults and the run's own (plant/fault_spec.h), merged once.
+  std::vector<plant::FaultSpec> faults;
   /// Dirt on the lens stays from cycle to cycle, and so does what the monitor learnt of it.
   perception::LensDirtMonitor lens_dirt;
   planning::ShovelPointConfig selection;  ///< Eq. (18) weights: Table 1 or --shovel-weights
@@ -180,9 +182,9 @@ ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<
     throw std::invalid_argument("autoshovel run: control must be the fastest rate");
   }
   // A fault that names a sensor must name one this machine has (else it would never strike).
-  std::vector<plant::FaultSpec> all_faults = scenario.faults;
-  all_faults.insert(all_faults.end(), options.faults.begin(), options.faults.end());
-  for (const plant::FaultSpec& f : all_faults) {
+  st.faults = scenario.faults;
+  st.faults.insert(st.faults.end(), options.faults.begin(), options.faults.end());
+  for (const plant::FaultSpec& f : st.faults) {
     if (f.kind != plant::FaultKind::kLidarDeadSector) continue;
     std::string names;
     bool known = false;
@@ -424,8 +426,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
 
   // Faults this cycle meets (plant/fault_spec.h): the scenario's and the run's own; and the
   // supervisor that answers them (safety_supervisor.h).
-  std::vector<plant::FaultSpec> faults = scenario.faults;
-  faults.insert(faults.end(), o.faults.begin(), o.faults.end());
+  const std::vector<plant::FaultSpec>& faults = st.faults;
   auto active = [&](plant::FaultKind kind) -> const plant::FaultSpec* {
     for (const plant::FaultSpec& f : faults) {
       if (f.kind == kind && f.ActiveAt(index, plant.time() - t0)) return &f;

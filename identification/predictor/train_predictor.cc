@@ -40,6 +40,22 @@ int main(int argc, char** argv) {
                  "after the bucket moves, follow a speed reference falling at this rate [m/s^2] "
                  "instead of releasing the drive (0: release, the shipped model's regime)")
       ->check(CLI::NonNegativeNumber);
+  double envelope_speed = 1.25;
+  app.add_option("--envelope-speed", envelope_speed,
+                 "also score the test runs approached at most this fast, and the faster ones "
+                 "apart [m/s] (the scoop cycle attacks at 1 m/s)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  predictor::SvrGrid grid;
+  app.add_option("--c", grid.c, "SVR cost values of the grid search")
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--gamma", grid.gamma, "RBF gamma values of the grid search")
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--epsilon", grid.epsilon, "epsilon-tube widths of the grid search [m]")
+      ->delimiter(',')
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -94,15 +110,29 @@ int main(int argc, char** argv) {
     prediction::FeatureScaling scaling;
     scaling.machine = machine.name;
     scaling.materials = materials;
-    char note[512];
-    std::snprintf(note, sizeof note,
-                  "trained by: train_predictor --machine %s --runs %d --seed %llu --out %s",
-                  machine.name.c_str(), runs, static_cast<unsigned long long>(seed), out.c_str());
+    auto joined = [](const std::vector<double>& values) {
+      std::string text;
+      char number[32];
+      for (double v : values) {
+        std::snprintf(number, sizeof number, "%g", v);
+        text += (text.empty() ? "" : ",") + std::string(number);
+      }
+      return text;
+    };
+    std::string note = "trained by: train_predictor --machine " + machine.name +
+                       " --runs " + std::to_string(runs) + " --seed " + std::to_string(seed) +
+                       " --c " + joined(grid.c) + " --gamma " + joined(grid.gamma) +
+                       " --epsilon " + joined(grid.epsilon) + " --out " + out;
+    if (scoop_deceleration > 0) {
+      char deceleration[64];
+      std::snprintf(deceleration, sizeof deceleration, " --scoop-deceleration %g",
+                    scoop_deceleration);
+      note += deceleration;
+    }
     scaling.notes.push_back(note);
     std::filesystem::create_directories(std::filesystem::path(out).parent_path().empty()
                                             ? std::filesystem::path(".")
                                             : std::filesystem::path(out).parent_path());
-    const predictor::SvrGrid grid;
     const predictor::SvrTrainingResult fit =
         predictor::TrainPenetrationSvr(train, grid, threads, scaling, out);
     const double training_time = elapsed() - generation_time;
@@ -144,6 +174,21 @@ int main(int argc, char** argv) {
         fit.support_vectors);
     std::printf("test:  %s\n", predictor::FormatEvaluation(on_test).c_str());
     std::printf("train: %s\n", predictor::FormatEvaluation(on_train).c_str());
+    // The error tail by approach speed: the closed loop attacks at 1 m/s, the runs are drawn up
+    // to 2 m/s, and a fast machine glides through a low pile past the 3 m the six heights see.
+    std::vector<const predictor::CrowdingRun*> slow_runs, fast_runs;
+    for (const predictor::CrowdingRun* run : test_runs)
+      (run->spec.approach_speed <= envelope_speed ? slow_runs : fast_runs).push_back(run);
+    for (const auto& [label, subset] :
+         {std::pair{"test, v0 <= ", &slow_runs}, std::pair{"test, v0 >  ", &fast_runs}}) {
+      if (subset->empty()) continue;
+      const predictor::PredictorEvaluation e =
+          predictor::EvaluatePredictor(model, machine, *subset, capacity);
+      std::printf("%s%.2f m/s: %d samples, |error| <= 0.10 m: %.1f %%   <= 0.15 m: %.1f %%   "
+                  "<= 0.20 m: %.1f %%\n",
+                  label, envelope_speed, e.samples, 100 * e.within_010, 100 * e.within_015,
+                  100 * e.within_020);
+    }
     std::printf("wrote %s.model and %s.scale\n", out.c_str(), out.c_str());
     return 0;
   } catch (const std::exception& e) {

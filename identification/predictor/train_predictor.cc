@@ -119,10 +119,10 @@ int main(int argc, char** argv) {
       }
       return text;
     };
-    std::string note = "trained by: train_predictor --machine " + machine.name +
-                       " --runs " + std::to_string(runs) + " --seed " + std::to_string(seed) +
-                       " --c " + joined(grid.c) + " --gamma " + joined(grid.gamma) +
-                       " --epsilon " + joined(grid.epsilon) + " --out " + out;
+    std::string note = "trained by: train_predictor --machine " + machine.name + " --runs " +
+                       std::to_string(runs) + " --seed " + std::to_string(seed) + " --c " +
+                       joined(grid.c) + " --gamma " + joined(grid.gamma) + " --epsilon " +
+                       joined(grid.epsilon) + " --out " + out;
     if (scoop_deceleration > 0) {
       char deceleration[64];
       std::snprintf(deceleration, sizeof deceleration, " --scoop-deceleration %g",
@@ -184,10 +184,11 @@ int main(int argc, char** argv) {
       if (subset->empty()) continue;
       const predictor::PredictorEvaluation e =
           predictor::EvaluatePredictor(model, machine, *subset, capacity);
-      std::printf("%s%.2f m/s: %d samples, |error| <= 0.10 m: %.1f %%   <= 0.15 m: %.1f %%   "
-                  "<= 0.20 m: %.1f %%\n",
-                  label, envelope_speed, e.samples, 100 * e.within_010, 100 * e.within_015,
-                  100 * e.within_020);
+      std::printf(
+          "%s%.2f m/s: %d samples, |error| <= 0.10 m: %.1f %%   <= 0.15 m: %.1f %%   "
+          "<= 0.20 m: %.1f %%\n",
+          label, envelope_speed, e.samples, 100 * e.within_010, 100 * e.within_015,
+          100 * e.within_020);
     }
     std::printf("wrote %s.model and %s.scale\n", out.c_str(), out.c_str());
     return 0;

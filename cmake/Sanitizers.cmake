@@ -6,10 +6,14 @@
 # malloc). UB is not recoverable, so the first report aborts the test that hit it instead of
 # scrolling past in its log. scripts/sanitize configures build-asan/ with this on.
 option(AUTOSHOVEL_SANITIZE "Build the project with -fsanitize=address,undefined" OFF)
+# Tests with a TIMEOUT of their own get this many times as long: instrumented code runs several
+# times slower (camera_lidar_tests' 10 s auto-calibrations took 35 s and more under ASan).
+set(AUTOSHOVEL_TEST_TIMEOUT_SCALE 1)
 if(AUTOSHOVEL_SANITIZE)
   set(AUTOSHOVEL_SANITIZER_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer
                                  -fno-sanitize-recover=undefined)
   add_compile_options(${AUTOSHOVEL_SANITIZER_FLAGS})
+  set(AUTOSHOVEL_TEST_TIMEOUT_SCALE 5)
   # Eigen stops trusting malloc's 16-byte alignment when it sees __SANITIZE_ADDRESS__ and then
   # allocates with an offset of its own (handmade_aligned_malloc). Debian's PCL, Ceres and
   # OpenCV were built without ASan and free Eigen storage with plain free(); when an

@@ -49,6 +49,29 @@ prediction::HeightGrid Crop(const plant::Terrain& terrain, const Eigen::Vector2d
   return grid;
 }
 
+// A revisit's pile: what a previous scoop along the same approach (the loader at the origin
+// facing +x) took away. The bucket cut at floor level across its width, plus 0.1 m a side, up to
+// x = `face_x`, and the face and walls it left stand at the material's angle of repose: every
+// cell is lowered to at most floor + tan(repose) · (distance to the cut). Cut straight to repose
+// rather than cut vertical and relaxed: the plant's relaxation is a diffusion that needs
+// thousands of sweeps to lay a 2 m face down. The removed material left with that bucket.
+void DigFace(const model::MachineDescription& machine, plant::World& world, double face_x) {
+  plant::Terrain& terrain = world.terrain;
+  const double half_cut = 0.5 * machine.bucket.width + 0.1;
+  for (int iy = 0; iy < terrain.ny(); ++iy) {
+    for (int ix = 0; ix < terrain.nx(); ++ix) {
+      const int material = terrain.material(ix, iy);
+      if (material < 0) continue;
+      const Eigen::Vector2d c = terrain.CellCenter(ix, iy);
+      const double dx = std::max(c.x() - face_x, 0.0);
+      const double dy = std::max(std::abs(c.y()) - half_cut, 0.0);
+      const double slope = std::tan(machine.materials[material].angle_of_repose);
+      const double cap = terrain.floor(ix, iy) + slope * std::hypot(dx, dy);
+      if (terrain.height(ix, iy) > cap) terrain.SetHeight(ix, iy, cap);
+    }
+  }
+}
+
 }  // namespace
 
 CrowdingRunSpec DrawSpec(const model::MachineDescription& machine,
@@ -71,6 +94,10 @@ CrowdingRunSpec DrawSpec(const model::MachineDescription& machine,
   spec.trigger_volume = machine.bucket.rated_capacity *
                         (options.min_trigger_fraction +
                          (options.max_trigger_fraction - options.min_trigger_fraction) * unit(rng));
+  if (options.dug_face_fraction > 0 && unit(rng) < options.dug_face_fraction) {
+    spec.dug_depth =
+        options.min_dug_depth + (options.max_dug_depth - options.min_dug_depth) * unit(rng);
+  }
   return spec;
 }
 
@@ -128,6 +155,7 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
   world.materials = machine.materials;
   std::vector<plant::Pile> piles = {pile};
   plant::BuildTerrain(world, piles, {});
+  if (spec.dug_depth > 0) DigFace(machine, world, toe + spec.dug_depth);
   const plant::Terrain before = world.terrain;
 
   plant::MachineState start;

@@ -45,6 +45,13 @@ struct CrowdingRunOptions {
   /// and the drive keeps pushing after it, as the scoop cycle's `scoop_deceleration` does
   /// (crowding while curling, docs/scooping_control.md).
   double scoop_deceleration = 0;
+  /// Share of runs whose pile a previous scoop has dug into (a revisit): a bucket-wide cut at
+  /// floor level from the toe in along the approach, its face and sides at the angle of
+  /// repose. 0 (the shipped model): every pile is fresh. Drawn after every other field of the
+  /// spec, so the fresh runs' specs do not change with it.
+  double dug_face_fraction = 0;
+  double min_dug_depth = 1.0;  ///< range of the cut's length from the toe [m]
+  double max_dug_depth = 3.0;
   double map_resolution = 0.05;  ///< of the yard grid [m]
   double map_margin = 2.0;       ///< kept around the tip path in the stored map [m]
 };
@@ -58,6 +65,7 @@ struct CrowdingRunSpec {
   double height = 0;          ///< pile peak [m]
   double approach_speed = 0;  ///< v0 [m/s]
   double trigger_volume = 0;  ///< V1 at which the scoop is triggered [m³]
+  double dug_depth = 0;       ///< 0: a fresh pile; > 0: cut this far in from the toe [m]
 };
 
 struct CrowdingRun {

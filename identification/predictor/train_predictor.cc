@@ -40,6 +40,15 @@ int main(int argc, char** argv) {
                  "after the bucket moves, follow a speed reference falling at this rate [m/s^2] "
                  "instead of releasing the drive (0: release, the shipped model's regime)")
       ->check(CLI::NonNegativeNumber);
+  double dug_face_fraction = 0;
+  app.add_option("--dug-face-fraction", dug_face_fraction,
+                 "share of runs on a pile a previous scoop has dug into (a revisit's face; 0: "
+                 "fresh piles only, the shipped model's regime)")
+      ->check(CLI::Range(0.0, 1.0));
+  std::string compare_with;
+  app.add_option("--compare", compare_with,
+                 "also score this model (path stem) on the same test runs, e.g. the shipped "
+                 "models/prediction/penetration_svr");
   double envelope_speed = 1.25;
   app.add_option("--envelope-speed", envelope_speed,
                  "also score the test runs approached at most this fast, and the faster ones "
@@ -70,6 +79,7 @@ int main(int argc, char** argv) {
     };
     predictor::CrowdingRunOptions options;
     options.scoop_deceleration = scoop_deceleration;
+    options.dug_face_fraction = dug_face_fraction;
     std::printf("train_predictor: %d crowding runs of %s on %d threads, seed %llu\n", runs,
                 machine.name.c_str(), threads, static_cast<unsigned long long>(seed));
     std::fflush(stdout);
@@ -123,6 +133,11 @@ int main(int argc, char** argv) {
                        std::to_string(runs) + " --seed " + std::to_string(seed) + " --c " +
                        joined(grid.c) + " --gamma " + joined(grid.gamma) + " --epsilon " +
                        joined(grid.epsilon) + " --out " + out;
+    if (dug_face_fraction > 0) {
+      char dug[64];
+      std::snprintf(dug, sizeof dug, " --dug-face-fraction %g", dug_face_fraction);
+      note += dug;
+    }
     if (scoop_deceleration > 0) {
       char deceleration[64];
       std::snprintf(deceleration, sizeof deceleration, " --scoop-deceleration %g",
@@ -143,7 +158,7 @@ int main(int argc, char** argv) {
       // tail can be read by cause (test set: runs i mod 5 = 4).
       std::ofstream csv(samples_csv);
       csv << "run,set,shape,material,height,v0,trigger_volume,trigger_cause,speed,V1,h1,h2,h3,h4,"
-             "h5,h6,penetration,predicted_penetration,payload\n";
+             "h5,h6,penetration,predicted_penetration,payload,dug_depth\n";
       for (const predictor::CrowdingRun& run : all) {
         if (!run.ok) continue;
         csv << run.spec.index << "," << (run.spec.index % 5 == 4 ? "test" : "train") << ","
@@ -153,7 +168,8 @@ int main(int argc, char** argv) {
         for (double h : run.features.heights) csv << "," << h;
         const prediction::PenetrationPrediction predicted = model.Predict(run.features);
         csv << "," << run.penetration << ","
-            << (predicted.ok ? predicted.penetration : std::nan("")) << "," << run.payload << "\n";
+            << (predicted.ok ? predicted.penetration : std::nan("")) << "," << run.payload << ","
+            << run.spec.dug_depth << "\n";
       }
       if (!csv) throw std::runtime_error("cannot write " + samples_csv);
     }
@@ -189,6 +205,37 @@ int main(int argc, char** argv) {
           "<= 0.20 m: %.1f %%\n",
           label, envelope_speed, e.samples, 100 * e.within_010, 100 * e.within_015,
           100 * e.within_020);
+    }
+    // Fresh piles and revisits apart, when the runs hold both.
+    std::vector<const predictor::CrowdingRun*> fresh_runs, dug_runs;
+    for (const predictor::CrowdingRun* run : test_runs)
+      (run->spec.dug_depth > 0 ? dug_runs : fresh_runs).push_back(run);
+    if (!dug_runs.empty()) {
+      for (const auto& [label, subset] :
+           {std::pair{"test, fresh piles", &fresh_runs}, std::pair{"test, dug faces", &dug_runs}}) {
+        if (subset->empty()) continue;
+        const predictor::PredictorEvaluation e =
+            predictor::EvaluatePredictor(model, machine, *subset, capacity);
+        std::printf("%s: %s\n", label, predictor::FormatEvaluation(e).c_str());
+      }
+    }
+    if (!compare_with.empty()) {
+      const prediction::PenetrationPredictor other =
+          prediction::PenetrationPredictor::Load(compare_with);
+      std::printf("%s on the test runs: %s\n", compare_with.c_str(),
+                  predictor::FormatEvaluation(
+                      predictor::EvaluatePredictor(other, machine, test_runs, capacity))
+                      .c_str());
+      if (!dug_runs.empty()) {
+        for (const auto& [label, subset] :
+             {std::pair{"fresh piles", &fresh_runs}, std::pair{"dug faces", &dug_runs}}) {
+          if (subset->empty()) continue;
+          std::printf("%s on the test runs, %s: %s\n", compare_with.c_str(), label,
+                      predictor::FormatEvaluation(
+                          predictor::EvaluatePredictor(other, machine, *subset, capacity))
+                          .c_str());
+        }
+      }
     }
     std::printf("wrote %s.model and %s.scale\n", out.c_str(), out.c_str());
     return 0;

@@ -1,0 +1,78 @@
+// Crowding runs on a dug face (a revisit, crowding_runs.h): the spec is the fresh run's with a
+// cut added, the face the loader meets lies further in, and what the cut left stands no steeper
+// than the material's angle of repose.
+#include "identification/predictor/crowding_runs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "generated/registry.h"
+
+namespace autoshovel::predictor {
+namespace {
+
+TEST(CrowdingRuns, DugFaceIsTheFreshPileCutBackToRepose) {
+  const model::MachineDescription machine =
+      model::LoadMachineDescription(model::ResolveMachineDescription(
+          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+  ASSERT_NE(functions, nullptr);
+  CrowdingRunOptions fresh_options, dug_options;
+  dug_options.dug_face_fraction = 1.0;
+
+  // The first tall cone of seed 1: its face is the clearest to measure.
+  int index = 0;
+  while (!(DrawSpec(machine, fresh_options, 1, index).shape == "cone" &&
+           DrawSpec(machine, fresh_options, 1, index).height > 2.5)) {
+    ASSERT_LT(++index, 200);
+  }
+  const CrowdingRunSpec fresh = DrawSpec(machine, fresh_options, 1, index);
+  const CrowdingRunSpec dug = DrawSpec(machine, dug_options, 1, index);
+  EXPECT_EQ(fresh.dug_depth, 0.0);
+  EXPECT_GE(dug.dug_depth, dug_options.min_dug_depth);
+  EXPECT_LE(dug.dug_depth, dug_options.max_dug_depth);
+  // Drawn after every other field: the fresh run's spec is unchanged (the shipped model's runs).
+  EXPECT_EQ(dug.seed, fresh.seed);
+  EXPECT_EQ(dug.shape, fresh.shape);
+  EXPECT_EQ(dug.material, fresh.material);
+  EXPECT_EQ(dug.height, fresh.height);
+  EXPECT_EQ(dug.approach_speed, fresh.approach_speed);
+  EXPECT_EQ(dug.trigger_volume, fresh.trigger_volume);
+
+  const CrowdingRun fresh_run = RunCrowding(machine, *functions, fresh_options, fresh);
+  const CrowdingRun dug_run = RunCrowding(machine, *functions, dug_options, dug);
+  ASSERT_TRUE(fresh_run.ok) << fresh_run.failure;
+  ASSERT_TRUE(dug_run.ok) << dug_run.failure;
+  const double fresh_contact = fresh_run.past_path.front().x();
+  const double dug_contact = dug_run.past_path.front().x();
+  std::printf(
+      "cut %.2f m: first contact at x = %.2f m (fresh %.2f m), payload %.2f m^3 (fresh "
+      "%.2f m^3)\n",
+      dug.dug_depth, dug_contact, fresh_contact, dug_run.payload, fresh_run.payload);
+  // The face the bucket meets is the cut's: its foot stands where the cut ended.
+  EXPECT_NEAR(dug_contact - fresh_contact, dug.dug_depth, 0.3);
+
+  // No neighbour pair steeper than repose where the cut was (the pre-contact map the run kept).
+  const prediction::HeightGrid& map = dug_run.map;
+  int material = 0;
+  for (std::size_t m = 0; m < machine.materials.size(); ++m) {
+    if (machine.materials[m].name == dug.material) material = static_cast<int>(m);
+  }
+  const double max_step =
+      map.resolution * std::tan(machine.materials[material].angle_of_repose) + 2e-3;
+  double steepest = 0;
+  for (int iy = 0; iy + 1 < map.ny; ++iy) {
+    for (int ix = 0; ix + 1 < map.nx; ++ix) {
+      const Eigen::Vector2d c = map.CellCenter(ix, iy);
+      if (std::abs(c.y()) > 0.5 * machine.bucket.width + 0.5) continue;
+      steepest = std::max({steepest, std::abs(map.at(ix + 1, iy) - map.at(ix, iy)),
+                           std::abs(map.at(ix, iy + 1) - map.at(ix, iy))});
+    }
+  }
+  EXPECT_LE(steepest, max_step);
+}
+
+}  // namespace
+}  // namespace autoshovel::predictor

@@ -190,52 +190,42 @@ int main(int argc, char** argv) {
         fit.support_vectors);
     std::printf("test:  %s\n", predictor::FormatEvaluation(on_test).c_str());
     std::printf("train: %s\n", predictor::FormatEvaluation(on_train).c_str());
-    // The error tail by approach speed: the closed loop attacks at 1 m/s, the runs are drawn up
-    // to 2 m/s, and a fast machine glides through a low pile past the 3 m the six heights see.
-    std::vector<const predictor::CrowdingRun*> slow_runs, fast_runs;
-    for (const predictor::CrowdingRun* run : test_runs)
+    // The test runs split two ways: by approach speed (the closed loop attacks at 1 m/s, the runs
+    // are drawn up to 2 m/s, and a fast machine glides through a low pile past the 3 m the six
+    // heights see) and, when the runs hold both, into fresh piles and dug faces.
+    std::vector<const predictor::CrowdingRun*> slow_runs, fast_runs, fresh_runs, dug_runs;
+    for (const predictor::CrowdingRun* run : test_runs) {
       (run->spec.approach_speed <= envelope_speed ? slow_runs : fast_runs).push_back(run);
-    for (const auto& [label, subset] :
-         {std::pair{"test, v0 <= ", &slow_runs}, std::pair{"test, v0 >  ", &fast_runs}}) {
-      if (subset->empty()) continue;
-      const predictor::PredictorEvaluation e =
-          predictor::EvaluatePredictor(model, machine, *subset, capacity);
-      std::printf(
-          "%s%.2f m/s: %d samples, |error| <= 0.10 m: %.1f %%   <= 0.15 m: %.1f %%   "
-          "<= 0.20 m: %.1f %%\n",
-          label, envelope_speed, e.samples, 100 * e.within_010, 100 * e.within_015,
-          100 * e.within_020);
-    }
-    // Fresh piles and revisits apart, when the runs hold both.
-    std::vector<const predictor::CrowdingRun*> fresh_runs, dug_runs;
-    for (const predictor::CrowdingRun* run : test_runs)
       (run->spec.dug_depth > 0 ? dug_runs : fresh_runs).push_back(run);
-    if (!dug_runs.empty()) {
-      for (const auto& [label, subset] :
-           {std::pair{"test, fresh piles", &fresh_runs}, std::pair{"test, dug faces", &dug_runs}}) {
-        if (subset->empty()) continue;
-        const predictor::PredictorEvaluation e =
-            predictor::EvaluatePredictor(model, machine, *subset, capacity);
-        std::printf("%s: %s\n", label, predictor::FormatEvaluation(e).c_str());
-      }
     }
+    char slow_label[64], fast_label[64];
+    std::snprintf(slow_label, sizeof slow_label, "v0 <= %.2f m/s", envelope_speed);
+    std::snprintf(fast_label, sizeof fast_label, "v0 > %.2f m/s", envelope_speed);
+    std::vector<std::pair<std::string, const std::vector<const predictor::CrowdingRun*>*>> subsets =
+        {{slow_label, &slow_runs}, {fast_label, &fast_runs}};
+    if (!dug_runs.empty()) {
+      subsets.push_back({"fresh piles", &fresh_runs});
+      subsets.push_back({"dug faces", &dug_runs});
+    }
+    auto score_subsets = [&](const prediction::PenetrationPredictor& scored,
+                             const std::string& prefix) {
+      for (const auto& [label, subset] : subsets) {
+        if (subset->empty()) continue;
+        std::printf("%stest, %s: %s\n", prefix.c_str(), label.c_str(),
+                    predictor::FormatEvaluation(
+                        predictor::EvaluatePredictor(scored, machine, *subset, capacity))
+                        .c_str());
+      }
+    };
+    score_subsets(model, "");
     if (!compare_with.empty()) {
       const prediction::PenetrationPredictor other =
           prediction::PenetrationPredictor::Load(compare_with);
-      std::printf("%s on the test runs: %s\n", compare_with.c_str(),
+      std::printf("%s, test: %s\n", compare_with.c_str(),
                   predictor::FormatEvaluation(
                       predictor::EvaluatePredictor(other, machine, test_runs, capacity))
                       .c_str());
-      if (!dug_runs.empty()) {
-        for (const auto& [label, subset] :
-             {std::pair{"fresh piles", &fresh_runs}, std::pair{"dug faces", &dug_runs}}) {
-          if (subset->empty()) continue;
-          std::printf("%s on the test runs, %s: %s\n", compare_with.c_str(), label,
-                      predictor::FormatEvaluation(
-                          predictor::EvaluatePredictor(other, machine, *subset, capacity))
-                          .c_str());
-        }
-      }
+      score_subsets(other, compare_with + ", ");
     }
     std::printf("wrote %s.model and %s.scale\n", out.c_str(), out.c_str());
     return 0;

@@ -56,12 +56,9 @@ TEST(CrowdingRuns, DugFaceIsTheFreshPileCutBackToRepose) {
 
   // No neighbour pair steeper than repose where the cut was (the pre-contact map the run kept).
   const prediction::HeightGrid& map = dug_run.map;
-  int material = 0;
-  for (std::size_t m = 0; m < machine.materials.size(); ++m) {
-    if (machine.materials[m].name == dug.material) material = static_cast<int>(m);
-  }
-  const double max_step =
-      map.resolution * std::tan(machine.materials[material].angle_of_repose) + 2e-3;
+  const model::Material* material = machine.FindMaterial(dug.material);
+  ASSERT_NE(material, nullptr);
+  const double max_step = map.resolution * std::tan(material->angle_of_repose) + 2e-3;
   double steepest = 0;
   for (int iy = 0; iy + 1 < map.ny; ++iy) {
     for (int ix = 0; ix + 1 < map.nx; ++ix) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "runtime/control/joint_angle_filter.h"
 #include "runtime/model/interpreted_model.h"
 
 namespace autoshovel::control {
@@ -56,6 +57,9 @@ std::string ScoopCycleOptions::Invalid() const {
                                  path_spacing};
   for (double v : non_negative) {
     if (!(v >= 0) || !std::isfinite(v)) return "scoop cycle: margins must be finite and >= 0";
+  }
+  if (!(joint_filter_gain > 0 && joint_filter_gain <= 1)) {
+    return "scoop cycle: joint_filter_gain must be in (0, 1]";
   }
   if (!std::isfinite(attack_pose.boom) || !std::isfinite(attack_pose.bucket)) {
     return "scoop cycle: attack_pose must be finite";
@@ -121,6 +125,7 @@ struct ScoopCycle::Runtime {
   Eigen::Vector2d trigger_hinge = Eigen::Vector2d::Zero();
   double trigger_heading = 0;
   std::optional<JointPid> boom_pid, bucket_pid;
+  std::optional<JointAngleFilter> boom_filter, bucket_filter;
   std::optional<SpeedPid> speed_pid;
   core::ActuatorCommand command;
   long tick = 0;
@@ -407,6 +412,8 @@ void ScoopCycle::Start(ScoopMachine& machine) {
   rt.bucket_pid.emplace(options_.bucket_gains,
                         machine_.hydraulics.actuators[bucket_valve_].valve.dead_zone);
   rt.speed_pid.emplace(options_.speed_gains);
+  rt.boom_filter.emplace(options_.joint_filter_gain);
+  rt.bucket_filter.emplace(options_.joint_filter_gain);
   const Proprioception s = machine.Sense();
   rt.speed_pid->Reset(std::isfinite(s.speed) ? s.speed : 0.0);
   rt.targets = options_.attack_pose;
@@ -433,12 +440,15 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
   if (rt_ == nullptr) throw std::logic_error("ScoopCycle::Tick before Start");
   Runtime& rt = *rt_;
   if (rt.phase == Phase::kDone) return false;
-  const Proprioception s = machine.Sense();
+  Proprioception s = machine.Sense();
   if (!Finite(s)) {
     rt.result.failure = "machine reports a non-finite state at t = " + std::to_string(s.time);
     rt.phase = Phase::kDone;
     return false;
   }
+  // Everything below (PIDs, the tip path of Eq. (19), V2's start) sees the filtered angles.
+  s.q_boom = rt.boom_filter->Update(s.q_boom, s.qd_boom, options_.tick);
+  s.q_bucket = rt.bucket_filter->Update(s.q_bucket, s.qd_bucket, options_.tick);
   const bool digging =
       rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop;
   if (digging) {

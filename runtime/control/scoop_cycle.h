@@ -103,7 +103,10 @@ struct ScoopCycleOptions {
   double arm_motion = 0.02;     ///< joint travel that shows the scoop has begun moving [rad]
   double action_timeout = 4.0;  ///< an atomic action that has not arrived by then is over [s]
   double path_spacing = 0.01;   ///< tip path points at least this far apart [m]
-  ArmTargets attack_pose;       ///< bucket on the floor (plant/poses.h BucketOnFloor in tests)
+  /// Gain k of the boom and bucket angle complementary filter (joint_angle_filter.h) every
+  /// tick; 1 uses the readings as they come.
+  double joint_filter_gain = 0.1;
+  ArmTargets attack_pose;  ///< bucket on the floor (plant/poses.h BucketOnFloor in tests)
   ScoopPolicy policy = ScoopPolicy::kAutoSelection;
   StrategyParameters strategy;
   FinishingParameters finishing;

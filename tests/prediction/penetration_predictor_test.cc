@@ -114,18 +114,20 @@ TEST(PenetrationPredictor, BadModelFilesGiveClearErrors) {
   std::filesystem::remove(stem + ".model");
 }
 
-// Fresh runs (seed 2024; the model was trained on seed 1). The figures the model reaches on its
-// 200 test runs (README: 92.5 / 95.0 / 96.5 %, volume 95.5 %) with the slack of a 100-run
-// estimate. The goals for the two outer buckets (97 / 99.5 %) are not reached: see README.
-TEST(PenetrationPredictor, FreshPlantRunsFallInTheErrorBuckets) {
+// Plant runs of seed 2024 (the model was trained on seed 1) scored with the shipped model:
+// `dug_face_fraction` of them on a face an earlier scoop left (crowding_runs.h).
+predictor::PredictorEvaluation ScoreShippedModel(double dug_face_fraction) {
   const model::MachineDescription machine =
       model::LoadMachineDescription(model::ResolveMachineDescription(
           "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
   const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-  ASSERT_NE(functions, nullptr);
+  EXPECT_NE(functions, nullptr);
+  if (functions == nullptr) return {};
   const PenetrationPredictor predictor = PenetrationPredictor::Load(kShipped);
+  predictor::CrowdingRunOptions options;
+  options.dug_face_fraction = dug_face_fraction;
   const std::vector<predictor::CrowdingRun> runs =
-      predictor::RunCrowdingBatch(machine, *functions, {}, 2024, 0, 100, 2);
+      predictor::RunCrowdingBatch(machine, *functions, options, 2024, 0, 100, 2);
   std::vector<const predictor::CrowdingRun*> pointers;
   for (const auto& run : runs) {
     EXPECT_TRUE(run.ok) << "run " << run.spec.index << ": " << run.failure;
@@ -135,15 +137,37 @@ TEST(PenetrationPredictor, FreshPlantRunsFallInTheErrorBuckets) {
   for (const auto& run : runs) capacity = std::max(capacity, run.payload);
   const predictor::PredictorEvaluation e =
       predictor::EvaluatePredictor(predictor, machine, pointers, capacity);
-  SCOPED_TRACE(predictor::FormatEvaluation(e));
-  EXPECT_EQ(e.samples, 100);
   std::printf("%s\n", predictor::FormatEvaluation(e).c_str());
+  EXPECT_EQ(e.samples, 100);
   EXPECT_EQ(e.refused, 0);
+  return e;
+}
+
+// Fresh piles. The figures the model reaches on its 134 fresh test runs (README: 95.5 / 96.3 /
+// 97.8 %, volume 95.8 %) with the slack of a 100-run estimate. The goals for the two
+// outer buckets (97 / 99.5 % over all runs) are not reached: see README.
+TEST(PenetrationPredictor, FreshPlantRunsFallInTheErrorBuckets) {
+  const predictor::PredictorEvaluation e = ScoreShippedModel(0.0);
+  SCOPED_TRACE(predictor::FormatEvaluation(e));
   EXPECT_GE(e.within_010, 0.85);
   EXPECT_GE(e.within_015, 0.90);
   EXPECT_GE(e.within_020, 0.93);
   EXPECT_GE(e.volume_accuracy, 0.90);
   EXPECT_GE(e.volume_accuracy_capped, 0.93);
+}
+
+// Every run on a dug face, the pile of every revisit. On these 100 runs the shipped model is
+// within 0.10 / 0.15 / 0.20 m on 83 / 87 / 92 %, MSE 0.0119 m², volume accuracy 94.4 % (README,
+// on the 66 dug test runs of seed 1: 89.4 / 92.4 / 95.5 %). The fresh-only model it replaced
+// gives 80 / 87 / 90 % and MSE 0.0355 m² here: its large misses on a dug face fail the MSE bound.
+TEST(PenetrationPredictor, DugFaceRunsFallInTheErrorBuckets) {
+  const predictor::PredictorEvaluation e = ScoreShippedModel(1.0);
+  SCOPED_TRACE(predictor::FormatEvaluation(e));
+  EXPECT_GE(e.within_010, 0.75);
+  EXPECT_GE(e.within_015, 0.80);
+  EXPECT_GE(e.within_020, 0.86);
+  EXPECT_LE(e.mse, 0.02);
+  EXPECT_GE(e.volume_accuracy, 0.90);
 }
 
 }  // namespace

@@ -50,6 +50,29 @@ bool BesideOccludingContour(const std::vector<float>& nearest, int bw, int bh, i
   return false;
 }
 
+// The elevation at `xy`, bilinear between the centres of the four cells around it; a missing
+// neighbour takes the height of the cell holding `xy`. NaN outside the map or over a hole.
+float InterpolatedHeight(const GridMap& g, const Eigen::MatrixXf& elevation,
+                         const Eigen::Vector2d& xy) {
+  Index cell;
+  if (!g.IndexOf(xy, cell)) return kNaN;
+  const float z00 = elevation(cell.x(), cell.y());
+  if (std::isnan(z00)) return kNaN;
+  const double r = g.resolution();
+  const Eigen::Vector2d centre = g.PositionOf(cell);
+  const Eigen::Vector2d f = (xy - centre) / r;  // in [−1/2, 1/2] on each axis
+  const Eigen::Vector2d step(f.x() >= 0 ? r : -r, f.y() >= 0 ? r : -r);
+  auto height = [&](const Eigen::Vector2d& offset) {
+    Index neighbour;
+    if (!g.IndexOf(centre + offset, neighbour)) return z00;
+    const float z = elevation(neighbour.x(), neighbour.y());
+    return std::isnan(z) ? z00 : z;
+  };
+  const float ax = static_cast<float>(std::abs(f.x())), ay = static_cast<float>(std::abs(f.y()));
+  const float zx = height({step.x(), 0}), zy = height({0, step.y()}), zxy = height(step);
+  return (1 - ax) * (1 - ay) * z00 + ax * (1 - ay) * zx + (1 - ax) * ay * zy + ax * ay * zxy;
+}
+
 // Standard normal CDF.
 double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
@@ -114,7 +137,7 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
   auto project_v = [&](const Eigen::Vector3f& p_world, float& v) {
     const Eigen::Vector3f p_body = R * p_world + t;
     if (!(p_body.x() > 0.3f)) return false;
-    v = static_cast<float>((camera.fy * (-p_body.z()) / p_body.x() + camera.cy) * sy);
+    v = static_cast<float>((camera.fy * (-p_body.z()) / p_body.x() + camera.cy + 0.5) * sy);
     return true;
   };
   std::vector<Hit> hits;
@@ -127,8 +150,12 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
       const Eigen::Vector3f p_body =
           R * Eigen::Vector3f(static_cast<float>(xy.x()), static_cast<float>(xy.y()), z) + t;
       if (!(p_body.x() > 0.3f)) continue;  // behind or at the lens
-      const double u = (camera.fx * (-p_body.y()) / p_body.x() + camera.cx) * sx;
-      const double v = (camera.fy * (-p_body.z()) / p_body.x() + camera.cy) * sy;
+      // Pixel centres lie at whole coordinates (the simulator's rays and OpenCV's convention),
+      // and a reduced image's pixel j spans [j, j + 1) / s − 1/2 of the camera's: the pixel a
+      // point falls in is floor((u + 1/2) s). (Truncating u itself, as before, looked up the
+      // pixel up to one to the left and above: over a pile's crest, the wall behind it.)
+      const double u = (camera.fx * (-p_body.y()) / p_body.x() + camera.cx + 0.5) * sx;
+      const double v = (camera.fy * (-p_body.z()) / p_body.x() + camera.cy + 0.5) * sy;
       if (!(u >= 0 && v >= 0 && u < w && v < h)) continue;
       const int pixel = static_cast<int>(v) * w + static_cast<int>(u);
       const float depth = p_body.x();
@@ -160,6 +187,46 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
                       row(std::max(v_edge[0], v_edge[1]))});
     }
   }
+  // Where a pixel's ray first meets the mapped surface, as a forward depth (the Hit::depth
+  // measure), cast lazily for the machine, person and wall pixels the footprints below look at.
+  // Such a pixel counts in full for a cell only when it shows the cell or something in front of
+  // it: past a pile's crest, or past the edge of a cut, the pixels beside the cell's centre (and
+  // at a crest seen edge-on the centre itself) show the wall 2 m behind, and the in-full rule
+  // put that wall on the crest, where the crowd look-ahead stopped for it (docs/main_job.md).
+  // The map's own cells are the only depth there is: the camera measures none.
+  float farthest = 0;
+  for (const Hit& hit : hits) farthest = std::max(farthest, hit.depth);
+  const float cast_limit = farthest + static_cast<float>(config_.behind_tolerance) + 1.0f;
+  const float cast_step = static_cast<float>(0.5 * g.resolution());
+  // The surface between cell centres is taken bilinear (a pile's flank sloping across the view
+  // is 0.1 m lower at a cell's edge than at its centre), and a ray skimming it within `skim`
+  // is not taken as meeting it: a ray grazing a crest passes a few centimetres over the true
+  // surface as often as under it, and what the pixel then shows is the wall behind. A ray onto
+  // an obstacle's face is that deep below its top at once.
+  const float skim = static_cast<float>(config_.skim_height);
+  const Eigen::Matrix<float, 3, 3> R_world_camera = R.transpose();
+  const Eigen::Vector3f origin = camera_world.cast<float>();
+  std::vector<float> surface_depth(static_cast<std::size_t>(w) * h, kNaN);
+  auto surface_depth_at = [&](int u, int v) {
+    float& depth = surface_depth[static_cast<std::size_t>(v) * w + u];
+    if (!std::isnan(depth)) return depth;
+    // Body-frame direction through the pixel's centre, scaled to unit forward depth.
+    const double u_camera = (u + 0.5) / sx - 0.5, v_camera = (v + 0.5) / sy - 0.5;
+    const Eigen::Vector3f d_body(1.0f, -static_cast<float>((u_camera - camera.cx) / camera.fx),
+                                 -static_cast<float>((v_camera - camera.cy) / camera.fy));
+    const Eigen::Vector3f d_world = R_world_camera * d_body;
+    depth = std::numeric_limits<float>::infinity();
+    for (float s = 0.3f; s <= cast_limit; s += cast_step) {
+      const Eigen::Vector3f p = origin + s * d_world;
+      const float z = InterpolatedHeight(g, elevation, Eigen::Vector2d(p.x(), p.y()));
+      if (!std::isnan(z) && p.z() <= z - skim) {
+        depth = s;
+        break;
+      }
+    }
+    return depth;
+  };
+
   // Pass 2: cells not hidden behind nearer ones take the pixel's confidences.
   Eigen::MatrixXf& ground = g["ground_confidence"];
   Eigen::MatrixXf& pile = g["pile_confidence"];
@@ -177,7 +244,9 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
     // rule of Eq. 11 applied to the footprint). The rows above the centre show what stands
     // behind the cell: a wall seen over a pile's surface is averaged, not handed to the pile in
     // front of it (docs/main_job.md: that put the look-ahead's sure cells 1.15 m before a bin's
-    // back wall, 2.5 m up its 3 m face). "Other" (debris, the sky over a crest) is averaged.
+    // back wall, 2.5 m up its 3 m face); so is a hard pixel in the other rows whose ray meets
+    // the map behind the cell (surface_depth_at above). "Other" (debris, the sky over a crest)
+    // is averaged.
     const int radius = std::clamp(
         static_cast<int>(camera.fx * sx * 0.5 * map_.map().resolution() / hit.depth), 1, 4);
     // Rows: the square of the cell's width, widened to the rows its surface covers (at most
@@ -200,6 +269,7 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
     // that an obstacle is *there* ("steep_obstacle_confidence", what the crowd look-ahead
     // stops for) takes the hard pixels in full only from steeper views.
     const bool steep = hit.v_max - hit.v_min >= config_.min_rows_for_hard;
+    const float behind = static_cast<float>(config_.behind_tolerance);
     Confidences c{0, 0, 0, 0};
     float hard_max = 0;
     int samples = 0;
@@ -210,7 +280,9 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
         const Confidences p = Collapse(probabilities, v * w + u);
         if (std::isnan(p.ground)) continue;
         c.ground += p.ground, c.pile += p.pile, c.obstacle += p.obstacle;
-        if (v >= pv) hard_max = std::max(hard_max, p.hard);
+        if (v > pv && p.hard > hard_max && surface_depth_at(u, v) <= hit.depth + behind) {
+          hard_max = p.hard;
+        }
         ++samples;
       }
     }

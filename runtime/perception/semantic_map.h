@@ -49,6 +49,15 @@ struct SemanticMapConfig {
   /// counts in full only when the cell's surface spans more than this many image rows; seen
   /// flatter, its pixels are averaged like the rest [rows].
   int min_rows_for_hard = 2;
+  /// A machine, person or wall pixel counts in full for a cell only when its ray meets the
+  /// mapped surface no farther than this behind the cell's depth; farther, it shows what
+  /// stands behind the cell (a wall past a pile's crest) and is averaged like the rest [m].
+  /// Half a metre: a ray onto an obstacle standing in the cell meets its mapped face within a
+  /// cell or two of the cell's centre.
+  double behind_tolerance = 0.5;
+  /// A pixel's ray meets the mapped surface when it passes this far below a cell's height:
+  /// a ray skimming a pile's crest is not taken as ending on it [m].
+  double skim_height = 0.15;
   double ground_z0 = 0.3;          ///< z0: cells at or below this height fit the ground [m]
   double ransac_threshold = 0.05;  ///< inlier distance of the plane fit [m]
   int ransac_iterations = 200;

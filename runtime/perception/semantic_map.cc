@@ -50,27 +50,33 @@ bool BesideOccludingContour(const std::vector<float>& nearest, int bw, int bh, i
   return false;
 }
 
-// The elevation at `xy`, bilinear between the centres of the four cells around it; a missing
-// neighbour takes the height of the cell holding `xy`. NaN outside the map or over a hole.
+// The elevation at `xy`, bilinear between the centres of the four cells around it (the
+// grid's matrix is indexed from its lower corner, as planning's Interpolate reads it); a
+// missing neighbour takes the height of the cell holding `xy`. NaN outside the map or over a
+// hole. On the hot path of the ray casts below: index arithmetic, no IndexOf per corner.
 float InterpolatedHeight(const GridMap& g, const Eigen::MatrixXf& elevation,
                          const Eigen::Vector2d& xy) {
-  Index cell;
-  if (!g.IndexOf(xy, cell)) return kNaN;
-  const float z00 = elevation(cell.x(), cell.y());
-  if (std::isnan(z00)) return kNaN;
-  const double r = g.resolution();
-  const Eigen::Vector2d centre = g.PositionOf(cell);
-  const Eigen::Vector2d f = (xy - centre) / r;  // in [−1/2, 1/2] on each axis
-  const Eigen::Vector2d step(f.x() >= 0 ? r : -r, f.y() >= 0 ? r : -r);
-  auto height = [&](const Eigen::Vector2d& offset) {
-    Index neighbour;
-    if (!g.IndexOf(centre + offset, neighbour)) return z00;
-    const float z = elevation(neighbour.x(), neighbour.y());
-    return std::isnan(z) ? z00 : z;
+  const int nx = g.size().x(), ny = g.size().y();
+  const Eigen::Vector2d origin = g.position() - g.length() / 2;
+  // Continuous index: cell i's centre at i.
+  const double fx = (xy.x() - origin.x()) / g.resolution() - 0.5;
+  const double fy = (xy.y() - origin.y()) / g.resolution() - 0.5;
+  if (!(fx >= -0.5 && fy >= -0.5 && fx < nx - 0.5 && fy < ny - 0.5)) return kNaN;
+  // The cell holding `xy`, as GridMap::IndexOf finds it.
+  const float own =
+      elevation(static_cast<int>(std::floor(fx + 0.5)), static_cast<int>(std::floor(fy + 0.5)));
+  if (std::isnan(own)) return kNaN;
+  const int ix = std::clamp(static_cast<int>(std::floor(fx)), 0, nx - 1);
+  const int iy = std::clamp(static_cast<int>(std::floor(fy)), 0, ny - 1);
+  const int jx = std::min(ix + 1, nx - 1), jy = std::min(iy + 1, ny - 1);
+  const float tx = static_cast<float>(std::clamp(fx - ix, 0.0, 1.0));
+  const float ty = static_cast<float>(std::clamp(fy - iy, 0.0, 1.0));
+  auto z = [&](int x, int y) {
+    const float v = elevation(x, y);
+    return std::isnan(v) ? own : v;
   };
-  const float ax = static_cast<float>(std::abs(f.x())), ay = static_cast<float>(std::abs(f.y()));
-  const float zx = height({step.x(), 0}), zy = height({0, step.y()}), zxy = height(step);
-  return (1 - ax) * (1 - ay) * z00 + ax * (1 - ay) * zx + (1 - ax) * ay * zy + ax * ay * zxy;
+  return (1 - ty) * ((1 - tx) * z(ix, iy) + tx * z(jx, iy)) +
+         ty * ((1 - tx) * z(ix, jy) + tx * z(jx, jy));
 }
 
 // Standard normal CDF.

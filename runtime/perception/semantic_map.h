@@ -55,8 +55,9 @@ struct SemanticMapConfig {
   /// Half a metre: a ray onto an obstacle standing in the cell meets its mapped face within a
   /// cell or two of the cell's centre.
   double behind_tolerance = 0.5;
-  /// A pixel's ray meets the mapped surface when it passes this far below a cell's height:
-  /// a ray skimming a pile's crest is not taken as ending on it [m].
+  /// A pixel's ray meets the mapped surface when it passes this far below it (heights
+  /// bilinear between cell centres): a ray skimming a pile's crest is not taken as ending on
+  /// it [m].
   double skim_height = 0.15;
   double ground_z0 = 0.3;          ///< z0: cells at or below this height fit the ground [m]
   double ransac_threshold = 0.05;  ///< inlier distance of the plane fit [m]

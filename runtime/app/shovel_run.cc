@@ -397,6 +397,12 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       std::max(0.0, ScoopReach(machine, scoop_options.attack_pose.boom,
                                scoop_options.attack_pose.bucket, scoop_options.strategy) -
                         st.loader.tip_reach);
+  // The look-ahead (below) ends the crowd once the sweep's front edge comes within the safety
+  // distance, the planning margin, a map cell and the stopping distance of an obstacle ahead;
+  // the selection's scoop drives on only as far (0.5 m stands in for the stopping distance,
+  // v / f + v² / 2a at crowding speeds, and the middle of the front edge for the corridor).
+  select_config.crowd_stop_distance =
+      o.safety_distance + o.planning_margin + st.map->map().resolution() + 0.5;
 
   // kSafeStop: the supervisor abandoned the cycle; the machine brakes to rest, then kDone.
   enum class Stage { kSelect, kNavigate, kScoop, kSafeStop, kDone } stage = Stage::kSelect;
@@ -658,23 +664,45 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         // The goal being driven to, as seen on the new map and planned from where the machine
         // is now: infeasible (an obstacle came into view) → take the best; beaten by 0.05 in F
         // (our selection only) → take the best; otherwise keep it, on its re-planned path.
+        // The goal is found again as the nearest candidate within 0.5 m and half the entry
+        // angles' spacing in heading: the boundary normal a heading is measured from moves a
+        // few degrees as more of the pile comes into view, and an exact match lost the goal
+        // every few frames and sent the machine round the pile after whatever scored best.
+        double half_angle_step = std::numbers::pi;
+        const std::vector<double>& offsets = select_config.entry_angle_offsets;
+        for (std::size_t i = 1; i < offsets.size(); ++i) {
+          half_angle_step = std::min(half_angle_step, 0.5 * std::abs(offsets[i] - offsets[i - 1]));
+        }
         const planning::ShovelCandidate* current = nullptr;
+        double current_mismatch = 1.0;
         for (const planning::ShovelCandidate& k : last_selection.ranked) {
-          if ((k.pose.xy - goal->pose.xy).norm() < 0.5 &&
-              std::abs(std::remainder(k.pose.entry_heading - goal->pose.entry_heading,
-                                      2 * std::numbers::pi)) < 1 * kDeg) {
-            current = &k;
-            break;
-          }
+          const double mismatch =
+              std::max((k.pose.xy - goal->pose.xy).norm() / 0.5,
+                       std::abs(std::remainder(k.pose.entry_heading - goal->pose.entry_heading,
+                                               2 * std::numbers::pi)) /
+                           half_angle_step);
+          if (mismatch < current_mismatch) current = &k, current_mismatch = mismatch;
         }
         if (current == nullptr || !current->feasible ||
             (o.selection == SelectionMethod::kOurs &&
              current->scores.approach_obstacle_distance < min_planned_clearance)) {
+          const std::string why = current == nullptr ? "not among the new candidates"
+                                  : !current->feasible
+                                      ? current->infeasible
+                                      : "approach " +
+                                            Fixed(current->scores.approach_obstacle_distance, 2) +
+                                            " m from an obstacle";
           start_path(*best);
-          say("re-selected (goal no longer feasible): F " + Fixed(best->score, 3));
+          say("re-selected (goal no longer feasible: " + why + "): point (" +
+              Fixed(best->pose.xy.x(), 2) + ", " + Fixed(best->pose.xy.y(), 2) + ") heading " +
+              Fixed(best->pose.entry_heading / kDeg, 1) + " deg, F " + Fixed(best->score, 3) +
+              ", d_min " + Fixed(best->scores.min_obstacle_distance, 2) + " m");
         } else if (o.selection == SelectionMethod::kOurs && best->score > current->score + 0.05) {
           start_path(*best);
-          say("re-selected: F " + Fixed(best->score, 3));
+          say("re-selected: point (" + Fixed(best->pose.xy.x(), 2) + ", " +
+              Fixed(best->pose.xy.y(), 2) + ") heading " +
+              Fixed(best->pose.entry_heading / kDeg, 1) + " deg, F " + Fixed(best->score, 3) +
+              ", d_min " + Fixed(best->scores.min_obstacle_distance, 2) + " m");
         } else {
           start_path(*current, /*new_goal=*/false);
         }

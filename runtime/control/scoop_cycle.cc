@@ -117,8 +117,9 @@ struct ScoopCycle::Runtime {
   /// When finite, the bucket target follows the boom so the bucket keeps this attitude
   /// q_boom + q_bucket in the arm plane [rad] (exit lift, levelling, carrying).
   double hold_attitude = NAN;
-  std::string stop_request;  ///< RequestStop's reason: crowding ends at the next decision
-  bool drive_held = false;   ///< after a stop request the scoop does not crowd on
+  std::string stop_request;         ///< RequestStop's reason: crowding ends at the next decision
+  bool drive_held = false;          ///< after a stop request the scoop does not crowd on
+  bool drive_hold_started = false;  ///< the speed profile restarted from the speed at the hold
   std::vector<Eigen::Vector3d> last_predicted_path;              ///< of the last V2 [m]
   double last_v2 = NAN;                                          ///< [m³]
   std::optional<prediction::PenetrationFeatures> last_features;  ///< of the last V2
@@ -479,6 +480,14 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     rt.result.arm_motion_after_trigger = s.time - rt.result.trigger_time;
   }
   double speed_target = options_.attack_speed;
+  if (rt.drive_held && !rt.drive_hold_started) {
+    // Brake from the speed the machine has, not from the profile's reference: stalled in the
+    // pile, the reference stays at the attack speed with the PI's integral wound up, and
+    // ramping that down keeps pushing for seconds (over a metre once the stairway's lifts free
+    // the bucket) past where the look-ahead, reckoning v / f + v² / 2 a_dec, asked for the stop.
+    rt.speed_pid->Reset(std::max(s.speed, 0.0));
+    rt.drive_hold_started = true;
+  }
   switch (rt.phase) {
     case Phase::kApproach:
     case Phase::kCrowd:

@@ -265,6 +265,10 @@ std::string ShovelPointConfig::Validate() const {
   if (!(scoop_advance >= 0) || !std::isfinite(scoop_advance)) {
     return "scoop_advance must be a finite length >= 0 m, got " + std::to_string(scoop_advance);
   }
+  if (!(crowd_stop_distance >= 0) || !std::isfinite(crowd_stop_distance)) {
+    return "crowd_stop_distance must be a finite length >= 0 m, got " +
+           std::to_string(crowd_stop_distance);
+  }
   if (!(entry_window > 0)) return "entry_window must be > 0 m";
   if (!(path_spacing > 0)) return "path_spacing must be > 0 m";
   if (!(max_drive_over_height >= 0)) return "max_drive_over_height must be >= 0 m";
@@ -487,7 +491,7 @@ double SweptObstacleDistance(const GridMap& map, const Eigen::MatrixXf& field,
 
 double ScoopSideClearance(const GridMap& map, const Eigen::MatrixXf& field,
                           const Pose2& front_axle_goal, const LoaderGeometry& loader,
-                          double advance, double spacing, double cap) {
+                          double advance, double spacing, double crowd_stop_distance, double cap) {
   const double hw = loader.HalfWidth();
   const double front = loader.tip_reach + loader.body_margin;
   const double rear = loader.hinge_to_rear_axle + loader.rear_overhang + loader.body_margin;
@@ -498,13 +502,13 @@ double ScoopSideClearance(const GridMap& map, const Eigen::MatrixXf& field,
   for (int k = 0; k <= steps && advance > 0; ++k) {
     const double s = std::min(k * spacing, advance);
     const Eigen::Vector2d hinge = hinge0 + s * u;
-    // The front frame's sides, as far as the front edge at contact: beyond it lies what the
-    // crowd meets head on, which the look-ahead ends the crowd for. The rear frame whole.
-    const double side_end = front - s;
-    if (side_end > 0) {
-      probe.Segment(hinge - hw * n, hinge + side_end * u - hw * n);
-      probe.Segment(hinge + hw * n, hinge + side_end * u + hw * n);
-    }
+    // The crowd drives on while the nearest obstacle to the front edge's middle stays beyond
+    // `crowd_stop_distance`; nearer, the look-ahead ends it (what lies ahead of the bucket, a
+    // wall behind a pile, is met head on and never reached) and the machine goes no farther.
+    if (k > 0 && Interpolate(map, field, hinge + front * u) < crowd_stop_distance) break;
+    // Up to there the whole machine counts, as the look-ahead's "beside" check counts the
+    // whole stopped footprint: the front frame to its front edge, the rear frame.
+    probe.Rectangle(hinge, u, 0.0, front, hw);
     probe.Rectangle(hinge, u, -rear, 0.0, hw);
     if (probe.Touching()) break;
   }
@@ -608,7 +612,7 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
     // a pile) ends the crowd first (the main job's look-ahead). The same for every word here.
     const double d_scoop =
         ScoopSideClearance(map, distance_field, c.front_axle_goal, loader, config.scoop_advance,
-                           config.path_spacing, clearance_cap);
+                           config.path_spacing, config.crowd_stop_distance, clearance_cap);
     int chosen = -1, rank = 3;  // 0: clear of d_res, 1: not touching, 2: neither
     double chosen_d_min = 0;
     std::vector<PathSample> chosen_samples;

@@ -99,6 +99,12 @@ struct ShovelPointConfig {
   /// the pile. d_min also covers the body's sides and rear driven straight on this much [m]
   /// (ScoopSideClearance).
   double scoop_advance = 2.0;
+  /// The scoop drives on only while the nearest obstacle to the middle of the front edge is
+  /// farther than this [m]: the main job's look-ahead ends the crowd there (safety distance,
+  /// planning margin, a map cell and a stopping allowance), so what lies beyond is met head on
+  /// and never reached. 0: the scoop always drives the whole scoop_advance. The default is the
+  /// main job's: 0.5 + 0.15 + 0.3 + 0.5 m.
+  double crowd_stop_distance = 1.45;
   double entry_window = 3.0;  ///< the end of the path whose mean |κ| is κ_im [m]
   // Paths.
   double path_spacing = 0.25;  ///< sampling of the planned path [m]
@@ -233,12 +239,14 @@ double SweptObstacleDistance(const perception::GridMap& map, const Eigen::Matrix
 
 /// The scoop's part of Eq. (14)'s A: the least distance from the obstacle cells to the loader
 /// driving straight on from the contact pose (front axle at `front_axle_goal`) by `advance`
-/// [m], sampled every `spacing`: the front frame's sides up to where its front edge was at
-/// contact, and the rear frame whole. What lies straight ahead of the bucket is left out: the
-/// crowd ends before it (the main job's look-ahead). Exact below `cap`, as SweptObstacleDistance.
+/// [m], sampled every `spacing`, the whole body (front frame to its front edge, rear frame)
+/// at every step. The drive ends early at the first step whose front edge's middle lies nearer
+/// than `crowd_stop_distance` to an obstacle: there the main job's look-ahead ends the crowd,
+/// so what lies straight ahead of the bucket is never reached. Exact below `cap`, as
+/// SweptObstacleDistance.
 double ScoopSideClearance(const perception::GridMap& map, const Eigen::MatrixXf& distance_field,
                           const Pose2& front_axle_goal, const LoaderGeometry& loader,
-                          double advance, double spacing,
+                          double advance, double spacing, double crowd_stop_distance,
                           double cap = std::numeric_limits<double>::infinity());
 
 const char* ToString(SelectionStatus status);

@@ -153,6 +153,56 @@ TEST(ScoopCycle, PressureTriggeredStairway3Baseline) {
   EXPECT_GE(out.result.boom_pressure_at_trigger, 120e5);
 }
 
+// The crowd look-ahead's stop (RequestStop) brakes from the speed the machine has. Stalled in
+// the pile the speed profile's reference sits at the attack speed with the PI's integral wound
+// up; braking from those kept pushing for seconds, and once a Stairway lift freed the bucket
+// the machine drove on over a metre past the request (a side wall came 0.47 m close). The
+// travel after the request is at most what the look-ahead reckons with, v / f + v² / 2 a_dec
+// (f = 20 Hz) at the request's speed, plus 0.05 m of PI lag.
+TEST(ScoopCycle, StopRequestBrakesFromTheSpeedTheMachineHas) {
+  testing::ConeYard yard(kMachine, "big_gravel", 3.0, 4.0);
+  const prediction::HeightGrid map = testing::ToHeightGrid(yard.world.terrain);
+  plant::Plant loader(yard.machine, plant::testing::Functions(kMachine), yard.world, yard.start);
+  testing::PlantMachine machine(loader);
+  ScoopCycleOptions options;
+  options.attack_pose = yard.attack_pose;
+  options.policy = ScoopPolicy::kStairwayFixed;
+  BoomPressureTrigger trigger(120e5);
+  ScoopCycle cycle(yard.machine, plant::testing::Functions(kMachine), map, *yard.material, trigger,
+                   &Predictor(), options);
+  cycle.Start(machine);
+  double scoop_since = NAN, request_speed = NAN, request_heading = 0, travel = 0;
+  Eigen::Vector2d request_xy = Eigen::Vector2d::Zero();
+  while (cycle.Tick(machine)) {
+    machine.Advance(options.tick);
+    const Proprioception s = machine.Sense();
+    const std::string phase = cycle.phase_name();
+    if (phase == "scoop" && std::isnan(scoop_since)) scoop_since = s.time;
+    // Three seconds into the steps: stalled at 0.08 m/s between two lifts. Braking from the
+    // profile's reference, the machine drove on 0.113 m here; from its speed, 0.001 m.
+    if (std::isnan(request_speed) && !std::isnan(scoop_since) && s.time - scoop_since > 3.0) {
+      cycle.RequestStop("obstacle_beside");
+      request_speed = std::max(s.speed, 0.0);
+      request_xy = s.hinge_xy;
+      request_heading = s.heading;
+    }
+    if (!std::isnan(request_speed) && phase != "retreat" && phase != "done") {
+      travel = std::max(
+          travel, (s.hinge_xy - request_xy)
+                      .dot(Eigen::Vector2d(std::cos(request_heading), std::sin(request_heading))));
+    }
+  }
+  const ScoopResult r = cycle.Finish(machine);
+  ASSERT_TRUE(r.ok) << r.failure;
+  ASSERT_FALSE(std::isnan(request_speed));
+  const double a_dec = options.speed_gains.max_deceleration;
+  const double allowed = request_speed / 20 + request_speed * request_speed / (2 * a_dec) + 0.05;
+  std::printf("[scoop] stop requested at %.2f m/s: drove on %.3f m (allowed %.3f m)\n",
+              request_speed, travel, allowed);
+  EXPECT_LE(travel, allowed);
+  EXPECT_GT(r.fill_rate, 0.0);  // the steps still scoop, without crowding on
+}
+
 TEST(ScoopCycle, Explore) {
   if (std::getenv("AUTOSHOVEL_SCOOP_EXPLORE") == nullptr) GTEST_SKIP();
   const char* which = std::getenv("AUTOSHOVEL_SCOOP_EXPLORE");

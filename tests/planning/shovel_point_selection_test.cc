@@ -179,9 +179,11 @@ TEST(ShovelScores, ObstacleDistanceFieldAndSweptDistance) {
   EXPECT_TRUE(std::isinf(ObstacleDistanceField(empty)(3, 3)));
 }
 
-// Eq. (14)'s A covers the scoop too: driving on into the pile brings the body alongside an
-// obstacle beside the pile's front, while one straight ahead is left to the crowd look-ahead.
-TEST(ShovelScores, ScoopSideClearanceSeesBesideNotAhead) {
+// Eq. (14)'s A covers the scoop too: driving on into the pile brings the whole body alongside
+// an obstacle beside the lane, unless an obstacle straight ahead ends the crowd first (the
+// main job's look-ahead stops it `crowd_stop_distance` short), so what lies past there is
+// never reached.
+TEST(ShovelScores, ScoopSideClearanceDrivesOnUntilTheCrowdWouldStop) {
   GridMap map = FlatMap(0.3, 39, {0.15, 0.15});
   Index beside, ahead;
   ASSERT_TRUE(map.IndexOf({8.1, 3.0}, beside));
@@ -192,30 +194,31 @@ TEST(ShovelScores, ScoopSideClearanceSeesBesideNotAhead) {
   // Contact with the front axle at the origin heading +x: hinge at −1.6, front edge at 3.2.
   const Pose2 contact{{0, 0}, 0};
   const double exact_beside = 3.0 - loader.HalfWidth() - 0.15;
-  // Without driving on, the obstacle is 4.8 m ahead of the front edge's end, far beyond d_res.
-  EXPECT_TRUE(std::isinf(ScoopSideClearance(map, field, contact, loader, 0.0, 0.25)));
-  // Driving 6 m on: the sides count only up to the contact's front edge (x ≤ 3.2) and the rear
-  // frame reaches x ≤ 4.4, so a cell at x = 8.1 (met head on, by the bucket) stays far.
-  const double d6 = ScoopSideClearance(map, field, contact, loader, 6.0, 0.25);
-  EXPECT_GT(d6, exact_beside + 1.0);
-  // A cell beside the front axle's contact position instead, (2.1, 3.0): the sides pass it.
-  map.at("class", beside) = static_cast<float>(CellClass::kGround);
-  ASSERT_TRUE(map.IndexOf({2.1, 3.0}, beside));
-  map.at("class", beside) = static_cast<float>(CellClass::kObstacle);
-  // And a wall straight ahead, 1 m beyond the front edge, across the corridor.
-  for (double y = -1.5; y <= 1.5; y += 0.3) {
-    ASSERT_TRUE(map.IndexOf({4.35, y}, ahead));
+  // Without driving on, the cell is 4.8 m ahead of the front edge's end, far beyond d_res.
+  EXPECT_TRUE(std::isinf(ScoopSideClearance(map, field, contact, loader, 0.0, 0.25, 0.0)));
+  // Driving 6 m on with nothing ahead: the front edge reaches x = 9.2, so the side passes the
+  // cell at x = 8.1, 3 − hw from its centre.
+  const double d6 = ScoopSideClearance(map, field, contact, loader, 6.0, 0.25, 1.45);
+  EXPECT_LE(d6, exact_beside + 1e-6);
+  EXPECT_GT(d6, exact_beside - 0.15);
+  // A wall straight ahead across the lane, its face at x = 6.2: the crowd stops with the front
+  // edge's middle 1.45 m from it (front edge at x ≤ 4.75 + one step), well short of x = 8.1.
+  for (double y = -2.1; y <= 2.1; y += 0.3) {
+    ASSERT_TRUE(map.IndexOf({6.35, y}, ahead));
     map.at("class", ahead) = static_cast<float>(CellClass::kObstacle);
   }
   const Eigen::MatrixXf field2 = ObstacleDistanceField(map);
-  const double d = ScoopSideClearance(map, field2, contact, loader, 3.0, 0.25);
-  // The side edge runs along y = hw, 3 − hw from the beside cell's centre; the wall's cells
-  // (x = 4.35) lie at least 1.15 m beyond the sides' ends (x ≤ 3.2): the beside cell decides.
-  EXPECT_LE(d, exact_beside + 1e-6);
-  EXPECT_GT(d, exact_beside - 0.15);
-  // The whole body driven 3 m on would run into that wall: SweptObstacleDistance says so.
+  const double stop = 1.45, spacing = 0.25;
+  const double d = ScoopSideClearance(map, field2, contact, loader, 6.0, spacing, stop);
+  // The wall decides: the last step driven kept at least `stop` to it (less the field's
+  // half-cell conservatism), the next would not have, so no more than `stop` + a step.
+  EXPECT_GT(d, stop - 0.15);
+  EXPECT_LE(d, stop + spacing + 1e-6);
+  EXPECT_GT(d, exact_beside);
+  // Without the stop the body would run into that wall, as SweptObstacleDistance says too.
+  EXPECT_LE(ScoopSideClearance(map, field2, contact, loader, 6.0, spacing, 0.0), 0.0);
   std::vector<PathSample> straight;
-  for (int k = 0; k <= 12; ++k) straight.push_back({0.25 * k, {0.25 * k, 0.0}, 0.0, 0.0});
+  for (int k = 0; k <= 24; ++k) straight.push_back({0.25 * k, {0.25 * k, 0.0}, 0.0, 0.0});
   EXPECT_LE(SweptObstacleDistance(map, field2, straight, loader), 0.0);
 }
 

@@ -101,6 +101,68 @@ void RaycastScene::UpdateBoxes() {
     p.radius = p.half.norm();
     prepared_.push_back(p);
   }
+  BuildBoxGrid();
+}
+
+void RaycastScene::BuildBoxGrid() {
+  BoxGrid& g = box_grid_;
+  g = BoxGrid{};
+  if (prepared_.empty()) return;
+  // World-axis footprint of each box.
+  std::vector<Eigen::Vector4d> footprint(prepared_.size());  // x_lo, y_lo, x_hi, y_hi
+  double x_lo = kInf, y_lo = kInf, x_hi = -kInf, y_hi = -kInf;
+  g.z_lo = kInf, g.z_hi = -kInf;
+  for (std::size_t i = 0; i < prepared_.size(); ++i) {
+    const PreparedBox& p = prepared_[i];
+    const double ex = std::abs(p.c) * p.half.x() + std::abs(p.s) * p.half.y();
+    const double ey = std::abs(p.s) * p.half.x() + std::abs(p.c) * p.half.y();
+    footprint[i] = {p.center.x() - ex, p.center.y() - ey, p.center.x() + ex, p.center.y() + ey};
+    x_lo = std::min(x_lo, footprint[i][0]), y_lo = std::min(y_lo, footprint[i][1]);
+    x_hi = std::max(x_hi, footprint[i][2]), y_hi = std::max(y_hi, footprint[i][3]);
+    g.z_lo = std::min(g.z_lo, p.center.z() - p.half.z());
+    g.z_hi = std::max(g.z_hi, p.center.z() + p.half.z());
+  }
+  if (!std::isfinite(x_lo + y_lo + x_hi + y_hi + g.z_lo + g.z_hi)) {
+    // A box with a non-finite coordinate: one cell of infinite size holding every box keeps
+    // the result the linear scan's (the slab test rejects what it cannot hit).
+    g.nx = g.ny = 1, g.cell = kInf;
+    g.cell_start = {0, static_cast<int>(prepared_.size())};
+    g.box_index.resize(prepared_.size());
+    for (std::size_t i = 0; i < prepared_.size(); ++i) g.box_index[i] = static_cast<int>(i);
+    return;
+  }
+  // Cells of 2 m (a wall's thickness to a machine's length), larger for a huge yard.
+  const double margin = 1e-6;
+  g.cell = std::max(2.0, std::max(x_hi - x_lo, y_hi - y_lo) / 256.0);
+  g.x0 = x_lo - margin, g.y0 = y_lo - margin;
+  g.nx = std::max(1, static_cast<int>(std::ceil((x_hi - x_lo + 2 * margin) / g.cell)));
+  g.ny = std::max(1, static_cast<int>(std::ceil((y_hi - y_lo + 2 * margin) / g.cell)));
+  auto span = [&](const Eigen::Vector4d& f, int& ix0, int& iy0, int& ix1, int& iy1) {
+    ix0 = std::clamp(static_cast<int>(std::floor((f[0] - g.x0) / g.cell)), 0, g.nx - 1);
+    iy0 = std::clamp(static_cast<int>(std::floor((f[1] - g.y0) / g.cell)), 0, g.ny - 1);
+    ix1 = std::clamp(static_cast<int>(std::floor((f[2] - g.x0) / g.cell)), 0, g.nx - 1);
+    iy1 = std::clamp(static_cast<int>(std::floor((f[3] - g.y0) / g.cell)), 0, g.ny - 1);
+  };
+  std::vector<int> count(static_cast<std::size_t>(g.nx) * g.ny + 1, 0);
+  for (const Eigen::Vector4d& f : footprint) {
+    int ix0, iy0, ix1, iy1;
+    span(f, ix0, iy0, ix1, iy1);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) ++count[iy * g.nx + ix + 1];
+    }
+  }
+  for (std::size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
+  g.cell_start = count;
+  g.box_index.resize(count.back());
+  for (std::size_t i = 0; i < footprint.size(); ++i) {
+    int ix0, iy0, ix1, iy1;
+    span(footprint[i], ix0, iy0, ix1, iy1);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) {
+        g.box_index[count[iy * g.nx + ix]++] = static_cast<int>(i);
+      }
+    }
+  }
 }
 
 float RaycastScene::PatchMax(int px, int py) const {
@@ -332,22 +394,64 @@ RayHit RaycastScene::CastTerrain(const Eigen::Vector3d& origin, const Eigen::Vec
 RayHit RaycastScene::CastBoxes(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                                double max_range) const {
   RayHit hit;
-  if (!origin.allFinite() || !direction.allFinite()) return hit;
+  if (!origin.allFinite() || !direction.allFinite() || prepared_.empty()) return hit;
+  const BoxGrid& g = box_grid_;
   double best = max_range;
-  for (std::size_t i = 0; i < prepared_.size(); ++i) {
-    const PreparedBox& p = prepared_[i];
-    // Bounding-sphere reject: the ray passes farther from the centre than the half diagonal.
-    const Eigen::Vector3d v = p.center - origin;
-    const double along = v.dot(direction);
-    if (along + p.radius < 0 || v.squaredNorm() - along * along > p.radius * p.radius) continue;
-    double range;
-    Eigen::Vector3d normal;
-    if (SlabTest(p.center, p.half, p.c, p.s, origin, direction, best, range, normal)) {
-      best = range;
-      hit.hit = true;
-      hit.range = range;
-      hit.normal = normal;
-      hit.box = static_cast<int>(i);
+  auto test_cell = [&](int cell) {
+    for (int k = g.cell_start[cell]; k < g.cell_start[cell + 1]; ++k) {
+      const int i = g.box_index[k];
+      const PreparedBox& p = prepared_[i];
+      // Bounding-sphere reject: the ray passes farther from the centre than the half diagonal.
+      const Eigen::Vector3d v = p.center - origin;
+      const double along = v.dot(direction);
+      if (along + p.radius < 0 || v.squaredNorm() - along * along > p.radius * p.radius) continue;
+      double range;
+      Eigen::Vector3d normal;
+      // SlabTest accepts range <= best. Of boxes at equal range the highest index wins, as in
+      // a scan of all boxes in order, whatever order the cells meet them in.
+      if (SlabTest(p.center, p.half, p.c, p.s, origin, direction, best, range, normal) &&
+          (!hit.hit || range < best || i > hit.box)) {
+        best = range;
+        hit.hit = true;
+        hit.range = range;
+        hit.normal = normal;
+        hit.box = i;
+      }
+    }
+  };
+  // The part of the ray inside the grid's box [x0, x0 + nx·cell] × [y0, …] × [z_lo, z_hi].
+  double t_lo = 0, t_hi = max_range;
+  const bool single = !std::isfinite(g.cell);
+  if (!single && (!ClipSlab(origin.x(), direction.x(), g.x0, g.x0 + g.nx * g.cell, t_lo, t_hi) ||
+                  !ClipSlab(origin.y(), direction.y(), g.y0, g.y0 + g.ny * g.cell, t_lo, t_hi) ||
+                  !ClipSlab(origin.z(), direction.z(), g.z_lo, g.z_hi, t_lo, t_hi))) {
+    return hit;
+  }
+  if (single) {
+    test_cell(0);
+  } else {
+    // 2-D DDA (Amanatides & Woo) from where the ray enters the grid.
+    const double px = origin.x() + t_lo * direction.x() - g.x0;
+    const double py = origin.y() + t_lo * direction.y() - g.y0;
+    int ix = std::clamp(static_cast<int>(std::floor(px / g.cell)), 0, g.nx - 1);
+    int iy = std::clamp(static_cast<int>(std::floor(py / g.cell)), 0, g.ny - 1);
+    const int step_x = direction.x() > 0 ? 1 : -1, step_y = direction.y() > 0 ? 1 : -1;
+    const double dt_x = direction.x() != 0 ? g.cell / std::abs(direction.x()) : kInf;
+    const double dt_y = direction.y() != 0 ? g.cell / std::abs(direction.y()) : kInf;
+    double next_x =
+        direction.x() != 0 ? t_lo + ((ix + (step_x > 0)) * g.cell - px) / direction.x() : kInf;
+    double next_y =
+        direction.y() != 0 ? t_lo + ((iy + (step_y > 0)) * g.cell - py) / direction.y() : kInf;
+    double t_cell = t_lo;  // where the ray enters the current cell
+    while (t_cell <= std::min(best, t_hi)) {
+      test_cell(iy * g.nx + ix);
+      if (next_x < next_y) {
+        t_cell = next_x, next_x += dt_x, ix += step_x;
+        if (ix < 0 || ix >= g.nx) break;
+      } else {
+        t_cell = next_y, next_y += dt_y, iy += step_y;
+        if (iy < 0 || iy >= g.ny) break;
+      }
     }
   }
   if (hit.hit) {

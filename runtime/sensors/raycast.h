@@ -119,6 +119,21 @@ class RaycastScene {
     double radius = 0;
   };
 
+  // The boxes' footprints binned on a uniform xy grid (compressed rows: the boxes of cell k are
+  // box_index_[cell_start_[k] .. cell_start_[k + 1])). A ray walks the cells it crosses, nearest
+  // first, and stops at the first cell that begins beyond its nearest hit: a yard has dozens of
+  // walls and machines, and a LiDAR frame tens of thousands of rays, most of which meet the
+  // ground long before most of the boxes. A kd-tree or BVH would do as well at this size; the
+  // grid's walk is the terrain pyramid's in two dimensions, and rebuilding it is O(boxes).
+  struct BoxGrid {
+    double x0 = 0, y0 = 0, cell = 1;  // corner of cell (0, 0), cell size [m]
+    int nx = 0, ny = 0;
+    double z_lo = 0, z_hi = 0;  // lowest bottom, highest top of all boxes [m]
+    std::vector<int> cell_start;
+    std::vector<int> box_index;
+  };
+  void BuildBoxGrid();
+
   void BuildPyramid();
   float PatchMax(int px, int py) const;
   void RefreshLevels(int px0, int py0, int px1, int py1);
@@ -134,6 +149,7 @@ class RaycastScene {
   std::vector<plant::OrientedBox> extra_boxes_;
   std::vector<plant::OrientedBox> boxes_;
   std::vector<PreparedBox> prepared_;
+  BoxGrid box_grid_;
   std::vector<Level> levels_;  // levels_[0]: (nx + 1) × (ny + 1) patches
   int grid_nx_ = 0, grid_ny_ = 0;
 };

@@ -250,6 +250,76 @@ TEST(RaycastScene, ClassesAndReflectivity) {
   EXPECT_NEAR(hit.range, 7.5, 0.05 * 2.0 / 3.0 / std::sqrt(2.0) * 1.5 + 1e-9);
 }
 
+// The box grid must give exactly what testing every box in order gives (nearest entry; of equal
+// entries the highest index), for rays from inside and outside the grid, along the axes, straight
+// down, grazing, and after the boxes move.
+TEST(RaycastScene, BoxGridMatchesTestingEveryBox) {
+  plant::World world = FlatWorld(60, 60, 0.1);
+  std::mt19937 rng(20261204);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto scatter = [&](int n) {
+    world.obstacles.clear();
+    for (int i = 0; i < n; ++i) {
+      const bool wall = i % 7 == 0;  // long thin walls cross many cells
+      const Eigen::Vector3d half =
+          wall ? Eigen::Vector3d(0.3, 6 + 8 * std::abs(u(rng)), 2.0)
+               : Eigen::Vector3d(0.1 + 2 * std::abs(u(rng)), 0.1 + 2 * std::abs(u(rng)),
+                                 0.2 + 1.5 * std::abs(u(rng)));
+      world.obstacles.push_back(MakeBox("b" + std::to_string(i),
+                                        {25 * u(rng), 25 * u(rng), half.z() + 0.5 * u(rng)}, half,
+                                        kPi * u(rng), SemanticClass::kWall));
+    }
+    world.obstacles.push_back(world.obstacles[3]);  // an exact twin: a tie on every hit
+  };
+  scatter(60);
+  RaycastScene scene(world);
+  int hits = 0, ties = 0;
+  auto check = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_range) {
+    int expected_box = -1;
+    double best = max_range, t;
+    Eigen::Vector3d n;
+    for (std::size_t i = 0; i < scene.boxes().size(); ++i) {
+      if (IntersectBox(scene.boxes()[i], o, d, best, t, n))
+        best = t, expected_box = static_cast<int>(i);
+    }
+    const RayHit hit = scene.CastBoxes(o, d, max_range);
+    ASSERT_EQ(hit.box, expected_box)
+        << "origin " << o.transpose() << " direction " << d.transpose();
+    ASSERT_EQ(hit.hit, expected_box >= 0);
+    if (hit.hit) {
+      ++hits;
+      ties += expected_box == static_cast<int>(scene.boxes().size()) - 1;
+      EXPECT_NEAR(hit.range, best, 1e-12);
+    }
+  };
+  for (int round = 0; round < 2; ++round) {
+    for (int k = 0; k < 4000; ++k) {
+      const Eigen::Vector3d o(40 * u(rng), 40 * u(rng), 1.5 + 2.5 * u(rng));
+      Eigen::Vector3d d;
+      switch (k % 5) {
+        case 0:
+          d = Eigen::Vector3d(u(rng) > 0 ? 1 : -1, 0, 0);
+          break;  // along x
+        case 1:
+          d = Eigen::Vector3d(0, u(rng) > 0 ? 1 : -1, 0);
+          break;  // along y
+        case 2:
+          d = -Eigen::Vector3d::UnitZ();
+          break;  // straight down
+        default:
+          d = Dir(kPi * u(rng), 0.3 * u(rng));
+          break;
+      }
+      check(o, d.normalized(), k % 3 == 0 ? 15.0 : 80.0);
+    }
+    scatter(25);  // the boxes move: the grid is rebuilt
+    scene.UpdateBoxes();
+  }
+  // The rays must exercise the walk: thousands of hits, some on the twin.
+  EXPECT_GT(hits, 1500);
+  EXPECT_GT(ties, 5);
+}
+
 TEST(RaycastScene, RaysLeavingTheYardOrBeyondRangeReturnNothing) {
   const plant::World world = FlatWorld(10, 10, 0.05);
   const RaycastScene scene(world);

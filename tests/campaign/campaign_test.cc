@@ -85,6 +85,40 @@ TEST(CampaignSpec, ReadsAndRefusesWithLocations) {
   EXPECT_NE(missing.find("weeks"), std::string::npos) << missing;
 }
 
+// A resumed campaign is checked against the stored spec by content: a comment, blank lines or
+// a list in block style instead of flow style change nothing; a value or a new key does.
+TEST(CampaignSpec, SameContentIgnoresCommentsAndLayoutOnly) {
+  const fs::path dir = TempDir("same");
+  auto write = [&](const std::string& name, const std::string& text) {
+    const fs::path file = dir / name;
+    std::ofstream(file) << text;
+    return file.string();
+  };
+  const std::string stored = write("stored.yaml", kSmallSpec);
+  const std::string commented = write(
+      "commented.yaml",
+      "# about 2 h on two cores\nname: resume_test   # the runs' prefix\n\nscenario: cone_pile\n"
+      "seed: 5\nweeks: 1\nshifts_per_week: 3\ncycles_per_shift: 2\npolicies:\n  - auto\n"
+      "  - stairway_fixed\n");
+  EXPECT_TRUE(SameCampaignContent(stored, stored));
+  EXPECT_TRUE(SameCampaignContent(stored, commented));
+  EXPECT_FALSE(SameCampaignContent(
+      stored,
+      write(
+          "seed.yaml",
+          std::string(kSmallSpec).replace(std::string(kSmallSpec).find("seed: 5"), 7, "seed: 6"))));
+  EXPECT_FALSE(SameCampaignContent(
+      stored, write("extra.yaml", std::string(kSmallSpec) + "stairway_steps: 3\n")));
+  EXPECT_FALSE(SameCampaignContent(
+      stored, write("order.yaml",
+                    "name: resume_test\nscenario: cone_pile\nseed: 5\nweeks: 1\n"
+                    "shifts_per_week: 3\ncycles_per_shift: 2\n"
+                    "policies: [stairway_fixed, auto]\n")));
+  EXPECT_FALSE(SameCampaignContent(stored, write("broken.yaml", "name: [unclosed\n")));
+  EXPECT_FALSE(SameCampaignContent(stored, (dir / "missing.yaml").string()));
+  fs::remove_all(dir);
+}
+
 TEST(CampaignJobs, PairPoliciesOnTheShiftSeed) {
   const fs::path dir = TempDir("jobs");
   CampaignSpec spec = LoadCampaignSpec(WriteSpec(dir, kSmallSpec).string());

@@ -18,7 +18,6 @@
 #include <functional>
 #include <iostream>
 #include <set>
-#include <sstream>
 #include <thread>
 
 #include "runtime/app/campaign/campaign_spec.h"
@@ -46,13 +45,6 @@ std::filesystem::path MergedPath(const std::filesystem::path& dir) {
 // OpenMPI's launcher sets these in every rank's environment.
 bool StartedByMpirun() {
   return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr;
-}
-
-std::string ReadFile(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
@@ -143,7 +135,8 @@ bool PrepareFolder(const CampaignOptions& o, const CampaignSpec& spec,
           << " already holds a campaign; add --resume to continue it, or choose another -o\n";
       return false;
     }
-    if (ReadFile(stored_spec) != ReadFile(o.spec)) {
+    // Compared as parsed YAML: editing a comment in the spec must not strand a half-run campaign.
+    if (!SameCampaignContent(stored_spec.string(), o.spec)) {
       err << kCommand << ": " << o.spec << " differs from the campaign in " << dir.string() << " ("
           << stored_spec.string()
           << "); a resumed campaign must keep its spec, or its rows would not be comparable\n";

@@ -20,7 +20,48 @@ std::uint64_t Mix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// The tree in a canonical form that keeps only what a node says: no comments, no layout, no
+// flow/block style (which yaml-cpp's emitter would keep); keys in their written order.
+void AppendCanonical(const YAML::Node& node, std::string& out) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar: {
+      const std::string& text = node.Scalar();
+      out += 'S' + std::to_string(text.size()) + ':' + text;
+      break;
+    }
+    case YAML::NodeType::Sequence:
+      out += '[';
+      for (const YAML::Node& item : node) AppendCanonical(item, out);
+      out += ']';
+      break;
+    case YAML::NodeType::Map:
+      out += '{';
+      for (const auto& entry : node) {
+        AppendCanonical(entry.first, out);
+        AppendCanonical(entry.second, out);
+      }
+      out += '}';
+      break;
+    default:
+      out += '~';  // null or undefined
+  }
+}
+
+std::string CanonicalYaml(const std::string& path) {
+  std::string out;
+  AppendCanonical(YAML::LoadFile(path), out);
+  return out;
+}
+
 }  // namespace
+
+bool SameCampaignContent(const std::string& path_a, const std::string& path_b) {
+  try {
+    return CanonicalYaml(path_a) == CanonicalYaml(path_b);
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
 
 control::ScoopPolicy ParseScoopPolicy(const std::string& name) {
   if (name == "auto") return control::ScoopPolicy::kAutoSelection;

@@ -84,6 +84,12 @@ struct CampaignSpec {
 /// Reads and validates a campaign file. Throws core::InputError with every problem found.
 CampaignSpec LoadCampaignSpec(const std::string& path);
 
+/// Whether two campaign files say the same thing: their YAML trees are equal once parsed, so
+/// comments, blank lines and quoting/flow style do not count, while any key or value does
+/// (a number is compared as written: 0.1 and 0.10 differ, which only ever refuses a resume).
+/// False when either file does not parse.
+bool SameCampaignContent(const std::string& path_a, const std::string& path_b);
+
 control::ScoopPolicy ParseScoopPolicy(const std::string& name);
 
 /// One unit of work: a shift under one policy (on one yard, under one fault case),

@@ -45,6 +45,15 @@ int main(int argc, char** argv) {
                  "share of runs on a pile a previous scoop has dug into (a revisit's face; 0: "
                  "fresh piles only, the shipped model's regime)")
       ->check(CLI::Range(0.0, 1.0));
+  predictor::CrowdingRunOptions run_options;
+  app.add_option("--min-speed", run_options.min_speed,
+                 "slowest approach speed v0 of the runs [m/s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--max-speed", run_options.max_speed,
+                 "fastest approach speed v0 of the runs [m/s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   std::string compare_with;
   app.add_option("--compare", compare_with,
                  "also score this model (path stem) on the same test runs, e.g. the shipped "
@@ -77,7 +86,10 @@ int main(int argc, char** argv) {
     auto elapsed = [&] {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    predictor::CrowdingRunOptions options;
+    if (!(run_options.min_speed <= run_options.max_speed)) {
+      throw std::runtime_error("--min-speed must not exceed --max-speed");
+    }
+    predictor::CrowdingRunOptions options = run_options;
     options.scoop_deceleration = scoop_deceleration;
     options.dug_face_fraction = dug_face_fraction;
     std::printf("train_predictor: %d crowding runs of %s on %d threads, seed %llu\n", runs,
@@ -133,6 +145,12 @@ int main(int argc, char** argv) {
                        std::to_string(runs) + " --seed " + std::to_string(seed) + " --c " +
                        joined(grid.c) + " --gamma " + joined(grid.gamma) + " --epsilon " +
                        joined(grid.epsilon) + " --out " + out;
+    {
+      char speeds[96];
+      std::snprintf(speeds, sizeof speeds, " --min-speed %g --max-speed %g", options.min_speed,
+                    options.max_speed);
+      note += speeds;
+    }
     if (dug_face_fraction > 0) {
       char dug[64];
       std::snprintf(dug, sizeof dug, " --dug-face-fraction %g", dug_face_fraction);

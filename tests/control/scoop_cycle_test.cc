@@ -71,9 +71,12 @@ Outcome RunScoop(const std::string& material, TriggerKind kind, ScoopPolicy poli
       r.trigger_reason.c_str(), ToString(r.strategy), r.stairway_steps, r.atomic_actions,
       r.fill_rate, r.payload, r.v1_at_trigger, r.v2_at_trigger, r.trigger_after_contact,
       r.arm_motion_after_trigger, r.ContactToScoopEndTime(), r.ContactToScoopEndEnergy() / 1e3);
-  std::printf("[scoop]   payload after scoop %.3f, boom p contact %.1f bar trigger %.1f bar\n",
-              r.payload_after_scoop, r.boom_pressure_at_contact / 1e5,
-              r.boom_pressure_at_trigger / 1e5);
+  std::printf(
+      "[scoop]   payload after scoop %.3f, boom p contact %.1f bar trigger %.1f bar, travel after "
+      "trigger %.2f m, crowd %.1f kJ, Eq19 true path at scoop end %.3f\n",
+      r.payload_after_scoop, r.boom_pressure_at_contact / 1e5, r.boom_pressure_at_trigger / 1e5,
+      r.travel_after_trigger, r.Phase("crowd") ? r.Phase("crowd")->energy / 1e3 : NAN,
+      r.feedback_volume);
   for (const PhaseRecord& p : r.phases) {
     const plant::Energy& e = out.plant_energy[p.name];
     std::printf("[scoop]   %-8s %6.2f s %7.1f kJ (plant: travel %.1f hydraulic %.1f kJ)\n",

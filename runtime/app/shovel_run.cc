@@ -659,7 +659,11 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
             Fixed(best->score, 3) + ", path " + Fixed(best->path.length(), 1) + " m, d_min " +
             Fixed(best->scores.min_obstacle_distance, 2) + " m (approach " +
             Fixed(best->scores.approach_obstacle_distance, 2) + " m, scoop " +
-            Fixed(select_config.scoop_advance, 1) + " m in)");
+            Fixed(select_config.scoop_advance, 1) + " m in); Eq. (18) scores s_t " +
+            Fixed(best->scores.s_t, 2) + ", s_s " + Fixed(best->scores.s_s, 2) + ", s_c " +
+            Fixed(best->scores.s_c, 0) + " (V_l/V_m/V_r " + Fixed(best->scores.volume_left, 2) +
+            "/" + Fixed(best->scores.volume_middle, 2) + "/" + Fixed(best->scores.volume_right, 2) +
+            " m3), s_e " + Fixed(best->scores.s_e, 2) + ", s_a " + Fixed(best->scores.s_a, 2));
       } else if (best != nullptr) {
         // The goal being driven to, as seen on the new map and planned from where the machine
         // is now: infeasible (an obstacle came into view) → take the best; beaten by 0.05 in F

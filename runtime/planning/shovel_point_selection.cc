@@ -4,6 +4,7 @@
 #include "runtime/planning/shovel_point_selection.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -32,22 +33,64 @@ double GroundZ(const Eigen::Vector3d& plane, const Eigen::Vector2d& xy) {
   return plane.x() * xy.x() + plane.y() * xy.y() + plane.z();
 }
 
-// Visits every cell whose centre lies in the rectangle ahead of `entry` along `heading`:
-// along ∈ [−ε/2, length], |λ| ≤ width/2 (λ left of the centre line). f(index, along, λ).
+// A convex polygon of at most 8 vertices: a map cell clipped by up to four half-planes.
+struct SmallPolygon {
+  std::array<Eigen::Vector2d, 8> p;
+  int n = 0;
+};
+
+// Sutherland–Hodgman against one half-plane {x : x·normal ≤ offset}. Hand-written rather than
+// Boost.Geometry or cv::intersectConvexConvex: it runs for every cell of every candidate's Ω at
+// 7 Hz, on squares against parallel strips, where these dozen lines need no allocation.
+SmallPolygon ClipHalfPlane(const SmallPolygon& in, const Eigen::Vector2d& normal, double offset) {
+  SmallPolygon out;
+  for (int k = 0; k < in.n; ++k) {
+    const Eigen::Vector2d& a = in.p[k];
+    const Eigen::Vector2d& b = in.p[(k + 1) % in.n];
+    const double da = a.dot(normal) - offset, db = b.dot(normal) - offset;
+    if (da <= 0) out.p[out.n++] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out.p[out.n++] = a + (b - a) * (da / (da - db));
+  }
+  return out;
+}
+
+// Area and centroid of a convex polygon (shoelace); area 0 for fewer than three vertices.
+double AreaAndCentroid(const SmallPolygon& poly, Eigen::Vector2d* centroid) {
+  double twice_area = 0;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int k = 0; k < poly.n; ++k) {
+    const Eigen::Vector2d& a = poly.p[k];
+    const Eigen::Vector2d& b = poly.p[(k + 1) % poly.n];
+    const double cross = a.x() * b.y() - a.y() * b.x();
+    twice_area += cross;
+    sum += (a + b) * cross;
+  }
+  if (std::abs(twice_area) < 1e-15) return 0.0;
+  *centroid = sum / (3 * twice_area);
+  return 0.5 * std::abs(twice_area);
+}
+
+// Visits every map cell that overlaps the band ahead of `entry` along `heading` with
+// along ∈ [−ε/2, length] and λ ∈ [lambda_min, lambda_max] (λ left of the centre line, in the
+// frame of `entry`), with the exact area of the overlap [m²] and the λ of its centroid [m]:
+// f(index, area, λ_centroid). Cells count by their share of area, not by where their centres
+// fall: on a 0.3 m grid the 1 m sections of a 3 m bucket (Eq. 15) hold three or four cell
+// centres depending on where the entry lies, which made the middle section of a level face a
+// quarter lighter than its sides and every point of a straight pile front "concave".
 template <typename F>
-void ForEachCellAhead(const GridMap& map, const Eigen::Vector2d& entry, double heading,
-                      double width, double length, F&& f) {
+void ForEachCellOverlap(const GridMap& map, const Eigen::Vector2d& entry, double heading,
+                        double length, double lambda_min, double lambda_max, F&& f) {
   const Eigen::Vector2d u = Direction(heading), v(-u.y(), u.x());
-  const double back = map.resolution() / 2;
+  const double r = map.resolution();
+  const double back = r / 2;
   Eigen::Vector2d lo = entry, hi = entry;
   for (const double a : {-back, length}) {
-    for (const double l : {-width / 2, width / 2}) {
+    for (const double l : {lambda_min, lambda_max}) {
       const Eigen::Vector2d corner = entry + a * u + l * v;
       lo = lo.cwiseMin(corner);
       hi = hi.cwiseMax(corner);
     }
   }
-  const double r = map.resolution();
   const Eigen::Vector2d origin = map.position() - map.length() / 2;
   const int x0 = std::max(0, static_cast<int>(std::floor((lo.x() - origin.x()) / r)));
   const int y0 = std::max(0, static_cast<int>(std::floor((lo.y() - origin.y()) / r)));
@@ -58,10 +101,22 @@ void ForEachCellAhead(const GridMap& map, const Eigen::Vector2d& entry, double h
   for (int iy = y0; iy <= y1; ++iy) {
     for (int ix = x0; ix <= x1; ++ix) {
       const Index index(ix, iy);
-      const Eigen::Vector2d d = map.PositionOf(index) - entry;
-      const double along = d.dot(u), lateral = d.dot(v);
-      if (along < -back || along > length || std::abs(lateral) > width / 2) continue;
-      f(index, along, lateral);
+      // The cell in the frame of the entry: x along the heading, y = λ.
+      const Eigen::Vector2d c = map.PositionOf(index) - entry;
+      SmallPolygon cell;
+      cell.n = 4;
+      int k = 0;
+      for (const auto& [sx, sy] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+        const Eigen::Vector2d corner = c + 0.5 * r * Eigen::Vector2d(sx, sy);
+        cell.p[k++] = {corner.dot(u), corner.dot(v)};
+      }
+      SmallPolygon piece = ClipHalfPlane(cell, {-1, 0}, back);
+      piece = ClipHalfPlane(piece, {1, 0}, length);
+      piece = ClipHalfPlane(piece, {0, -1}, -lambda_min);
+      piece = ClipHalfPlane(piece, {0, 1}, lambda_max);
+      Eigen::Vector2d centroid;
+      const double area = AreaAndCentroid(piece, &centroid);
+      if (area > 1e-12 * r * r) f(index, area, centroid.y());
     }
   }
 }
@@ -269,6 +324,9 @@ std::string ShovelPointConfig::Validate() const {
     return "crowd_stop_distance must be a finite length >= 0 m, got " +
            std::to_string(crowd_stop_distance);
   }
+  if (!(concavity_tolerance >= 0 && concavity_tolerance < 1)) {
+    return "concavity_tolerance must be in [0, 1), got " + std::to_string(concavity_tolerance);
+  }
   if (!(entry_window > 0)) return "entry_window must be > 0 m";
   if (!(path_spacing > 0)) return "path_spacing must be > 0 m";
   if (!(max_drive_over_height >= 0)) return "max_drive_over_height must be >= 0 m";
@@ -288,13 +346,13 @@ double PileHeightAboveGround(const GridMap& map, const Eigen::Vector3d& plane, c
 
 double TorqueMoment(const GridMap& map, const Eigen::Vector3d& plane, const Eigen::Vector2d& entry,
                     double heading, double width, double length) {
-  // Eq. (12): T_c = Σ_{i,j∈Ω} h_ij λ_i; each cell weighted by its area ε² (a first moment of
-  // volume about the bucket's centre line, left positive).
-  const double area = map.resolution() * map.resolution();
+  // Eq. (12): T_c = Σ_{i,j∈Ω} h_ij λ_i; each cell weighted by its area in Ω (a first moment of
+  // volume about the bucket's centre line, left positive; λ of the part of the cell inside).
   double torque = 0;
-  ForEachCellAhead(map, entry, heading, width, length, [&](const Index& i, double, double lambda) {
-    torque += PileHeightAboveGround(map, plane, i) * lambda * area;
-  });
+  ForEachCellOverlap(map, entry, heading, length, -width / 2, width / 2,
+                     [&](const Index& i, double area, double lambda) {
+                       torque += PileHeightAboveGround(map, plane, i) * lambda * area;
+                     });
   return torque;
 }
 
@@ -317,25 +375,23 @@ SectionVolumes ConcavityVolumes(const GridMap& map, const Eigen::Vector3d& plane
                                 double length) {
   // Eq. (15)'s three-section bucket model: the future shoveling area split evenly by the bucket
   // width into left (λ > w/6), middle and right (λ < −w/6) strips.
-  const double area = map.resolution() * map.resolution();
   SectionVolumes v;
-  ForEachCellAhead(map, entry, heading, width, length, [&](const Index& i, double, double lambda) {
-    const double volume = PileHeightAboveGround(map, plane, i) * area;
-    if (lambda > width / 6) {
-      v.left += volume;
-    } else if (lambda < -width / 6) {
-      v.right += volume;
-    } else {
-      v.middle += volume;
-    }
-  });
+  const std::array<std::pair<double*, double>, 3> sections = {
+      std::pair{&v.right, -width / 2}, {&v.middle, -width / 6}, {&v.left, width / 6}};
+  for (const auto& [volume, lambda_min] : sections) {
+    ForEachCellOverlap(map, entry, heading, length, lambda_min, lambda_min + width / 3,
+                       [&, volume = volume](const Index& i, double area, double) {
+                         *volume += PileHeightAboveGround(map, plane, i) * area;
+                       });
+  }
   return v;
 }
 
-double ConcavityScore(const SectionVolumes& v) {
-  // Eq. (15): convex (1) if V_m ≥ max{V_l, V_r}, concave (0) otherwise.
+double ConcavityScore(const SectionVolumes& v, double tolerance) {
+  // Eq. (15): convex (1) if V_m ≥ max{V_l, V_r}, concave (0) otherwise; "≥" within the
+  // relative tolerance.
   const double side = std::max(v.left, v.right);
-  return v.middle >= side - 1e-9 * std::max(side, 1e-12) ? 1.0 : 0.0;
+  return v.middle >= (1 - tolerance) * side ? 1.0 : 0.0;
 }
 
 double EfficiencyScore(double length, double min_length, double max_length) {
@@ -644,7 +700,7 @@ ShovelPointResult SelectShovelPoints(const GridMap& map,
     const SectionVolumes v = ConcavityVolumes(map, plane, pose.xy, pose.entry_heading,
                                               loader.bucket_width, config.penetration_length);
     s.volume_left = v.left, s.volume_middle = v.middle, s.volume_right = v.right;
-    s.s_c = ConcavityScore(v);
+    s.s_c = ConcavityScore(v, config.concavity_tolerance);
     s.s_a = EntryAngleScore(s.entry_curvature, result.max_curvature);
     if (s.s_t == kMinusInfinity) {
       c.infeasible = "torque |T_c| >= T_res";

@@ -105,6 +105,11 @@ struct ShovelPointConfig {
   /// and never reached. 0: the scoop always drives the whole scoop_advance. The default is the
   /// main job's: 0.5 + 0.15 + 0.3 + 0.5 m.
   double crowd_stop_distance = 1.45;
+  /// Eq. (15) counts a flat face as convex (V_m ≥ max{V_l, V_r}). On a perceived map a flat
+  /// face's sections differ by the map's noise, and the binary score then flips on it: 0.13 of
+  /// F (k_c) from one 7 Hz map to the next, which sent re-selection round a pile. A middle
+  /// section within this fraction of the larger side counts as flat, hence convex [-].
+  double concavity_tolerance = 0.05;
   double entry_window = 3.0;  ///< the end of the path whose mean |κ| is κ_im [m]
   // Paths.
   double path_spacing = 0.25;  ///< sampling of the planned path [m]
@@ -192,9 +197,10 @@ ShovelPointResult SelectShovelPoints(const perception::GridMap& map,
 double PileHeightAboveGround(const perception::GridMap& map, const Eigen::Vector3d& ground_plane,
                              const perception::Index& index);
 
-/// Eq. (12): T_c = Σ_{Ω} h_ij λ_i ε² over the cells whose centres lie in the rectangle of
-/// `width` across and `length` deep ahead of `entry` along `heading` (from half a cell behind
-/// it); λ is the lateral offset from the bucket's centre line, left positive [m⁴].
+/// Eq. (12): T_c = Σ_{Ω} h_ij λ_i a_ij over Ω, the rectangle of `width` across and `length`
+/// deep ahead of `entry` along `heading` (from half a cell behind it); a_ij is the area of the
+/// cell inside Ω (cells count by their exact share, not by their centres) and λ_i the lateral
+/// offset of that part's centroid from the bucket's centre line, left positive [m⁴].
 double TorqueMoment(const perception::GridMap& map, const Eigen::Vector3d& ground_plane,
                     const Eigen::Vector2d& entry, double heading, double width, double length);
 /// Eq. (13), with |T_c|.
@@ -206,13 +212,16 @@ struct SectionVolumes {
   double left = 0, middle = 0, right = 0;  ///< [m³]
 };
 /// The three-section bucket model of Eq. (15): the rectangle of TorqueMoment split into three
-/// strips of width/3 across; volumes above the ground plane.
+/// strips of width/3 across; volumes above the ground plane, each cell split between the
+/// strips by area (exact polygon clipping), so that a level face gives three equal volumes
+/// wherever the entry falls on the grid.
 SectionVolumes ConcavityVolumes(const perception::GridMap& map, const Eigen::Vector3d& ground_plane,
                                 const Eigen::Vector2d& entry, double heading, double width,
                                 double length);
-/// Eq. (15). Equal volumes (a flat face) count as convex (V_m ≥ max): the seed's "≥", with a
-/// relative tolerance of 1e-9 for rounding.
-double ConcavityScore(const SectionVolumes& volumes);
+/// Eq. (15). Equal volumes (a flat face) count as convex (V_m ≥ max): the seed's "≥", here
+/// V_m ≥ (1 − `tolerance`)·max{V_l, V_r}, a relative tolerance for the map's noise
+/// (ShovelPointConfig::concavity_tolerance; 1e-9 leaves only rounding).
+double ConcavityScore(const SectionVolumes& volumes, double tolerance = 1e-9);
 /// Eq. (16); 1 when l_max = l_min (a single candidate, or all paths equally long).
 double EfficiencyScore(double length, double min_length, double max_length);
 /// Eq. (17).

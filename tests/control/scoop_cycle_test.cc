@@ -223,5 +223,84 @@ TEST(ScoopCycle, Explore) {
   }
 }
 
+// The V2 path against the machine's (docs/scooping_control.md): one predicted-trigger
+// "Just in & out" scoop per material, the tip, joints and travel after the trigger every 0.1 s
+// beside the predicted path at the same time (plan time step 0.02 s). Off unless asked.
+TEST(ScoopCycle, TraceAfterTrigger) {
+  const char* which = std::getenv("AUTOSHOVEL_SCOOP_TRACE");
+  if (which == nullptr) GTEST_SKIP();
+  for (const char* m : {"big_gravel", "river_sand"}) {
+    if (which[0] != '*' && std::string(which) != m) continue;
+    testing::ConeYard yard(kMachine, m, 3.0, 4.0);
+    const prediction::HeightGrid map = testing::ToHeightGrid(yard.world.terrain);
+    plant::Plant loader(yard.machine, plant::testing::Functions(kMachine), yard.world, yard.start);
+    testing::PlantMachine machine(loader);
+    ScoopCycleOptions options;
+    options.attack_pose = yard.attack_pose;
+    options.policy = ScoopPolicy::kJustInOut;
+    if (const char* decel = std::getenv("AUTOSHOVEL_SCOOP_DECEL")) {
+      options.scoop_deceleration = std::atof(decel);
+    }
+    // AUTOSHOVEL_TRACE_V1=x: fire at V1 ≥ x instead (V2 still computed, for its path).
+    struct V1Trigger : ScoopTrigger {
+      double target = 0, threshold = 0;
+      bool Fire(const TriggerInputs& in) override {
+        return threshold > 0 ? in.v1 >= threshold : in.v1 + in.v2 >= target;
+      }
+      bool NeedsPrediction() const override { return true; }
+      std::string Name() const override { return "trace"; }
+    } trigger;
+    trigger.target = options.target_fill * yard.machine.bucket.rated_capacity;
+    if (const char* v1 = std::getenv("AUTOSHOVEL_TRACE_V1")) trigger.threshold = std::atof(v1);
+    ScoopCycle cycle(yard.machine, plant::testing::Functions(kMachine), map, *yard.material,
+                     trigger, &Predictor(), options);
+    cycle.Start(machine);
+    struct Row {
+      double t, travel, speed, q_boom, q_bucket, x, z, payload;
+    };
+    std::vector<Row> rows;
+    double t_trig = NAN;
+    Eigen::Vector2d xy0 = Eigen::Vector2d::Zero();
+    double heading0 = 0;
+    while (cycle.Tick(machine)) {
+      machine.Advance(options.tick);
+      const Proprioception s = machine.Sense();
+      const std::string phase = cycle.phase_name();
+      if (phase == "scoop" && std::isnan(t_trig)) {
+        t_trig = s.time, xy0 = s.hinge_xy, heading0 = s.heading;
+      }
+      if (!std::isnan(t_trig) && phase == "scoop") {
+        const Eigen::Vector2d u(std::cos(heading0), std::sin(heading0));
+        const Eigen::Vector2d tip = prediction::TipInBase(yard.machine, s.q_boom, s.q_bucket);
+        rows.push_back({s.time - t_trig, (s.hinge_xy - xy0).dot(u), s.speed, s.q_boom, s.q_bucket,
+                        (s.hinge_xy - xy0).dot(u) + tip.x(), tip.y(), machine.PayloadVolume()});
+      }
+    }
+    const ScoopResult r = cycle.Finish(machine);
+    std::printf(
+        "[trace] %s trigger %.2f s after contact, V1 %.3f V2 %.3f, fill %.3f, predicted d %.3f, "
+        "travel after trigger %.3f, Eq19 true path %.3f, crowd %.1f kJ\n",
+        m, r.trigger_after_contact, r.v1_at_trigger, r.v2_at_trigger, r.fill_rate,
+        r.has_features_at_trigger ? Predictor().Predict(r.features_at_trigger).penetration : NAN,
+        r.travel_after_trigger, r.feedback_volume,
+        r.Phase("crowd") ? r.Phase("crowd")->energy / 1e3 : NAN);
+    const Eigen::Vector2d u(std::cos(heading0), std::sin(heading0));
+    const std::vector<Eigen::Vector3d>& pred = r.predicted_tip_path;
+    for (std::size_t i = 0; i < rows.size(); i += 10) {
+      const Row& w = rows[i];
+      const std::size_t k = static_cast<std::size_t>(std::lround(w.t / 0.02));
+      double px = NAN, pz = NAN;
+      if (k < pred.size()) {
+        px = (pred[k].head<2>() - xy0).dot(u);
+        pz = pred[k].z();
+      }
+      std::printf(
+          "[trace] t %.2f travel %.3f v %.2f q_boom %.3f q_bucket %.3f tip x %.3f z %.3f | "
+          "predicted x %.3f z %.3f | payload %.3f\n",
+          w.t, w.travel, w.speed, w.q_boom, w.q_bucket, w.x, w.z, px, pz, w.payload);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace autoshovel::control

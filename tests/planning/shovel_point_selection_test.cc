@@ -107,22 +107,53 @@ TEST(ShovelScores, ConcavityThreeSectionsByHand) {
     }
     return map;
   };
-  // Entering at (0.125, 0) heading +x, 1.9 m deep: 8 cells along, 4 across per section.
+  // Entering at (0.125, 0) heading +x, 1.875 m deep from half a cell behind the entry: x from
+  // 0 to 2 m, 8 cells along, 4 across per section.
   const Eigen::Vector2d entry(0.125, 0);
   const GridMap flat = face([](double) { return 1.0; });
-  const SectionVolumes v = ConcavityVolumes(flat, kLevel, entry, 0.0, 3.0, 1.9);
+  const SectionVolumes v = ConcavityVolumes(flat, kLevel, entry, 0.0, 3.0, 1.875);
   EXPECT_NEAR(v.left, 8 * 4 * 0.0625, 1e-12);  // 2 m³ each
   EXPECT_NEAR(v.middle, 2.0, 1e-12);
   EXPECT_NEAR(v.right, 2.0, 1e-12);
   EXPECT_EQ(ConcavityScore(v), 1.0);  // a flat face: V_m = max(V_l, V_r), convex by "≥"
   const GridMap ridge = face([](double y) { return 2.0 - std::abs(y); });
-  EXPECT_EQ(ConcavityScore(ConcavityVolumes(ridge, kLevel, entry, 0.0, 3.0, 1.9)), 1.0);
+  EXPECT_EQ(ConcavityScore(ConcavityVolumes(ridge, kLevel, entry, 0.0, 3.0, 1.875)), 1.0);
   const GridMap gully = face([](double y) { return 0.5 + std::abs(y); });
-  const SectionVolumes g = ConcavityVolumes(gully, kLevel, entry, 0.0, 3.0, 1.9);
+  const SectionVolumes g = ConcavityVolumes(gully, kLevel, entry, 0.0, 3.0, 1.875);
   EXPECT_LT(g.middle, g.left);
   EXPECT_EQ(ConcavityScore(g), 0.0);  // concave: the seed scores it 0
   // Only one side higher than the middle is enough to be concave.
   EXPECT_EQ(ConcavityScore({1.0, 0.9, 0.2}), 0.0);
+  // Within the map-noise tolerance a face is flat, hence convex; beyond it, concave.
+  EXPECT_EQ(ConcavityScore({1.0, 0.96, 0.2}, 0.05), 1.0);
+  EXPECT_EQ(ConcavityScore({1.0, 0.94, 0.2}, 0.05), 0.0);
+  EXPECT_EQ(ConcavityScore({0.2, 0.96, 1.0}, 0.05), 1.0);
+  EXPECT_EQ(ConcavityScore({1.0, 0.96, 0.2}), 0.0);  // the seed's exact "≥"
+}
+
+// Cells count by their share of area in Ω: on the main job's 0.3 m grid, the 1 m sections of a
+// 3 m bucket do not fall on cell edges. A level face 1 m high must give three equal sections
+// and Ω's exact area, wherever the entry lies and whatever the heading; counted by centres,
+// the sections held 3 or 4 cells each and a straight pile front was "concave" everywhere.
+TEST(ShovelScores, ConcavitySectionsCountCellsByArea) {
+  GridMap map = FlatMap(0.3, 20, {0, 0});
+  for (perception::GridMapIterator it(map); !it.done(); ++it) {
+    map.at("elevation", *it) = 1.0f;
+    map.at("class", *it) = static_cast<float>(CellClass::kPile);
+  }
+  const double width = 3.0, length = 2.0;
+  for (const Eigen::Vector2d& entry :
+       {Eigen::Vector2d(0.15, 0.15), Eigen::Vector2d(0.07, -0.21), Eigen::Vector2d(-0.4, 0.33)}) {
+    for (const double heading : {0.0, 0.3, kPi / 2, -2.0}) {
+      const SectionVolumes v = ConcavityVolumes(map, kLevel, entry, heading, width, length);
+      const double section = width / 3 * (length + 0.15);  // from half a cell behind the entry
+      EXPECT_NEAR(v.left, section, 1e-9) << entry.transpose() << " at " << heading;
+      EXPECT_NEAR(v.middle, section, 1e-9) << entry.transpose() << " at " << heading;
+      EXPECT_NEAR(v.right, section, 1e-9) << entry.transpose() << " at " << heading;
+      // A level face is balanced: Eq. (12)'s first moment vanishes.
+      EXPECT_NEAR(TorqueMoment(map, kLevel, entry, heading, width, length), 0.0, 1e-9);
+    }
+  }
 }
 
 TEST(ShovelScores, EfficiencyEntryAngleAndWeights) {
@@ -282,6 +313,9 @@ TEST(ShovelPointConfig, ValidateNamesTheProblem) {
   config = {};
   config.scoop_advance = std::nan("");
   EXPECT_NE(config.Validate().find("scoop_advance"), std::string::npos);
+  config = {};
+  config.concavity_tolerance = std::nan("");
+  EXPECT_NE(config.Validate().find("concavity_tolerance"), std::string::npos);
 }
 
 }  // namespace

@@ -71,6 +71,8 @@ ShovelRunOptions Base(const CompareOptions& o) {
   r.figures = false;
   r.truth_labels = !o.network;
   r.pressure_threshold = o.pressure_threshold;
+  r.scoop_deceleration = o.scoop_deceleration;
+  r.predictor = o.predictor;
   return r;
 }
 
@@ -131,7 +133,9 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
   };
   out << "Table 5: trigger and scooping strategy (" << o.trials
       << " trials per material; pressure threshold " << o.pressure_threshold / 1e5
-      << " bar). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
+      << " bar; scoop deceleration " << o.scoop_deceleration << " m/s^2; predictor "
+      << (o.predictor.empty() ? std::string("shipped") : o.predictor)
+      << "). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
          "the third column as printed).\n\n";
   out << "| trigger | strategy | material | crowd s (seed) | crowd kJ (seed) | scoop s | scoop kJ "
          "(seed 3rd) | trigger after contact s | fill % | strategies chosen |\n"

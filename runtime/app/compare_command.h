@@ -26,6 +26,8 @@ struct CompareOptions {
   int trials = 5;
   bool network = false;
   double pressure_threshold = 150e5;  ///< [Pa]
+  double scoop_deceleration = 1.0;    ///< ShovelRunOptions::scoop_deceleration [m/s²]
+  std::string predictor;              ///< SVR model prefix; empty: the shipped one
 };
 
 /// Prints the table; returns 0, or 2 on bad input.

@@ -378,6 +378,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("--pressure-bar", run_pressure_bar, "Threshold of --trigger pressure [bar]")
       ->capture_default_str();
+  run_cmd
+      ->add_option("--scoop-deceleration", run.scoop_deceleration,
+                   "Fall of the speed reference once the scoop moves the arm [m/s^2] (the "
+                   "predictor must be trained for it: docs/scooping_control.md)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   run_cmd->add_option("--stairway-steps", run.stairway_steps, "N of Stairway #N")
       ->capture_default_str();
   run_cmd->add_option("--selection", run_selection, "ours | chen2024")
@@ -429,6 +435,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   compare_cmd->add_flag("--network", compare.network,
                         "Segmentation network instead of the simulator's labels");
+  compare_cmd
+      ->add_option("--scoop-deceleration", compare.scoop_deceleration,
+                   "Fall of the speed reference once the scoop moves the arm [m/s^2]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  compare_cmd->add_option("--predictor", compare.predictor,
+                          "Penetration SVR (path without .model; default: the shipped one)");
   compare_cmd
       ->add_option("--pressure-bar", compare_pressure_bar,
                    "Threshold of the pressure trigger [bar]")

@@ -293,6 +293,7 @@ std::string ShovelJob::ConfigYaml() const {
     << "policy: " << control::ToString(o.policy) << "\n"
     << "pressure_threshold_bar: " << o.pressure_threshold / 1e5 << "\n"
     << "stairway_steps: " << o.stairway_steps << "\n"
+    << "scoop_deceleration_mps2: " << o.scoop_deceleration << "\n"
     << "approach_distance_m: " << o.approach_distance << "\n"
     << "safety_distance_m: " << o.safety_distance << "\n"
     << "d_res_m: " << o.d_res << "\n"
@@ -370,6 +371,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   scoop_options.attack_pose = {.boom = q_attack[0], .bucket = q_attack[1]};
   scoop_options.policy = o.policy;
   scoop_options.strategy.fixed_steps = o.stairway_steps;
+  scoop_options.scoop_deceleration = o.scoop_deceleration;
   out.target_volume = scoop_options.target_fill * machine.bucket.rated_capacity;
 
   perception::PerceptionFromPlantOptions perceive;

@@ -48,6 +48,9 @@ struct ShovelRunOptions {
   TriggerChoice trigger = TriggerChoice::kPredicted;
   double pressure_threshold = 150e5;  ///< boom cylinder pressure of the pressure trigger [Pa]
   int stairway_steps = 3;             ///< N of "Stairway #N"
+  /// Fall of the drive's speed reference once the scoop moves the arm [m/s²]
+  /// (control::ScoopCycleOptions::scoop_deceleration). The predictor must be trained for it.
+  double scoop_deceleration = 1.0;
   SelectionMethod selection = SelectionMethod::kOurs;
   double approach_distance = 12.0;  ///< cycle start, out of the bin's open front [m]
   /// The safety rule every cycle is held to and checked against (ground truth, 20 Hz): the

@@ -112,6 +112,12 @@ std::string ScoopPlan::Invalid() const {
     return bad(bucket_curl, "bucket_curl", "rad");
   if (!(boom_rate >= 0) || !std::isfinite(boom_rate)) return bad(boom_rate, "boom_rate", "rad/s");
   if (!(boom_lift >= 0) || !std::isfinite(boom_lift)) return bad(boom_lift, "boom_lift", "rad");
+  for (std::size_t i = 0; i < bucket_rate_along_curl.size(); ++i) {
+    const double r = bucket_rate_along_curl[i];
+    if (!(r >= 0) || !std::isfinite(r)) {
+      return bad(r, ("bucket_rate_along_curl[" + std::to_string(i) + "]").c_str(), "rad/s");
+    }
+  }
   if (!(time_step > 0) || !std::isfinite(time_step)) {
     return "time_step must be > 0 s, got " + std::to_string(time_step);
   }
@@ -168,7 +174,40 @@ ScoopPlan ScoopPlanFromMachine(const model::MachineDescription& machine,
   plan.boom_rate = JointRate(machine, functions, 0, q, boom_command);
   plan.bucket_curl = bucket_curl;
   plan.boom_lift = boom_lift;
+  constexpr int kCurlSamples = 16;
+  if (bucket_curl > 0) {
+    std::vector<double> at = q;
+    for (int k = 0; k <= kCurlSamples; ++k) {
+      at[1] = q[1] + bucket_curl * k / kCurlSamples;
+      plan.bucket_rate_along_curl.push_back(JointRate(machine, functions, 1, at, bucket_command));
+    }
+  }
   return plan;
+}
+
+CurlSchedule PlanCurl(const ScoopPlan& plan) {
+  // Explicit Euler on the time grid: over one 20 ms step the rate changes by well under 1 %.
+  auto rate_at = [&](double curl) {
+    const std::vector<double>& table = plan.bucket_rate_along_curl;
+    if (table.size() < 2 || plan.bucket_curl <= 0) return plan.bucket_rate;
+    const double f =
+        std::clamp(curl / plan.bucket_curl, 0.0, 1.0) * static_cast<double>(table.size() - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(f), table.size() - 2);
+    return table[i] + (f - static_cast<double>(i)) * (table[i + 1] - table[i]);
+  };
+  const double dt = plan.time_step;
+  CurlSchedule out;
+  out.curl.push_back(0.0);
+  out.t_curled = plan.bucket_curl <= 0 ? plan.delay : plan.horizon;
+  for (int k = 1; k * dt <= plan.horizon + 1e-12; ++k) {
+    double c = out.curl.back();
+    if (k * dt > plan.delay && c < plan.bucket_curl) {
+      c = std::min(c + rate_at(c) * dt, plan.bucket_curl);
+      if (c >= plan.bucket_curl) out.t_curled = k * dt;
+    }
+    out.curl.push_back(c);
+  }
+  return out;
 }
 
 FutureVolume PredictFutureVolume(const model::MachineDescription& machine, const HeightGrid& map,
@@ -187,27 +226,33 @@ FutureVolume PredictFutureVolume(const model::MachineDescription& machine, const
   }
   const double v = std::max(at_trigger.speed, 0.0);
   const double d = penetration;
-  // Travel s(t): constant deceleration from v to rest over d. A machine that is (nearly) at rest
-  // yet predicted to move covers d at the slowest pace we consider (0.1 m/s).
+  const double dt = plan.time_step;
+  const CurlSchedule schedule = PlanCurl(plan);
+  const std::vector<double>& curl_at = schedule.curl;
+  const double t_curled = schedule.t_curled;
+  const double t_lifted =
+      std::min(t_curled + (plan.boom_rate > 0 ? plan.boom_lift / plan.boom_rate : plan.horizon),
+               plan.horizon);
+  // Travel: constant deceleration from v to rest over d. A machine that is (nearly) at rest yet
+  // predicted to move covers d at the slowest pace we consider (0.1 m/s). The scoop cycle keeps
+  // pushing while it curls (ScoopCycleOptions::scoop_deceleration); d, learnt in that regime,
+  // carries it, and the shape within d matters less than its end (docs/scooping_control.md).
   const double v_start = std::max(v, 0.1);
   const double t_stop = d > 0 ? 2 * d / v_start : 0.0;
   auto travel = [&](double t) {
     if (t >= t_stop) return d;
     return v_start * t - v_start * v_start * t * t / (4 * d);
   };
-  const double t_curled =
-      plan.delay + (plan.bucket_rate > 0 ? plan.bucket_curl / plan.bucket_rate : plan.horizon);
-  const double t_lifted =
-      t_curled + (plan.boom_rate > 0 ? plan.boom_lift / plan.boom_rate : plan.horizon);
   const double t_end = std::min(std::max(t_stop, t_lifted), plan.horizon);
   const Eigen::Vector2d forward(std::cos(at_trigger.heading), std::sin(at_trigger.heading));
 
   FutureVolume out;
   const double q_boom0 = at_trigger.q[0], q_bucket0 = at_trigger.q[1];
-  const int steps = static_cast<int>(std::ceil(t_end / plan.time_step));
+  const int steps = static_cast<int>(std::ceil(t_end / dt));
   for (int k = 0; k <= steps; ++k) {
-    const double t = std::min(k * plan.time_step, t_end);
-    const double curl = std::clamp((t - plan.delay) * plan.bucket_rate, 0.0, plan.bucket_curl);
+    const double t = std::min(k * dt, t_end);
+    const double curl =
+        curl_at[std::min(static_cast<std::size_t>(std::lround(t / dt)), curl_at.size() - 1)];
     const double lift = std::clamp((t - t_curled) * plan.boom_rate, 0.0, plan.boom_lift);
     const Eigen::Vector2d tip = TipInBase(machine, q_boom0 + lift, q_bucket0 + curl);
     const Eigen::Vector2d xy = at_trigger.hinge_xy + (travel(t) + tip.x()) * forward;

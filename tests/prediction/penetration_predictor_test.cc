@@ -20,6 +20,10 @@ namespace {
 
 const std::string kShipped =
     std::string(AUTOSHOVEL_SOURCE_DIR) + "/models/prediction/penetration_svr";
+// Trained for the pushing scoop (scoop deceleration 0.3 m/s², approached at the 1 m/s attack
+// speed): identification/predictor/README.md.
+const std::string kPushing =
+    std::string(AUTOSHOVEL_SOURCE_DIR) + "/models/prediction/penetration_svr_push";
 
 PenetrationFeatures SomeFeatures() {
   PenetrationFeatures f;
@@ -114,17 +118,18 @@ TEST(PenetrationPredictor, BadModelFilesGiveClearErrors) {
   std::filesystem::remove(stem + ".model");
 }
 
-// Plant runs of seed 2024 (the model was trained on seed 1) scored with the shipped model:
-// `dug_face_fraction` of them on a face an earlier scoop left (crowding_runs.h).
-predictor::PredictorEvaluation ScoreShippedModel(double dug_face_fraction) {
+// Plant runs of seed 2024 (the models were trained on seed 1) scored with the model `stem`:
+// `dug_face_fraction` of them on a face an earlier scoop left (crowding_runs.h), in the regime
+// `options` (default: the shipped model's).
+predictor::PredictorEvaluation ScoreModel(const std::string& stem, double dug_face_fraction,
+                                          predictor::CrowdingRunOptions options = {}) {
   const model::MachineDescription machine =
       model::LoadMachineDescription(model::ResolveMachineDescription(
           "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
   const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
   EXPECT_NE(functions, nullptr);
   if (functions == nullptr) return {};
-  const PenetrationPredictor predictor = PenetrationPredictor::Load(kShipped);
-  predictor::CrowdingRunOptions options;
+  const PenetrationPredictor predictor = PenetrationPredictor::Load(stem);
   options.dug_face_fraction = dug_face_fraction;
   const std::vector<predictor::CrowdingRun> runs =
       predictor::RunCrowdingBatch(machine, *functions, options, 2024, 0, 100, 2);
@@ -147,7 +152,7 @@ predictor::PredictorEvaluation ScoreShippedModel(double dug_face_fraction) {
 // 0.0002 m² (README: 100 % of its 249 fresh test runs of seed 1). Asserted: the seed's §7.4.1
 // goals of issue 6 (80 / 97 / 99.5 %), the outer one as at most one miss in 100.
 TEST(PenetrationPredictor, FreshPlantRunsFallInTheErrorBuckets) {
-  const predictor::PredictorEvaluation e = ScoreShippedModel(0.0);
+  const predictor::PredictorEvaluation e = ScoreModel(kShipped, 0.0);
   SCOPED_TRACE(predictor::FormatEvaluation(e));
   EXPECT_GE(e.within_010, 0.80);
   EXPECT_GE(e.within_015, 0.97);
@@ -157,18 +162,35 @@ TEST(PenetrationPredictor, FreshPlantRunsFallInTheErrorBuckets) {
 }
 
 // Every run on a dug face, the pile of every revisit. On these 100 runs the shipped model is
-// within 0.10 / 0.15 / 0.20 m on 99 / 99 / 99 %, MSE 0.0024 m², volume accuracy 95.3 % (README,
+// within 0.10 / 0.15 / 0.20 m on 99 / 99 / 99 %, MSE 0.0024 m², volume accuracy 95.2 % (README,
 // on the 151 dug test runs of seed 1: 96.0 / 98.0 / 99.3 %, MSE 0.0015 m²). On those same 151
 // runs the model shipped before it (1000 runs approached at up to 2 m/s) had MSE 0.0079 m²,
 // above the bound here.
 TEST(PenetrationPredictor, DugFaceRunsFallInTheErrorBuckets) {
-  const predictor::PredictorEvaluation e = ScoreShippedModel(1.0);
+  const predictor::PredictorEvaluation e = ScoreModel(kShipped, 1.0);
   SCOPED_TRACE(predictor::FormatEvaluation(e));
   EXPECT_GE(e.within_010, 0.90);
   EXPECT_GE(e.within_015, 0.95);
   EXPECT_GE(e.within_020, 0.97);
   EXPECT_LE(e.mse, 0.006);
   EXPECT_GE(e.volume_accuracy, 0.93);
+}
+
+// The pushing scoop's model on runs of its own regime (40 % dug faces, as it was trained): the
+// §7.4.1 goals, the outer one as at most one miss in 100. Trained with the approach speed free
+// in 0.5–1.25 m/s, the same runs gave 83.2 / 91.0 / 93.8 %: under the pushing scoop the speed
+// reference restarts from the attack speed, not from the speed at the trigger, so the approach
+// speed was a hidden variable of d (docs/scooping_control.md).
+TEST(PenetrationPredictor, PushingScoopModelFallsInTheErrorBuckets) {
+  predictor::CrowdingRunOptions options;
+  options.scoop_deceleration = 0.3;
+  options.min_speed = options.max_speed = 1.0;
+  const predictor::PredictorEvaluation e = ScoreModel(kPushing, 0.4, options);
+  SCOPED_TRACE(predictor::FormatEvaluation(e));
+  EXPECT_GE(e.within_010, 0.80);
+  EXPECT_GE(e.within_015, 0.97);
+  EXPECT_GE(e.within_020, 0.99);
+  EXPECT_LE(e.mse, 0.004);
 }
 
 }  // namespace

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "generated/registry.h"
+#include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
+#include "tests/plant/plant_test_support.h"
 
 namespace autoshovel::prediction {
 namespace {
@@ -125,6 +128,57 @@ TEST(FutureVolume, CurlingTheBucketTakesLessThanHoldingItAndDelayFromTheDescript
   ScoopPlan bad = plan;
   bad.delay = -1;
   EXPECT_NE(bad.Invalid(), "");
+}
+
+// The curl V2 assumes against the plant's: the tilt valve fully open from the attack pose (the
+// bucket just off the floor, empty), until the bucket joint has racked back as far as the scoop
+// cycle curls it. The rate along the stroke follows the lever arm; the rate at the trigger alone
+// misses how the arm's geometry speeds the curl up as it goes.
+TEST(PlanCurl, RateAlongTheStrokeMatchesThePlantsCurl) {
+  const model::MachineDescription machine = Loader();
+  const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+  ASSERT_NE(functions, nullptr);
+  std::vector<double> q = plant::BucketOnFloor(machine);
+  q[0] += 0.1;  // off the floor: no ground contact to slow the curl
+  const double curl = machine.links[1].joint_max - 0.1 - q[1];  // ScoopCycleOptions' margin
+  ASSERT_GT(curl, 0.5);
+  const ScoopPlan plan = ScoopPlanFromMachine(machine, *functions, q, 1.0, 1.0, curl, 0.3);
+  ASSERT_EQ(plan.bucket_rate_along_curl.size(), 17u);
+  EXPECT_DOUBLE_EQ(plan.bucket_rate_along_curl.front(), plan.bucket_rate);
+  const CurlSchedule schedule = PlanCurl(plan);
+  const double constant_rate_time = plan.delay + curl / plan.bucket_rate;
+
+  plant::World world = plant::testing::FlatYard(machine, 20.0, 0.1);
+  plant::Plant machine_plant(machine, *functions, world,
+                             plant::testing::LoaderAt(machine, 0.0, q[0], q[1]));
+  core::ActuatorCommand command;
+  command.valve.assign(machine.hydraulics.actuators.size(), 0.0);
+  command.valve[static_cast<std::size_t>(machine.ActuatorOfJoint(1))] = 1.0;
+  double plant_time = NAN;
+  while (machine_plant.time() < 8.0) {
+    ASSERT_TRUE(machine_plant.SetCommand(command));
+    machine_plant.Advance(0.01);
+    if (machine_plant.state().q[1] >= q[1] + curl) {
+      plant_time = machine_plant.time();
+      break;
+    }
+  }
+  ASSERT_TRUE(std::isfinite(plant_time)) << "the plant never curled " << curl << " rad";
+  std::printf(
+      "curl of %.3f rad: plant %.3f s, along the stroke %.3f s, at the trigger's rate %.3f s\n",
+      curl, plant_time, schedule.t_curled, constant_rate_time);
+  EXPECT_NEAR(schedule.t_curled, plant_time, 0.1 * plant_time);
+  EXPECT_LT(std::abs(schedule.t_curled - plant_time), std::abs(constant_rate_time - plant_time));
+  // The schedule is still through the delay, monotone, and ends at the full curl.
+  const std::size_t in_delay = static_cast<std::size_t>(plan.delay / plan.time_step);
+  EXPECT_EQ(schedule.curl[in_delay], 0.0);
+  for (std::size_t k = 1; k < schedule.curl.size(); ++k) {
+    ASSERT_GE(schedule.curl[k], schedule.curl[k - 1]);
+  }
+  EXPECT_DOUBLE_EQ(schedule.curl.back(), curl);
+  ScoopPlan bad = plan;
+  bad.bucket_rate_along_curl[3] = NAN;
+  EXPECT_NE(bad.Invalid().find("bucket_rate_along_curl[3]"), std::string::npos);
 }
 
 }  // namespace

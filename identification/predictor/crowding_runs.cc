@@ -74,6 +74,15 @@ void DigFace(const model::MachineDescription& machine, plant::World& world, doub
 
 }  // namespace
 
+double TravelAt(const CrowdingRun& run, double t) {
+  const std::vector<double>& s = run.travel_after_trigger;
+  if (s.empty() || !(run.travel_sample_period > 0)) return run.penetration;
+  const double k = std::max(t, 0.0) / run.travel_sample_period;
+  if (k >= static_cast<double>(s.size() - 1)) return s.back();
+  const std::size_t i = static_cast<std::size_t>(k);
+  return s[i] + (k - static_cast<double>(i)) * (s[i + 1] - s[i]);
+}
+
 CrowdingRunSpec DrawSpec(const model::MachineDescription& machine,
                          const CrowdingRunOptions& options, std::uint64_t seed, int index) {
   std::seed_seq sequence{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
@@ -174,7 +183,9 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
   const double heading = 0;
   const double rack_back = machine.links[1].joint_max - options.rack_back_margin;
   double boom_target = 0, max_travel = 0;
-  long tick = 0;
+  long tick = 0, trigger_tick = 0;
+  run.travel_sample_period = options.travel_sample_period;
+  const long sample_every = std::max(1L, std::lround(options.travel_sample_period / options.tick));
   while (true) {
     const plant::MachineState& s = loader.state();
     const double t = loader.time();
@@ -198,6 +209,7 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
         if (v1 >= spec.trigger_volume || stalled || t - contact_time > options.max_crowd_time) {
           triggered = true;
           trigger_time = t;
+          trigger_tick = tick;
           run.trigger_cause = v1 >= spec.trigger_volume ? "volume" : stalled ? "stall" : "time_out";
           const Eigen::Vector3d tip = run.past_path.back();
           run.features.speed = s.speed;
@@ -220,7 +232,9 @@ CrowdingRun RunCrowding(const model::MachineDescription& machine,
       }
     }
     if (triggered) {
-      max_travel = std::max(max_travel, (s.hinge_xy - run.at_trigger.hinge_xy).x());
+      const double travel = (s.hinge_xy - run.at_trigger.hinge_xy).x();
+      max_travel = std::max(max_travel, travel);
+      if ((tick - trigger_tick) % sample_every == 0) run.travel_after_trigger.push_back(travel);
       if (!curled && s.q[1] >= rack_back) curled = true;
       if (!arm_moving && s.q[1] > run.at_trigger.q[1] + 0.02) arm_moving = true;
       command.valve[tilt_valve] = curled ? 0.0 : 1.0;

@@ -57,6 +57,8 @@ struct CrowdingRunOptions {
   double dug_face_fraction = 0;
   double min_dug_depth = 1.0;  ///< range of the cut's length from the toe [m]
   double max_dug_depth = 3.0;
+  /// Period of CrowdingRun::travel_after_trigger [s] (a multiple of `tick`).
+  double travel_sample_period = 0.05;
   double map_resolution = 0.05;  ///< of the yard grid [m]
   double map_margin = 2.0;       ///< kept around the tip path in the stored map [m]
 };
@@ -87,8 +89,16 @@ struct CrowdingRun {
   std::vector<Eigen::Vector3d> past_path;  ///< tip path from first contact to the trigger
   prediction::MachineAtTrigger at_trigger;
   prediction::ScoopPlan plan;
-  double simulated_time = 0;  ///< [s]
+  /// Forward travel of the hinge from the trigger [m], sampled every `travel_sample_period`
+  /// from the trigger on (first 0): the travel curve's targets (train_predictor --travel-curve).
+  std::vector<double> travel_after_trigger;
+  double travel_sample_period = 0;  ///< [s]
+  double simulated_time = 0;        ///< [s]
 };
+
+/// The run's travel `t` seconds after the trigger [m]: linear between samples, the last sample
+/// after the end of the run.
+double TravelAt(const CrowdingRun& run, double t);
 
 /// Draws the spec of run `index` from `seed` (deterministic).
 CrowdingRunSpec DrawSpec(const model::MachineDescription& machine,

@@ -26,14 +26,29 @@ PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& pr
     e.within_015 += error <= 0.15;
     e.within_020 += error <= 0.20;
     e.mse += error * error;
+    const std::vector<double>& times = predictor.scaling().travel_times;
+    e.travel_knots = static_cast<int>(times.size());
+    for (std::size_t k = 0; k < times.size() && k < p.travel.size(); ++k) {
+      const double travel_error = std::abs(p.travel[k] - TravelAt(*run, times[k]));
+      e.travel_within_010 += travel_error <= 0.10;
+      e.travel_mse += travel_error * travel_error;
+    }
     if (run->payload < 0.2) continue;
     const double v1 = run->features.shoveled_volume;
+    prediction::ScoopPlan plan = run->plan;  // with the model's travel curve, if it has one
+    plan.travel_times = predictor.scaling().travel_times;
+    plan.travel_at = p.travel;
     const double v2 = prediction::PredictFutureVolume(machine, run->map, run->past_path,
-                                                      run->at_trigger, p.penetration, run->plan)
+                                                      run->at_trigger, p.penetration, plan)
                           .total();
+    // The oracle: the true penetration and, with a curve, the run's own travel at its knots.
+    prediction::ScoopPlan true_plan = plan;
+    for (std::size_t k = 0; k < plan.travel_times.size(); ++k) {
+      true_plan.travel_at[k] = TravelAt(*run, plan.travel_times[k]);
+    }
     const double v2_oracle =
         prediction::PredictFutureVolume(machine, run->map, run->past_path, run->at_trigger,
-                                        run->penetration, run->plan)
+                                        run->penetration, true_plan)
             .total();
     const double predicted = v1 + v2;
     ++e.capped_samples;
@@ -52,6 +67,8 @@ PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& pr
     e.within_010 /= e.samples, e.within_015 /= e.samples, e.within_020 /= e.samples;
     e.mse /= std::max(e.samples - e.refused, 1);
     e.mean_penetration /= e.samples;
+    const int pairs = std::max(e.samples - e.refused, 1) * std::max(e.travel_knots, 1);
+    e.travel_within_010 /= pairs, e.travel_mse /= pairs;
   }
   if (e.volume_samples > 0) {
     e.volume_accuracy = 1 - volume_error / e.volume_samples;
@@ -77,7 +94,14 @@ std::string FormatEvaluation(const PredictorEvaluation& e) {
       100 * e.within_020, e.mse, 100 * e.volume_accuracy, e.volume_samples,
       100 * e.oracle_volume_accuracy, e.mean_payload, e.mean_predicted_volume, e.capped_samples,
       100 * e.volume_accuracy_capped, e.full_runs);
-  return text;
+  std::string out = text;
+  if (e.travel_knots > 0) {
+    std::snprintf(text, sizeof text,
+                  "\n  travel curve (%d knots): %.1f %% of the knots within 0.10 m, MSE %.4f m^2",
+                  e.travel_knots, 100 * e.travel_within_010, e.travel_mse);
+    out += text;
+  }
+  return out;
 }
 
 }  // namespace autoshovel::predictor

@@ -27,8 +27,11 @@ struct PredictorEvaluation {
   int full_runs = 0;                  ///< runs whose payload reached 95 % of the capacity
   double mean_payload = 0;            ///< [m³]
   double mean_predicted_volume = 0;   ///< [m³]
-  int volume_samples = 0;  ///< runs not full with a payload ≥ 0.2 m³ (the ratio needs one)
-  int capped_samples = 0;  ///< all runs with a payload ≥ 0.2 m³
+  int volume_samples = 0;        ///< runs not full with a payload ≥ 0.2 m³ (the ratio needs one)
+  int capped_samples = 0;        ///< all runs with a payload ≥ 0.2 m³
+  int travel_knots = 0;          ///< knots of the model's travel curve (0: none)
+  double travel_within_010 = 0;  ///< fraction of (run, knot) pairs within 0.10 m
+  double travel_mse = 0;         ///< over the (run, knot) pairs [m²]
 };
 
 /// `capacity`: what the bucket holds when full, racked back [m³] (the plant's bucket holds less

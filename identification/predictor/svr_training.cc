@@ -154,4 +154,32 @@ SvrTrainingResult TrainPenetrationSvr(const SvrDataset& train, const SvrGrid& gr
   return result;
 }
 
+int FitSvr(const SvrDataset& train, const prediction::FeatureScaling& scaling, double c,
+           double gamma, double epsilon, const std::string& model_path) {
+  const std::size_t n = train.x.size();
+  if (n == 0 || train.y.size() != n) {
+    throw std::invalid_argument("FitSvr: need samples with targets, got " + std::to_string(n) +
+                                " and " + std::to_string(train.y.size()));
+  }
+  std::vector<std::vector<double>> scaled = train.x;
+  for (auto& row : scaled) {
+    if (row.size() != scaling.min.size()) throw std::invalid_argument("FitSvr: ragged samples");
+    for (std::size_t j = 0; j < row.size(); ++j) {
+      const double span = scaling.max[j] - scaling.min[j];
+      row[j] = span > 0 ? 2 * (row[j] - scaling.min[j]) / span - 1 : 0.0;
+    }
+  }
+  svm_set_print_string_function(&Quiet);
+  std::vector<int> all(n);
+  for (std::size_t i = 0; i < n; ++i) all[i] = static_cast<int>(i);
+  Problem problem(scaled, train.y, all);
+  const svm_parameter p = Parameters(c, gamma, epsilon);
+  svm_model* model = svm_train(&problem.problem, &p);
+  const int support_vectors = model->l;
+  const int saved = svm_save_model(model_path.c_str(), model);
+  svm_free_and_destroy_model(&model);
+  if (saved != 0) throw std::runtime_error("cannot write " + model_path);
+  return support_vectors;
+}
+
 }  // namespace autoshovel::predictor

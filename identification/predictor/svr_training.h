@@ -38,4 +38,11 @@ SvrTrainingResult TrainPenetrationSvr(const SvrDataset& train, const SvrGrid& gr
                                       prediction::FeatureScaling& scaling,
                                       const std::string& path_stem);
 
+/// One more ε-SVR on the same features and scaling (`scaling` min/max as TrainPenetrationSvr
+/// set them) with the given setting, saved to `model_path`; returns its support vectors. For
+/// the travel curve's knots: their targets are the same machine's travel at other instants, so
+/// the setting chosen for d is reused rather than searched again (one fit instead of 300).
+int FitSvr(const SvrDataset& train, const prediction::FeatureScaling& scaling, double c,
+           double gamma, double epsilon, const std::string& model_path);
+
 }  // namespace autoshovel::predictor

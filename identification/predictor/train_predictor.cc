@@ -54,6 +54,15 @@ int main(int argc, char** argv) {
                  "fastest approach speed v0 of the runs [m/s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  bool travel_curve = false;
+  app.add_flag("--travel-curve", travel_curve,
+               "also train one SVR per --travel-times knot for the machine's travel that long "
+               "after the trigger (files <stem>.travel<k>.model): V2 then follows the predicted "
+               "curve instead of a constant deceleration over d");
+  std::vector<double> travel_times = {0.5, 1.0, 1.5, 2.0, 2.5, 3.0};
+  app.add_option("--travel-times", travel_times, "knots of the travel curve [s after the trigger]")
+      ->delimiter(',')
+      ->capture_default_str();
   std::string compare_with;
   app.add_option("--compare", compare_with,
                  "also score this model (path stem) on the same test runs, e.g. the shipped "
@@ -162,12 +171,29 @@ int main(int argc, char** argv) {
                     scoop_deceleration);
       note += deceleration;
     }
+    if (travel_curve) {
+      note += " --travel-curve --travel-times " + joined(travel_times);
+      scaling.travel_times = travel_times;
+    }
     scaling.notes.push_back(note);
     std::filesystem::create_directories(std::filesystem::path(out).parent_path().empty()
                                             ? std::filesystem::path(".")
                                             : std::filesystem::path(out).parent_path());
     const predictor::SvrTrainingResult fit =
         predictor::TrainPenetrationSvr(train, grid, threads, scaling, out);
+    if (travel_curve) {
+      for (std::size_t k = 0; k < travel_times.size(); ++k) {
+        predictor::SvrDataset knot;
+        knot.x = train.x;
+        for (const predictor::CrowdingRun* run : train_runs) {
+          knot.y.push_back(predictor::TravelAt(*run, travel_times[k]));
+        }
+        const std::string path = prediction::PenetrationPredictor::TravelModelPath(out, k);
+        const int vectors = predictor::FitSvr(knot, scaling, fit.c, fit.gamma, fit.epsilon, path);
+        std::printf("travel at %.2f s: %d support vectors, %s\n", travel_times[k], vectors,
+                    path.c_str());
+      }
+    }
     const double training_time = elapsed() - generation_time;
 
     const prediction::PenetrationPredictor model = prediction::PenetrationPredictor::Load(out);

@@ -210,9 +210,12 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
   }
   try {
     const std::vector<double> q = {s.q_boom, s.q_bucket};
-    const prediction::ScoopPlan plan = prediction::ScoopPlanFromMachine(
+    prediction::ScoopPlan plan = prediction::ScoopPlanFromMachine(
         machine_, functions_, q, 1.0, 1.0, std::max(limits_.bucket_max - s.q_bucket, 0.0),
         options_.strategy.exit_boom_lift);
+    // The travel within d as the model predicts it, when it has a travel curve.
+    plan.travel_times = predictor_->scaling().travel_times;
+    plan.travel_at = d.travel;
     prediction::MachineAtTrigger at;
     at.hinge_xy = s.hinge_xy;
     at.heading = s.heading;

@@ -129,8 +129,10 @@ void CheckLibsvmModel(const std::string& path, int features) {
 
 struct PenetrationPredictor::Model {
   svm_model* svm = nullptr;
+  std::vector<svm_model*> travel;  ///< one per FeatureScaling::travel_times
   ~Model() {
     if (svm != nullptr) svm_free_and_destroy_model(&svm);
+    for (svm_model*& m : travel) svm_free_and_destroy_model(&m);
   }
 };
 
@@ -191,6 +193,14 @@ PenetrationPrediction PenetrationPredictor::Predict(const PenetrationFeatures& f
   out.penetration = std::max(svm_predict(model_->svm, nodes.data()), 0.0);
   out.ok = std::isfinite(out.penetration);
   if (!out.ok) out.message = "the model returned a non-finite penetration";
+  for (const svm_model* travel : model_->travel) {
+    const double s = std::max(svm_predict(travel, nodes.data()), 0.0);
+    if (!std::isfinite(s)) {
+      out.ok = false;
+      out.message = "the model returned a non-finite travel";
+    }
+    out.travel.push_back(s);
+  }
   return out;
 }
 
@@ -207,6 +217,11 @@ void PenetrationPredictor::SaveScaling(const std::string& path_stem, const Featu
   file << "\n";
   for (std::size_t i = 0; i < s.names.size(); ++i) {
     file << "feature " << s.names[i] << " " << s.min[i] << " " << s.max[i] << "\n";
+  }
+  if (!s.travel_times.empty()) {
+    file << "travel_times";
+    for (double t : s.travel_times) file << " " << t;
+    file << "\n";
   }
   for (const std::string& note : s.notes) file << "note " << note << "\n";
   if (!file) throw std::runtime_error("cannot write " + path);
@@ -255,13 +270,28 @@ FeatureScaling PenetrationPredictor::LoadScaling(const std::string& path_stem) {
         continue;
       }
       s.names.push_back(name), s.min.push_back(lo), s.max.push_back(hi);
+    } else if (key == "travel_times") {
+      double t = 0;
+      std::vector<double> times;
+      while (in >> t) times.push_back(t);
+      bool ok = in.eof() && !times.empty();
+      for (std::size_t i = 0; ok && i < times.size(); ++i) {
+        ok = std::isfinite(times[i]) && times[i] > (i == 0 ? 0.0 : times[i - 1]);
+      }
+      if (!ok) {
+        error(line, "expected 'travel_times <t1> <t2> …' [s], finite, > 0 and increasing, got '" +
+                        text + "'");
+        continue;
+      }
+      s.travel_times = std::move(times);
     } else if (key == "note") {
       std::string rest;
       std::getline(in >> std::ws, rest);
       s.notes.push_back(rest);
     } else {
-      error(line, "unknown key '" + key +
-                      "' (expected format, machine, delta_l, materials, feature or note)");
+      error(line,
+            "unknown key '" + key +
+                "' (expected format, machine, delta_l, materials, feature, travel_times or note)");
     }
   }
   if (!have_format) error(0, "missing the 'format " + std::string(kFormat) + "' line");
@@ -281,39 +311,53 @@ FeatureScaling PenetrationPredictor::LoadScaling(const std::string& path_stem) {
   return s;
 }
 
-PenetrationPredictor PenetrationPredictor::Load(const std::string& path_stem) {
-  FeatureScaling scaling = LoadScaling(path_stem);
-  const std::string path = path_stem + ".model";
+namespace {
+
+// One ε-SVR RBF model file over `features` features, checked before and after libsvm reads it.
+svm_model* LoadSvr(const std::string& path, int features) {
   if (!std::filesystem::is_regular_file(path)) {
     Refuse(path, 0, "cannot open the libsvm model file (written by train_predictor)");
   }
-  CheckLibsvmModel(path, static_cast<int>(scaling.names.size()));
-  auto model = std::make_unique<Model>();
-  model->svm = svm_load_model(path.c_str());
-  if (model->svm == nullptr) {
+  CheckLibsvmModel(path, features);
+  svm_model* svm = svm_load_model(path.c_str());
+  if (svm == nullptr)
     Refuse(path, 0, "not a libsvm model file (svm_load_model could not parse it)");
+  auto refuse = [&](const std::string& why) {
+    svm_free_and_destroy_model(&svm);
+    Refuse(path, 0, why);
+  };
+  if (svm_get_svm_type(svm) != EPSILON_SVR) {
+    refuse("expected an epsilon_svr model, got svm_type " + std::to_string(svm_get_svm_type(svm)));
   }
-  if (svm_get_svm_type(model->svm) != EPSILON_SVR) {
-    Refuse(path, 0,
-           "expected an epsilon_svr model, got svm_type " +
-               std::to_string(svm_get_svm_type(model->svm)));
+  if (svm->param.kernel_type != RBF) {
+    refuse("expected an rbf kernel, got kernel_type " + std::to_string(svm->param.kernel_type));
   }
-  if (model->svm->param.kernel_type != RBF) {
-    Refuse(
-        path, 0,
-        "expected an rbf kernel, got kernel_type " + std::to_string(model->svm->param.kernel_type));
-  }
-  if (model->svm->l <= 0) Refuse(path, 0, "the model has no support vectors");
-  const int features = static_cast<int>(scaling.names.size());
-  for (int i = 0; i < model->svm->l; ++i) {
-    for (const svm_node* node = model->svm->SV[i]; node->index != -1; ++node) {
+  if (svm->l <= 0) refuse("the model has no support vectors");
+  for (int i = 0; i < svm->l; ++i) {
+    for (const svm_node* node = svm->SV[i]; node->index != -1; ++node) {
       if (node->index < 1 || node->index > features) {
-        Refuse(path, 0,
-               "support vector " + std::to_string(i + 1) + " uses feature index " +
-                   std::to_string(node->index) + ", the scaling file has " +
-                   std::to_string(features) + " features");
+        refuse("support vector " + std::to_string(i + 1) + " uses feature index " +
+               std::to_string(node->index) + ", the scaling file has " + std::to_string(features) +
+               " features");
       }
     }
+  }
+  return svm;
+}
+
+}  // namespace
+
+std::string PenetrationPredictor::TravelModelPath(const std::string& path_stem, std::size_t k) {
+  return path_stem + ".travel" + std::to_string(k + 1) + ".model";
+}
+
+PenetrationPredictor PenetrationPredictor::Load(const std::string& path_stem) {
+  FeatureScaling scaling = LoadScaling(path_stem);
+  const int features = static_cast<int>(scaling.names.size());
+  auto model = std::make_unique<Model>();
+  model->svm = LoadSvr(path_stem + ".model", features);
+  for (std::size_t k = 0; k < scaling.travel_times.size(); ++k) {
+    model->travel.push_back(LoadSvr(TravelModelPath(path_stem, k), features));
   }
   return PenetrationPredictor(std::move(model), std::move(scaling));
 }

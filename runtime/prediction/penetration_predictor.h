@@ -19,7 +19,13 @@
 //   delta_l <m>
 //   materials <name> <name> …
 //   feature <name> <min> <max>        (one per feature, in order)
+//   travel_times <t1> <t2> …          (optional: the travel curve below) [s]
 //   note <free text>                  (any number: the training command, figures)
+//
+// The optional travel curve: one more ε-SVR per time t_k on the same scaled features,
+// `<name>.travel<k>.model` (k = 1, 2, …), predicting how far the machine has travelled t_k
+// after the trigger (train_predictor --travel-curve). V2 then follows those knots instead of a
+// constant deceleration over d (volume_estimation.h, ScoopPlan::travel_at).
 #pragma once
 
 #include <Eigen/Core>
@@ -57,6 +63,8 @@ struct FeatureScaling {
   std::vector<std::string> names;      ///< feature names, in vector order
   std::vector<double> min, max;        ///< per feature
   std::vector<std::string> notes;
+  /// Times after the trigger of the travel curve's models [s] (empty: no curve).
+  std::vector<double> travel_times;
 
   /// The names of the features for `materials`: speed, shoveled_volume, material_<m>…, h1..h6.
   static std::vector<std::string> FeatureNames(const std::vector<std::string>& materials);
@@ -66,13 +74,18 @@ struct FeatureScaling {
 /// is something a controller must handle, not a bug).
 struct PenetrationPrediction {
   bool ok = false;
-  double penetration = 0;  ///< [m], ≥ 0
-  std::string message;     ///< why not, when !ok
+  double penetration = 0;      ///< [m], ≥ 0
+  std::vector<double> travel;  ///< [m] at FeatureScaling::travel_times (empty: no curve)
+  std::string message;         ///< why not, when !ok
 };
 
 class PenetrationPredictor {
  public:
-  /// Loads `<path_stem>.model` and `<path_stem>.scale`. Throws core::InputError naming the file,
+  /// The travel curve's model file for knot k (0-based): `<path_stem>.travel<k+1>.model`.
+  static std::string TravelModelPath(const std::string& path_stem, std::size_t k);
+
+  /// Loads `<path_stem>.model`, `<path_stem>.scale` and the travel curve's models if the scaling
+  /// names travel times. Throws core::InputError naming the file,
   /// the line where known and what is wrong (missing file, not a libsvm ε-SVR RBF model, feature
   /// count mismatch, malformed scaling).
   static PenetrationPredictor Load(const std::string& path_stem);

@@ -118,6 +118,20 @@ std::string ScoopPlan::Invalid() const {
       return bad(r, ("bucket_rate_along_curl[" + std::to_string(i) + "]").c_str(), "rad/s");
     }
   }
+  if (travel_times.size() != travel_at.size()) {
+    return "travel_times and travel_at differ in length (" + std::to_string(travel_times.size()) +
+           " and " + std::to_string(travel_at.size()) + ")";
+  }
+  for (std::size_t i = 0; i < travel_times.size(); ++i) {
+    const double before = i == 0 ? 0.0 : travel_times[i - 1];
+    if (!std::isfinite(travel_times[i]) || !(travel_times[i] > before)) {
+      return "travel_times must be finite, > 0 and increasing, got " +
+             std::to_string(travel_times[i]) + " at " + std::to_string(i);
+    }
+    if (!std::isfinite(travel_at[i])) {
+      return "travel_at[" + std::to_string(i) + "] is not finite";
+    }
+  }
   if (!(time_step > 0) || !std::isfinite(time_step)) {
     return "time_step must be > 0 s, got " + std::to_string(time_step);
   }
@@ -233,15 +247,33 @@ FutureVolume PredictFutureVolume(const model::MachineDescription& machine, const
   const double t_lifted =
       std::min(t_curled + (plan.boom_rate > 0 ? plan.boom_lift / plan.boom_rate : plan.horizon),
                plan.horizon);
-  // Travel: constant deceleration from v to rest over d. A machine that is (nearly) at rest yet
-  // predicted to move covers d at the slowest pace we consider (0.1 m/s). The scoop cycle keeps
-  // pushing while it curls (ScoopCycleOptions::scoop_deceleration); d, learnt in that regime,
-  // carries it, and the shape within d matters less than its end (docs/scooping_control.md).
+  // Travel: through the predicted knots when the plan has them, else a constant deceleration
+  // from v to rest over d. A machine that is (nearly) at rest yet predicted to move covers d at
+  // the slowest pace we consider (0.1 m/s).
   const double v_start = std::max(v, 0.1);
-  const double t_stop = d > 0 ? 2 * d / v_start : 0.0;
+  std::vector<double> knot_t = {0.0}, knot_s = {0.0};
+  for (std::size_t i = 0; i < plan.travel_times.size(); ++i) {
+    knot_t.push_back(plan.travel_times[i]);
+    knot_s.push_back(std::clamp(plan.travel_at[i], knot_s.back(), std::max(d, knot_s.back())));
+  }
+  // From the last knot (t = 0 without knots): constant deceleration over what is left of d.
+  const double t_last = knot_t.back(), s_last = knot_s.back();
+  const double v_last =
+      knot_t.size() < 2
+          ? v_start
+          : std::max((s_last - knot_s[knot_s.size() - 2]) / (t_last - knot_t[knot_t.size() - 2]),
+                     0.1);
+  const double rest = std::max(d - s_last, 0.0);
+  const double t_stop = t_last + (rest > 0 ? 2 * rest / v_last : 0.0);
   auto travel = [&](double t) {
-    if (t >= t_stop) return d;
-    return v_start * t - v_start * v_start * t * t / (4 * d);
+    if (t >= t_stop) return s_last + rest;
+    if (t >= t_last) {
+      const double u = t - t_last;
+      return s_last + v_last * u - v_last * v_last * u * u / (4 * rest);
+    }
+    const std::size_t i = static_cast<std::size_t>(
+        std::upper_bound(knot_t.begin(), knot_t.end(), t) - knot_t.begin() - 1);
+    return knot_s[i] + (t - knot_t[i]) / (knot_t[i + 1] - knot_t[i]) * (knot_s[i + 1] - knot_s[i]);
   };
   const double t_end = std::min(std::max(t_stop, t_lifted), plan.horizon);
   const Eigen::Vector2d forward(std::cos(at_trigger.heading), std::sin(at_trigger.heading));

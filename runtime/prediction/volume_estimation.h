@@ -19,8 +19,15 @@
 //   V22 — "Control": then the bucket curls at the rate its valve's rated flow gives through the
 //         cylinder's lever arm (generated kinematics), and once curled the boom lifts; the machine
 //         keeps moving until it has covered d.
-// The machine's travel is modelled as a constant deceleration from the current speed v to rest
-// over d: s(t) = v·t − v²·t²/(4d) for t ≤ 2d/v. The teeth follow Eq. (2) (planar two-link arm
+// The machine's travel within d is by default a constant deceleration from the current speed v
+// to rest over d: s(t) = v·t − v²·t²/(4d) for t ≤ 2d/v. A model that also predicts the travel
+// at fixed times after the trigger (ScoopPlan::travel_at, penetration_predictor.h) replaces that
+// shape: s(t) runs piecewise linear through (0, 0) and the predicted (t_k, s_k), then from the
+// last knot at a constant deceleration from the last segment's speed to rest at d. Under a scoop
+// that keeps pushing while it curls, how fast the machine loses speed depends on the pile: on a
+// tall gravel cone it is 0.17 m behind the constant deceleration 2 s after the trigger, which
+// puts the curling bucket where it never cuts (docs/scooping_control.md). The teeth follow
+// Eq. (2) (planar two-link arm
 // in the front frame) on that path; V21 and V22 are Eq. (19) over the past path extended by the
 // two parts in turn, less what was already counted, so no cell is counted twice.
 #pragma once
@@ -82,6 +89,11 @@ struct ScoopPlan {
   /// 0.82 rad in 2.63 s, this table predicts 2.70 s, the rate at the trigger alone 3.15 s
   /// (tests/prediction, PlanCurl). Empty: `bucket_rate` throughout.
   std::vector<double> bucket_rate_along_curl;
+  /// Predicted travel [m] at `travel_times` [s after the trigger, increasing, > 0]. Both empty:
+  /// the constant deceleration over d. A knot beyond d counts as d and one behind the knot
+  /// before it as that one (a regression per knot need not be monotone).
+  std::vector<double> travel_times;
+  std::vector<double> travel_at;
   double time_step = 0.02;  ///< of the predicted path [s]
   double horizon = 8.0;     ///< the prediction stops here whatever happens [s]
 

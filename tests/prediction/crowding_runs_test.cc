@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -69,6 +70,30 @@ TEST(CrowdingRuns, DugFaceIsTheFreshPileCutBackToRepose) {
     }
   }
   EXPECT_LE(steepest, max_step);
+}
+
+// A run under the pushing scoop records its travel after the trigger: from 0, every
+// travel_sample_period, up to the penetration it reports (the largest travel), starting at the
+// speed the features saw.
+TEST(CrowdingRuns, RecordTheTravelAfterTheTrigger) {
+  const model::MachineDescription machine =
+      model::LoadMachineDescription(model::ResolveMachineDescription(
+          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+  ASSERT_NE(functions, nullptr);
+  CrowdingRunOptions options;
+  options.scoop_deceleration = 0.3;
+  options.min_speed = options.max_speed = 1.0;
+  const CrowdingRun run =
+      RunCrowding(machine, *functions, options, DrawSpec(machine, options, 1, 0));
+  ASSERT_TRUE(run.ok) << run.failure;
+  const std::vector<double>& s = run.travel_after_trigger;
+  ASSERT_GE(s.size(), 10u);
+  EXPECT_NEAR(s.front(), 0.0, 1e-12);
+  // Sampled every 50 ms: the largest sample misses the stop by what the machine creeps in one.
+  EXPECT_NEAR(*std::max_element(s.begin(), s.end()), run.penetration, 1e-3);
+  // The machine at the trigger moves at the speed the features report.
+  EXPECT_NEAR((s[1] - s[0]) / options.travel_sample_period, run.features.speed, 0.1);
 }
 
 }  // namespace

@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "generated/registry.h"
 #include "identification/predictor/crowding_runs.h"
@@ -118,6 +120,61 @@ TEST(PenetrationPredictor, BadModelFilesGiveClearErrors) {
   std::filesystem::remove(stem + ".model");
 }
 
+// The optional travel curve: its times survive a save and load, a bad line names itself, and a
+// scaling that names travel times needs their model files.
+TEST(PenetrationPredictor, TravelCurveRoundTripsAndBadOnesNameTheirLineOrFile) {
+  const std::string stem = TempStem("travel");
+  FeatureScaling scaling = PenetrationPredictor::LoadScaling(kShipped);
+  EXPECT_TRUE(scaling.travel_times.empty());  // the braking scoop's model has none
+  scaling.travel_times = {0.5, 1.0, 1.5};
+  PenetrationPredictor::SaveScaling(stem, scaling);
+  const FeatureScaling back = PenetrationPredictor::LoadScaling(stem);
+  EXPECT_EQ(back.travel_times, scaling.travel_times);
+  EXPECT_EQ(back.names, scaling.names);
+
+  // The d model stands in for every knot: the curve then predicts d at each time.
+  std::filesystem::copy_file(kShipped + ".model", stem + ".model",
+                             std::filesystem::copy_options::overwrite_existing);
+  for (std::size_t k = 0; k < 3; ++k) {
+    std::filesystem::copy_file(kShipped + ".model", PenetrationPredictor::TravelModelPath(stem, k),
+                               std::filesystem::copy_options::overwrite_existing);
+  }
+  const PenetrationPrediction p = PenetrationPredictor::Load(stem).Predict(SomeFeatures());
+  ASSERT_TRUE(p.ok) << p.message;
+  ASSERT_EQ(p.travel.size(), 3u);
+  for (double s : p.travel) EXPECT_DOUBLE_EQ(s, p.penetration);
+
+  std::filesystem::remove(PenetrationPredictor::TravelModelPath(stem, 2));
+  std::string error = LoadError(stem);
+  EXPECT_NE(error.find(stem + ".travel3.model"), std::string::npos) << error;
+  EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
+
+  std::ifstream in(stem + ".scale");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find("travel_times ");
+  ASSERT_NE(at, std::string::npos);
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+  const std::size_t end = text.find('\n', at);
+  for (const char* bad : {"travel_times 0.5 0.4", "travel_times 0 1", "travel_times",
+                          "travel_times 0.5 nan", "travel_times 0.5 x"}) {
+    Write(stem + ".scale", text.substr(0, at) + bad + text.substr(end));
+    error.clear();
+    try {
+      PenetrationPredictor::LoadScaling(stem);
+    } catch (const core::InputError& e) {
+      error = e.what();
+    }
+    EXPECT_NE(error.find(stem + ".scale:" + std::to_string(line) + ":"), std::string::npos)
+        << bad << ": " << error;
+    EXPECT_NE(error.find("travel_times"), std::string::npos) << error;
+  }
+  std::filesystem::remove(stem + ".scale");
+  std::filesystem::remove(stem + ".model");
+  for (std::size_t k = 0; k < 2; ++k) {
+    std::filesystem::remove(PenetrationPredictor::TravelModelPath(stem, k));
+  }
+}
+
 // Plant runs of seed 2024 (the models were trained on seed 1) scored with the model `stem`:
 // `dug_face_fraction` of them on a face an earlier scoop left (crowding_runs.h), in the regime
 // `options` (default: the shipped model's).
@@ -191,6 +248,10 @@ TEST(PenetrationPredictor, PushingScoopModelFallsInTheErrorBuckets) {
   EXPECT_GE(e.within_015, 0.97);
   EXPECT_GE(e.within_020, 0.99);
   EXPECT_LE(e.mse, 0.004);
+  // Its travel curve: six knots, 0.5–3 s after the trigger, as close as d itself.
+  EXPECT_EQ(e.travel_knots, 6);
+  EXPECT_GE(e.travel_within_010, 0.95);
+  EXPECT_LE(e.travel_mse, 0.002);
 }
 
 }  // namespace

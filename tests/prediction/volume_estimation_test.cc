@@ -130,6 +130,75 @@ TEST(FutureVolume, CurlingTheBucketTakesLessThanHoldingItAndDelayFromTheDescript
   EXPECT_NE(bad.Invalid(), "");
 }
 
+// The predicted travel curve (ScoopPlan::travel_at): knots on the constant deceleration give
+// its path to the chord error; knots that lag (the machine slows early) put the teeth behind it
+// at every knot, and from the last knot the machine brakes to rest at d.
+TEST(FutureVolume, TravelCurveShapesThePathWithinTheSamePenetration) {
+  const model::MachineDescription machine = Loader();
+  const std::vector<double> q = plant::BucketOnFloor(machine);
+  const HeightGrid grid = BoxGrid(0.0, 4.9, 1.05);
+  MachineAtTrigger m;
+  m.hinge_xy = Eigen::Vector2d(0.5 - TipInBase(machine, q[0], q[1]).x(), 0.0);
+  m.speed = 1.0;
+  m.q = q;
+  ScoopPlan plan;  // the arm held: the path is the travel alone
+  plan.delay = 0.6;
+  const double d = 2.0;
+  const FutureVolume constant = PredictFutureVolume(machine, grid, {}, m, d, plan);
+  auto travel_at = [&](const FutureVolume& v, double t) {
+    return v.path[static_cast<std::size_t>(std::lround(t / plan.time_step))].x() - v.path[0].x();
+  };
+
+  ScoopPlan sampled = plan;
+  for (int k = 1; k <= 16; ++k) {
+    const double t = 0.25 * k;  // s = t − t²/8 up to t = 4 s, where it reaches d = 2 m
+    sampled.travel_times.push_back(t);
+    sampled.travel_at.push_back(t - t * t / 8);
+  }
+  ASSERT_EQ(sampled.Invalid(), "");
+  const FutureVolume same = PredictFutureVolume(machine, grid, {}, m, d, sampled);
+  for (double t = 0; t <= 4.0; t += 0.1) {
+    // Chords of a parabola 0.25 s apart: at most Δt²/8·|s''| = 0.0625/8·0.25 ≈ 2e-3 m off.
+    EXPECT_NEAR(travel_at(same, t), travel_at(constant, t), 2.5e-3) << "t " << t;
+  }
+  EXPECT_NEAR(same.total(), constant.total(), 0.02);
+
+  ScoopPlan lagging = plan;
+  lagging.travel_times = {0.5, 1.0, 1.5, 2.0};
+  lagging.travel_at = {0.45, 0.80, 1.07, 1.32};  // the tall gravel cone's crowding run
+  const FutureVolume behind = PredictFutureVolume(machine, grid, {}, m, d, lagging);
+  for (std::size_t k = 0; k < lagging.travel_times.size(); ++k) {
+    EXPECT_NEAR(travel_at(behind, lagging.travel_times[k]), lagging.travel_at[k], 1e-9);
+    if (k == 0) continue;  // from 1 s on the cone's machine is 0.07–0.18 m behind
+    EXPECT_LT(travel_at(behind, lagging.travel_times[k]),
+              travel_at(constant, lagging.travel_times[k]) - 0.05);
+  }
+  // From 2 s at the last chord's 0.5 m/s, braking to rest over the 0.68 m left: 2.72 s more.
+  EXPECT_NEAR(travel_at(behind, 3.0), 1.32 + 0.5 - 0.25 / (4 * 0.68), 1e-6);
+  EXPECT_NEAR(behind.path.back().x() - behind.path[0].x(), d, 1e-9);
+  EXPECT_NEAR(behind.total(), constant.total(), 0.1 * 1.0 * machine.bucket.width);
+
+  // A knot past d counts as d; one behind its predecessor as the predecessor.
+  ScoopPlan odd = plan;
+  odd.travel_times = {0.5, 1.0, 1.5};
+  odd.travel_at = {0.6, 0.5, 2.4};
+  const FutureVolume clamped = PredictFutureVolume(machine, grid, {}, m, d, odd);
+  EXPECT_NEAR(travel_at(clamped, 1.0), 0.6, 1e-9);
+  EXPECT_NEAR(travel_at(clamped, 1.5), d, 1e-9);
+  EXPECT_NEAR(clamped.path.back().x() - clamped.path[0].x(), d, 1e-9);
+
+  ScoopPlan bad = lagging;
+  bad.travel_times[2] = bad.travel_times[1];  // not increasing
+  EXPECT_NE(bad.Invalid(), "");
+  bad = lagging;
+  bad.travel_at.pop_back();
+  EXPECT_NE(bad.Invalid(), "");
+  bad = lagging;
+  bad.travel_at[1] = std::nan("");
+  EXPECT_NE(bad.Invalid(), "");
+  EXPECT_THROW(PredictFutureVolume(machine, grid, {}, m, d, bad), std::invalid_argument);
+}
+
 // The curl V2 assumes against the plant's: the tilt valve fully open from the attack pose (the
 // bucket just off the floor, empty), until the bucket joint has racked back as far as the scoop
 // cycle curls it. The rate along the stroke follows the lever arm; the rate at the trigger alone

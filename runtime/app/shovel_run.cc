@@ -1196,6 +1196,11 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     say("skipped " + site.name + ": " + out.failure);
     return out;
   }
+  if (scoop && !r.payload_at_actions.empty()) {
+    std::string volumes;
+    for (double v : r.payload_at_actions) volumes += (volumes.empty() ? "" : ", ") + Fixed(v, 2);
+    say("bucket volume before the first atomic action and after each: " + volumes + " m^3");
+  }
   say(std::string(rec.completed ? "done" : "NOT completed: " + out.failure) + " — " + site.name +
       ", " + rec.material + ", " + rec.strategy + " (" + rec.atomic_actions + "), fill " +
       Fixed(100 * rec.fill_rate, 1) + " %, trigger " + Fixed(r.trigger_after_contact, 2) +

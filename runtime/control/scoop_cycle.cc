@@ -331,6 +331,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         if (paused || s.time - rt.action_start > options_.action_timeout) rt.action.reset();
       }
       if (!rt.action) {
+        rt.result.payload_at_actions.push_back(machine.PayloadVolume());
         rt.action = rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
         if (rt.action) {
           rt.result.action_names.emplace_back(ToString(rt.action->kind));

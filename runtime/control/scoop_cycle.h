@@ -151,6 +151,10 @@ struct ScoopResult {
   double feedback_volume = 0;                   ///< V1 at the end of the scoop phase [m³]
   int atomic_actions = 0;
   std::vector<std::string> action_names;  ///< the atomic actions in order (atomic_actions.h)
+  /// Bucket volume (ScoopMachine::PayloadVolume) each time the sequencer was asked for the next
+  /// atomic action: before the first, then as each one ended (actions + 1 entries) [m³]. Shows
+  /// which action took material in and which let it go.
+  std::vector<double> payload_at_actions;
   int stairway_steps = 0;
   double boom_pressure_at_contact = 0;  ///< [Pa]
   double boom_pressure_at_trigger = 0;  ///< [Pa]

@@ -106,6 +106,13 @@ void ExpectSound(const Outcome& out) {
   }
   EXPECT_GT(r.trigger_after_contact, 0);
   EXPECT_GT(r.arm_motion_after_trigger, 0);
+  // The bucket volume before each atomic action and after the last: the last is the scoop's.
+  ASSERT_EQ(r.payload_at_actions.size(), static_cast<std::size_t>(r.atomic_actions) + 1);
+  EXPECT_DOUBLE_EQ(r.payload_at_actions.back(), r.payload_after_scoop);
+  for (double v : r.payload_at_actions) {
+    EXPECT_GE(v, 0.0);
+    EXPECT_LE(v, 1.01 * r.target_volume);  // V_t: the rated heaped capacity (target fill 1)
+  }
 }
 
 // Algorithm 3 on gravel: the predicted volume fires before the machine stalls and "Just in &

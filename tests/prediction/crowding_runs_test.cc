@@ -96,5 +96,36 @@ TEST(CrowdingRuns, RecordTheTravelAfterTheTrigger) {
   EXPECT_NEAR((s[1] - s[0]) / options.travel_sample_period, run.features.speed, 0.1);
 }
 
+// Why V2 needs a travel curve per pile (docs/scooping_control.md): on a tall gravel cone under
+// the pushing scoop the machine loses speed as the curl loads the lip, and from 1 s on it is
+// well behind a constant deceleration over the same penetration; it still ends at d.
+TEST(CrowdingRuns, TallGravelConeLagsTheConstantDeceleration) {
+  const model::MachineDescription machine =
+      model::LoadMachineDescription(model::ResolveMachineDescription(
+          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
+  ASSERT_NE(functions, nullptr);
+  CrowdingRunOptions options;
+  options.scoop_deceleration = 0.3;
+  CrowdingRunSpec spec;
+  spec.seed = 7;
+  spec.shape = "cone";
+  spec.material = "big_gravel";
+  spec.height = 3.0;
+  spec.approach_speed = 1.0;
+  spec.trigger_volume = 0.1;
+  const CrowdingRun run = RunCrowding(machine, *functions, options, spec);
+  ASSERT_TRUE(run.ok) << run.failure;
+  const double v = run.at_trigger.speed, d = run.penetration;
+  std::printf("tall gravel cone: v %.2f m/s, d %.3f m, travel at 0.5..3 s:", v, d);
+  for (int k = 1; k <= 6; ++k) std::printf(" %.2f", TravelAt(run, 0.5 * k));
+  std::printf("\n");
+  for (double t : {1.0, 1.5, 2.0, 2.5}) {
+    const double constant = v * t - v * v * t * t / (4 * d);
+    EXPECT_LT(TravelAt(run, t), constant - 0.05) << "t " << t;
+  }
+  EXPECT_NEAR(TravelAt(run, 10.0), d, 1e-3);
+}
+
 }  // namespace
 }  // namespace autoshovel::predictor

@@ -62,6 +62,36 @@ double Predict(const svm_model* model, const std::vector<double>& x) {
   return std::max(svm_predict(model, row.data()), 0.0);
 }
 
+// The rows scaled to [−1, 1] with the scaling's per-feature min and max (as Predict does).
+std::vector<std::vector<double>> ScaleRows(const std::vector<std::vector<double>>& x,
+                                           const prediction::FeatureScaling& scaling) {
+  std::vector<std::vector<double>> scaled = x;
+  for (auto& row : scaled) {
+    if (row.size() != scaling.min.size())
+      throw std::invalid_argument("SVR training: ragged samples");
+    for (std::size_t j = 0; j < row.size(); ++j) {
+      const double span = scaling.max[j] - scaling.min[j];
+      row[j] = span > 0 ? 2 * (row[j] - scaling.min[j]) / span - 1 : 0.0;
+    }
+  }
+  return scaled;
+}
+
+// Fits one ε-SVR on every scaled row and saves it to `model_path`; returns its support vectors.
+int FitAndSave(const std::vector<std::vector<double>>& scaled, const std::vector<double>& y,
+               double c, double gamma, double epsilon, const std::string& model_path) {
+  std::vector<int> all(scaled.size());
+  for (std::size_t i = 0; i < scaled.size(); ++i) all[i] = static_cast<int>(i);
+  Problem problem(scaled, y, all);
+  const svm_parameter p = Parameters(c, gamma, epsilon);
+  svm_model* model = svm_train(&problem.problem, &p);
+  const int support_vectors = model->l;
+  const int saved = svm_save_model(model_path.c_str(), model);
+  svm_free_and_destroy_model(&model);
+  if (saved != 0) throw std::runtime_error("cannot write " + model_path);
+  return support_vectors;
+}
+
 }  // namespace
 
 SvrTrainingResult TrainPenetrationSvr(const SvrDataset& train, const SvrGrid& grid, int threads,
@@ -90,13 +120,7 @@ SvrTrainingResult TrainPenetrationSvr(const SvrDataset& train, const SvrGrid& gr
       scaling.max[j] = std::max(scaling.max[j], row[j]);
     }
   }
-  std::vector<std::vector<double>> scaled = train.x;
-  for (auto& row : scaled) {
-    for (std::size_t j = 0; j < dim; ++j) {
-      const double span = scaling.max[j] - scaling.min[j];
-      row[j] = span > 0 ? 2 * (row[j] - scaling.min[j]) / span - 1 : 0.0;
-    }
-  }
+  const std::vector<std::vector<double>> scaled = ScaleRows(train.x, scaling);
   svm_set_print_string_function(&Quiet);
 
   struct Setting {
@@ -136,50 +160,25 @@ SvrTrainingResult TrainPenetrationSvr(const SvrDataset& train, const SvrGrid& gr
   const Setting best =
       *std::min_element(settings.begin(), settings.end(),
                         [](const Setting& a, const Setting& b) { return a.mse < b.mse; });
-  std::vector<int> all(n);
-  for (std::size_t i = 0; i < n; ++i) all[i] = static_cast<int>(i);
-  Problem problem(scaled, train.y, all);
-  const svm_parameter p = Parameters(best.c, best.gamma, best.epsilon);
-  svm_model* model = svm_train(&problem.problem, &p);
   SvrTrainingResult result;
   result.c = best.c, result.gamma = best.gamma, result.epsilon = best.epsilon;
   result.cv_mse = best.mse;
-  result.support_vectors = model->l;
   result.settings_tried = static_cast<int>(settings.size());
-  const std::string model_path = path_stem + ".model";
-  const int saved = svm_save_model(model_path.c_str(), model);
-  svm_free_and_destroy_model(&model);
-  if (saved != 0) throw std::runtime_error("cannot write " + model_path);
+  result.support_vectors =
+      FitAndSave(scaled, train.y, best.c, best.gamma, best.epsilon, path_stem + ".model");
   prediction::PenetrationPredictor::SaveScaling(path_stem, scaling);
   return result;
 }
 
 int FitSvr(const SvrDataset& train, const prediction::FeatureScaling& scaling, double c,
            double gamma, double epsilon, const std::string& model_path) {
-  const std::size_t n = train.x.size();
-  if (n == 0 || train.y.size() != n) {
-    throw std::invalid_argument("FitSvr: need samples with targets, got " + std::to_string(n) +
-                                " and " + std::to_string(train.y.size()));
-  }
-  std::vector<std::vector<double>> scaled = train.x;
-  for (auto& row : scaled) {
-    if (row.size() != scaling.min.size()) throw std::invalid_argument("FitSvr: ragged samples");
-    for (std::size_t j = 0; j < row.size(); ++j) {
-      const double span = scaling.max[j] - scaling.min[j];
-      row[j] = span > 0 ? 2 * (row[j] - scaling.min[j]) / span - 1 : 0.0;
-    }
+  if (train.x.empty() || train.y.size() != train.x.size()) {
+    throw std::invalid_argument("FitSvr: need samples with targets, got " +
+                                std::to_string(train.x.size()) + " and " +
+                                std::to_string(train.y.size()));
   }
   svm_set_print_string_function(&Quiet);
-  std::vector<int> all(n);
-  for (std::size_t i = 0; i < n; ++i) all[i] = static_cast<int>(i);
-  Problem problem(scaled, train.y, all);
-  const svm_parameter p = Parameters(c, gamma, epsilon);
-  svm_model* model = svm_train(&problem.problem, &p);
-  const int support_vectors = model->l;
-  const int saved = svm_save_model(model_path.c_str(), model);
-  svm_free_and_destroy_model(&model);
-  if (saved != 0) throw std::runtime_error("cannot write " + model_path);
-  return support_vectors;
+  return FitAndSave(ScaleRows(train.x, scaling), train.y, c, gamma, epsilon, model_path);
 }
 
 }  // namespace autoshovel::predictor

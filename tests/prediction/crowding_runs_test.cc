@@ -14,10 +14,21 @@
 namespace autoshovel::predictor {
 namespace {
 
+model::MachineDescription Loader() {
+  return model::LoadMachineDescription(model::ResolveMachineDescription(
+      "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+}
+
+// The pushing scoop's regime (crowding_runs.h), as penetration_svr_push was trained.
+CrowdingRunOptions PushingScoop() {
+  CrowdingRunOptions options;
+  options.scoop_deceleration = 0.3;
+  options.min_speed = options.max_speed = 1.0;
+  return options;
+}
+
 TEST(CrowdingRuns, DugFaceIsTheFreshPileCutBackToRepose) {
-  const model::MachineDescription machine =
-      model::LoadMachineDescription(model::ResolveMachineDescription(
-          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const model::MachineDescription machine = Loader();
   const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
   ASSERT_NE(functions, nullptr);
   CrowdingRunOptions fresh_options, dug_options;
@@ -76,14 +87,10 @@ TEST(CrowdingRuns, DugFaceIsTheFreshPileCutBackToRepose) {
 // travel_sample_period, up to the penetration it reports (the largest travel), starting at the
 // speed the features saw.
 TEST(CrowdingRuns, RecordTheTravelAfterTheTrigger) {
-  const model::MachineDescription machine =
-      model::LoadMachineDescription(model::ResolveMachineDescription(
-          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const model::MachineDescription machine = Loader();
   const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
   ASSERT_NE(functions, nullptr);
-  CrowdingRunOptions options;
-  options.scoop_deceleration = 0.3;
-  options.min_speed = options.max_speed = 1.0;
+  const CrowdingRunOptions options = PushingScoop();
   const CrowdingRun run =
       RunCrowding(machine, *functions, options, DrawSpec(machine, options, 1, 0));
   ASSERT_TRUE(run.ok) << run.failure;
@@ -100,13 +107,10 @@ TEST(CrowdingRuns, RecordTheTravelAfterTheTrigger) {
 // the pushing scoop the machine loses speed as the curl loads the lip, and from 1 s on it is
 // well behind a constant deceleration over the same penetration; it still ends at d.
 TEST(CrowdingRuns, TallGravelConeLagsTheConstantDeceleration) {
-  const model::MachineDescription machine =
-      model::LoadMachineDescription(model::ResolveMachineDescription(
-          "xcmg_968ev", std::string(AUTOSHOVEL_SOURCE_DIR) + "/models"));
+  const model::MachineDescription machine = Loader();
   const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
   ASSERT_NE(functions, nullptr);
-  CrowdingRunOptions options;
-  options.scoop_deceleration = 0.3;
+  const CrowdingRunOptions options = PushingScoop();
   CrowdingRunSpec spec;
   spec.seed = 7;
   spec.shape = "cone";

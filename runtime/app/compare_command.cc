@@ -72,6 +72,7 @@ ShovelRunOptions Base(const CompareOptions& o) {
   r.truth_labels = !o.network;
   r.pressure_threshold = o.pressure_threshold;
   r.scoop_deceleration = o.scoop_deceleration;
+  r.attitude_feed_forward = o.attitude_feed_forward;
   r.predictor = o.predictor;
   return r;
 }
@@ -133,7 +134,8 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
   };
   out << "Table 5: trigger and scooping strategy (" << o.trials
       << " trials per material; pressure threshold " << o.pressure_threshold / 1e5
-      << " bar; scoop deceleration " << o.scoop_deceleration << " m/s^2; predictor "
+      << " bar; scoop deceleration " << o.scoop_deceleration << " m/s^2; exit-lift "
+      << (o.attitude_feed_forward ? "feed-forward" : "PID only") << "; predictor "
       << (o.predictor.empty() ? std::string("shipped") : o.predictor)
       << "). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
          "the third column as printed).\n\n";

@@ -27,6 +27,7 @@ struct CompareOptions {
   bool network = false;
   double pressure_threshold = 150e5;  ///< [Pa]
   double scoop_deceleration = 1.0;    ///< ShovelRunOptions::scoop_deceleration [m/s²]
+  bool attitude_feed_forward = true;  ///< ShovelRunOptions::attitude_feed_forward
   std::string predictor;              ///< SVR model prefix; empty: the shipped one
 };
 

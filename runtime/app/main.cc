@@ -384,6 +384,10 @@ int main(int argc, char** argv) {
                    "predictor must be trained for it: docs/scooping_control.md)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  bool run_no_feed_forward = false;
+  run_cmd->add_flag("--no-attitude-feed-forward", run_no_feed_forward,
+                    "Hold the bucket's attitude in the exit lift by its PID alone (no tilt "
+                    "feed-forward from the boom's demand: docs/scooping_control.md)");
   run_cmd->add_option("--stairway-steps", run.stairway_steps, "N of Stairway #N")
       ->capture_default_str();
   run_cmd->add_option("--selection", run_selection, "ours | chen2024")
@@ -440,6 +444,9 @@ int main(int argc, char** argv) {
                    "Fall of the speed reference once the scoop moves the arm [m/s^2]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  bool compare_no_feed_forward = false;
+  compare_cmd->add_flag("--no-attitude-feed-forward", compare_no_feed_forward,
+                        "Hold the bucket's attitude in the exit lift by its PID alone");
   compare_cmd->add_option("--predictor", compare.predictor,
                           "Penetration SVR (path without .model; default: the shipped one)");
   compare_cmd
@@ -452,6 +459,7 @@ int main(int argc, char** argv) {
   if (*compare_cmd) {
     compare.models_dir = models_dir;
     compare.pressure_threshold = compare_pressure_bar * 1e5;
+    compare.attitude_feed_forward = !compare_no_feed_forward;
     return autoshovel::app::RunCompare(compare, std::cout, std::cerr);
   }
 
@@ -482,6 +490,7 @@ int main(int argc, char** argv) {
     }
     run.models_dir = models_dir;
     run.figures = !run_no_figures;
+    run.attitude_feed_forward = !run_no_feed_forward;
     run.pressure_threshold = run_pressure_bar * 1e5;
     using autoshovel::control::ScoopPolicy;
     run.policy = run_policy == "auto"          ? ScoopPolicy::kAutoSelection

@@ -294,6 +294,7 @@ std::string ShovelJob::ConfigYaml() const {
     << "pressure_threshold_bar: " << o.pressure_threshold / 1e5 << "\n"
     << "stairway_steps: " << o.stairway_steps << "\n"
     << "scoop_deceleration_mps2: " << o.scoop_deceleration << "\n"
+    << "attitude_feed_forward: " << (o.attitude_feed_forward ? "true" : "false") << "\n"
     << "approach_distance_m: " << o.approach_distance << "\n"
     << "safety_distance_m: " << o.safety_distance << "\n"
     << "d_res_m: " << o.d_res << "\n"
@@ -372,6 +373,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   scoop_options.policy = o.policy;
   scoop_options.strategy.fixed_steps = o.stairway_steps;
   scoop_options.scoop_deceleration = o.scoop_deceleration;
+  scoop_options.attitude_feed_forward = o.attitude_feed_forward;
   out.target_volume = scoop_options.target_fill * machine.bucket.rated_capacity;
 
   perception::PerceptionFromPlantOptions perceive;

@@ -51,6 +51,9 @@ struct ShovelRunOptions {
   /// Fall of the drive's speed reference once the scoop moves the arm [m/s²]
   /// (control::ScoopCycleOptions::scoop_deceleration). The predictor must be trained for it.
   double scoop_deceleration = 1.0;
+  /// control::ScoopCycleOptions::attitude_feed_forward: the exit lift opens the tilt valve as
+  /// the boom's demand will move the boom (false: the bucket PID alone, the earlier behaviour).
+  bool attitude_feed_forward = true;
   SelectionMethod selection = SelectionMethod::kOurs;
   double approach_distance = 12.0;  ///< cycle start, out of the bin's open front [m]
   /// The safety rule every cycle is held to and checked against (ground truth, 20 Hz): the

@@ -43,20 +43,20 @@ void JointPid::Reset() {
   last_demand_ = 0;
 }
 
-double JointPid::Update(double target, double q, double qd, double dt) {
+double JointPid::Update(double target, double q, double qd, double dt, double feed_forward) {
   if (!std::isfinite(target) || !std::isfinite(q) || !std::isfinite(qd) || !std::isfinite(dt) ||
-      dt <= 0) {
+      dt <= 0 || !std::isfinite(feed_forward)) {
     ++refused_;
     last_demand_ = 0;
     return 0.0;
   }
   const double error = target - q;
   if (std::abs(error) <= gains_.tolerance) {
-    // Holding: the integral is kept (it carries the load) but no demand is issued.
-    last_demand_ = 0;
-    return 0.0;
+    // Holding: the integral is kept (it carries the load) but no feedback demand is issued.
+    last_demand_ = std::clamp(feed_forward, -gains_.output_limit, gains_.output_limit);
+    return compensate_ ? CompensateDeadZone(last_demand_, dead_zone_) : last_demand_;
   }
-  const double unclamped = gains_.kp * error + integral_ - gains_.kd * qd;
+  const double unclamped = gains_.kp * error + integral_ - gains_.kd * qd + feed_forward;
   const double demand = std::clamp(unclamped, -gains_.output_limit, gains_.output_limit);
   if (demand == unclamped) {  // integrate only when not saturated (no wind-up)
     integral_ = std::clamp(integral_ + gains_.ki * error * dt, -gains_.integral_limit,

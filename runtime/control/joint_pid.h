@@ -40,9 +40,11 @@ class JointPid {
   JointPid(const JointPidGains& gains, double dead_zone, bool compensate = true);
 
   /// One control step of `dt` [s] towards `target` [rad] from the measured position `q` [rad]
-  /// and rate `qd` [rad/s]; returns the valve duty in [−1, 1]. Non-finite inputs give 0 and
-  /// are counted (never a NaN command).
-  double Update(double target, double q, double qd, double dt);
+  /// and rate `qd` [rad/s]; returns the valve duty in [−1, 1]. `feed_forward` [-] is a spool
+  /// opening added to the PID demand before the output limit (a moving target's rate, see
+  /// arm_feed_forward.h); it is issued within the tolerance too, where the PID part is zero.
+  /// Non-finite inputs give 0 and are counted (never a NaN command).
+  double Update(double target, double q, double qd, double dt, double feed_forward = 0);
   void Reset();
 
   /// The PID output before dead-zone compensation at the last step [-].

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <stdexcept>
 
 #include "runtime/control/joint_angle_filter.h"
@@ -22,6 +23,23 @@ bool Finite(const Proprioception& s) {
                            s.q_boom, s.q_bucket,     s.qd_boom,      s.qd_bucket};
   return std::all_of(std::begin(values), std::end(values),
                      [](double v) { return std::isfinite(v); });
+}
+
+// Low-pass estimate of the achieved over the modelled joint rate, updated only while the
+// modelled rate is large enough to tell (time constant 0.1 s: a few sensor samples). In
+// [0, 1.5]: 0 for a joint held fast in the pile, above 1 where the joint runs faster than the
+// valve model says (the loaded boom of the sand-bin cycle rose at ~0.18 rad/s at full opening,
+// the model's 0.16).
+void UpdateResponse(double& response, double measured_rate, double modelled_rate, double dt) {
+  constexpr double kMinRate = 0.02, kTimeConstant = 0.1, kMaxRatio = 1.5;  // [rad/s], [s], [-]
+  if (std::abs(modelled_rate) < kMinRate || !std::isfinite(measured_rate)) return;
+  const double ratio = std::clamp(measured_rate / modelled_rate, 0.0, kMaxRatio);
+  response += std::min(dt / kTimeConstant, 1.0) * (ratio - response);
+}
+
+void RememberOpening(std::deque<double>& openings, double opening, std::size_t keep) {
+  openings.push_back(opening);
+  while (openings.size() > keep) openings.pop_front();
 }
 
 }  // namespace
@@ -126,6 +144,12 @@ struct ScoopCycle::Runtime {
   Eigen::Vector2d trigger_hinge = Eigen::Vector2d::Zero();
   double trigger_heading = 0;
   std::optional<JointPid> boom_pid, bucket_pid;
+  /// Spool openings sent within each valve's delay (transport + spool lag), oldest first.
+  std::deque<double> boom_openings, bucket_openings;
+  /// Achieved over modelled rate of each joint while holding an attitude [-] (1: as modelled).
+  double boom_response = 1, bucket_response = 1;
+  bool exit_hold_reached = false;  ///< the exit lift's bucket has reached the held attitude
+  double exit_error_held = 0, exit_error_overall = 0;  ///< largest |attitude − held| [rad]
   std::optional<JointAngleFilter> boom_filter, bucket_filter;
   std::optional<SpeedPid> speed_pid;
   core::ActuatorCommand command;
@@ -165,12 +189,54 @@ ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
   limits_.bucket_max = machine.links[1].joint_max - options.rack_back_margin;
   const model::Valve& valve = machine.hydraulics.actuators[bucket_valve_].valve;
   bucket_delay_ = valve.transport_delay + valve.spool_time_constant;
+  if (options.attitude_feed_forward) attitude_feed_forward_.emplace(machine, functions);
+  const model::Valve& boom_valve = machine.hydraulics.actuators[boom_valve_].valve;
+  boom_delay_ticks_ = static_cast<std::size_t>(
+      std::lround((boom_valve.transport_delay + boom_valve.spool_time_constant) / options.tick));
+  bucket_delay_ticks_ = static_cast<std::size_t>(std::lround(bucket_delay_ / options.tick));
   // "The bucket's upper edge is leveled" (§6.2).
   level_attitude_ = model::BucketLevelAttitude(machine) + options.finishing.carry_tilt_back;
 }
 
 double ScoopCycle::BucketTargetForAttitude(double attitude, double q_boom) const {
   return std::clamp(attitude - q_boom, machine_.links[1].joint_min, limits_.bucket_max);
+}
+
+void ScoopCycle::HoldAttitudeAhead(const Proprioception& s, Runtime& rt, double& bucket_now,
+                                   double& feed_forward) const {
+  const AttitudeHoldFeedForward& hold = *attitude_feed_forward_;
+  const std::vector<double> q = {s.q_boom, s.q_bucket};
+  // How much of the valve model's rate each joint gets now, from the opening acting now (sent
+  // one valve delay ago): a bucket still in the pile may hold the boom back or stop it, and
+  // neither the prediction nor the feed-forward may count on motion that does not come.
+  const double boom_acting = rt.boom_openings.empty() ? 0.0 : rt.boom_openings.front();
+  const double bucket_acting = rt.bucket_openings.empty() ? 0.0 : rt.bucket_openings.front();
+  const double passive = hold.PassiveBucketPerBoom(q);
+  UpdateResponse(rt.boom_response, s.qd_boom, hold.JointRate(0, boom_acting, q), options_.tick);
+  UpdateResponse(rt.bucket_response, s.qd_bucket - passive * s.qd_boom,
+                 hold.JointRate(1, bucket_acting, q), options_.tick);
+  // Smith predictor over the valves' delay: the PID compares the joints as the openings already
+  // sent will leave them, so it neither fights motion still in the pipe nor keeps pushing for
+  // what it cannot see yet (the rack-back arrives still moving; the lift moves 0.6 s late).
+  double boom_ahead = s.q_boom, bucket_ahead = s.q_bucket;
+  for (double opening : rt.boom_openings) {
+    boom_ahead += rt.boom_response * hold.JointRate(0, opening, q) * options_.tick;
+  }
+  for (double opening : rt.bucket_openings) {
+    bucket_ahead += rt.bucket_response * hold.JointRate(1, opening, q) * options_.tick;
+  }
+  bucket_ahead += passive * (boom_ahead - s.q_boom);
+  const double unclamped = rt.hold_attitude - boom_ahead;
+  rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, boom_ahead);
+  bucket_now = bucket_ahead;
+  // The boom opening sent boom_lag() ago moves the boom when this tilt opening moves the bucket.
+  // Only while the attitude is reachable: at a joint limit the bucket cannot follow.
+  const auto lag_ticks = static_cast<std::size_t>(std::lround(hold.boom_lag() / options_.tick));
+  const double boom_opening = rt.boom_openings.size() > lag_ticks
+                                  ? rt.boom_openings[rt.boom_openings.size() - 1 - lag_ticks]
+                                  : 0.0;
+  feed_forward =
+      rt.targets.bucket == unclamped ? hold.BucketDemand(rt.boom_response * boom_opening, q) : 0.0;
 }
 
 void ScoopCycle::EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s,
@@ -342,11 +408,14 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
           const bool final_part = rt.sequencer->strategy() == ScoopStrategy::kJustInOut ||
                                   rt.sequencer->actions() > 2 * rt.sequencer->steps();
           if (final_part) rt.finishing_drive = true;
-          // The exit lift keeps the racked bucket's attitude: a Z-bar arm tips the bucket back
-          // as the boom rises (q_bucket is relative to the boom), which would pour the heap out
-          // over the back wall; a parallel-lift linkage does this mechanically.
+          // The exit lift holds the bucket's attitude: a Z-bar arm tips the bucket back as the
+          // boom rises (q_bucket is relative to the boom), which would pour the heap out over
+          // the back wall; a parallel-lift linkage does this mechanically. It holds the racked
+          // attitude, but no further back than the carrying one (level_attitude_): a heap is
+          // largest with the opening level (bucket_terrain.cc HoldableVolume), racked past it
+          // the bucket holds no more, and every further tip-back as it leaves the pile pours.
           if (final_part && rt.action->kind == AtomicKind::kLiftBoom) {
-            rt.hold_attitude = s.q_boom + rt.targets.bucket;
+            rt.hold_attitude = std::min(s.q_boom + rt.targets.bucket, level_attitude_);
           }
         } else {
           rt.result.feedback_volume = rt.v1;
@@ -454,6 +523,16 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
   // Everything below (PIDs, the tip path of Eq. (19), V2's start) sees the filtered angles.
   s.q_boom = rt.boom_filter->Update(s.q_boom, s.qd_boom, options_.tick);
   s.q_bucket = rt.bucket_filter->Update(s.q_bucket, s.qd_bucket, options_.tick);
+  if (rt.phase == Phase::kScoop && std::isfinite(rt.hold_attitude)) {
+    // Counted from when the bucket first reaches the held attitude: a rack-back that ended on
+    // the cylinder's end stop starts the lift beyond it, which is not the lift's doing.
+    const double error = std::abs(s.q_boom + s.q_bucket - rt.hold_attitude);
+    if (error <= 2 * options_.bucket_gains.tolerance) rt.exit_hold_reached = true;
+    rt.exit_error_overall = std::max(rt.exit_error_overall, error);
+    if (rt.exit_hold_reached) rt.exit_error_held = std::max(rt.exit_error_held, error);
+    rt.result.exit_lift_attitude_error =
+        rt.exit_hold_reached ? rt.exit_error_held : rt.exit_error_overall;
+  }
   const bool digging =
       rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop;
   if (digging) {
@@ -525,8 +604,16 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
   command.articulation_rate = 0;
   command.valve[boom_valve_] =
       rt.boom_pid->Update(rt.targets.boom, s.q_boom, s.qd_boom, options_.tick);
+  double bucket_feed_forward = 0;
+  double bucket_now = s.q_bucket;  // what the bucket PID compares with its target
   if (std::isfinite(rt.hold_attitude)) {
-    rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, s.q_boom);
+    if (attitude_feed_forward_) {
+      HoldAttitudeAhead(s, rt, bucket_now, bucket_feed_forward);
+    } else {
+      rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, s.q_boom);
+    }
+  } else {
+    rt.boom_response = rt.bucket_response = 1;
   }
   if (rt.phase == Phase::kShake) {
     const double t = s.time - rt.shake_start;
@@ -535,8 +622,16 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
                                        ? (pulse % 2 == 0 ? 1 : -1) * options_.finishing.shake_duty
                                        : 0.0;
   } else {
-    command.valve[bucket_valve_] =
-        rt.bucket_pid->Update(rt.targets.bucket, s.q_bucket, s.qd_bucket, options_.tick);
+    command.valve[bucket_valve_] = rt.bucket_pid->Update(rt.targets.bucket, bucket_now, s.qd_bucket,
+                                                         options_.tick, bucket_feed_forward);
+  }
+  if (attitude_feed_forward_) {
+    // The openings in flight: sent within each valve's delay, not yet moving the joint.
+    const AttitudeHoldFeedForward& hold = *attitude_feed_forward_;
+    RememberOpening(rt.boom_openings, hold.OpeningOfDuty(0, command.valve[boom_valve_]),
+                    boom_delay_ticks_);
+    RememberOpening(rt.bucket_openings, hold.OpeningOfDuty(1, command.valve[bucket_valve_]),
+                    bucket_delay_ticks_);
   }
   // NaN never reaches the machine: a non-finite field is replaced by a safe value and counted.
   bool blocked = false;

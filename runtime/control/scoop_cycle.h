@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "generated/machine_functions.h"
+#include "runtime/control/arm_feed_forward.h"
 #include "runtime/control/atomic_actions.h"
 #include "runtime/control/joint_pid.h"
 #include "runtime/control/scoop_triggers.h"
@@ -100,6 +101,10 @@ struct ScoopCycleOptions {
   double contact_volume = 0.005;        ///< V1 above which the bucket is in the pile [m³]
   double rack_back_margin = 0.1;        ///< racked target below the bucket joint limit [rad]
   double boom_margin = 0.05;            ///< highest boom target below its limit [rad]
+  /// While the bucket holds an attitude (exit lift, levelling, carrying), also open the tilt
+  /// valve as the boom valve's demand will move the boom (arm_feed_forward.h); false leaves the
+  /// attitude to the bucket PID alone, which lags the boom by the valves' delay.
+  bool attitude_feed_forward = true;
   double arm_motion = 0.02;     ///< joint travel that shows the scoop has begun moving [rad]
   double action_timeout = 4.0;  ///< an atomic action that has not arrived by then is over [s]
   double path_spacing = 0.01;   ///< tip path points at least this far apart [m]
@@ -159,8 +164,12 @@ struct ScoopResult {
   double boom_pressure_at_contact = 0;  ///< [Pa]
   double boom_pressure_at_trigger = 0;  ///< [Pa]
   double payload_after_scoop = 0;       ///< before levelling and shaking [m³]
-  double payload = 0;                   ///< at the end [m³]
-  double fill_rate = 0;                 ///< payload / rated capacity [-]
+  /// Largest |q_boom + q_bucket − held attitude| while the final lift raises the racked bucket
+  /// out of the pile [rad], from when the bucket first reaches that attitude (over the whole
+  /// lift if it never does): tipped back or forward this far, a heaped load pours out.
+  double exit_lift_attitude_error = 0;
+  double payload = 0;           ///< at the end [m³]
+  double fill_rate = 0;         ///< payload / rated capacity [-]
   long non_finite_blocked = 0;  ///< commands with a NaN stopped before the machine (must be 0)
   long refused_commands = 0;    ///< commands the machine refused
   long prediction_failures = 0;
@@ -225,6 +234,10 @@ class ScoopCycle {
   /// The bucket joint target that gives `attitude` (q_boom + q_bucket) at this boom angle,
   /// within the bucket's range.
   double BucketTargetForAttitude(double attitude, double q_boom) const;
+  /// While holding an attitude with the feed-forward on: sets the bucket target, the bucket
+  /// angle the PID compares it with (Smith predictor) and the tilt feed-forward opening.
+  void HoldAttitudeAhead(const Proprioception& s, Runtime& rt, double& bucket_now,
+                         double& feed_forward) const;
 
   const model::MachineDescription& machine_;
   const generated::MachineFunctions& functions_;
@@ -235,7 +248,9 @@ class ScoopCycle {
   ScoopCycleOptions options_;
   ArmLimits limits_;
   int boom_valve_ = -1, bucket_valve_ = -1;
-  double bucket_delay_ = 0;    ///< transport delay + spool time constant of the bucket valve [s]
+  double bucket_delay_ = 0;  ///< transport delay + spool time constant of the bucket valve [s]
+  std::optional<AttitudeHoldFeedForward> attitude_feed_forward_;  ///< when the option is on
+  std::size_t boom_delay_ticks_ = 0, bucket_delay_ticks_ = 0;     ///< valve delays in ticks
   double level_attitude_ = 0;  ///< bucket attitude with the opening level, plus carry tilt [rad]
   std::unique_ptr<Runtime> rt_;
 };

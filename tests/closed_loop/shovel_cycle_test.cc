@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "runtime/app/shovel_run.h"
 #include "tests/closed_loop/cycle_runner.h"
@@ -48,8 +49,9 @@ TEST(ShovelCycle, GravelConeIsJustInAndOutAndFull) {
 
 // River sand in the mixing station's bin_4 (a difficult material, γ ∈ 𝒴): "Stairway". The
 // ridge lies against the bin's back wall, and the crowd look-ahead ends crowding before it:
-// fill measured 0.974 (0.923 while the look-ahead still stopped for the wall's labels seen over
-// the crest at a grazing angle; semantic_map.h), held at 0.9; clearance 1.34 m.
+// fill measured 0.998 (0.974 while the exit lift left the bucket's attitude to its PID alone;
+// 0.923 while the look-ahead still stopped for the wall's labels seen over the crest at a
+// grazing angle; semantic_map.h), held at 0.9; clearance 2.06 m.
 TEST(ShovelCycle, SandInABinIsStairwayAndFull) {
   ShovelRunOptions options = Options("mixing_station");
   options.bins = {"bin_4"};
@@ -58,6 +60,24 @@ TEST(ShovelCycle, SandInABinIsStairwayAndFull) {
   EXPECT_EQ(out.record.material, "river_sand");
   EXPECT_EQ(out.record.strategy, "stairway");
   EXPECT_GE(out.record.fill_rate, 0.9);
+}
+
+// The pushing scoop (crowding on through the curl at 0.3 m/s², with the model trained for it)
+// in the same bin fills the bucket after one Stairway step; the exit lift then held the racked
+// attitude by the bucket PID alone and poured 0.22 m³ over the back wall (fill 0.938). With the
+// tilt feed-forward and the attitude held no further back than level it keeps the full load.
+TEST(ShovelCycle, PushingScoopKeepsItsSandThroughTheExitLift) {
+  ShovelRunOptions options = Options("mixing_station");
+  options.bins = {"bin_4"};
+  options.scoop_deceleration = 0.3;
+  options.predictor = options.models_dir + "/prediction/penetration_svr_push";
+  const CycleOutcome out = RunOne(options);
+  ExpectSafeAndWhole(options, out);
+  EXPECT_EQ(out.record.strategy, "stairway");
+  const std::vector<double>& volumes = out.scoop.payload_at_actions;
+  ASSERT_GE(volumes.size(), 2u);
+  EXPECT_GE(volumes.back(), 0.995 * volumes[volumes.size() - 2]);  // the exit lift keeps it
+  EXPECT_GE(out.record.fill_rate, 0.98);
 }
 
 // The thin low sand remainder in dim light (0.45 m high): the bucket crosses the whole pile;

@@ -71,6 +71,20 @@ TEST(JointPid, NonFiniteInputsGiveZero) {
   EXPECT_THROW(JointPid(JointPidGains{.kp = -1}, 0.08), std::invalid_argument);
 }
 
+// The feed-forward opening adds to the PID's demand before the limit and passes alone within
+// the tolerance (where the PID holds), dead-zone compensated like the rest.
+TEST(JointPid, FeedForwardAddsToTheDemandAndPassesWithinTheTolerance) {
+  const JointPidGains gains{.kp = 2.0, .ki = 0.0};
+  JointPid pid(gains, 0.08, /*compensate=*/false);
+  EXPECT_DOUBLE_EQ(pid.Update(0.5, 0.5, 0.0, 0.01, -0.3), -0.3);  // at the target
+  EXPECT_NEAR(pid.Update(0.6, 0.5, 0.0, 0.01, -0.3), 2.0 * 0.1 - 0.3, 1e-12);
+  EXPECT_DOUBLE_EQ(pid.Update(1.5, 0.5, 0.0, 0.01, 0.5), 1.0);  // limited
+  JointPid compensated(gains, 0.08);
+  EXPECT_NEAR(compensated.Update(0.5, 0.5, 0.0, 0.01, 0.3), CompensateDeadZone(0.3, 0.08), 1e-12);
+  EXPECT_EQ(compensated.Update(0.5, 0.5, 0.0, 0.01, NAN), 0.0);
+  EXPECT_EQ(compensated.refused_inputs(), 1);
+}
+
 struct PidRun {
   double first_motion = NAN;  ///< when the joint had moved 5 mrad [s]
   double settled_error = NAN;

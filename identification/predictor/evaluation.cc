@@ -3,8 +3,38 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace autoshovel::predictor {
+
+std::map<std::string, double> FitIntakeFactors(const prediction::PenetrationPredictor& predictor,
+                                               const model::MachineDescription& machine,
+                                               const std::vector<const CrowdingRun*>& runs,
+                                               double capacity) {
+  // κ_M = Σ V·V̂ / Σ V̂² per material: the least-squares gain through the origin.
+  std::map<std::string, std::pair<double, double>> sums;
+  for (const CrowdingRun* run : runs) {
+    if (!run->ok || run->payload < 0.2 || run->payload >= 0.95 * capacity) continue;
+    const prediction::PenetrationPrediction p = predictor.Predict(run->features);
+    if (!p.ok) continue;
+    prediction::ScoopPlan plan = run->plan;
+    plan.travel_times = predictor.scaling().travel_times;
+    plan.travel_at = p.travel;
+    const double swept = run->features.shoveled_volume +
+                         prediction::PredictFutureVolume(machine, run->map, run->past_path,
+                                                         run->at_trigger, p.penetration, plan)
+                             .total();
+    if (!std::isfinite(swept) || swept <= 0) continue;
+    auto& [payload_times_swept, swept_squared] = sums[run->features.material];
+    payload_times_swept += run->payload * swept;
+    swept_squared += swept * swept;
+  }
+  std::map<std::string, double> factors;
+  for (const auto& [material, s] : sums) {
+    if (s.second > 0) factors[material] = s.first / s.second;
+  }
+  return factors;
+}
 
 PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& predictor,
                                       const model::MachineDescription& machine,
@@ -50,7 +80,9 @@ PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& pr
         prediction::PredictFutureVolume(machine, run->map, run->past_path, run->at_trigger,
                                         run->penetration, true_plan)
             .total();
-    const double predicted = v1 + v2;
+    // What the trigger compares with V_t: V1 + V2 times the model's intake factor.
+    const double intake = predictor.IntakeFactor(run->features.material);
+    const double predicted = intake * (v1 + v2);
     ++e.capped_samples;
     capped_error += std::abs(std::min(predicted, capacity) - run->payload) / run->payload;
     if (run->payload >= 0.95 * capacity) {
@@ -61,7 +93,7 @@ PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& pr
     e.mean_payload += run->payload;
     e.mean_predicted_volume += predicted;
     volume_error += std::abs(predicted - run->payload) / run->payload;
-    oracle_error += std::abs(v1 + v2_oracle - run->payload) / run->payload;
+    oracle_error += std::abs(intake * (v1 + v2_oracle) - run->payload) / run->payload;
   }
   if (e.samples > 0) {
     e.within_010 /= e.samples, e.within_015 /= e.samples, e.within_020 /= e.samples;

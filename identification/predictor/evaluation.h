@@ -1,10 +1,12 @@
 // Scoring the penetration predictor the way the wheel-loader seed reports it (§7.4.1): the share
 // of test samples whose absolute penetration error is within 0.1, 0.15 and 0.2 m, the mean
 // squared error, and the final volume prediction accuracy, 1 − mean(|V̂ − V| / V) over the runs,
-// with V̂ = V1 + V2 predicted at the trigger (V2 along the SVR's penetration, volume_estimation.h)
+// with V̂ = κ_M·(V1 + V2) predicted at the trigger (V2 along the SVR's penetration,
+// volume_estimation.h; κ_M the model's intake factor, 1 when it has none)
 // and V the payload the plant's bucket holds at the end of the scoop.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -42,6 +44,15 @@ struct PredictorEvaluation {
 PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& predictor,
                                       const model::MachineDescription& machine,
                                       const std::vector<const CrowdingRun*>& runs, double capacity);
+
+/// κ_M per material of `runs` (penetration_predictor.h, the intake factor): the least-squares
+/// gain through the origin of the payload on V1 + V2 (V2 along the predictor's penetration and
+/// travel curve) over the runs whose payload is at least 0.2 m³ and below 95 % of `capacity`
+/// (a full bucket's payload is capped and says nothing about the intake).
+std::map<std::string, double> FitIntakeFactors(const prediction::PenetrationPredictor& predictor,
+                                               const model::MachineDescription& machine,
+                                               const std::vector<const CrowdingRun*>& runs,
+                                               double capacity);
 
 std::string FormatEvaluation(const PredictorEvaluation& e);
 

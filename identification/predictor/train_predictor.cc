@@ -63,6 +63,11 @@ int main(int argc, char** argv) {
   app.add_option("--travel-times", travel_times, "knots of the travel curve [s after the trigger]")
       ->delimiter(',')
       ->capture_default_str();
+  bool intake_factor = false;
+  app.add_flag("--intake-factor", intake_factor,
+               "also fit the intake factor per material (payload over V1 + V2 on the training "
+               "runs whose bucket did not fill) and write it to the .scale file: the trigger then "
+               "compares it times V1 + V2 with V_t (penetration_predictor.h)");
   std::string compare_with;
   app.add_option("--compare", compare_with,
                  "also score this model (path stem) on the same test runs, e.g. the shipped "
@@ -175,6 +180,7 @@ int main(int argc, char** argv) {
       note += " --travel-curve --travel-times " + joined(travel_times);
       scaling.travel_times = travel_times;
     }
+    if (intake_factor) note += " --intake-factor";
     scaling.notes.push_back(note);
     std::filesystem::create_directories(std::filesystem::path(out).parent_path().empty()
                                             ? std::filesystem::path(".")
@@ -196,6 +202,20 @@ int main(int argc, char** argv) {
     }
     const double training_time = elapsed() - generation_time;
 
+    double capacity = 0;  // what the bucket holds full and racked back (evaluation.h)
+    for (const predictor::CrowdingRun* run : train_runs)
+      capacity = std::max(capacity, run->payload);
+    if (intake_factor) {
+      // Fitted with the final d and travel models on the training runs, then stored beside them.
+      const prediction::PenetrationPredictor fitted = prediction::PenetrationPredictor::Load(out);
+      prediction::FeatureScaling with_intake = fitted.scaling();
+      with_intake.intake_factor =
+          predictor::FitIntakeFactors(fitted, machine, train_runs, capacity);
+      for (const auto& [material, factor] : with_intake.intake_factor) {
+        std::printf("intake factor %s: %.3f\n", material.c_str(), factor);
+      }
+      prediction::PenetrationPredictor::SaveScaling(out, with_intake);
+    }
     const prediction::PenetrationPredictor model = prediction::PenetrationPredictor::Load(out);
     if (!samples_csv.empty()) {
       // Every completed run with the final model's prediction beside its target, so the error
@@ -217,9 +237,6 @@ int main(int argc, char** argv) {
       }
       if (!csv) throw std::runtime_error("cannot write " + samples_csv);
     }
-    double capacity = 0;  // what the bucket holds full and racked back (evaluation.h)
-    for (const predictor::CrowdingRun* run : train_runs)
-      capacity = std::max(capacity, run->payload);
     std::printf("bucket capacity racked back (largest training payload): %.3f m^3\n", capacity);
     const predictor::PredictorEvaluation on_test =
         predictor::EvaluatePredictor(model, machine, test_runs, capacity);

@@ -333,7 +333,9 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
           trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
       rt.last_features.reset();
       in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
+      in.intake_factor = predictor_ != nullptr ? predictor_->IntakeFactor(material_.name) : 1.0;
       rt.last_v2 = predict ? in.v2 : NAN;
+      rt.result.intake_factor = in.intake_factor;
       const bool fired = trigger_.Fire(in);
       std::optional<ScoopStrategy> strategy;
       if (options_.policy == ScoopPolicy::kAutoSelection) {
@@ -548,7 +550,7 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     if (digging && !rt.tip_path.empty()) {
       rt.result.samples.push_back({.time = s.time,
                                    .v1 = rt.v1,
-                                   .v1_plus_v2 = rt.v1 + rt.last_v2,
+                                   .v1_plus_v2 = rt.result.intake_factor * (rt.v1 + rt.last_v2),
                                    .triggered = !std::isnan(rt.result.trigger_time),
                                    .tip = rt.tip_path.back()});
     }

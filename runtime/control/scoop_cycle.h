@@ -134,9 +134,11 @@ struct PhaseRecord {
 /// One state-machine decision of the digging phases (approach, crowd, scoop): the report's
 /// volume-against-time figure.
 struct ScoopSample {
-  double time = 0;                                ///< machine clock [s]
-  double v1 = 0;                                  ///< Eq. (19) [m³]
-  double v1_plus_v2 = NAN;                        ///< when V2 was computed at this decision [m³]
+  double time = 0;  ///< machine clock [s]
+  double v1 = 0;    ///< Eq. (19) [m³]
+  /// κ_M·(V1 + V2), the predicted volume the trigger compares with V_t, when V2 was computed
+  /// at this decision [m³] (κ_M = 1 for a model without an intake factor).
+  double v1_plus_v2 = NAN;
   bool triggered = false;                         ///< the scoop has been triggered
   Eigen::Vector3d tip = Eigen::Vector3d::Zero();  ///< bucket tip, world [m]
 };
@@ -152,8 +154,9 @@ struct ScoopResult {
   std::string trigger_reason;             ///< the trigger's name, or "stopped"
   ScoopStrategy strategy = ScoopStrategy::kJustInOut;
   double v1_at_trigger = 0, v2_at_trigger = 0;  ///< [m³]
-  double target_volume = 0;                     ///< V_t [m³]
-  double feedback_volume = 0;                   ///< V1 at the end of the scoop phase [m³]
+  double intake_factor = 1;    ///< κ_M the predicted-volume trigger scaled V1 + V2 by [-]
+  double target_volume = 0;    ///< V_t [m³]
+  double feedback_volume = 0;  ///< V1 at the end of the scoop phase [m³]
   int atomic_actions = 0;
   std::vector<std::string> action_names;  ///< the atomic actions in order (atomic_actions.h)
   /// Bucket volume (ScoopMachine::PayloadVolume) each time the sequencer was asked for the next

@@ -20,7 +20,8 @@ PredictedVolumeTrigger::PredictedVolumeTrigger(double target_volume)
     : target_volume_(Positive(target_volume, "predicted-volume trigger: target volume")) {}
 
 bool PredictedVolumeTrigger::Fire(const TriggerInputs& in) {
-  return in.v1 > 0 && in.v1 + in.v2 >= target_volume_;  // NaN compares false
+  // NaN compares false; a non-positive κ never fires.
+  return in.v1 > 0 && in.intake_factor > 0 && in.intake_factor * (in.v1 + in.v2) >= target_volume_;
 }
 
 PerceptionTrigger::PerceptionTrigger(double target_volume)

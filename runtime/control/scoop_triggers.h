@@ -1,5 +1,7 @@
 // When the crowding ends and the scoop begins, wheel-loader seed §6.1–6.2, §7.4.2 (Table 5):
-//  - PredictedVolumeTrigger: V1 + V2 ≥ V_t (Algorithm 3 line 7), the proposed method;
+//  - PredictedVolumeTrigger: V1 + V2 ≥ V_t (Algorithm 3 line 7), the proposed method, with
+//    V1 + V2 scaled by the penetration model's intake factor κ_M where it has one
+//    (penetration_predictor.h): κ_M·(V1 + V2) ≥ V_t;
 //  - PerceptionTrigger: V1 ≥ V_t, "perception-triggered methods without shoveling volume
 //    prediction" (Fig. 10(c));
 //  - BoomPressureTrigger: the boom cylinder's cap pressure reaches a threshold, the "Pressure"
@@ -17,6 +19,7 @@ namespace autoshovel::control {
 struct TriggerInputs {
   double v1 = 0;             ///< Eq. (19) [m³]
   double v2 = 0;             ///< V21 + V22 [m³] (0 when not predicted)
+  double intake_factor = 1;  ///< κ_M of the penetration model for the pile's material [-]
   double boom_pressure = 0;  ///< boom cylinder cap-side pressure [Pa]
 };
 

@@ -146,6 +146,12 @@ std::vector<std::string> FeatureScaling::FeatureNames(const std::vector<std::str
 PenetrationPredictor::PenetrationPredictor(std::unique_ptr<Model> model, FeatureScaling scaling)
     : model_(std::move(model)), scaling_(std::move(scaling)) {}
 PenetrationPredictor::PenetrationPredictor(PenetrationPredictor&&) noexcept = default;
+
+double PenetrationPredictor::IntakeFactor(const std::string& material) const {
+  const auto it = scaling_.intake_factor.find(material);
+  return it == scaling_.intake_factor.end() ? 1.0 : it->second;
+}
+
 PenetrationPredictor& PenetrationPredictor::operator=(PenetrationPredictor&&) noexcept = default;
 PenetrationPredictor::~PenetrationPredictor() = default;
 
@@ -223,6 +229,9 @@ void PenetrationPredictor::SaveScaling(const std::string& path_stem, const Featu
     for (double t : s.travel_times) file << " " << t;
     file << "\n";
   }
+  for (const auto& [material, factor] : s.intake_factor) {
+    file << "intake_factor " << material << " " << factor << "\n";
+  }
   for (const std::string& note : s.notes) file << "note " << note << "\n";
   if (!file) throw std::runtime_error("cannot write " + path);
 }
@@ -284,14 +293,31 @@ FeatureScaling PenetrationPredictor::LoadScaling(const std::string& path_stem) {
         continue;
       }
       s.travel_times = std::move(times);
+    } else if (key == "intake_factor") {
+      std::string material;
+      double factor = 0;
+      std::string extra;
+      if (!(in >> material >> factor) || (in >> extra) || !std::isfinite(factor) || !(factor > 0)) {
+        error(line, "expected 'intake_factor <material> <factor>' with a finite factor > 0, got '" +
+                        text + "'");
+        continue;
+      }
+      if (std::find(s.materials.begin(), s.materials.end(), material) == s.materials.end()) {
+        error(line, "intake_factor for '" + material +
+                        "', which is not in the 'materials' line (it must come after it)");
+        continue;
+      }
+      if (!s.intake_factor.emplace(material, factor).second) {
+        error(line, "a second intake_factor for '" + material + "'");
+      }
     } else if (key == "note") {
       std::string rest;
       std::getline(in >> std::ws, rest);
       s.notes.push_back(rest);
     } else {
-      error(line,
-            "unknown key '" + key +
-                "' (expected format, machine, delta_l, materials, feature, travel_times or note)");
+      error(line, "unknown key '" + key +
+                      "' (expected format, machine, delta_l, materials, feature, travel_times, "
+                      "intake_factor or note)");
     }
   }
   if (!have_format) error(0, "missing the 'format " + std::string(kFormat) + "' line");

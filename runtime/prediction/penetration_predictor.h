@@ -20,17 +20,28 @@
 //   materials <name> <name> …
 //   feature <name> <min> <max>        (one per feature, in order)
 //   travel_times <t1> <t2> …          (optional: the travel curve below) [s]
+//   intake_factor <material> <κ>      (optional, one per material: see below) [-]
 //   note <free text>                  (any number: the training command, figures)
 //
 // The optional travel curve: one more ε-SVR per time t_k on the same scaled features,
 // `<name>.travel<k>.model` (k = 1, 2, …), predicting how far the machine has travelled t_k
 // after the trigger (train_predictor --travel-curve). V2 then follows those knots instead of a
 // constant deceleration over d (volume_estimation.h, ScoopPlan::travel_at).
+//
+// The optional intake factor κ_M per material (train_predictor --intake-factor): what the
+// bucket takes in over what V1 + V2 counts. Eq. (19) counts the pile above the tip path; the
+// pushing scoop's training runs that do not fill the bucket end with 1.06 (big gravel) to 1.23
+// (river sand) times that (the cut faces relaxing to their angle of repose into the bucket's
+// path is the likely reason, strongest in sand; not measured apart). κ_M is the least-squares
+// gain through the origin of the payload on V1 + V2 over the training runs of M whose bucket did
+// not fill; the trigger compares κ_M·(V1 + V2) with V_t. Absent, κ = 1 (the seed's
+// V1 + V2 ≥ V_t as written).
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +76,8 @@ struct FeatureScaling {
   std::vector<std::string> notes;
   /// Times after the trigger of the travel curve's models [s] (empty: no curve).
   std::vector<double> travel_times;
+  /// κ_M per material (empty: none; a material not listed has κ = 1).
+  std::map<std::string, double> intake_factor;
 
   /// The names of the features for `materials`: speed, shoveled_volume, material_<m>…, h1..h6.
   static std::vector<std::string> FeatureNames(const std::vector<std::string>& materials);
@@ -103,6 +116,8 @@ class PenetrationPredictor {
                                     const std::vector<std::string>& materials, std::string* why);
 
   const FeatureScaling& scaling() const { return scaling_; }
+  /// κ_M of `material`: the model's intake factor, 1 where it has none.
+  double IntakeFactor(const std::string& material) const;
 
   /// Writes `<path_stem>.scale` (and nothing else: the .model is written by libsvm's
   /// svm_save_model). Throws std::runtime_error when the file cannot be written.

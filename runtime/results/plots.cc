@@ -25,7 +25,7 @@ void WriteVolumePlotPng(const CycleRecord& cycle, double target_volume_m3,
   plot.y_label = "volume [m^3]";
   plot.y_from_zero = true;
   PlotSeries v1{"V1 (estimated, Eq. 19)", {}, {}, kBlue, 2, false, false};
-  PlotSeries v1v2{"V1 + V2 (with predicted)", {}, {}, kOrange, 2, true, false};
+  PlotSeries v1v2{"V1 + V2 x intake factor (predicted)", {}, {}, kOrange, 2, true, false};
   for (const CycleSample& s : cycle.samples) {
     v1.x.push_back(s.t);
     v1.y.push_back(s.v1);

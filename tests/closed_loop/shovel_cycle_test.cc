@@ -63,9 +63,10 @@ TEST(ShovelCycle, SandInABinIsStairwayAndFull) {
 }
 
 // The pushing scoop (crowding on through the curl at 0.3 m/s², with the model trained for it)
-// in the same bin fills the bucket after one Stairway step; the exit lift then held the racked
-// attitude by the bucket PID alone and poured 0.22 m³ over the back wall (fill 0.938). With the
-// tilt feed-forward and the attitude held no further back than level it keeps the full load.
+// in the same bin fills the bucket in its Stairway; the exit lift then held the racked attitude
+// by the bucket PID alone and poured 0.22 m³ over the back wall (fill 0.938). With the tilt
+// feed-forward and the attitude held no further back than level it keeps the full load
+// (measured 0.998, triggered 0.95 s after contact by κ·(V1 + V2)).
 TEST(ShovelCycle, PushingScoopKeepsItsSandThroughTheExitLift) {
   ShovelRunOptions options = Options("mixing_station");
   options.bins = {"bin_4"};

@@ -40,6 +40,10 @@ TEST(ScoopTriggers, Thresholds) {
   EXPECT_TRUE(predicted.Fire({.v1 = 1.0, .v2 = 2.0}));
   EXPECT_FALSE(predicted.Fire({.v1 = 0.0, .v2 = 3.0}));  // not in the pile
   EXPECT_FALSE(predicted.Fire({.v1 = 1.0, .v2 = std::nan("")}));
+  // With the model's intake factor κ: κ·(V1 + V2) ≥ V_t.
+  EXPECT_TRUE(predicted.Fire({.v1 = 1.0, .v2 = 1.5, .intake_factor = 1.2}));
+  EXPECT_FALSE(predicted.Fire({.v1 = 1.0, .v2 = 1.4, .intake_factor = 1.2}));
+  EXPECT_FALSE(predicted.Fire({.v1 = 1.0, .v2 = 2.5, .intake_factor = 0.0}));
   PerceptionTrigger perception(3.0);
   EXPECT_FALSE(perception.Fire({.v1 = 1.0, .v2 = 2.5}));  // V2 is not read
   EXPECT_TRUE(perception.Fire({.v1 = 3.0}));

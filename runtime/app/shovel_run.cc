@@ -2,7 +2,6 @@
 #include "runtime/app/shovel_run.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -375,7 +374,6 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   scoop_options.strategy.fixed_steps = o.stairway_steps;
   scoop_options.scoop_deceleration = o.scoop_deceleration;
   scoop_options.attitude_feed_forward = o.attitude_feed_forward;
-  if (const char* tf = std::getenv("AS_TF")) scoop_options.target_fill = std::atof(tf);
   out.target_volume = scoop_options.target_fill * machine.bucket.rated_capacity;
 
   perception::PerceptionFromPlantOptions perceive;

@@ -6,6 +6,27 @@
 #include <utility>
 
 namespace autoshovel::predictor {
+namespace {
+
+// The run's scoop plan with the model's travel curve, if it has one.
+prediction::ScoopPlan PlanWithCurve(const CrowdingRun& run,
+                                    const prediction::PenetrationPredictor& predictor,
+                                    const prediction::PenetrationPrediction& p) {
+  prediction::ScoopPlan plan = run.plan;
+  plan.travel_times = predictor.scaling().travel_times;
+  plan.travel_at = p.travel;
+  return plan;
+}
+
+// V2 (V21 + V22) of the run from its trigger along `plan` with penetration d [m³].
+double FutureVolume(const model::MachineDescription& machine, const CrowdingRun& run,
+                    double penetration, const prediction::ScoopPlan& plan) {
+  return prediction::PredictFutureVolume(machine, run.map, run.past_path, run.at_trigger,
+                                         penetration, plan)
+      .total();
+}
+
+}  // namespace
 
 std::map<std::string, double> FitIntakeFactors(const prediction::PenetrationPredictor& predictor,
                                                const model::MachineDescription& machine,
@@ -17,13 +38,9 @@ std::map<std::string, double> FitIntakeFactors(const prediction::PenetrationPred
     if (!run->ok || run->payload < 0.2 || run->payload >= 0.95 * capacity) continue;
     const prediction::PenetrationPrediction p = predictor.Predict(run->features);
     if (!p.ok) continue;
-    prediction::ScoopPlan plan = run->plan;
-    plan.travel_times = predictor.scaling().travel_times;
-    plan.travel_at = p.travel;
-    const double swept = run->features.shoveled_volume +
-                         prediction::PredictFutureVolume(machine, run->map, run->past_path,
-                                                         run->at_trigger, p.penetration, plan)
-                             .total();
+    const double swept =
+        run->features.shoveled_volume +
+        FutureVolume(machine, *run, p.penetration, PlanWithCurve(*run, predictor, p));
     if (!std::isfinite(swept) || swept <= 0) continue;
     auto& [payload_times_swept, swept_squared] = sums[run->features.material];
     payload_times_swept += run->payload * swept;
@@ -65,21 +82,14 @@ PredictorEvaluation EvaluatePredictor(const prediction::PenetrationPredictor& pr
     }
     if (run->payload < 0.2) continue;
     const double v1 = run->features.shoveled_volume;
-    prediction::ScoopPlan plan = run->plan;  // with the model's travel curve, if it has one
-    plan.travel_times = predictor.scaling().travel_times;
-    plan.travel_at = p.travel;
-    const double v2 = prediction::PredictFutureVolume(machine, run->map, run->past_path,
-                                                      run->at_trigger, p.penetration, plan)
-                          .total();
+    const prediction::ScoopPlan plan = PlanWithCurve(*run, predictor, p);
+    const double v2 = FutureVolume(machine, *run, p.penetration, plan);
     // The oracle: the true penetration and, with a curve, the run's own travel at its knots.
     prediction::ScoopPlan true_plan = plan;
     for (std::size_t k = 0; k < plan.travel_times.size(); ++k) {
       true_plan.travel_at[k] = TravelAt(*run, plan.travel_times[k]);
     }
-    const double v2_oracle =
-        prediction::PredictFutureVolume(machine, run->map, run->past_path, run->at_trigger,
-                                        run->penetration, true_plan)
-            .total();
+    const double v2_oracle = FutureVolume(machine, *run, run->penetration, true_plan);
     // What the trigger compares with V_t: V1 + V2 times the model's intake factor.
     const double intake = predictor.IntakeFactor(run->features.material);
     const double predicted = intake * (v1 + v2);

@@ -29,14 +29,13 @@ double FullOpeningFlow(const model::MachineDescription& machine, const model::Va
 
 AttitudeHoldFeedForward::AttitudeHoldFeedForward(const model::MachineDescription& machine,
                                                  const generated::MachineFunctions& functions)
-    : machine_(machine), functions_(functions) {
+    : functions_(functions) {
   if (machine.links.size() != 2 || functions.num_joints != 2) {
     throw std::invalid_argument("attitude feed-forward: machine '" + machine.name +
                                 "' is not a two-link loader arm");
   }
-  boom_actuator_ = machine.ActuatorOfJoint(0);
-  bucket_actuator_ = machine.ActuatorOfJoint(1);
-  for (int a : {boom_actuator_, bucket_actuator_}) {
+  for (int joint : {0, 1}) {
+    const int a = machine.ActuatorOfJoint(joint);
     if (a < 0) {
       throw std::invalid_argument("attitude feed-forward: machine '" + machine.name +
                                   "' has no actuator on the boom or bucket joint");
@@ -47,9 +46,21 @@ AttitudeHoldFeedForward::AttitudeHoldFeedForward(const model::MachineDescription
       throw std::invalid_argument("attitude feed-forward: actuator '" + act.name +
                                   "' needs a cylinder with bore > rod and a positive rated flow");
     }
+    Cylinder& cylinder = joint == 0 ? boom_ : bucket_;
+    cylinder.actuator = a;
+    cylinder.cap_area = act.count * std::numbers::pi / 4 * act.bore * act.bore;
+    cylinder.rod_area =
+        act.count * std::numbers::pi / 4 * (act.bore * act.bore - act.rod * act.rod);
+    cylinder.full_flow = FullOpeningFlow(machine, act.valve);
+    cylinder.dead_zone = act.valve.dead_zone;
   }
-  boom_lag_ = std::max(0.0, ValveLag(machine.hydraulics.actuators[boom_actuator_].valve) -
-                                ValveLag(machine.hydraulics.actuators[bucket_actuator_].valve));
+  boom_lag_ = std::max(0.0, ValveLag(machine.hydraulics.actuators[boom_.actuator].valve) -
+                                ValveLag(machine.hydraulics.actuators[bucket_.actuator].valve));
+}
+
+const AttitudeHoldFeedForward::Cylinder& AttitudeHoldFeedForward::CylinderOf(int joint) const {
+  if (joint != 0 && joint != 1) throw std::out_of_range("attitude feed-forward: joint 0 or 1");
+  return joint == 0 ? boom_ : bucket_;
 }
 
 double AttitudeHoldFeedForward::LengthGradient(int actuator, int joint,
@@ -65,50 +76,46 @@ double AttitudeHoldFeedForward::LengthGradient(int actuator, int joint,
          (2 * kStep);
 }
 
-double AttitudeHoldFeedForward::LengthRateOfOpening(int actuator, double opening) const {
-  const model::Actuator& act = machine_.hydraulics.actuators[actuator];
-  const double cap = act.count * std::numbers::pi / 4 * act.bore * act.bore;
-  const double rod = act.count * std::numbers::pi / 4 * (act.bore * act.bore - act.rod * act.rod);
+double AttitudeHoldFeedForward::LengthRateOfOpening(const Cylinder& cylinder, double opening) {
   const double x = std::clamp(opening, -1.0, 1.0);
-  return x * FullOpeningFlow(machine_, act.valve) / (x >= 0 ? cap : rod);
+  return x * cylinder.full_flow / (x >= 0 ? cylinder.cap_area : cylinder.rod_area);
 }
 
-double AttitudeHoldFeedForward::OpeningOfLengthRate(int actuator, double length_rate) const {
-  const model::Actuator& act = machine_.hydraulics.actuators[actuator];
-  const double cap = act.count * std::numbers::pi / 4 * act.bore * act.bore;
-  const double rod = act.count * std::numbers::pi / 4 * (act.bore * act.bore - act.rod * act.rod);
-  const double x =
-      length_rate * (length_rate >= 0 ? cap : rod) / FullOpeningFlow(machine_, act.valve);
-  return std::clamp(x, -1.0, 1.0);
+double AttitudeHoldFeedForward::OpeningOfLengthRate(const Cylinder& cylinder, double length_rate) {
+  const double area = length_rate >= 0 ? cylinder.cap_area : cylinder.rod_area;
+  return std::clamp(length_rate * area / cylinder.full_flow, -1.0, 1.0);
 }
 
 double AttitudeHoldFeedForward::JointRate(int joint, double demand,
                                           const std::vector<double>& q) const {
-  if (joint != 0 && joint != 1) throw std::out_of_range("attitude feed-forward: joint 0 or 1");
-  const int actuator = joint == 0 ? boom_actuator_ : bucket_actuator_;
-  const double gradient = LengthGradient(actuator, joint, q);
+  const Cylinder& cylinder = CylinderOf(joint);
+  const double gradient = LengthGradient(cylinder.actuator, joint, q);
   if (!std::isfinite(gradient) || std::abs(gradient) < 1e-6) return 0.0;
-  return LengthRateOfOpening(actuator, demand) / gradient;
+  return LengthRateOfOpening(cylinder, demand) / gradient;
+}
+
+double AttitudeHoldFeedForward::JointTravel(int joint, const std::deque<double>& openings,
+                                            const std::vector<double>& q, double dt) const {
+  const Cylinder& cylinder = CylinderOf(joint);
+  const double gradient = LengthGradient(cylinder.actuator, joint, q);
+  if (!std::isfinite(gradient) || std::abs(gradient) < 1e-6) return 0.0;
+  double length = 0;
+  for (double opening : openings) length += LengthRateOfOpening(cylinder, opening) * dt;
+  return length / gradient;
 }
 
 double AttitudeHoldFeedForward::PassiveBucketPerBoom(const std::vector<double>& q) const {
-  const double own = LengthGradient(bucket_actuator_, 1, q);
+  const double own = LengthGradient(bucket_.actuator, 1, q);
   if (!std::isfinite(own) || std::abs(own) < 1e-6) return 0.0;
-  return -LengthGradient(bucket_actuator_, 0, q) / own;
+  return -LengthGradient(bucket_.actuator, 0, q) / own;
 }
 
 double AttitudeHoldFeedForward::OpeningOfDuty(int joint, double duty) const {
-  if (joint != 0 && joint != 1) throw std::out_of_range("attitude feed-forward: joint 0 or 1");
+  const double dead_zone = CylinderOf(joint).dead_zone;
   if (!std::isfinite(duty)) return 0.0;
-  const int actuator = joint == 0 ? boom_actuator_ : bucket_actuator_;
-  const double dead_zone = machine_.hydraulics.actuators[actuator].valve.dead_zone;
   const double magnitude = std::min(std::abs(duty), 1.0);
   if (magnitude <= dead_zone) return 0.0;
   return std::copysign((magnitude - dead_zone) / (1 - dead_zone), duty);
-}
-
-double AttitudeHoldFeedForward::BoomRate(double boom_demand, const std::vector<double>& q) const {
-  return JointRate(0, boom_demand, q);
 }
 
 double AttitudeHoldFeedForward::BucketDemand(double boom_demand,
@@ -117,12 +124,12 @@ double AttitudeHoldFeedForward::BucketDemand(double boom_demand,
       !std::isfinite(q[1])) {
     return 0.0;
   }
-  const double boom_rate = BoomRate(boom_demand, q);
+  const double boom_rate = JointRate(0, boom_demand, q);
   // Constant attitude: q̇_bucket = −q̇_boom; the tilt cylinder's length moves with both joints.
-  const double length_rate = LengthGradient(bucket_actuator_, 0, q) * boom_rate +
-                             LengthGradient(bucket_actuator_, 1, q) * -boom_rate;
+  const double length_rate = LengthGradient(bucket_.actuator, 0, q) * boom_rate +
+                             LengthGradient(bucket_.actuator, 1, q) * -boom_rate;
   if (!std::isfinite(length_rate)) return 0.0;
-  return OpeningOfLengthRate(bucket_actuator_, length_rate);
+  return OpeningOfLengthRate(bucket_, length_rate);
 }
 
 }  // namespace autoshovel::control

@@ -18,6 +18,7 @@
 // tilt cylinder may be mounted on the chassis, making its length depend on the boom too).
 #pragma once
 
+#include <deque>
 #include <vector>
 
 #include "generated/machine_functions.h"
@@ -29,17 +30,20 @@ class AttitudeHoldFeedForward {
  public:
   /// A two-link loader arm (boom joint 0, bucket joint 1) with a cylinder on each joint. Throws
   /// std::invalid_argument otherwise or when a valve's rated flow or a cylinder's bore is not
-  /// positive. Both references must outlive this object.
+  /// positive. `functions` must outlive this object.
   AttitudeHoldFeedForward(const model::MachineDescription& machine,
                           const generated::MachineFunctions& functions);
 
-  /// Boom joint rate [rad/s] that a boom spool opening `boom_demand` ∈ [−1, 1] gives at arm
-  /// angles q = {q_boom, q_bucket} [rad].
-  double BoomRate(double boom_demand, const std::vector<double>& q) const;
-
   /// Joint rate [rad/s] of joint `joint` (0 boom, 1 bucket) that its spool opening `demand`
-  /// gives at q while the other joint stands still.
+  /// ∈ [−1, 1] gives at arm angles q = {q_boom, q_bucket} [rad] while the other joint stands
+  /// still.
   double JointRate(int joint, double demand, const std::vector<double>& q) const;
+
+  /// Σ JointRate(joint, opening, q)·dt over `openings` [rad]: how far the openings sent and not
+  /// yet acting will move the joint. One length gradient for all of them (the Smith predictor
+  /// sums a valve delay's worth of openings every control tick).
+  double JointTravel(int joint, const std::deque<double>& openings, const std::vector<double>& q,
+                     double dt) const;
 
   /// q̇_bucket per q̇_boom with the tilt cylinder standing still [-]: 0 when the tilt cylinder
   /// rides on the boom, nonzero for one mounted on the chassis.
@@ -58,15 +62,23 @@ class AttitudeHoldFeedForward {
   double boom_lag() const { return boom_lag_; }
 
  private:
+  /// The cylinder driving a joint, as the valve model sees it.
+  struct Cylinder {
+    int actuator = -1;
+    double cap_area = 0, rod_area = 0;  ///< all cylinders of the actuator together [m²]
+    double full_flow = 0;               ///< at a fully open spool [m³/s]
+    double dead_zone = 0;               ///< of its valve [-]
+  };
+
   /// ∂L/∂q_joint of `actuator` at q [m/rad].
   double LengthGradient(int actuator, int joint, const std::vector<double>& q) const;
   /// Cylinder length rate [m/s] of a spool opening x, and its inverse.
-  double LengthRateOfOpening(int actuator, double opening) const;
-  double OpeningOfLengthRate(int actuator, double length_rate) const;
+  static double LengthRateOfOpening(const Cylinder& cylinder, double opening);
+  static double OpeningOfLengthRate(const Cylinder& cylinder, double length_rate);
+  const Cylinder& CylinderOf(int joint) const;
 
-  const model::MachineDescription& machine_;
   const generated::MachineFunctions& functions_;
-  int boom_actuator_ = -1, bucket_actuator_ = -1;
+  Cylinder boom_, bucket_;
   double boom_lag_ = 0;
 };
 

@@ -218,14 +218,11 @@ void ScoopCycle::HoldAttitudeAhead(const Proprioception& s, Runtime& rt, double&
   // Smith predictor over the valves' delay: the PID compares the joints as the openings already
   // sent will leave them, so it neither fights motion still in the pipe nor keeps pushing for
   // what it cannot see yet (the rack-back arrives still moving; the lift moves 0.6 s late).
-  double boom_ahead = s.q_boom, bucket_ahead = s.q_bucket;
-  for (double opening : rt.boom_openings) {
-    boom_ahead += rt.boom_response * hold.JointRate(0, opening, q) * options_.tick;
-  }
-  for (double opening : rt.bucket_openings) {
-    bucket_ahead += rt.bucket_response * hold.JointRate(1, opening, q) * options_.tick;
-  }
-  bucket_ahead += passive * (boom_ahead - s.q_boom);
+  const double boom_ahead =
+      s.q_boom + rt.boom_response * hold.JointTravel(0, rt.boom_openings, q, options_.tick);
+  const double bucket_ahead =
+      s.q_bucket + rt.bucket_response * hold.JointTravel(1, rt.bucket_openings, q, options_.tick) +
+      passive * (boom_ahead - s.q_boom);
   const double unclamped = rt.hold_attitude - boom_ahead;
   rt.targets.bucket = BucketTargetForAttitude(rt.hold_attitude, boom_ahead);
   bucket_now = bucket_ahead;

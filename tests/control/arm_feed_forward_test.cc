@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <deque>
 #include <stdexcept>
 
 #include "runtime/control/joint_pid.h"
@@ -62,7 +63,7 @@ TEST(AttitudeHoldFeedForward, PredictsThePlantsBoomRate) {
   const AttitudeHoldFeedForward feed_forward(machine, plant::testing::Functions(kMachine));
   for (double opening : {0.4, 0.8}) {
     const Motion m = OpenLoopLift(opening, 0.0, 1.0);
-    const double predicted = feed_forward.BoomRate(opening, m.q_middle);
+    const double predicted = feed_forward.JointRate(0, opening, m.q_middle);
     std::printf("[feed-forward] boom opening %.1f: plant %.3f rad/s, model %.3f rad/s\n", opening,
                 m.boom_rate, predicted);
     EXPECT_GT(m.boom_rate, 0.05);
@@ -98,7 +99,12 @@ TEST(AttitudeHoldFeedForward, OpeningOfDutyInvertsTheDeadZoneCompensation) {
   EXPECT_EQ(feed_forward.OpeningOfDuty(1, 0.5 * dead), 0.0);  // inside the dead zone
   EXPECT_EQ(feed_forward.OpeningOfDuty(1, NAN), 0.0);
   EXPECT_EQ(feed_forward.BucketDemand(NAN, {0.0, 0.5}), 0.0);
-  EXPECT_EQ(feed_forward.BoomRate(0.0, {0.0, 0.5}), 0.0);
+  EXPECT_EQ(feed_forward.JointRate(0, 0.0, {0.0, 0.5}), 0.0);
+  // The travel of a run of openings is their rates' sum times the step.
+  const std::deque<double> openings = {0.5, -0.25, 1.0};
+  double sum = 0;
+  for (double x : openings) sum += feed_forward.JointRate(1, x, {0.0, 0.5}) * 0.01;
+  EXPECT_NEAR(feed_forward.JointTravel(1, openings, {0.0, 0.5}, 0.01), sum, 1e-12);
   // Same valves on both joints of this machine: no lag between them.
   EXPECT_EQ(feed_forward.boom_lag(), 0.0);
 }

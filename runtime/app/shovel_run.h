@@ -52,7 +52,8 @@ struct ShovelRunOptions {
   /// (control::ScoopCycleOptions::scoop_deceleration). The predictor must be trained for it.
   double scoop_deceleration = 1.0;
   /// control::ScoopCycleOptions::attitude_feed_forward: the exit lift opens the tilt valve as
-  /// the boom's demand will move the boom (false: the bucket PID alone, the earlier behaviour).
+  /// the boom's demand will move the boom (false: the bucket PID alone; the attitude held is
+  /// the same either way).
   bool attitude_feed_forward = true;
   SelectionMethod selection = SelectionMethod::kOurs;
   double approach_distance = 12.0;  ///< cycle start, out of the bin's open front [m]

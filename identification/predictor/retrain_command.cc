@@ -10,6 +10,7 @@
 #include "identification/predictor/svr_training.h"
 #include "runtime/model/description.h"
 #include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/shipped_models.h"
 #include "runtime/results/results_db.h"
 
 namespace autoshovel::predictor {
@@ -80,7 +81,7 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
       err << kCommand << ": give --out STEM for the new model (.model and .scale)\n";
       return 2;
     }
-    const std::string base = o.base.empty() ? o.models_dir + "/prediction/penetration_svr" : o.base;
+    const std::string base = o.base.empty() ? prediction::MainJobPredictor(o.models_dir) : o.base;
     for (const char* ext : {".model", ".scale"}) {
       if (std::filesystem::exists(o.out + ext)) {
         err << kCommand << ": " << o.out << ext

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "runtime/app/shovel_run.h"
+#include "runtime/prediction/shipped_models.h"
 
 namespace autoshovel::app {
 
@@ -72,6 +73,8 @@ ShovelRunOptions Base(const CompareOptions& o) {
   r.truth_labels = !o.network;
   r.pressure_threshold = o.pressure_threshold;
   r.scoop_deceleration = o.scoop_deceleration;
+  r.attack_speed = o.attack_speed;
+  r.target_fill = o.target_fill;
   r.attitude_feed_forward = o.attitude_feed_forward;
   r.predictor = o.predictor;
   return r;
@@ -134,9 +137,11 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
   };
   out << "Table 5: trigger and scooping strategy (" << o.trials
       << " trials per material; pressure threshold " << o.pressure_threshold / 1e5
-      << " bar; scoop deceleration " << o.scoop_deceleration << " m/s^2; exit-lift "
+      << " bar; attack speed " << o.attack_speed << " m/s; V_t " << 100 * o.target_fill
+      << " % of capacity; scoop deceleration " << o.scoop_deceleration << " m/s^2; exit-lift "
       << (o.attitude_feed_forward ? "feed-forward" : "PID only") << "; predictor "
-      << (o.predictor.empty() ? std::string("shipped") : o.predictor)
+      << (o.predictor.empty() ? std::string("models/") + prediction::kMainJobPredictor
+                              : o.predictor)
       << "). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
          "the third column as printed).\n\n";
   out << "| trigger | strategy | material | crowd s (seed) | crowd kJ (seed) | scoop s | scoop kJ "

@@ -26,7 +26,9 @@ struct CompareOptions {
   int trials = 5;
   bool network = false;
   double pressure_threshold = 150e5;  ///< [Pa]
-  double scoop_deceleration = 1.0;    ///< ShovelRunOptions::scoop_deceleration [m/s²]
+  double scoop_deceleration = 0.6;    ///< ShovelRunOptions::scoop_deceleration [m/s²]
+  double attack_speed = 1.5;          ///< ShovelRunOptions::attack_speed [m/s]
+  double target_fill = 1.0;           ///< ShovelRunOptions::target_fill [-]
   bool attitude_feed_forward = true;  ///< ShovelRunOptions::attitude_feed_forward
   std::string predictor;              ///< SVR model prefix; empty: the shipped one
 };

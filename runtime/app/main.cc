@@ -260,8 +260,9 @@ int main(int argc, char** argv) {
       ->required();
   retrain_cmd->add_option("-o,--out", retrain.out, "Path stem of the new model")->required();
   retrain_cmd->add_option("--machine", retrain.machine, "Wheel loader")->capture_default_str();
-  retrain_cmd->add_option("--base", retrain.base,
-                          "Model to compare with (default: the shipped penetration_svr)");
+  retrain_cmd->add_option(
+      "--base", retrain.base,
+      "Model to compare with (default: the main job's, models/prediction/penetration_svr_fast)");
   retrain_cmd->add_option("--strategy", retrain.strategy, "Samples of this scoop only, or all")
       ->capture_default_str();
   retrain_cmd->add_option("--threads", retrain.threads, "0: every core")->capture_default_str();
@@ -384,6 +385,17 @@ int main(int argc, char** argv) {
                    "predictor must be trained for it: docs/scooping_control.md)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  run_cmd
+      ->add_option("--attack-speed", run.attack_speed,
+                   "Approach and crowding speed [m/s] (the predictor must be trained for it)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  run_cmd
+      ->add_option("--target-fill", run.target_fill,
+                   "V_t as a fraction of the rated capacity: the trigger's and the adaptive "
+                   "Stairway's target")
+      ->check(CLI::Range(0.1, 1.5))
+      ->capture_default_str();
   bool run_no_feed_forward = false;
   run_cmd->add_flag("--no-attitude-feed-forward", run_no_feed_forward,
                     "Hold the bucket's attitude in the exit lift by its PID alone (no tilt "
@@ -443,6 +455,14 @@ int main(int argc, char** argv) {
       ->add_option("--scoop-deceleration", compare.scoop_deceleration,
                    "Fall of the speed reference once the scoop moves the arm [m/s^2]")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  compare_cmd
+      ->add_option("--attack-speed", compare.attack_speed, "Approach and crowding speed [m/s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  compare_cmd
+      ->add_option("--target-fill", compare.target_fill, "V_t as a fraction of the rated capacity")
+      ->check(CLI::Range(0.1, 1.5))
       ->capture_default_str();
   bool compare_no_feed_forward = false;
   compare_cmd->add_flag("--no-attitude-feed-forward", compare_no_feed_forward,

@@ -34,6 +34,7 @@
 #include "runtime/plant/scenario.h"
 #include "runtime/plant/scenario_builder.h"
 #include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/shipped_models.h"
 #include "runtime/prediction/volume_estimation.h"
 #include "runtime/results/plots.h"
 #include "runtime/results/report.h"
@@ -153,7 +154,7 @@ struct ShovelJob::State {
       : options(o),
         setup(plant::LoadScenarioWithMachine(o.scenario, o.models_dir, o.machine)),
         predictor(prediction::PenetrationPredictor::Load(
-            o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor)),
+            o.predictor.empty() ? prediction::MainJobPredictor(o.models_dir) : o.predictor)),
         rng(o.seed) {
     if (!o.shovel_weights.empty()) planning::ReadShovelWeights(o.shovel_weights, selection);
     plant::VaryPiles(setup.scenario, o.seed, o.yard_variation);
@@ -268,6 +269,20 @@ const std::vector<std::string>& ShovelJob::sites() const { return state_->site_n
 const std::string& ShovelJob::scenario_name() const { return state_->setup.scenario.name; }
 const std::string& ShovelJob::machine_name() const { return state_->setup.machine.name; }
 
+std::string ShovelJob::PredictorMismatch() const {
+  const prediction::FeatureScaling& scaling = state_->predictor.scaling();
+  // The speed feature's range is the speeds seen at the training runs' triggers: at most the
+  // approach speed. 0.1 m/s of slack covers the speed PID's overshoot.
+  constexpr double kSlack = 0.1;
+  if (scaling.max.empty() || !(state_->options.attack_speed > scaling.max[0] + kSlack)) return "";
+  char why[200];
+  std::snprintf(why, sizeof why,
+                "the predictor was trained at speeds up to %.2f m/s but the machine attacks at "
+                "%.2f m/s; V2 is extrapolated (retrain with train_predictor --max-speed)",
+                scaling.max[0], state_->options.attack_speed);
+  return why;
+}
+
 std::string ShovelJob::ConfigYaml() const {
   const ShovelRunOptions& o = state_->options;
   std::ostringstream y;
@@ -283,7 +298,7 @@ std::string ShovelJob::ConfigYaml() const {
   y << "]\n"
     << "semantics: " << (o.truth_labels ? "simulator labels" : state_->segmenter) << "\n"
     << "predictor: "
-    << (o.predictor.empty() ? o.models_dir + "/prediction/penetration_svr" : o.predictor) << "\n"
+    << (o.predictor.empty() ? prediction::MainJobPredictor(o.models_dir) : o.predictor) << "\n"
     << "selection: " << ToString(o.selection) << "\n"
     << "shovel_weights: {k_t: " << state_->selection.k_t << ", k_s: " << state_->selection.k_s
     << ", k_c: " << state_->selection.k_c << ", k_e: " << state_->selection.k_e
@@ -294,6 +309,8 @@ std::string ShovelJob::ConfigYaml() const {
     << "pressure_threshold_bar: " << o.pressure_threshold / 1e5 << "\n"
     << "stairway_steps: " << o.stairway_steps << "\n"
     << "scoop_deceleration_mps2: " << o.scoop_deceleration << "\n"
+    << "attack_speed_mps: " << o.attack_speed << "\n"
+    << "target_fill: " << o.target_fill << "\n"
     << "attitude_feed_forward: " << (o.attitude_feed_forward ? "true" : "false") << "\n"
     << "approach_distance_m: " << o.approach_distance << "\n"
     << "safety_distance_m: " << o.safety_distance << "\n"
@@ -373,6 +390,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   scoop_options.policy = o.policy;
   scoop_options.strategy.fixed_steps = o.stairway_steps;
   scoop_options.scoop_deceleration = o.scoop_deceleration;
+  scoop_options.attack_speed = o.attack_speed;
+  scoop_options.target_fill = o.target_fill;
   scoop_options.attitude_feed_forward = o.attitude_feed_forward;
   out.target_volume = scoop_options.target_fill * machine.bucket.rated_capacity;
 
@@ -1249,6 +1268,10 @@ int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::pat
       << job->scenario_name() << " -> " << folder->dir().string() << "\n";
   log.Info("run " + info.run_id + ": " + std::to_string(options.cycles) + " cycles, seed " +
            std::to_string(options.seed));
+  if (const std::string mismatch = job->PredictorMismatch(); !mismatch.empty()) {
+    err << "autoshovel run: warning: " << mismatch << "\n";
+    log.Warning(mismatch);
+  }
 
   std::vector<results::ReportFigure> figures;
   int incomplete = 0;

@@ -43,14 +43,29 @@ struct ShovelRunOptions {
   std::vector<std::string> bins;
   bool truth_labels = false;  ///< simulator labels instead of the segmentation network
   std::string segmenter;      ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
-  std::string predictor;      ///< SVR model prefix; empty: models/prediction/penetration_svr
+  /// SVR model prefix; empty: prediction::MainJobPredictor (models/prediction/
+  /// penetration_svr_fast, trained for the scoop profile below).
+  std::string predictor;
   control::ScoopPolicy policy = control::ScoopPolicy::kAutoSelection;
   TriggerChoice trigger = TriggerChoice::kPredicted;
   double pressure_threshold = 150e5;  ///< boom cylinder pressure of the pressure trigger [Pa]
   int stairway_steps = 3;             ///< N of "Stairway #N"
-  /// Fall of the drive's speed reference once the scoop moves the arm [m/s²]
-  /// (control::ScoopCycleOptions::scoop_deceleration). The predictor must be trained for it.
-  double scoop_deceleration = 1.0;
+  /// The scoop profile. The main job attacks at 1.5 m/s and keeps pushing while the arm curls,
+  /// its speed reference falling at 0.6 m/s² once the scoop moves the arm. The machine then
+  /// carries enough way into the pile that V1 + V2 reaches V_t within 0.05–0.2 s of contact
+  /// (seed Table 5: 0.32–0.41 s), where the braking scoop of control::ScoopCycleOptions
+  /// (1 m/s, 1 m/s²) waits 2.2–7.6 s, crowding at full traction all the while; docs/results.md
+  /// gives both, and the cost: a few percent more energy per cycle. The predictor must be
+  /// trained for the profile it drives (train_predictor --min-speed/--max-speed
+  /// --scoop-deceleration; identification/predictor/README.md).
+  /// Fall of the drive's speed reference once the scoop moves the arm
+  /// (control::ScoopCycleOptions::scoop_deceleration) [m/s²].
+  double scoop_deceleration = 0.6;
+  /// Approach and crowding speed (control::ScoopCycleOptions::attack_speed) [m/s].
+  double attack_speed = 1.5;
+  /// V_t as a fraction of the bucket's rated capacity (control::ScoopCycleOptions::target_fill):
+  /// the trigger fires when κ·(V1 + V2) reaches it and the adaptive Stairway stops there [-].
+  double target_fill = 1.0;
   /// control::ScoopCycleOptions::attitude_feed_forward: the exit lift opens the tilt valve as
   /// the boom's demand will move the boom (false: the bucket PID alone; the attitude held is
   /// the same either way).
@@ -154,6 +169,9 @@ class ShovelJob {
   const std::string& machine_name() const;
   /// The resolved configuration, as YAML (config.yaml of the run folder).
   std::string ConfigYaml() const;
+  /// Empty, or why the predictor does not fit the scoop profile: its training speeds end below
+  /// the attack speed (it would extrapolate V2 for a machine it never saw).
+  std::string PredictorMismatch() const;
 
  private:
   CycleOutcome RunCycleAt(int index, int site, const std::filesystem::path& figures_dir,

@@ -91,8 +91,9 @@ struct ScoopCycleOptions {
   /// Seed §6.2, "fixed acceleration control upon scooping initiation": once the final curl
   /// moves the arm, the speed reference falls from the attack speed at this rate and the drive
   /// follows it. 1 m/s² (the speed profile's a_dec) stops the machine within about its
-  /// hydraulic-delay travel, the regime the shipped penetration predictor is trained in
-  /// (identification/predictor). Gentler rates crowd while curling; docs/scooping_control.md
+  /// hydraulic-delay travel: the braking scoop, the regime models/prediction/penetration_svr is
+  /// trained in, and this struct's default. Gentler rates crowd while curling (the main job
+  /// attacks at 1.5 m/s and falls at 0.6 m/s²: app::ShovelRunOptions); docs/scooping_control.md
   /// gives what they do to fill and why the Eq. (19) volume model then mispredicts the intake.
   double scoop_deceleration = 1.0;      ///< [m/s²]
   double retreat_speed = 1.0;           ///< reversing speed [m/s]

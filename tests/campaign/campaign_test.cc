@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -81,6 +82,21 @@ TEST(CampaignSpec, ReadsAndRefusesWithLocations) {
       "name: a\nscenario: cone_pile\nweeks: 1\nshifts_per_week: 1\ncycles_per_shift: 1\n"
       "policies: [auto, auto]\n");
   EXPECT_NE(twice.find("listed twice"), std::string::npos) << twice;
+  // The scoop profile: read as written; the main job's when left out.
+  EXPECT_TRUE(std::isnan(spec.attack_speed));
+  EXPECT_TRUE(spec.predictor.empty());
+  const CampaignSpec braking = LoadCampaignSpec(
+      WriteSpec(dir, std::string(kSmallSpec) +
+                         "attack_speed: 1.0\nscoop_deceleration: 1.0\npredictor: penetration_svr\n")
+          .string());
+  EXPECT_DOUBLE_EQ(braking.attack_speed, 1.0);
+  EXPECT_DOUBLE_EQ(braking.scoop_deceleration, 1.0);
+  EXPECT_EQ(braking.predictor, "penetration_svr");
+  const std::string deceleration = SpecError(
+      "name: a\nscenario: cone_pile\nweeks: 1\nshifts_per_week: 1\ncycles_per_shift: 1\n"
+      "policies: [auto]\nscoop_deceleration: 0\n");
+  EXPECT_NE(deceleration.find("spec.yaml:7:21: scoop_deceleration"), std::string::npos)
+      << deceleration;
   const std::string missing = SpecError("name: a\nscenario: cone_pile\n");
   EXPECT_NE(missing.find("weeks"), std::string::npos) << missing;
 }

@@ -10,6 +10,7 @@
 
 #include "identification/predictor/retrain_command.h"
 #include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/shipped_models.h"
 #include "runtime/results/results_db.h"
 
 namespace autoshovel::predictor {
@@ -39,9 +40,13 @@ results::CycleRecord Cycle(int index) {
 
 // `n` cycles with crowding samples drawn in the training ranges; the travel is what the shipped
 // model predicts plus `offset`.
+// The site's samples are made from the braking scoop's model, which is also the base the
+// retrained model is compared with (RetrainOptions::base).
+const std::string kSiteBase = kModels + "/" + prediction::kBrakingScoopPredictor;
+
 void WriteSite(const fs::path& file, int n, double offset) {
   const prediction::PenetrationPredictor shipped =
-      prediction::PenetrationPredictor::Load(kModels + "/prediction/penetration_svr");
+      prediction::PenetrationPredictor::Load(kSiteBase);
   results::ResultsDb db(file);
   results::RunInfo info;
   info.run_id = "site";
@@ -111,6 +116,7 @@ TEST(RetrainPredictor, LearnsASiteThatPenetratesFurther) {
   RetrainOptions o;
   o.database = (dir / "site.sqlite").string();
   o.models_dir = kModels;
+  o.base = kSiteBase;
   o.out = (dir / "site_svr").string();
   o.threads = 2;
   std::ostringstream out, err;

@@ -206,8 +206,10 @@ TEST(Faults, StuckBucketImuAbandonsTheCycle) {
 
 // The boom IMU's bias walks off. Nothing on board measures the boom twice, so a slow drift
 // (0.1°/s, 2° by the end of the cycle) is not seen: the bucket rides a few centimetres off
-// and the cycle completes. A fast one (1°/s) has the joint PID press the bucket into the floor
-// to reach the angle it reads: the boom stops answering its valve, and the cycle is abandoned.
+// and the cycle completes. A fast one (1.5°/s) has the joint PID press the bucket into the
+// floor to reach the angle it reads: the boom stops answering its valve, and the cycle is
+// abandoned before the pile. (At 1°/s the 1.5 m/s attack reaches the pile first and the cycle
+// completes with the bucket riding high, fill 0.905.)
 TEST(Faults, SlowBoomImuDriftCompletesAFastOneIsStopped) {
   ShovelRunOptions o = Options("bin_1");
   FaultSpec drift = Fault(FaultKind::kImuBiasDrift, 0.0, INFINITY);
@@ -219,7 +221,7 @@ TEST(Faults, SlowBoomImuDriftCompletesAFastOneIsStopped) {
   EXPECT_TRUE(slow.record.completed) << slow.failure;
   EXPECT_GE(slow.record.fill_rate, 0.9);
 
-  o.faults[0].rate_rad_s = 1.0 * M_PI / 180;
+  o.faults[0].rate_rad_s = 1.5 * M_PI / 180;
   const CycleOutcome fast = RunOne(o);
   ExpectSafe(o, fast);
   EXPECT_FALSE(fast.record.completed);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -61,6 +62,13 @@ ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
   o.trigger = spec.trigger == "perception" ? TriggerChoice::kPerception
               : spec.trigger == "pressure" ? TriggerChoice::kPressure
                                            : TriggerChoice::kPredicted;
+  if (std::isfinite(spec.attack_speed)) o.attack_speed = spec.attack_speed;
+  if (std::isfinite(spec.scoop_deceleration)) o.scoop_deceleration = spec.scoop_deceleration;
+  if (!spec.predictor.empty()) {
+    o.predictor = spec.predictor.find('/') == std::string::npos
+                      ? models_dir + "/prediction/" + spec.predictor
+                      : spec.predictor;
+  }
   o.figures = false;
   o.yard_variation = spec.yard_variation;
   o.faults = job.faults;

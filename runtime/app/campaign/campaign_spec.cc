@@ -124,6 +124,17 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
       spec.trigger = root.Enum("trigger", {"predicted", "perception", "pressure"});
     if (root.Has("truth_labels"))
       spec.truth_labels = root.Enum("truth_labels", {"true", "false"}) == "true";
+    if (root.Has("attack_speed")) {
+      spec.attack_speed = root.Number("attack_speed", core::NumberRule::Closed(0.1, 4.0, "m/s"));
+    }
+    if (root.Has("scoop_deceleration")) {
+      spec.scoop_deceleration =
+          root.Number("scoop_deceleration", core::NumberRule::Closed(0.05, 5.0, "m/s^2"));
+    }
+    if (root.Has("predictor")) {
+      spec.predictor = root.String("predictor");
+      if (spec.predictor.empty()) root.Error("predictor", "empty model name");
+    }
     if (root.Has("yard_variation")) {
       spec.yard_variation = root.Number("yard_variation", core::NumberRule::Closed(0.0, 0.9, ""));
     }

@@ -14,6 +14,10 @@
 //   stairway_steps: 3                 # N of "Stairway #N" (stairway_fixed)
 //   trigger: predicted                # predicted | perception | pressure
 //   truth_labels: true                # simulator labels instead of the network (faster)
+//   attack_speed: 1.5                 # scoop profile (app::ShovelRunOptions): attack [m/s],
+//   scoop_deceleration: 0.6           # speed reference's fall once the arm moves [m/s²], and
+//   predictor: penetration_svr_fast   # its model: a name under <models>/prediction, or a path
+//                                     # stem; all three default to the main job's
 //   yard_variation: 0.25              # each shift's piles up to 25 % lower than written, and
 //                                     # irregular heaps re-seeded (plant::VaryPiles); default 0
 //   faults: [...]                     # injected faults, as in a scenario (plant/fault_spec.h)
@@ -35,6 +39,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -64,6 +69,9 @@ struct CampaignSpec {
   int stairway_steps = 3;
   std::string trigger = "predicted";
   bool truth_labels = true;
+  double attack_speed = NAN;        ///< [m/s]; NaN: the main job's
+  double scoop_deceleration = NAN;  ///< [m/s²]; NaN: the main job's
+  std::string predictor;            ///< as written; empty: the main job's
   double yard_variation = 0;
   double max_cycle_time_s = 120;
   /// Faults every shift's cycles meet (plant/fault_spec.h), on top of the scenario's own.

@@ -1222,6 +1222,9 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     for (double v : r.payload_at_actions) volumes += (volumes.empty() ? "" : ", ") + Fixed(v, 2);
     say("bucket volume before the first atomic action and after each: " + volumes + " m^3");
   }
+  if (scoop && r.drive_eased_for_boom) {
+    say("the drive eased: the boom stalled lifting against the pile");
+  }
   say(std::string(rec.completed ? "done" : "NOT completed: " + out.failure) + " — " + site.name +
       ", " + rec.material + ", " + rec.strategy + " (" + rec.atomic_actions + "), fill " +
       Fixed(100 * rec.fill_rate, 1) + " %, trigger " + Fixed(r.trigger_after_contact, 2) +

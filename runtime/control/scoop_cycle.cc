@@ -61,6 +61,10 @@ const char* ToString(ScoopPolicy policy) {
 std::string ScoopCycleOptions::Invalid() const {
   if (!(tick > 0) || !std::isfinite(tick)) return "scoop cycle: tick must be > 0 s";
   if (decision_every < 1) return "scoop cycle: decision_every must be >= 1";
+  const double stall[] = {boom_stall_time, boom_stall_rate, boom_stall_opening};
+  for (double v : stall) {
+    if (!(v >= 0) || !std::isfinite(v)) return "scoop cycle: boom stall limits must be >= 0";
+  }
   const double positive[] = {attack_speed, scoop_deceleration, retreat_speed,
                              target_fill,  max_approach,       max_crowd,
                              max_scoop,    max_retreat,        action_timeout};
@@ -137,6 +141,9 @@ struct ScoopCycle::Runtime {
   double hold_attitude = NAN;
   std::string stop_request;         ///< RequestStop's reason: crowding ends at the next decision
   bool drive_held = false;          ///< after a stop request the scoop does not crowd on
+  double boom_lifting_since = NAN;  ///< scoop: the boom valve opened to lift since [s]
+  double boom_stalled_since = NAN;  ///< scoop: the boom slower than the stall rate since [s]
+  bool drive_eased = false;         ///< scoop: eased for a stalled boom, until the next action
   bool drive_hold_started = false;  ///< the speed profile restarted from the speed at the hold
   std::vector<Eigen::Vector3d> last_predicted_path;              ///< of the last V2 [m]
   double last_v2 = NAN;                                          ///< [m³]
@@ -200,6 +207,34 @@ ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
 
 double ScoopCycle::BucketTargetForAttitude(double attitude, double q_boom) const {
   return std::clamp(attitude - q_boom, machine_.links[1].joint_min, limits_.bucket_max);
+}
+
+bool ScoopCycle::BoomPinnedByTheDrive(const Proprioception& s, Runtime& rt) const {
+  if (rt.drive_eased) return true;
+  if (!(options_.boom_stall_time > 0) || !rt.action) return false;
+  // The opening sent last tick: the boom valve's own command, before the dead-zone inverse
+  // (positive lifts).
+  // A lifting opening takes the valve's delay to move the boom, so the boom counts as stalled
+  // only once the opening has been held that long plus the stall time, with the boom slow for
+  // the stall time.
+  const bool lifting = rt.command.valve[boom_valve_] >= options_.boom_stall_opening;
+  if (!lifting) rt.boom_lifting_since = NAN;
+  if (lifting && std::isnan(rt.boom_lifting_since)) rt.boom_lifting_since = s.time;
+  if (s.qd_boom >= options_.boom_stall_rate) rt.boom_stalled_since = NAN;
+  if (s.qd_boom < options_.boom_stall_rate && std::isnan(rt.boom_stalled_since)) {
+    rt.boom_stalled_since = s.time;
+  }
+  const double boom_delay = static_cast<double>(boom_delay_ticks_) * options_.tick;
+  if (!lifting || s.time - rt.boom_lifting_since < boom_delay + options_.boom_stall_time ||
+      s.time - rt.boom_stalled_since < options_.boom_stall_time) {
+    return false;
+  }
+  // Brake from the speed the machine has (as for a held drive): the PI's integral is wound
+  // up against the pile.
+  rt.drive_eased = true;
+  rt.result.drive_eased_for_boom = true;
+  rt.speed_pid->Reset(std::max(s.speed, 0.0));
+  return true;
 }
 
 void ScoopCycle::HoldAttitudeAhead(const Proprioception& s, Runtime& rt, double& bucket_now,
@@ -403,6 +438,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
           rt.targets = TargetsAfter(*rt.action, rt.targets, limits_);
           rt.action_start = s.time;
           rt.arrived_at = NAN;
+          rt.drive_eased = false;
           // The final rack-back and lift leave the pile: stop crowding.
           const bool final_part = rt.sequencer->strategy() == ScoopStrategy::kJustInOut ||
                                   rt.sequencer->actions() > 2 * rt.sequencer->steps();
@@ -582,6 +618,7 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
         speed_target = std::max(
             options_.attack_speed - options_.scoop_deceleration * (s.time - rt.slowing_since), 0.0);
       }
+      if (BoomPinnedByTheDrive(s, rt)) speed_target = 0;
       if (rt.drive_held) speed_target = 0;
       break;
     case Phase::kLevel:

@@ -108,7 +108,18 @@ struct ScoopCycleOptions {
   bool attitude_feed_forward = true;
   double arm_motion = 0.02;     ///< joint travel that shows the scoop has begun moving [rad]
   double action_timeout = 4.0;  ///< an atomic action that has not arrived by then is over [s]
-  double path_spacing = 0.01;   ///< tip path points at least this far apart [m]
+  /// Feathering the drive: while scooping, a boom opened at least `boom_stall_opening` to lift
+  /// that rises slower than `boom_stall_rate` for `boom_stall_time` (after the valve's delay)
+  /// is pinned by the drive pressing the bucket into the pile (a Stairway step deep in sand).
+  /// The drive then eases to a stop until the next atomic action, as an operator lifts off
+  /// the throttle to let the boom rise. 1 s, half the supervisor's stuck-valve time: a
+  /// shorter stall frees itself (at 0.5 s the adaptive Stairway eased where it did not need to
+  /// and spent 45 % more energy lifting through the heap). A boom that stalls for another
+  /// reason (a stuck valve) stays stalled, and the supervisor still sees it. 0 s: never.
+  double boom_stall_time = 1.0;     ///< [s]
+  double boom_stall_rate = 0.005;   ///< [rad/s]
+  double boom_stall_opening = 0.5;  ///< [-]
+  double path_spacing = 0.01;       ///< tip path points at least this far apart [m]
   /// Gain k of the boom and bucket angle complementary filter (joint_angle_filter.h) every
   /// tick; 1 uses the readings as they come.
   double joint_filter_gain = 0.1;
@@ -165,6 +176,9 @@ struct ScoopResult {
   /// which action took material in and which let it go.
   std::vector<double> payload_at_actions;
   int stairway_steps = 0;
+  /// The drive eased at least once because the boom stalled lifting
+  /// (ScoopCycleOptions::boom_stall_time).
+  bool drive_eased_for_boom = false;
   double boom_pressure_at_contact = 0;  ///< [Pa]
   double boom_pressure_at_trigger = 0;  ///< [Pa]
   double payload_after_scoop = 0;       ///< before levelling and shaking [m³]
@@ -242,6 +256,9 @@ class ScoopCycle {
   /// angle the PID compares it with (Smith predictor) and the tilt feed-forward opening.
   void HoldAttitudeAhead(const Proprioception& s, Runtime& rt, double& bucket_now,
                          double& feed_forward) const;
+  /// Scoop phase, every tick: whether the drive is to ease because the boom, opened to lift,
+  /// has stalled for ScoopCycleOptions::boom_stall_time (latched until the next action).
+  bool BoomPinnedByTheDrive(const Proprioception& s, Runtime& rt) const;
 
   const model::MachineDescription& machine_;
   const generated::MachineFunctions& functions_;

@@ -212,9 +212,8 @@ double ScoopCycle::BucketTargetForAttitude(double attitude, double q_boom) const
 bool ScoopCycle::BoomPinnedByTheDrive(const Proprioception& s, Runtime& rt) const {
   if (rt.drive_eased) return true;
   if (!(options_.boom_stall_time > 0) || !rt.action) return false;
-  // The opening sent last tick: the boom valve's own command, before the dead-zone inverse
-  // (positive lifts).
-  // A lifting opening takes the valve's delay to move the boom, so the boom counts as stalled
+  // The opening sent last tick to the boom valve (the PID's output, dead zone compensated;
+  // positive lifts). A lifting opening takes the valve's delay to move the boom, so the boom counts as stalled
   // only once the opening has been held that long plus the stall time, with the boom slow for
   // the stall time.
   const bool lifting = rt.command.valve[boom_valve_] >= options_.boom_stall_opening;

@@ -213,9 +213,9 @@ bool ScoopCycle::BoomPinnedByTheDrive(const Proprioception& s, Runtime& rt) cons
   if (rt.drive_eased) return true;
   if (!(options_.boom_stall_time > 0) || !rt.action) return false;
   // The opening sent last tick to the boom valve (the PID's output, dead zone compensated;
-  // positive lifts). A lifting opening takes the valve's delay to move the boom, so the boom counts as stalled
-  // only once the opening has been held that long plus the stall time, with the boom slow for
-  // the stall time.
+  // positive lifts). A lifting opening takes the valve's delay to move the boom, so the boom counts
+  // as stalled only once the opening has been held that long plus the stall time, with the boom
+  // slow for the stall time.
   const bool lifting = rt.command.valve[boom_valve_] >= options_.boom_stall_opening;
   if (!lifting) rt.boom_lifting_since = NAN;
   if (lifting && std::isnan(rt.boom_lifting_since)) rt.boom_lifting_since = s.time;

@@ -9,6 +9,7 @@
 
 #include "codegen/expression_printer.h"
 #include "codegen/symbolic_model.h"
+#include "runtime/core/file_output.h"
 #include "runtime/model/interpreted_model.h"
 
 namespace autoshovel::codegen {
@@ -44,24 +45,33 @@ std::string FindClangFormat(const std::string& given) {
 }
 
 void WriteFormatted(const fs::path& path, const std::string& text, const std::string& formatter) {
-  fs::create_directories(path.parent_path());
+  core::CreateFolders(path.parent_path());
   const fs::path temporary = path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    if (!out) throw std::runtime_error(temporary.string() + ": cannot write");
-    out << text;
-  }
+  core::WriteFileAtomically(temporary, text);
   // Through standard input so that --assume-filename holds: include sorting must see the final
   // name to recognise the file's own header.
   const fs::path formatted = path.string() + ".formatted";
   const std::string command = formatter + " --style=\"" + kClangFormatStyle +
                               "\" --assume-filename='" + path.string() + "' < '" +
                               temporary.string() + "' > '" + formatted.string() + "'";
-  if (std::system(command.c_str()) != 0) {
-    throw std::runtime_error("codegen: clang-format failed on " + temporary.string());
+  const int status = std::system(command.c_str());
+  std::string bytes;
+  {
+    std::ifstream in(formatted, std::ios::binary);
+    std::ostringstream read_back;
+    read_back << in.rdbuf();
+    bytes = read_back.str();
   }
-  fs::remove(temporary);
-  fs::rename(formatted, path);  // atomic: a half-written file never replaces a good one
+  std::error_code ignored;
+  fs::remove(temporary, ignored);
+  fs::remove(formatted, ignored);
+  // A shell redirect into a full disk can leave clang-format's output short with status 0: an
+  // empty result for a non-empty text is a failed write too.
+  if (status != 0 || (bytes.empty() && !text.empty())) {
+    throw core::OutputError(path, "clang-format failed or its output could not be written");
+  }
+  // Checked and atomic (core/file_output.h): a half-written file never replaces a good one.
+  core::WriteFileAtomically(path, bytes);
 }
 
 std::string Doubles(const std::vector<double>& values) {
@@ -391,14 +401,11 @@ std::vector<fs::path> EmitRegistry(const EmitOptions& options) {
       "if(COMMAND autoshovel_generated_warnings)\n"
       "  autoshovel_generated_warnings(autoshovel_generated)\nendif()\n";
   const fs::path dir = options.output_dir;
-  fs::create_directories(dir);
+  core::CreateFolders(dir);
   WriteFormatted(dir / "machine_functions.h", InterfaceHeader(), formatter);
   WriteFormatted(dir / "registry.h", registry_h, formatter);
   WriteFormatted(dir / "registry.cc", registry_cc, formatter);
-  {
-    std::ofstream out(dir / "CMakeLists.txt", std::ios::binary);
-    out << cmake;
-  }
+  core::WriteFileAtomically(dir / "CMakeLists.txt", cmake);
   return {dir / "machine_functions.h", dir / "registry.h", dir / "registry.cc",
           dir / "CMakeLists.txt"};
 }
@@ -408,15 +415,13 @@ std::vector<fs::path> EmitMachine(const model::MachineDescription& machine,
   const std::string formatter = FindClangFormat(options.clang_format);
   const MachineTexts texts = MachineCode(machine);
   const fs::path dir = options.output_dir / machine.name;
-  fs::create_directories(dir);
+  core::CreateFolders(dir);
   const fs::path header = dir / (machine.name + ".h");
   const fs::path source = dir / (machine.name + ".cc");
   WriteFormatted(header, texts.header, formatter);
   WriteFormatted(source, texts.source, formatter);
-  {
-    std::ofstream marker(dir / kMarkerFile, std::ios::binary);
-    marker << "generated from " << BannerPath(machine.source_file) << "\n";
-  }
+  core::WriteFileAtomically(dir / kMarkerFile,
+                            "generated from " + BannerPath(machine.source_file) + "\n");
   std::vector<fs::path> written{header, source};
   for (auto& path : EmitRegistry(options)) written.push_back(path);
   return written;

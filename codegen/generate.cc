@@ -55,9 +55,10 @@ int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& er
   try {
     EmitOptions options{request.output_dir, ""};
     for (const auto& m : machines) {
+      // Said once the files are written, never before (a failed write is not a success).
+      EmitMachine(m, options);
       out << "codegen: " << m.source_file << " -> " << (request.output_dir / m.name).string() << "/"
           << std::endl;
-      EmitMachine(m, options);
     }
     if (request.clean && fs::is_directory(request.output_dir)) {
       for (const auto& entry : fs::directory_iterator(request.output_dir)) {
@@ -69,9 +70,14 @@ int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& er
       }
       EmitRegistry(options);
     }
+  } catch (const fs::filesystem_error& e) {
+    // std::filesystem's what() is "filesystem error: cannot create directories: ... [path]":
+    // said here as the path and the reason, like every other write failure.
+    err << "codegen: " << e.path1().string() << ": cannot write: " << e.code().message() << '\n';
+    return 1;
   } catch (const std::exception& e) {
-    err << e.what() << '\n';
-    return 2;
+    err << "codegen: " << e.what() << '\n';
+    return 1;
   }
   return 0;
 }

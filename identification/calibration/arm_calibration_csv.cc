@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/input_file.h"
 
 namespace autoshovel::identification {
 
@@ -35,6 +36,11 @@ struct Column {
 ArmCalibrationData ReadArmCalibrationCsv(const std::string& path,
                                          const std::vector<std::string>& link_names) {
   core::DiagnosticSink sink;
+  // Checked before opening: a named pipe would block the open, a folder would read as empty.
+  if (const std::string why = core::NotARegularFile(path); !why.empty()) {
+    sink.Add({path, 0, 0}, "", "cannot open: " + why);
+    sink.ThrowIfAny();
+  }
   std::ifstream file(path);
   if (!file) {
     sink.Add({path, 0, 0}, "", "cannot open the file");

@@ -6,11 +6,13 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <sstream>
 
 #include "generated/registry.h"
 #include "identification/calibration/arm_calibration_csv.h"
 #include "identification/common/overlay_file.h"
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
 #include "runtime/model/description.h"
 #include "runtime/model/interpreted_model.h"
 #include "runtime/plot/bar_chart.h"
@@ -30,8 +32,8 @@ void Simulate(const model::MachineDescription& machine, const std::string& path,
   std::normal_distribution<double> gauss(0.0, 1.0);
   const double boom_plan[] = {0.05, 0.95, 0.5, 0.2, 0.8, 0.35, 0.65};
   const double other_plan[] = {0.9, 0.1, 0.5, 0.15, 0.85, 0.7, 0.3};
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
+  // Composed in memory, then one checked atomic write (core/file_output.h).
+  std::ostringstream out;
   out << "# simulated by autoshovel calibrate arm --simulate: machine " << machine.name << ", seed "
       << seed << ", IMU noise 0.1 deg, rangefinder noise 5 mm\n";
   out << "theta_cab_deg";
@@ -68,6 +70,7 @@ void Simulate(const model::MachineDescription& machine, const std::string& path,
     }
     out << "\n";
   }
+  core::WriteFileAtomically(path, out.str());
 }
 
 }  // namespace

@@ -12,16 +12,21 @@
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <ostream>
+#include <sstream>
 
 #include "identification/camera_lidar/auto_calibration.h"
 #include "identification/camera_lidar/board_detection.h"
 #include "identification/camera_lidar/board_simulation.h"
+#include "identification/camera_lidar/image_header.h"
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "identification/camera_lidar/projection_render.h"
 #include "identification/camera_lidar/yard_simulation.h"
 #include "identification/common/overlay_file.h"
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/yaml_reader.h"
 #include "runtime/model/description.h"
+#include "runtime/plot/image_file.h"
 #include "runtime/sensors/sensor_pose.h"
 
 namespace autoshovel::identification {
@@ -65,13 +70,21 @@ std::vector<FramePaths> ListFrames(const std::string& dir) {
 }
 
 cv::Mat ReadImage(const std::string& path, const CameraIntrinsics& intrinsics) {
+  // The size from the header first: cv::imread allocates whatever the header announces (a
+  // 1.1 MB PNG saying 20000 x 20000 px took 1.3 GB before this check could refuse it).
+  const ImageHeader header = ReadImageHeader(path);
+  if (header.width != intrinsics.width || header.height != intrinsics.height) {
+    Fail(path, 0,
+         "image is " + ImageSizeText(header.width, header.height) + " (" + header.format +
+             " header), the intrinsics say " + ImageSizeText(intrinsics.width, intrinsics.height) +
+             ": not decoded");
+  }
   const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
   if (image.empty()) Fail(path, 0, "cannot read the image");
   if (image.cols != intrinsics.width || image.rows != intrinsics.height) {
     Fail(path, 0,
-         "image is " + std::to_string(image.cols) + " x " + std::to_string(image.rows) +
-             " px, the intrinsics say " + std::to_string(intrinsics.width) + " x " +
-             std::to_string(intrinsics.height) + " px");
+         "image is " + ImageSizeText(image.cols, image.rows) + ", the intrinsics say " +
+             ImageSizeText(intrinsics.width, intrinsics.height));
   }
   return image;
 }
@@ -81,7 +94,7 @@ BoardGeometry ReadBoardYaml(const std::string& path) {
   if (!fs::exists(path)) return board;  // the default board
   core::DiagnosticSink sink;
   try {
-    const YAML::Node root = YAML::LoadFile(path);
+    const YAML::Node root = core::LoadYamlFile(path, sink);
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();
       const YAML::Mark m = kv.second.Mark();
@@ -132,8 +145,8 @@ double BasinHalfWidth(const ScoreSlice& slice) {
 void Simulate(const model::MachineDescription& machine, const model::Lidar& lidar,
               const CalibrateCameraLidarOptions& options, std::ostream& out) {
   const std::string dir = options.simulate;
-  fs::create_directories(dir + "/board");
-  fs::create_directories(dir + "/frames");
+  core::CreateFolders(dir + "/board");
+  core::CreateFolders(dir + "/frames");
   const Eigen::Isometry3d T_base_lidar = sensors::PoseToIsometry(lidar.pose);
   const Eigen::Isometry3d T_nominal =
       T_base_lidar.inverse() * sensors::PoseToIsometry(machine.sensors.camera.pose);
@@ -142,11 +155,12 @@ void Simulate(const model::MachineDescription& machine, const model::Lidar& lida
   // Step 1 data: the board, seen with the mounting as built (the description's).
   const BoardGeometry board;
   {
-    std::ofstream f(dir + "/board/board.yaml");
+    std::ostringstream f;
     f << "# calibration board (seed Fig. 4): square, four square holes at (+/-offset, "
          "+/-offset) [m]\nside: "
       << board.side << "\nhole_side: " << board.hole_side << "\nhole_offset: " << board.hole_offset
       << "\n";
+    core::WriteFileAtomically(dir + "/board/board.yaml", f.str());
   }
   sensors::Rng rng(options.seed);
   int k = 0;
@@ -155,7 +169,7 @@ void Simulate(const model::MachineDescription& machine, const model::Lidar& lida
         SimulateBoardFrame(machine.sensors.camera, lidar, T_nominal, T_base_board, board, 1.0, rng);
     char name[64];
     std::snprintf(name, sizeof name, "%s/board/board_%03d", dir.c_str(), k++);
-    cv::imwrite(std::string(name) + ".png", f.image);
+    plot::WriteImageFile(std::string(name) + ".png", f.image);
     WritePcd(std::string(name) + ".pcd", f.cloud, PcdEncoding::kBinary);
   }
   // Step 2 data: after "a period of operation" (seed Fig. 12) the camera has moved by 1.5° and
@@ -170,16 +184,17 @@ void Simulate(const model::MachineDescription& machine, const model::Lidar& lida
   for (std::size_t i = 0; i < frames.size(); ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%03zu", i);
-    cv::imwrite(dir + "/frames/" + name + ".png", frames[i].image);
+    plot::WriteImageFile(dir + "/frames/" + name + ".png", frames[i].image);
     const std::string cloud = dir + "/frames/" + name;
     if (i % 3 == 0) WritePcd(cloud + ".pcd", frames[i].cloud, PcdEncoding::kBinaryCompressed);
     if (i % 3 == 1) WritePcd(cloud + ".pcd", frames[i].cloud, PcdEncoding::kAscii);
     if (i % 3 == 2) WriteKittiBin(cloud + ".bin", frames[i].cloud);
     WriteMaskFolder(dir + "/masks/" + name, frames[i].masks);
   }
-  std::ofstream truth(dir + "/truth.yaml");
-  truth << "# simulation truth: T_lidar_camera (camera body in the LiDAR frame)\n"
-        << "board_session: " << PoseText(T_nominal) << "\nframes: " << PoseText(T_drifted) << "\n";
+  core::WriteFileAtomically(dir + "/truth.yaml",
+                            "# simulation truth: T_lidar_camera (camera body in the LiDAR frame)\n"
+                            "board_session: " +
+                                PoseText(T_nominal) + "\nframes: " + PoseText(T_drifted) + "\n");
   out << "simulated data set: " << dir << " (" << DefaultBoardPoses(machine.sensors.camera).size()
       << " board views, " << frames.size() << " yard frames with SAM-style masks)\n"
       << "try: autoshovel calibrate camera-lidar --machine " << machine.name << " --frames " << dir
@@ -187,7 +202,10 @@ void Simulate(const model::MachineDescription& machine, const model::Lidar& lida
 }
 
 Eigen::Isometry3d ReadTruth(const std::string& path) {
-  const YAML::Node node = YAML::LoadFile(path)["frames"];
+  core::DiagnosticSink sink;
+  const YAML::Node root = core::LoadYamlFile(path, sink);
+  sink.ThrowIfAny();
+  const YAML::Node node = root["frames"];
   model::Pose3 pose;
   for (int i = 0; i < 3; ++i) {
     pose.xyz[i] = node["xyz"][i].as<double>();
@@ -274,10 +292,23 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
       std::string mask_source;
     };
     std::vector<Loaded> loaded;
+    std::size_t points_read = 0, non_finite = 0, skipped = 0;
     for (const FramePaths& f : frames) {
       Loaded l;
       l.image = Undistort(ReadImage(f.image, intrinsics), intrinsics, false);
-      l.cloud = ReadPointCloud(f.cloud, options.max_points);
+      PointCloudReadStats stats;
+      l.cloud = ReadPointCloud(f.cloud, options.max_points, &stats);
+      points_read += stats.points_in_file;
+      non_finite += stats.non_finite;
+      // An all-NaN cloud used to count as a frame and pull the score towards noise.
+      if (stats.finite() < kMinFramePoints) {
+        err << kCommand << ": warning: " << f.cloud << ": " << stats.finite() << " of "
+            << stats.points_in_file << " points are finite (" << stats.non_finite
+            << " NaN or infinite dropped), fewer than the " << kMinFramePoints
+            << " a frame needs: frame '" << f.name << "' skipped\n";
+        ++skipped;
+        continue;
+      }
       std::string mask_path;
       for (const std::string& candidate :
            {masks_root + "/" + f.name, masks_root + "/" + f.name + ".png",
@@ -294,6 +325,12 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
         l.mask_source = "built-in segmenter";
       }
       loaded.push_back(std::move(l));
+    }
+    if (loaded.empty()) {
+      Fail(options.frames.empty() ? frames.front().cloud : options.frames, 0,
+           "no usable frame: all " + std::to_string(frames.size()) +
+               " point clouds have fewer than " + std::to_string(kMinFramePoints) +
+               " finite points");
     }
     // The masks are already undistorted: score with an undistorted camera.
     CameraIntrinsics pinhole = intrinsics;
@@ -354,8 +391,14 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
     const Eigen::Isometry3d T_base_camera = T_base_lidar * result.T_lidar_camera;
     char line[256];
     out << "camera-lidar calibration of " << machine.name << " (" << lidar->name << "), "
-        << frames.size() << " frames, masks: " << loaded.front().mask_source
-        << (loaded.size() > 1 ? ", ..." : "") << "\n";
+        << loaded.size() << " frames";
+    if (skipped > 0)
+      out << " (" << skipped << " of " << frames.size() << " skipped: too few finite points)";
+    out << ", masks: " << loaded.front().mask_source << (loaded.size() > 1 ? ", ..." : "") << "\n";
+    if (non_finite > 0) {
+      out << "  clouds: " << non_finite << " of " << points_read
+          << " points dropped for a NaN or infinite coordinate\n";
+    }
     out << "  start: " << start << "\n";
     {
       // The floor's noise decides how the ground class is made (cloud_features.h); a user with
@@ -430,7 +473,8 @@ int RunCalibrateCameraLidar(const CalibrateCameraLidarOptions& options, std::ost
         << "\nscore surface and board residuals: " << residuals_png << "\n";
     return 0;
   } catch (const core::InputError& e) {
-    err << e.what() << "\n" << kCommand << ": nothing written\n";
+    // The located refusal alone: a refused input never writes anything, so saying so is noise.
+    err << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     err << kCommand << ": " << e.what() << "\n";

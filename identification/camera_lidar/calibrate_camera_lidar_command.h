@@ -19,6 +19,12 @@
 
 namespace autoshovel::identification {
 
+/// The fewest finite points a scene frame needs to be scored: 1000. A LiDAR frame has 10^4 to
+/// 10^5; a cloud with fewer finite points saw almost nothing (an organised cloud of NaN "no
+/// returns", a covered sensor) and would only pull the consistency score towards noise. Such a
+/// frame is skipped with a warning naming its file and counts; none left is an error.
+inline constexpr std::size_t kMinFramePoints = 1000;
+
 struct CalibrateCameraLidarOptions {
   std::string machine;                      ///< machine name or description path
   std::string models_dir;                   ///< where machine names and scenarios are looked up

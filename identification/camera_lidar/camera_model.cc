@@ -6,8 +6,11 @@
 #include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/yaml_reader.h"
 
 namespace autoshovel::identification {
 
@@ -30,16 +33,9 @@ CameraIntrinsics IntrinsicsFromDescription(const model::Camera& camera) {
 
 CameraIntrinsics ReadCameraInfoYaml(const std::string& path) {
   core::DiagnosticSink sink;
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    sink.Add({path, 0, 0}, "", "cannot open the intrinsics file");
-    sink.ThrowIfAny();
-  } catch (const YAML::Exception& e) {
-    sink.Add({path, e.mark.line + 1, e.mark.column + 1}, "", e.msg);
-    sink.ThrowIfAny();
-  }
+  // The project's YAML loader: size limit, syntax errors and duplicate keys, located.
+  const YAML::Node root = core::LoadYamlFile(path, sink);
+  sink.ThrowIfAny();
   CameraIntrinsics c;
   auto integer = [&](const char* key, int& value) {
     const YAML::Node node = root[key];
@@ -107,8 +103,7 @@ CameraIntrinsics ReadCameraInfoYaml(const std::string& path) {
 }
 
 void WriteCameraInfoYaml(const std::string& path, const CameraIntrinsics& c) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
+  std::ostringstream out;  // then one checked atomic write (core/file_output.h)
   out.precision(10);
   out << "# ROS camera_info: pinhole K and plumb_bob distortion D\n"
       << "image_width: " << c.width << "\nimage_height: " << c.height << "\ncamera_name: camera\n"
@@ -118,6 +113,7 @@ void WriteCameraInfoYaml(const std::string& path, const CameraIntrinsics& c) {
       << c.D.size() << "\n  data: [";
   for (std::size_t i = 0; i < c.D.size(); ++i) out << (i ? ", " : "") << c.D[i];
   out << "]\n";
+  core::WriteFileAtomically(path, out.str());
 }
 
 cv::Mat Undistort(const cv::Mat& image, const CameraIntrinsics& c, bool nearest) {

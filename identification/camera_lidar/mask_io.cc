@@ -9,7 +9,11 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "identification/camera_lidar/image_header.h"
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/yaml_reader.h"
+#include "runtime/plot/image_file.h"
 
 namespace autoshovel::identification {
 
@@ -27,11 +31,23 @@ namespace {
 
 std::string SizeText(int w, int h) { return std::to_string(w) + " x " + std::to_string(h) + " px"; }
 
-void CheckSize(const std::string& file, const cv::Mat& m, int width, int height) {
-  if (m.cols != width || m.rows != height) {
+void CheckSize(const std::string& file, int mask_width, int mask_height, int width, int height) {
+  if (mask_width != width || mask_height != height) {
     Fail(file, 0, 0, "",
-         "mask is " + SizeText(m.cols, m.rows) + ", the image is " + SizeText(width, height));
+         "mask is " + SizeText(mask_width, mask_height) + ", the image is " +
+             SizeText(width, height));
   }
+}
+
+// Decodes a mask PNG only once its header says it is the image's size: cv::imread allocates
+// what the header announces, however small the file (image_header.h).
+cv::Mat ReadMaskPng(const std::string& file, int flags, int width, int height) {
+  const ImageHeader header = ReadImageHeader(file);
+  CheckSize(file, header.width, header.height, width, height);
+  const cv::Mat m = cv::imread(file, flags);
+  if (m.empty()) Fail(file, 0, 0, "", "cannot read the PNG");
+  CheckSize(file, m.cols, m.rows, width, height);
+  return m;
 }
 
 MaskSet ReadFolder(const std::string& dir, int width, int height) {
@@ -51,18 +67,14 @@ MaskSet ReadFolder(const std::string& dir, int width, int height) {
   });
   MaskSet set{width, height, {}};
   for (const auto& f : files) {
-    const cv::Mat m = cv::imread(f.string(), cv::IMREAD_GRAYSCALE);
-    if (m.empty()) Fail(f.string(), 0, 0, "", "cannot read the PNG");
-    CheckSize(f.string(), m, width, height);
+    const cv::Mat m = ReadMaskPng(f.string(), cv::IMREAD_GRAYSCALE, width, height);
     set.masks.push_back(m > 127);
   }
   return set;
 }
 
 MaskSet ReadLabelPng(const std::string& path, int width, int height) {
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
-  if (raw.empty()) Fail(path, 0, 0, "", "cannot read the PNG");
-  CheckSize(path, raw, width, height);
+  const cv::Mat raw = ReadMaskPng(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE, width, height);
   cv::Mat labels;
   raw.convertTo(labels, CV_32S);
   std::vector<int> values(labels.begin<int>(), labels.end<int>());
@@ -77,14 +89,11 @@ MaskSet ReadLabelPng(const std::string& path, int width, int height) {
 }
 
 MaskSet ReadCocoRle(const std::string& path, int width, int height) {
-  YAML::Node root;  // JSON is YAML 1.2 flow style: yaml-cpp reads it with line marks
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    Fail(path, 0, 0, "", "cannot open the RLE file");
-  } catch (const YAML::Exception& e) {
-    Fail(path, e.mark.line + 1, e.mark.column + 1, "", e.msg);
-  }
+  // JSON is YAML 1.2 flow style: the project's YAML loader reads it with line marks, its size
+  // limit and its duplicate-key check.
+  core::DiagnosticSink sink;
+  const YAML::Node root = core::LoadYamlFile(path, sink);
+  sink.ThrowIfAny();
   YAML::Node records = root.IsMap() ? root["annotations"] : root;
   if (!records || !records.IsSequence()) {
     Fail(path, 1, 1, "", "expected a list of mask records or {\"annotations\": [...]}");
@@ -221,10 +230,10 @@ std::string EncodeRleString(const cv::Mat& mask) {
 }
 
 void WriteMaskFolder(const std::string& dir, const MaskSet& masks) {
-  fs::create_directories(dir);
+  core::CreateFolders(dir);
   for (std::size_t i = 0; i < masks.masks.size(); ++i) {
     const std::string file = dir + "/" + std::to_string(i) + ".png";
-    if (!cv::imwrite(file, masks.masks[i])) throw std::runtime_error("cannot write " + file);
+    plot::WriteImageFile(file, masks.masks[i]);
   }
 }
 

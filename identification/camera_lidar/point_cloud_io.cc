@@ -17,6 +17,8 @@
 #include <vector>
 
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/input_file.h"
 
 namespace autoshovel::identification {
 
@@ -65,6 +67,10 @@ void Reduce(std::vector<sensors::LidarPoint>& points, std::size_t max_points) {
 // Checks the PCD header line by line (pcl::io reports problems on the console only) and the
 // size of the data that follows.
 void CheckPcd(const std::string& path, bool& has_intensity) {
+  // Checked before opening: a named pipe would block the open, a folder would read as empty.
+  if (const std::string why = core::NotARegularFile(path); !why.empty()) {
+    Fail(path, 0, "", "cannot open the point cloud: " + why);
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) Fail(path, 0, "", "cannot open the point cloud");
   std::vector<std::string> fields;
@@ -72,7 +78,7 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
   std::vector<std::string> types;
   long width = -1, height = -1, points = -1;
   std::string data;
-  int line_no = 0, fields_line = 0, data_line = 0;
+  int line_no = 0, fields_line = 0, data_line = 0, width_line = 0, points_line = 0;
   std::string line;
   const char* const keys[] = {"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
                               "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
@@ -146,10 +152,12 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
       types.assign(w.begin() + 1, w.end());
     } else if (key == "WIDTH") {
       positive(width, true);
+      width_line = line_no;
     } else if (key == "HEIGHT") {
       positive(height, false);
     } else if (key == "POINTS") {
       positive(points, true);
+      points_line = line_no;
     } else if (key == "VIEWPOINT") {
       if (n != 7)
         Fail(path, line_no, key,
@@ -174,6 +182,20 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
   if (counts.empty()) counts.assign(fields.size(), 1);
   if (width < 0) Fail(path, data_line, "WIDTH", "missing");
   if (height < 0) height = 1;
+  // Before any arithmetic on them and before pcl::io allocates: a 200-byte header may promise a
+  // billion points, which pcl::io would try to hold.
+  const long max_points = static_cast<long>(kMaxCloudPoints);
+  const std::string limit = std::to_string(kMaxCloudPoints);
+  if (points > max_points) {
+    Fail(path, points_line, "POINTS",
+         std::to_string(points) + " points, more than the " + limit +
+             " a point cloud may have: not decoded");
+  }
+  if (width > max_points || width > max_points / height) {
+    Fail(path, width_line, "WIDTH",
+         std::to_string(width) + " x HEIGHT " + std::to_string(height) + " is more than the " +
+             limit + " points a point cloud may have: not decoded");
+  }
   if (points < 0) points = width * height;
   if (points != width * height) {
     Fail(path, data_line, "POINTS",
@@ -271,7 +293,8 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
   }
 }
 
-sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points) {
+sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points,
+                            PointCloudReadStats& stats) {
   bool has_intensity = false;
   CheckPcd(path, has_intensity);
   pcl::PCLPointCloud2 blob;
@@ -283,8 +306,12 @@ sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points) {
     pcl::PointCloud<pcl::PointXYZI> points;
     pcl::fromPCLPointCloud2(blob, points);
     cloud.points.reserve(points.size());
+    stats.points_in_file = points.size();
     for (const auto& p : points) {
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        ++stats.non_finite;
+        continue;
+      }
       sensors::LidarPoint q;
       q.p_sensor = Eigen::Vector3f(p.x, p.y, p.z);
       q.intensity = std::isfinite(p.intensity) ? p.intensity : 0.0f;
@@ -293,8 +320,12 @@ sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points) {
   } else {
     pcl::PointCloud<pcl::PointXYZ> points;
     pcl::fromPCLPointCloud2(blob, points);
+    stats.points_in_file = points.size();
     for (const auto& p : points) {
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        ++stats.non_finite;
+        continue;
+      }
       sensors::LidarPoint q;
       q.p_sensor = Eigen::Vector3f(p.x, p.y, p.z);
       cloud.points.push_back(q);
@@ -304,7 +335,11 @@ sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points) {
   return cloud;
 }
 
-sensors::PointCloud ReadKittiBin(const std::string& path, std::size_t max_points) {
+sensors::PointCloud ReadKittiBin(const std::string& path, std::size_t max_points,
+                                 PointCloudReadStats& stats) {
+  if (const std::string why = core::NotARegularFile(path); !why.empty()) {
+    Fail(path, 0, "", "cannot open the point cloud: " + why);
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) Fail(path, 0, "", "cannot open the point cloud");
   in.seekg(0, std::ios::end);
@@ -315,13 +350,23 @@ sensors::PointCloud ReadKittiBin(const std::string& path, std::size_t max_points
          "size " + std::to_string(bytes) +
              " bytes is not a multiple of 16 (float32 x, y, z, intensity per point)");
   }
+  if (bytes / 16 > static_cast<long>(kMaxCloudPoints)) {
+    Fail(path, 0, "",
+         "size " + std::to_string(bytes) + " bytes is " + std::to_string(bytes / 16) +
+             " points, more than the " + std::to_string(kMaxCloudPoints) +
+             " a point cloud may have: not read");
+  }
+  stats.points_in_file = static_cast<std::size_t>(bytes / 16);
   sensors::PointCloud cloud;
   cloud.sensor = std::filesystem::path(path).stem().string();
   std::mt19937_64 rng(0x5eed);
   long seen = 0, offset = 0;
   float v[4];
   for (; in.read(reinterpret_cast<char*>(v), sizeof v); offset += sizeof v) {
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+      ++stats.non_finite;
+      continue;
+    }
     // No LiDAR sees 10 km: such a coordinate is a file that is not float32 x y z i (text, a PCD
     // renamed .bin, float64), which would otherwise decode to a cloud of nonsense.
     for (int k = 0; k < 3; ++k) {
@@ -350,10 +395,14 @@ sensors::PointCloud ReadKittiBin(const std::string& path, std::size_t max_points
 
 }  // namespace
 
-sensors::PointCloud ReadPointCloud(const std::string& path, std::size_t max_points) {
+sensors::PointCloud ReadPointCloud(const std::string& path, std::size_t max_points,
+                                   PointCloudReadStats* stats) {
+  PointCloudReadStats local;
+  PointCloudReadStats& out = stats != nullptr ? *stats : local;
+  out = {};
   const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".pcd") return ReadPcd(path, max_points);
-  if (ext == ".bin") return ReadKittiBin(path, max_points);
+  if (ext == ".pcd") return ReadPcd(path, max_points, out);
+  if (ext == ".bin") return ReadKittiBin(path, max_points, out);
   Fail(path, 0, "", "unknown point cloud format '" + ext + "' (expected .pcd or .bin)");
 }
 
@@ -370,31 +419,46 @@ void WritePcd(const std::string& path, const sensors::PointCloud& cloud, PcdEnco
   }
   points.width = static_cast<std::uint32_t>(points.size());
   points.height = 1;
-  pcl::PCDWriter writer;
-  int rc = 0;
+  // PCL writes to a path only, unchecked against a full disk: it writes a scratch file beside the
+  // target, whose bytes then go through the project's checked atomic write (core/file_output.h).
+  std::string bytes;
   if (points.empty()) {  // PCL refuses to write an empty cloud; write the header by hand
-    std::ofstream out(path);
-    out << "VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
-           "WIDTH 0\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n";
-    rc = out ? 0 : -1;
-  } else if (encoding == PcdEncoding::kAscii) {
-    rc = writer.writeASCII(path, points, 7);
-  } else if (encoding == PcdEncoding::kBinary) {
-    rc = writer.writeBinary(path, points);
+    bytes =
+        "VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+        "WIDTH 0\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n";
   } else {
-    rc = writer.writeBinaryCompressed(path, points);
+    const std::string scratch = path + ".pcl.tmp";
+    pcl::PCDWriter writer;
+    int rc = 0;
+    if (encoding == PcdEncoding::kAscii) {
+      rc = writer.writeASCII(scratch, points, 7);
+    } else if (encoding == PcdEncoding::kBinary) {
+      rc = writer.writeBinary(scratch, points);
+    } else {
+      rc = writer.writeBinaryCompressed(scratch, points);
+    }
+    std::ifstream in(scratch, std::ios::binary);
+    std::ostringstream read_back;
+    read_back << in.rdbuf();
+    in.close();
+    std::error_code ignored;
+    std::filesystem::remove(scratch, ignored);
+    if (rc != 0 || read_back.str().empty()) {
+      throw core::OutputError(path, "pcl::io could not write the cloud");
+    }
+    bytes = read_back.str();
   }
-  if (rc != 0) throw std::runtime_error("cannot write " + path);
+  core::WriteFileAtomically(path, bytes);
 }
 
 void WriteKittiBin(const std::string& path, const sensors::PointCloud& cloud) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error("cannot write " + path);
+  std::string bytes;
+  bytes.reserve(cloud.points.size() * 16);
   for (const auto& p : cloud.points) {
     const float v[4] = {p.p_sensor.x(), p.p_sensor.y(), p.p_sensor.z(), p.intensity};
-    out.write(reinterpret_cast<const char*>(v), sizeof v);
+    bytes.append(reinterpret_cast<const char*>(v), sizeof v);
   }
-  if (!out) throw std::runtime_error("cannot write " + path);
+  core::WriteFileAtomically(path, bytes);
 }
 
 }  // namespace autoshovel::identification

@@ -25,9 +25,24 @@ namespace autoshovel::identification {
 
 enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
 
+/// The most points a cloud file may hold: 20 million, 76 frames of a 128-beam spinning LiDAR
+/// (2048 x 128 points). pcl::io decodes a whole PCD before it can be sampled, at about 70 bytes
+/// a point (1.4 GB here), so a PCD's POINTS (or WIDTH x HEIGHT) and a .bin's size / 16 are
+/// checked against it before anything is decoded (docs/camera_lidar_calibration.md).
+inline constexpr std::size_t kMaxCloudPoints = 20'000'000;
+
+/// What a read found in the file, before sampling.
+struct PointCloudReadStats {
+  std::size_t points_in_file = 0;  ///< every point the file holds
+  std::size_t non_finite = 0;      ///< dropped: a NaN or infinite x, y or z ("no return")
+  std::size_t finite() const { return points_in_file - non_finite; }
+};
+
 /// Reads a .pcd or .bin (by extension). `max_points` > 0 bounds memory: a .bin is sampled while
-/// it is read (reservoir sampling, fixed seed: deterministic), a PCD after decoding.
-sensors::PointCloud ReadPointCloud(const std::string& path, std::size_t max_points = 0);
+/// it is read (reservoir sampling, fixed seed: deterministic), a PCD after decoding. Points with
+/// a non-finite coordinate are dropped and counted in `stats`.
+sensors::PointCloud ReadPointCloud(const std::string& path, std::size_t max_points = 0,
+                                   PointCloudReadStats* stats = nullptr);
 
 /// Writes x y z intensity (float32); throws std::runtime_error naming the path on failure.
 void WritePcd(const std::string& path, const sensors::PointCloud& cloud, PcdEncoding encoding);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "identification/camera_lidar/camera_model.h"
+#include "runtime/plot/image_file.h"
 
 namespace autoshovel::identification {
 
@@ -40,7 +41,7 @@ void WriteBeforeAfterPng(const std::string& path, const cv::Mat& image,
   cv::rectangle(right, {0, 0}, {right.cols - 1, right.rows - 1}, {0, 0, 255}, 3);  // Fig. 12
   cv::Mat both;
   cv::hconcat(left, right, both);
-  if (!cv::imwrite(path, both)) throw std::runtime_error("cannot write " + path);
+  plot::WriteImageFile(path, both);
 }
 
 void WriteScoreSurfacePng(const std::string& path, const std::vector<ScoreSlice>& slices,
@@ -92,7 +93,7 @@ void WriteScoreSurfacePng(const std::string& path, const std::vector<ScoreSlice>
     }
     cv::circle(canvas, c, 20, {180, 180, 180}, 1);  // 1 px
   }
-  if (!cv::imwrite(path, canvas)) throw std::runtime_error("cannot write " + path);
+  plot::WriteImageFile(path, canvas);
 }
 
 }  // namespace autoshovel::identification

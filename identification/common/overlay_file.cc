@@ -1,11 +1,6 @@
 #include "identification/common/overlay_file.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <stdexcept>
+#include "runtime/core/file_output.h"
 
 namespace autoshovel::identification {
 
@@ -18,27 +13,7 @@ std::string OverlayHeader(const model::MachineDescription& machine,
 }
 
 void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file) {
-      throw std::runtime_error("cannot write " + temporary + ": " + std::strerror(errno));
-    }
-    file << text;
-    file.flush();
-    if (!file) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      throw std::runtime_error("cannot write " + temporary + ": " + std::strerror(errno));
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw std::runtime_error("cannot replace " + path + ": " + error.message());
-  }
+  core::WriteFileAtomically(path, text);
 }
 
 }  // namespace autoshovel::identification

@@ -15,8 +15,9 @@ namespace autoshovel::identification {
 std::string OverlayHeader(const model::MachineDescription& machine,
                           const std::string& command_line);
 
-/// Writes `text` to `path` atomically (temporary file, then rename). Throws std::runtime_error
-/// naming the path when it cannot be written; the old file, if any, is then untouched.
+/// Writes `text` to `path` atomically: core::WriteFileAtomically (temporary file, fsync, rename).
+/// Throws core::OutputError naming the path when it cannot be written; the old file, if any, is
+/// then untouched.
 void WriteFileAtomically(const std::string& path, const std::string& text);
 
 }  // namespace autoshovel::identification

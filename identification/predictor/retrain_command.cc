@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "identification/predictor/svr_training.h"
+#include "runtime/core/file_output.h"
 #include "runtime/model/description.h"
 #include "runtime/prediction/penetration_predictor.h"
 #include "runtime/prediction/shipped_models.h"
@@ -105,7 +106,8 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
     std::vector<results::CrowdingSample> training, held_out;
     int skipped = 0;
     {
-      const results::ResultsDb db(o.database);
+      // Read-only and checked with PRAGMA integrity_check; values through the typed reader.
+      const results::ResultsDb db(o.database, results::ResultsDb::Access::kReadOnly);
       for (const results::ResultsDb::StoredCrowdingSample& s : db.CrowdingSamples()) {
         if (o.strategy != "all" && s.sample.strategy != o.strategy) {
           ++skipped;
@@ -127,13 +129,27 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
     std::vector<std::string> materials;
     for (const model::Material& m : machine.materials) materials.push_back(m.name);
     SvrDataset train;
+    int not_measured = 0, not_encodable = 0;
     for (const results::CrowdingSample& s : training) {
+      // NULL penetration: not measured (the reader refuses text and infinities outright).
+      if (std::isnan(s.penetration)) {
+        ++not_measured;
+        continue;
+      }
       std::string why;
       const std::vector<double> x =
           prediction::PenetrationPredictor::Encode(FeaturesOf(s), materials, &why);
-      if (x.empty() || !std::isfinite(s.penetration)) continue;  // refused, as the model would
+      if (x.empty()) {  // refused, as the model would refuse it
+        ++not_encodable;
+        continue;
+      }
       train.x.push_back(x);
       train.y.push_back(s.penetration);
+    }
+    if (not_measured > 0 || not_encodable > 0) {
+      out << "left out of training: " << not_measured << " of " << training.size()
+          << " samples with penetration_m not measured (NULL), " << not_encodable
+          << " the model cannot encode (a NULL input or an unknown material)\n";
     }
     prediction::FeatureScaling scaling;
     scaling.machine = machine.name;
@@ -142,7 +158,7 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
                             o.out + " (" + std::to_string(train.x.size()) + " samples of " +
                             o.strategy + ")");
     const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
+    core::CreateFolders(parent);
     const int threads = o.threads > 0
                             ? o.threads
                             : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));

@@ -5,9 +5,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
+
+#include "runtime/core/file_output.h"
 
 namespace autoshovel::predictor {
 
@@ -86,9 +91,23 @@ int FitAndSave(const std::vector<std::vector<double>>& scaled, const std::vector
   const svm_parameter p = Parameters(c, gamma, epsilon);
   svm_model* model = svm_train(&problem.problem, &p);
   const int support_vectors = model->l;
-  const int saved = svm_save_model(model_path.c_str(), model);
+  // libsvm writes to a path in place; it writes a scratch file, whose bytes then go through the
+  // project's checked atomic write (core/file_output.h), so a failed save never leaves half a
+  // model under the final name.
+  const std::string scratch = model_path + ".svm.tmp";
+  const int saved = svm_save_model(scratch.c_str(), model);
   svm_free_and_destroy_model(&model);
-  if (saved != 0) throw std::runtime_error("cannot write " + model_path);
+  std::ostringstream bytes;
+  {
+    std::ifstream in(scratch, std::ios::binary);
+    bytes << in.rdbuf();
+  }
+  std::error_code ignored;
+  std::filesystem::remove(scratch, ignored);
+  if (saved != 0 || bytes.str().empty()) {
+    throw core::OutputError(model_path, "libsvm could not write the model");
+  }
+  core::WriteFileAtomically(model_path, bytes.str());
   return support_vectors;
 }
 

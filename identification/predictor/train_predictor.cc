@@ -8,12 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include "generated/registry.h"
 #include "identification/predictor/crowding_runs.h"
 #include "identification/predictor/evaluation.h"
 #include "identification/predictor/svr_training.h"
+#include "runtime/core/file_output.h"
 
 using namespace autoshovel;
 
@@ -220,7 +222,7 @@ int main(int argc, char** argv) {
     if (!samples_csv.empty()) {
       // Every completed run with the final model's prediction beside its target, so the error
       // tail can be read by cause (test set: runs i mod 5 = 4).
-      std::ofstream csv(samples_csv);
+      std::ostringstream csv;  // then one checked atomic write (core/file_output.h)
       csv << "run,set,shape,material,height,v0,trigger_volume,trigger_cause,speed,V1,h1,h2,h3,h4,"
              "h5,h6,penetration,predicted_penetration,payload,dug_depth\n";
       for (const predictor::CrowdingRun& run : all) {
@@ -235,7 +237,7 @@ int main(int argc, char** argv) {
             << (predicted.ok ? predicted.penetration : std::nan("")) << "," << run.payload << ","
             << run.spec.dug_depth << "\n";
       }
-      if (!csv) throw std::runtime_error("cannot write " + samples_csv);
+      core::WriteFileAtomically(samples_csv, csv.str());
     }
     std::printf("bucket capacity racked back (largest training payload): %.3f m^3\n", capacity);
     const predictor::PredictorEvaluation on_test =

@@ -17,6 +17,8 @@
 
 #include "identification/segmentation/tool_args.h"
 #include "identification/segmentation/yard_views.h"
+#include "runtime/core/file_output.h"
+#include "runtime/plot/image_file.h"
 
 namespace {
 
@@ -87,8 +89,8 @@ int Run(int argc, char** argv) {
   }
   const identification::YardViewSampler sampler(
       args.String("models", AUTOSHOVEL_DEFAULT_MODELS_DIR), args.List("scenarios"));
-  fs::create_directories(out / "images");
-  fs::create_directories(out / "labels");
+  core::CreateFolders(out / "images");
+  core::CreateFolders(out / "labels");
 
   std::vector<std::string> lines(static_cast<std::size_t>(count));
   std::atomic<std::int64_t> done{0};
@@ -102,10 +104,9 @@ int Run(int argc, char** argv) {
                       const_cast<std::uint8_t*>(v.frame.bgr.data()));
     const cv::Mat labels(v.frame.height, v.frame.width, CV_8UC1,
                          const_cast<std::uint8_t*>(v.frame.labels.data()));
-    if (!cv::imwrite((out / "images" / (std::string(id) + ".png")).string(), bgr) ||
-        !cv::imwrite((out / "labels" / (std::string(id) + ".png")).string(), labels)) {
-      throw std::runtime_error("cannot write PNG files under " + out.string());
-    }
+    // Checked and atomic (runtime/plot/image_file.h): no half PNG in a training set.
+    plot::WriteImageFile(out / "images" / (std::string(id) + ".png"), bgr);
+    plot::WriteImageFile(out / "labels" / (std::string(id) + ".png"), labels);
     const std::string split = args.has("split") ? args.String("split", "")
                               : (val_every > 0 && index % val_every == val_every - 1) ? "val"
                                                                                       : "train";
@@ -121,7 +122,11 @@ int Run(int argc, char** argv) {
   // Appends when the set is made in pieces (--first > 0), so one split file lists them all.
   const fs::path split_file = out / "split.csv";
   const bool fresh = first == 0 || !fs::exists(split_file);
-  std::ofstream csv(split_file, fresh ? std::ios::trunc : std::ios::app);
+  std::ostringstream csv;  // the old file's rows, then the new ones, in one checked write
+  if (!fresh) {
+    std::ifstream old(split_file, std::ios::binary);
+    csv << old.rdbuf();
+  }
   if (fresh) {
     csv << "# segmentation_dataset --seed " << seed << "; scenarios:";
     for (const std::string& s : sampler.scenario_names()) csv << ' ' << s;
@@ -129,7 +134,7 @@ int Run(int argc, char** argv) {
            "extra_obstacles\n";
   }
   for (const std::string& line : lines) csv << line << '\n';
-  if (!csv) throw std::runtime_error("cannot write " + split_file.string());
+  core::WriteFileAtomically(split_file, csv.str());
   std::cout << "wrote " << count << " views to " << out.string() << '\n';
   return 0;
 }

@@ -8,11 +8,14 @@
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "generated/registry.h"
 #include "identification/weights/demonstration_generation.h"
 #include "identification/weights/weight_tuning.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/progress_line.h"
 #include "runtime/model/description.h"
 
 namespace autoshovel::identification {
@@ -23,28 +26,34 @@ constexpr const char* kWeightNames[5] = {"k_t", "k_s", "k_c", "k_e", "k_a"};
 
 bool HeldOut(int id) { return id % 5 == 4; }
 
-// A progress line rewritten in place: done/total, rate, ETA.
+// done/total, rate, ETA: rewritten in place on a terminal, a line per update elsewhere
+// (core/progress_line.h).
 class Progress {
  public:
-  Progress(std::ostream& out, std::string what) : out_(out), what_(std::move(what)) {}
+  Progress(std::ostream& out, std::string what) : line_(out), what_(std::move(what)) {}
   void Update(int done, int total) {
     const double elapsed = Seconds();
-    if (finished_ || (done < total && elapsed - last_ < 0.5)) return;
+    const double interval = line_.terminal() ? 0.5 : 10.0;
+    if (finished_ || (done < total && elapsed - last_ < interval)) return;
     finished_ = done >= total;
     last_ = elapsed;
     const double rate = elapsed > 0 ? done / elapsed : 0;
     const double eta = rate > 0 ? (total - done) / rate : 0;
     char line[160];
-    std::snprintf(line, sizeof line, "\r%s %d/%d (%.1f/s, ETA %.0f s)   ", what_.c_str(), done,
-                  total, rate, eta);
-    out_ << line << (done == total ? "\n" : "") << std::flush;
+    std::snprintf(line, sizeof line, "%s %d/%d (%.1f/s, ETA %.0f s)", what_.c_str(), done, total,
+                  rate, eta);
+    if (done >= total) {
+      line_.Finish(line);
+    } else {
+      line_.Update(line);
+    }
   }
   double Seconds() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
 
  private:
-  std::ostream& out_;
+  core::ProgressLine line_;
   std::string what_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   double last_ = -1;
@@ -85,7 +94,7 @@ void PrintAgreement(std::ostream& out, const char* set, const char* weights, con
 void WriteWeights(const std::filesystem::path& file, const ShovelWeights& w,
                   const TrainWeightsOptions& o, int demonstrations, const Agreement& before,
                   const Agreement& after) {
-  std::ofstream f(file);
+  std::ostringstream f;  // then one checked atomic write (core/file_output.h)
   f << "# Eq. (18) weights tuned by `" << kCommand << "` (wheel-loader seed §5) on "
     << demonstrations << " demonstrations from " << o.demos << ", seed " << o.seed << ".\n";
   char line[200];
@@ -98,7 +107,7 @@ void WriteWeights(const std::filesystem::path& file, const ShovelWeights& w,
     std::snprintf(line, sizeof line, "%s: %.4f\n", kWeightNames[k], w[k]);
     f << line;
   }
-  if (!f) throw std::runtime_error(file.string() + ": cannot write the weights");
+  core::WriteFileAtomically(file, f.str());
 }
 
 }  // namespace

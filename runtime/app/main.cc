@@ -16,6 +16,7 @@
 #include "identification/weights/train_weights_command.h"
 #include "runtime/app/campaign/campaign_command.h"
 #include "runtime/app/campaign/production_report.h"
+#include "runtime/app/cli_checks.h"
 #include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/map_command.h"
@@ -24,6 +25,7 @@
 #include "runtime/app/shovel_run.h"
 #include "runtime/app/train_segmentation.h"
 #include "runtime/app/truck_loading/truck_loading_job.h"
+#include "runtime/core/file_output.h"
 #include "runtime/planning/select_command.h"
 
 namespace {
@@ -42,6 +44,18 @@ int RunGenerator(const std::vector<std::string>& arguments) {
   std::cerr << "autoshovel gen: cannot run " << generator.string() << ": " << std::strerror(errno)
             << " (build it: cmake --build build --target autoshovel-codegen)\n";
   return 2;
+}
+
+// Everything a command printed to standard output must have reached it: a full disk behind
+// `> file` or a closed pipe is a failure, not a success (core/file_output.h).
+int FinishOutput(int status) {
+  try {
+    autoshovel::core::FlushStandardOutput();
+  } catch (const autoshovel::core::OutputError& e) {
+    std::cerr << "autoshovel: " << e.what() << "\n";
+    return status == 0 ? 1 : status;
+  }
+  return status;
 }
 
 }  // namespace
@@ -87,16 +101,28 @@ int main(int argc, char** argv) {
   step_cmd->add_option("--machine", step.machine, "Machine name or description file")->required();
   step_cmd->add_option("--actuator", step.actuator, "Actuator name")->capture_default_str();
   step_cmd->add_option("--amplitude", step.amplitude, "Valve duty of the step, in [-1, 1]")
+      ->check(autoshovel::app::FiniteIn(-1, 1))
       ->capture_default_str();
   step_cmd->add_flag("--chirp", step.chirp, "Linear frequency sweep instead of a step");
-  step_cmd->add_option("--f0", step.chirp_f0, "Chirp start frequency [Hz]")->capture_default_str();
-  step_cmd->add_option("--f1", step.chirp_f1, "Chirp end frequency [Hz]")->capture_default_str();
-  step_cmd->add_option("--start", step.step_time, "Time of the step [s]")->capture_default_str();
-  step_cmd->add_option("--duration", step.duration, "Length of the log [s]")->capture_default_str();
+  step_cmd->add_option("--f0", step.chirp_f0, "Chirp start frequency [Hz]")
+      ->check(autoshovel::app::FiniteIn(0, 100, true))
+      ->capture_default_str();
+  step_cmd->add_option("--f1", step.chirp_f1, "Chirp end frequency [Hz]")
+      ->check(autoshovel::app::FiniteIn(0, 100, true))
+      ->capture_default_str();
+  step_cmd->add_option("--start", step.step_time, "Time of the step [s]")
+      ->check(autoshovel::app::FiniteIn(0, 1e5))
+      ->capture_default_str();
+  step_cmd->add_option("--duration", step.duration, "Length of the log [s]")
+      ->check(autoshovel::app::FiniteIn(0, 1e6, true))
+      ->capture_default_str();
   step_cmd->add_option("--rate", step.sample_rate, "Control and logging rate [Hz]")
+      ->check(autoshovel::app::FiniteIn(1, 1e4))
       ->capture_default_str();
   step_cmd->add_flag("--noise", step.noise, "Add data-logger sensor noise");
-  step_cmd->add_option("--seed", step.seed, "Seed of the noise")->capture_default_str();
+  step_cmd->add_option("--seed", step.seed, "Seed of the noise")
+      ->check(autoshovel::app::SeedRange())
+      ->capture_default_str();
   step_cmd->add_option("-o,--output", step.output, "CSV file (default: standard output)");
 
   autoshovel::app::ScenarioOptions scenario;
@@ -106,6 +132,7 @@ int main(int argc, char** argv) {
       ->required();
   scenario_cmd->add_option("-o,--png", scenario.png, "Write the top view to this PNG");
   scenario_cmd->add_option("--mpp", scenario.metres_per_pixel, "Top view metres per pixel")
+      ->check(autoshovel::app::FiniteIn(0.005, 10))
       ->capture_default_str();
 
   autoshovel::app::MapOptions map;
@@ -116,8 +143,11 @@ int main(int argc, char** argv) {
   map_cmd->add_option("scenario", map.scenario, "Scenario name or .yaml path")->required();
   map_cmd->add_option("-o,--png", map.png, "Six-layer picture")->capture_default_str();
   map_cmd->add_option("--lighting", map.lighting, "normal, bright or dim (default: scenario's)");
-  map_cmd->add_option("--frames", map.frames, "LiDAR frames per sensor")->capture_default_str();
+  map_cmd->add_option("--frames", map.frames, "LiDAR frames per sensor")
+      ->check(autoshovel::app::IntegerIn(1, 100))
+      ->capture_default_str();
   map_cmd->add_option("--advance", map.advance, "Start this far ahead of the start pose [m]")
+      ->check(autoshovel::app::FiniteIn(-50, 50))
       ->capture_default_str();
   map_cmd->add_option("--segmenter", map.segmenter,
                       "ONNX segmentation network (default: models/segmentation/yard_segmenter)");
@@ -135,13 +165,16 @@ int main(int argc, char** argv) {
   arm_cmd
       ->add_option("--initial", calibrate_arm.initial,
                    "Start: lengths [m] then offsets [deg] (default: the description's)")
+      ->check(autoshovel::app::FiniteIn(-1e3, 1e3))
       ->delimiter(',');
   arm_cmd->add_option("-o,--overlay", calibrate_arm.overlay, "Overlay to write");
   arm_cmd->add_option("--png", calibrate_arm.png,
                       "Residual chart to write (default: <overlay>.png)");
   arm_cmd->add_option("--simulate", calibrate_arm.simulate,
                       "Write a simulated measurement file (7 poses, seed's noise) and stop");
-  arm_cmd->add_option("--seed", calibrate_arm.seed, "Seed of --simulate")->capture_default_str();
+  arm_cmd->add_option("--seed", calibrate_arm.seed, "Seed of --simulate")
+      ->check(autoshovel::app::SeedRange())
+      ->capture_default_str();
 
   autoshovel::identification::CalibrateCameraLidarOptions camera_lidar;
   CLI::App* camera_lidar_cmd = calibrate_cmd->add_subcommand(
@@ -167,6 +200,7 @@ int main(int argc, char** argv) {
   camera_lidar_cmd
       ->add_option("--initial", camera_lidar.initial,
                    "T_lidar_camera start: x y z [m] roll pitch yaw [deg]")
+      ->check(autoshovel::app::FiniteIn(-1e3, 1e3))
       ->expected(6)
       ->delimiter(',');
   camera_lidar_cmd->add_option("--lock", camera_lidar.lock, "Hold rotation or translation fixed")
@@ -174,6 +208,7 @@ int main(int argc, char** argv) {
   camera_lidar_cmd
       ->add_option("--max-points", camera_lidar.max_points,
                    "Points per frame kept (bounds memory on dense clouds)")
+      ->check(autoshovel::app::IntegerIn(100, 100000000))
       ->capture_default_str();
   camera_lidar_cmd->add_option("-o,--overlay", camera_lidar.overlay, "Overlay to write");
   camera_lidar_cmd->add_option("--png", camera_lidar.png, "Before/after projection image");
@@ -182,6 +217,7 @@ int main(int argc, char** argv) {
   camera_lidar_cmd->add_option("--simulate", camera_lidar.simulate,
                                "Write a simulated data set (board and yard frames) here and stop");
   camera_lidar_cmd->add_option("--seed", camera_lidar.seed, "Seed of --simulate")
+      ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
 
   autoshovel::identification::IdentifyHydraulicsOptions hydraulics;
@@ -215,8 +251,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"Pa", "bar", "MPa"}));
   hydraulics_cmd->add_option("--time-units", hydraulics.time_units, "s | ms")
       ->check(CLI::IsMember({"s", "ms"}));
-  hydraulics_cmd->add_option("--header-lines", hydraulics.header_lines,
-                             "Lines before the first sample (default: detected)");
+  hydraulics_cmd
+      ->add_option("--header-lines", hydraulics.header_lines,
+                   "Lines before the first sample (default: detected)")
+      ->check(autoshovel::app::IntegerIn(0, 1000000));
   hydraulics_cmd->add_option("-o,--overlay", hydraulics.overlay,
                              "Overlay to write (default: <first log>.overlay.yaml)");
   hydraulics_cmd->add_option("--png", hydraulics.png,
@@ -229,6 +267,7 @@ int main(int argc, char** argv) {
                              "Write simulated plant logs (steps 30/60/100 % both ways, a chirp) "
                              "into DIR and stop");
   hydraulics_cmd->add_option("--seed", hydraulics.seed, "Seed of --simulate")
+      ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
 
   autoshovel::identification::TrainWeightsOptions train_weights;
@@ -240,17 +279,22 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   weights_cmd->add_option("--demos", train_weights.demos, "Demonstrations database (SQLite)")
       ->capture_default_str();
-  weights_cmd->add_option("--generate", train_weights.generate,
-                          "First write this many simulated expert demonstrations to --demos "
-                          "(the seed used 482)");
+  weights_cmd
+      ->add_option("--generate", train_weights.generate,
+                   "First write this many simulated expert demonstrations to --demos "
+                   "(the seed used 482)")
+      ->check(autoshovel::app::IntegerIn(1, 1000000));
   weights_cmd->add_option("--seed", train_weights.seed, "Seed of the scenes and of CMA-ES")
+      ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
   weights_cmd
       ->add_option("-o,--out", train_weights.out, "Weights YAML to write (never overwritten)")
       ->capture_default_str();
   weights_cmd->add_option("--evaluations", train_weights.evaluations, "CMA-ES budget")
+      ->check(autoshovel::app::IntegerIn(10, 10000000))
       ->capture_default_str();
   weights_cmd->add_option("--threads", train_weights.threads, "Worker threads (0: every core)")
+      ->check(autoshovel::app::IntegerIn(0, 1024))
       ->capture_default_str();
 
   autoshovel::predictor::RetrainOptions retrain;
@@ -265,7 +309,9 @@ int main(int argc, char** argv) {
       "Model to compare with (default: the main job's, models/prediction/penetration_svr_fast)");
   retrain_cmd->add_option("--strategy", retrain.strategy, "Samples of this scoop only, or all")
       ->capture_default_str();
-  retrain_cmd->add_option("--threads", retrain.threads, "0: every core")->capture_default_str();
+  retrain_cmd->add_option("--threads", retrain.threads, "0: every core")
+      ->check(autoshovel::app::IntegerIn(0, 1024))
+      ->capture_default_str();
 
   autoshovel::app::TrainSegmentationOptions segmentation;
   CLI::App* segmentation_cmd = train_cmd->add_subcommand(
@@ -278,17 +324,24 @@ int main(int argc, char** argv) {
   segmentation_cmd->add_option("--base", segmentation.base,
                                "Network to start from (default: the shipped one)");
   segmentation_cmd->add_option("--views", segmentation.views, "Training views to render")
+      ->check(autoshovel::app::IntegerIn(1, 1000000))
       ->capture_default_str();
   segmentation_cmd->add_option("--heldout", segmentation.heldout, "Held-out views to render")
+      ->check(autoshovel::app::IntegerIn(1, 1000000))
       ->capture_default_str();
   segmentation_cmd->add_option("--steps", segmentation.steps, "Fine-tuning steps (batch 8)")
+      ->check(autoshovel::app::IntegerIn(1, 10000000))
       ->capture_default_str();
   segmentation_cmd->add_option("--lr", segmentation.learning_rate, "Peak learning rate")
+      ->check(autoshovel::app::FiniteIn(0, 1, true))
       ->capture_default_str();
   segmentation_cmd
       ->add_option("--seed", segmentation.seed, "Training views' seed (held-out: seed + 1000)")
+      ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
-  segmentation_cmd->add_option("--jobs", segmentation.jobs, "Threads")->capture_default_str();
+  segmentation_cmd->add_option("--jobs", segmentation.jobs, "Threads")
+      ->check(autoshovel::app::IntegerIn(1, 1024))
+      ->capture_default_str();
   segmentation_cmd->add_option("--work", segmentation.work_dir,
                                "Folder for the rendered views and logs (default: <out>.data)");
 
@@ -302,6 +355,7 @@ int main(int argc, char** argv) {
   campaign_cmd->add_option("-o,--out", campaign_out,
                            "Campaign folder (default: runs/campaign_<name>)");
   campaign_cmd->add_option("--workers", campaign.workers, "Worker processes (0: every core)")
+      ->check(autoshovel::app::IntegerIn(0, 1024))
       ->capture_default_str();
   campaign_cmd->add_flag("--resume", campaign.resume,
                          "Continue the campaign in the folder: merge, then run what is missing");
@@ -335,19 +389,27 @@ int main(int argc, char** argv) {
                        "Perceive with the simulator's labels instead of the network");
   select_cmd->add_option("--segmenter", select.segmenter, "ONNX segmentation network");
   select_cmd->add_option("--frames", select.frames, "LiDAR frames per sensor")
+      ->check(autoshovel::app::IntegerIn(1, 100))
       ->capture_default_str();
   select_cmd->add_option("--advance", select.advance, "Drive the start pose this far ahead [m]")
+      ->check(autoshovel::app::FiniteIn(-50, 50))
       ->capture_default_str();
   select_cmd->add_option("--spacing", select.spacing, "Candidate spacing along the front [m]")
+      ->check(autoshovel::app::FiniteIn(0.05, 10))
       ->capture_default_str();
   select_cmd
       ->add_option("--angles", select.entry_angles_deg,
                    "Entry headings relative to the face normal [deg]")
+      ->check(autoshovel::app::FiniteIn(-90, 90))
       ->delimiter(',');
   select_cmd->add_option("--safety-distance", select.safety_distance, "d_res [m]")
+      ->check(autoshovel::app::FiniteIn(0, 20))
       ->capture_default_str();
-  select_cmd->add_option("--top", select.top, "Candidates listed and drawn")->capture_default_str();
-  select_cmd->add_option("--pile", select.pile, "Only this pile (index, largest first)");
+  select_cmd->add_option("--top", select.top, "Candidates listed and drawn")
+      ->check(autoshovel::app::IntegerIn(1, 1000))
+      ->capture_default_str();
+  select_cmd->add_option("--pile", select.pile, "Only this pile (index, largest first)")
+      ->check(autoshovel::app::IntegerIn(0, 1000));
   bool no_baseline = false;
   select_cmd->add_flag("--no-baseline", no_baseline, "Skip the Chen et al. (2024) ranking");
 
@@ -363,8 +425,12 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--machine", run.machine,
                       "Wheel-loader name or description (default: "
                       "the scenario's)");
-  run_cmd->add_option("--cycles", run.cycles, "Shoveling cycles")->capture_default_str();
-  run_cmd->add_option("--seed", run.seed, "Seed of every random draw")->capture_default_str();
+  run_cmd->add_option("--cycles", run.cycles, "Shoveling cycles")
+      ->check(autoshovel::app::IntegerIn(1, 100000))
+      ->capture_default_str();
+  run_cmd->add_option("--seed", run.seed, "Seed of every random draw")
+      ->check(autoshovel::app::SeedRange())
+      ->capture_default_str();
   run_cmd->add_option("-o,--out", run_out, "Run folder (default: runs/<UTC timestamp>)");
   run_cmd->add_option("--bins", run.bins, "Bins to shovel from in turn (default: all with piles)");
   run_cmd->add_flag("--truth", run.truth_labels,
@@ -378,29 +444,31 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"predicted", "perception", "pressure"}))
       ->capture_default_str();
   run_cmd->add_option("--pressure-bar", run_pressure_bar, "Threshold of --trigger pressure [bar]")
+      ->check(autoshovel::app::FiniteIn(0, 420, true))
       ->capture_default_str();
   run_cmd
       ->add_option("--scoop-deceleration", run.scoop_deceleration,
                    "Fall of the speed reference once the scoop moves the arm [m/s^2] (the "
                    "predictor must be trained for it: docs/scooping_control.md)")
-      ->check(CLI::PositiveNumber)
+      ->check(autoshovel::app::FiniteIn(0, 10, true))
       ->capture_default_str();
   run_cmd
       ->add_option("--attack-speed", run.attack_speed,
                    "Approach and crowding speed [m/s] (the predictor must be trained for it)")
-      ->check(CLI::PositiveNumber)
+      ->check(autoshovel::app::FiniteIn(0, 3, true))
       ->capture_default_str();
   run_cmd
       ->add_option("--target-fill", run.target_fill,
                    "V_t as a fraction of the rated capacity: the trigger's and the adaptive "
                    "Stairway's target")
-      ->check(CLI::Range(0.1, 1.5))
+      ->check(autoshovel::app::FiniteIn(0.1, 1.5))
       ->capture_default_str();
   bool run_no_feed_forward = false;
   run_cmd->add_flag("--no-attitude-feed-forward", run_no_feed_forward,
                     "Hold the bucket's attitude in the exit lift by its PID alone (no tilt "
                     "feed-forward from the boom's demand: docs/scooping_control.md)");
   run_cmd->add_option("--stairway-steps", run.stairway_steps, "N of Stairway #N")
+      ->check(autoshovel::app::IntegerIn(1, 20))
       ->capture_default_str();
   run_cmd->add_option("--selection", run_selection, "ours | chen2024")
       ->check(CLI::IsMember({"ours", "chen2024"}))
@@ -408,12 +476,15 @@ int main(int argc, char** argv) {
   run_cmd
       ->add_option("--safety-distance", run.safety_distance,
                    "Never closer to an obstacle (footprint with 0.3 m margins) [m]")
+      ->check(autoshovel::app::FiniteIn(0, 20))
       ->capture_default_str();
-  run_cmd->add_option("--d-res", run.d_res, "d_res of Eq. (14) [m]")->capture_default_str();
+  run_cmd->add_option("--d-res", run.d_res, "d_res of Eq. (14) [m]")
+      ->check(autoshovel::app::FiniteIn(0, 20, true))
+      ->capture_default_str();
   run_cmd
       ->add_option("--sure-obstacle-growth", run.sure_obstacle_growth_cells,
                    "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
-      ->check(CLI::Range(0, 10))
+      ->check(autoshovel::app::IntegerIn(0, 10))
       ->capture_default_str();
   run_cmd
       ->add_option("--faults", run_faults,
@@ -422,7 +493,7 @@ int main(int argc, char** argv) {
   run_cmd
       ->add_option("--yard-variation", run.yard_variation,
                    "Restock the piles up to this fraction lower (a campaign's yard_variation)")
-      ->check(CLI::Range(0.0, 0.9))
+      ->check(autoshovel::app::FiniteIn(0, 0.9))
       ->capture_default_str();
   run_cmd->add_option("--shovel-weights", run.shovel_weights,
                       "Eq. (18) weights YAML from `autoshovel train weights` (default: Table 1)");
@@ -433,6 +504,7 @@ int main(int argc, char** argv) {
   run_cmd
       ->add_option("--dig-evaluations", truck_loading.dig_evaluations,
                    "Excavator scenarios: plant simulations per dig plan")
+      ->check(autoshovel::app::IntegerIn(1, 100000))
       ->capture_default_str();
   run_cmd->add_flag(
       "--dust", truck_loading_dust,
@@ -448,21 +520,22 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::IsMember({"table4", "table5"}));
   compare_cmd->add_option("--trials", compare.trials, "Single-cycle runs per cell")
+      ->check(autoshovel::app::IntegerIn(1, 1000))
       ->capture_default_str();
   compare_cmd->add_flag("--network", compare.network,
                         "Segmentation network instead of the simulator's labels");
   compare_cmd
       ->add_option("--scoop-deceleration", compare.scoop_deceleration,
                    "Fall of the speed reference once the scoop moves the arm [m/s^2]")
-      ->check(CLI::PositiveNumber)
+      ->check(autoshovel::app::FiniteIn(0, 10, true))
       ->capture_default_str();
   compare_cmd
       ->add_option("--attack-speed", compare.attack_speed, "Approach and crowding speed [m/s]")
-      ->check(CLI::PositiveNumber)
+      ->check(autoshovel::app::FiniteIn(0, 3, true))
       ->capture_default_str();
   compare_cmd
       ->add_option("--target-fill", compare.target_fill, "V_t as a fraction of the rated capacity")
-      ->check(CLI::Range(0.1, 1.5))
+      ->check(autoshovel::app::FiniteIn(0.1, 1.5))
       ->capture_default_str();
   bool compare_no_feed_forward = false;
   compare_cmd->add_flag("--no-attitude-feed-forward", compare_no_feed_forward,
@@ -472,144 +545,157 @@ int main(int argc, char** argv) {
   compare_cmd
       ->add_option("--pressure-bar", compare_pressure_bar,
                    "Threshold of the pressure trigger [bar]")
+      ->check(autoshovel::app::FiniteIn(0, 420, true))
       ->capture_default_str();
 
-  CLI11_PARSE(app, argc, argv);
-
-  if (*compare_cmd) {
-    compare.models_dir = models_dir;
-    compare.pressure_threshold = compare_pressure_bar * 1e5;
-    compare.attitude_feed_forward = !compare_no_feed_forward;
-    return autoshovel::app::RunCompare(compare, std::cout, std::cerr);
+  // One line naming the command and the option for any refused command line (cli_checks.h).
+  app.failure_message(autoshovel::app::FailureLine);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
   }
 
-  if (*run_cmd) {
-    // An excavator's scenario (truck_loading) runs the truck-loading job: passes instead of
-    // cycles, until the truck is full unless --cycles is given.
-    bool excavator = false;
-    try {
-      excavator =
-          autoshovel::app::TruckLoadingJob::IsTruckLoadingScenario(run.scenario, models_dir);
-    } catch (const std::exception&) {
-      // Not loadable here: the shovel job reports what is wrong with it.
+  const int status = [&]() -> int {
+    if (*compare_cmd) {
+      compare.models_dir = models_dir;
+      compare.pressure_threshold = compare_pressure_bar * 1e5;
+      compare.attitude_feed_forward = !compare_no_feed_forward;
+      return autoshovel::app::RunCompare(compare, std::cout, std::cerr);
     }
-    if (excavator) {
-      truck_loading.scenario = run.scenario;
-      truck_loading.models_dir = models_dir;
-      truck_loading.seed = run.seed;
-      truck_loading.figures = !run_no_figures;
-      if (run_cmd->count("--cycles") > 0) truck_loading.passes = run.cycles;
-      if (truck_loading_dust) {
-        const double azimuth = truck_loading.truck_azimuth_deg * 3.14159265358979 / 180.0;
-        autoshovel::app::DustCloud cloud;
-        cloud.p_world_center = Eigen::Vector3d(truck_loading.truck_radius * std::cos(azimuth),
-                                               truck_loading.truck_radius * std::sin(azimuth), 0.5);
-        truck_loading.dust.push_back(cloud);
-      }
-      return autoshovel::app::RunTruckLoadingCommand(truck_loading, run_out, std::cout, std::cerr);
-    }
-    run.models_dir = models_dir;
-    run.figures = !run_no_figures;
-    run.attitude_feed_forward = !run_no_feed_forward;
-    run.pressure_threshold = run_pressure_bar * 1e5;
-    using autoshovel::control::ScoopPolicy;
-    run.policy = run_policy == "auto"          ? ScoopPolicy::kAutoSelection
-                 : run_policy == "just_in_out" ? ScoopPolicy::kJustInOut
-                 : run_policy == "stairway"    ? ScoopPolicy::kStairway
-                                               : ScoopPolicy::kStairwayFixed;
-    using autoshovel::app::TriggerChoice;
-    run.trigger = run_trigger == "predicted"    ? TriggerChoice::kPredicted
-                  : run_trigger == "perception" ? TriggerChoice::kPerception
-                                                : TriggerChoice::kPressure;
-    run.selection = run_selection == "ours" ? autoshovel::app::SelectionMethod::kOurs
-                                            : autoshovel::app::SelectionMethod::kChen2024;
-    if (!run_faults.empty()) {
+
+    if (*run_cmd) {
+      // An excavator's scenario (truck_loading) runs the truck-loading job: passes instead of
+      // cycles, until the truck is full unless --cycles is given.
+      bool excavator = false;
       try {
-        run.faults = autoshovel::plant::LoadFaults(run_faults);
-      } catch (const std::exception& e) {
-        std::cerr << "autoshovel run: " << e.what() << "\n";
+        excavator =
+            autoshovel::app::TruckLoadingJob::IsTruckLoadingScenario(run.scenario, models_dir);
+      } catch (const std::exception&) {
+        // Not loadable here: the shovel job reports what is wrong with it.
+      }
+      if (excavator) {
+        truck_loading.scenario = run.scenario;
+        truck_loading.models_dir = models_dir;
+        truck_loading.seed = run.seed;
+        truck_loading.figures = !run_no_figures;
+        if (run_cmd->count("--cycles") > 0) truck_loading.passes = run.cycles;
+        if (truck_loading_dust) {
+          const double azimuth = truck_loading.truck_azimuth_deg * 3.14159265358979 / 180.0;
+          autoshovel::app::DustCloud cloud;
+          cloud.p_world_center =
+              Eigen::Vector3d(truck_loading.truck_radius * std::cos(azimuth),
+                              truck_loading.truck_radius * std::sin(azimuth), 0.5);
+          truck_loading.dust.push_back(cloud);
+        }
+        return autoshovel::app::RunTruckLoadingCommand(truck_loading, run_out, std::cout,
+                                                       std::cerr);
+      }
+      run.models_dir = models_dir;
+      run.figures = !run_no_figures;
+      run.attitude_feed_forward = !run_no_feed_forward;
+      run.pressure_threshold = run_pressure_bar * 1e5;
+      using autoshovel::control::ScoopPolicy;
+      run.policy = run_policy == "auto"          ? ScoopPolicy::kAutoSelection
+                   : run_policy == "just_in_out" ? ScoopPolicy::kJustInOut
+                   : run_policy == "stairway"    ? ScoopPolicy::kStairway
+                                                 : ScoopPolicy::kStairwayFixed;
+      using autoshovel::app::TriggerChoice;
+      run.trigger = run_trigger == "predicted"    ? TriggerChoice::kPredicted
+                    : run_trigger == "perception" ? TriggerChoice::kPerception
+                                                  : TriggerChoice::kPressure;
+      run.selection = run_selection == "ours" ? autoshovel::app::SelectionMethod::kOurs
+                                              : autoshovel::app::SelectionMethod::kChen2024;
+      if (!run_faults.empty()) {
+        try {
+          run.faults = autoshovel::plant::LoadFaults(run_faults);
+        } catch (const std::exception& e) {
+          std::cerr << "autoshovel run: " << e.what() << "\n";
+          return 2;
+        }
+      }
+      return autoshovel::app::RunShovelCommand(run, run_out, std::cout, std::cerr);
+    }
+
+    if (*describe_cmd) {
+      describe.models_dir = models_dir;
+      return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
+    }
+    if (*arm_cmd) {
+      calibrate_arm.models_dir = models_dir;
+      if (calibrate_arm.data.empty() && calibrate_arm.simulate.empty()) {
+        std::cerr << "autoshovel calibrate arm: give a measurement CSV (or --simulate FILE)\n";
         return 2;
       }
+      return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
     }
-    return autoshovel::app::RunShovelCommand(run, run_out, std::cout, std::cerr);
-  }
-
-  if (*describe_cmd) {
-    describe.models_dir = models_dir;
-    return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
-  }
-  if (*arm_cmd) {
-    calibrate_arm.models_dir = models_dir;
-    if (calibrate_arm.data.empty() && calibrate_arm.simulate.empty()) {
-      std::cerr << "autoshovel calibrate arm: give a measurement CSV (or --simulate FILE)\n";
-      return 2;
+    if (*production_cmd) {
+      production.database = production_db;
+      production.png = production_png;
+      return autoshovel::app::RunProductionReport(production, std::cout, std::cerr);
     }
-    return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
-  }
-  if (*production_cmd) {
-    production.database = production_db;
-    production.png = production_png;
-    return autoshovel::app::RunProductionReport(production, std::cout, std::cerr);
-  }
-  if (*campaign_cmd) {
-    campaign.models_dir = models_dir;
-    campaign.out_dir = campaign_out;
-    return autoshovel::app::RunCampaign(campaign, std::cout, std::cerr);
-  }
-  if (*segmentation_cmd) {
-    segmentation.models_dir = models_dir;
-    return autoshovel::app::RunTrainSegmentation(segmentation, std::cout, std::cerr);
-  }
-  if (*retrain_cmd) {
-    retrain.models_dir = models_dir;
-    return autoshovel::predictor::RunRetrainPredictor(retrain, std::cout, std::cerr);
-  }
-  if (*weights_cmd) {
-    train_weights.models_dir = models_dir;
-    return autoshovel::identification::RunTrainWeights(train_weights, std::cout, std::cerr);
-  }
-  if (*select_cmd) {
-    select.models_dir = models_dir;
-    select.baseline = !no_baseline;
-    return autoshovel::planning::RunSelect(select, std::cout, std::cerr);
-  }
-  if (*camera_lidar_cmd) {
-    camera_lidar.models_dir = models_dir;
-    if (camera_lidar.frames.empty() && camera_lidar.pairs.empty() &&
-        camera_lidar.simulate.empty()) {
-      std::cerr << "autoshovel calibrate camera-lidar: give --frames DIR or --pair IMAGE,CLOUD "
-                   "(or --simulate DIR)\n";
-      return 2;
+    if (*campaign_cmd) {
+      campaign.models_dir = models_dir;
+      campaign.out_dir = campaign_out;
+      return autoshovel::app::RunCampaign(campaign, std::cout, std::cerr);
     }
-    return autoshovel::identification::RunCalibrateCameraLidar(camera_lidar, std::cout, std::cerr);
-  }
-  if (*hydraulics_cmd) {
-    hydraulics.models_dir = models_dir;
-    hydraulics.cross_validate = !no_cross_validation;
-    hydraulics.exclude_end_stops = !keep_end_stops;
-    if (hydraulics.logs.empty() && hydraulics.simulate.empty()) {
-      std::cerr << "autoshovel identify hydraulics: give one or more logs (or --simulate DIR)\n";
-      return 2;
+    if (*segmentation_cmd) {
+      segmentation.models_dir = models_dir;
+      return autoshovel::app::RunTrainSegmentation(segmentation, std::cout, std::cerr);
     }
-    return autoshovel::identification::RunIdentifyHydraulics(hydraulics, std::cout, std::cerr);
-  }
-  if (*map_cmd) {
-    map.models_dir = models_dir;
-    return autoshovel::app::RunMap(map, std::cout, std::cerr);
-  }
-  if (*scenario_cmd) {
-    scenario.models_dir = models_dir;
-    return autoshovel::app::RunScenario(scenario, std::cout, std::cerr);
-  }
-  if (*step_cmd) {
-    step.models_dir = models_dir;
-    return autoshovel::app::RunPlantStep(step, std::cout, std::cerr);
-  }
-  if (*gen_cmd) {
-    std::vector<std::string> arguments{"-o", gen_output};
-    if (!gen_materials.empty()) arguments.insert(arguments.end(), {"--materials", gen_materials});
-    arguments.insert(arguments.end(), gen_descriptions.begin(), gen_descriptions.end());
-    return RunGenerator(arguments);
-  }
-  return 0;
+    if (*retrain_cmd) {
+      retrain.models_dir = models_dir;
+      return autoshovel::predictor::RunRetrainPredictor(retrain, std::cout, std::cerr);
+    }
+    if (*weights_cmd) {
+      train_weights.models_dir = models_dir;
+      return autoshovel::identification::RunTrainWeights(train_weights, std::cout, std::cerr);
+    }
+    if (*select_cmd) {
+      select.models_dir = models_dir;
+      select.baseline = !no_baseline;
+      return autoshovel::planning::RunSelect(select, std::cout, std::cerr);
+    }
+    if (*camera_lidar_cmd) {
+      camera_lidar.models_dir = models_dir;
+      if (camera_lidar.frames.empty() && camera_lidar.pairs.empty() &&
+          camera_lidar.simulate.empty()) {
+        std::cerr << "autoshovel calibrate camera-lidar: give --frames DIR or --pair IMAGE,CLOUD "
+                     "(or --simulate DIR)\n";
+        return 2;
+      }
+      return autoshovel::identification::RunCalibrateCameraLidar(camera_lidar, std::cout,
+                                                                 std::cerr);
+    }
+    if (*hydraulics_cmd) {
+      hydraulics.models_dir = models_dir;
+      hydraulics.cross_validate = !no_cross_validation;
+      hydraulics.exclude_end_stops = !keep_end_stops;
+      if (hydraulics.logs.empty() && hydraulics.simulate.empty()) {
+        std::cerr << "autoshovel identify hydraulics: give one or more logs (or --simulate DIR)\n";
+        return 2;
+      }
+      return autoshovel::identification::RunIdentifyHydraulics(hydraulics, std::cout, std::cerr);
+    }
+    if (*map_cmd) {
+      map.models_dir = models_dir;
+      return autoshovel::app::RunMap(map, std::cout, std::cerr);
+    }
+    if (*scenario_cmd) {
+      scenario.models_dir = models_dir;
+      return autoshovel::app::RunScenario(scenario, std::cout, std::cerr);
+    }
+    if (*step_cmd) {
+      step.models_dir = models_dir;
+      return autoshovel::app::RunPlantStep(step, std::cout, std::cerr);
+    }
+    if (*gen_cmd) {
+      std::vector<std::string> arguments{"-o", gen_output};
+      if (!gen_materials.empty()) arguments.insert(arguments.end(), {"--materials", gen_materials});
+      arguments.insert(arguments.end(), gen_descriptions.begin(), gen_descriptions.end());
+      return RunGenerator(arguments);
+    }
+    return 0;
+  }();
+  return FinishOutput(status);
 }

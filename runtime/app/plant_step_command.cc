@@ -10,6 +10,7 @@
 
 #include "generated/registry.h"
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
 #include "runtime/model/description.h"
 #include "runtime/plant/plant.h"
 
@@ -77,14 +78,9 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
     plant::World world = plant::EmptyYard(machine);
     plant::Plant plant(machine, *functions, world, StartState(machine));
 
-    std::ofstream file;
-    if (!options.output.empty()) {
-      file.open(options.output);
-      if (!file) {
-        err << "autoshovel plant step: cannot write " << options.output << "\n";
-        return 2;
-      }
-    }
+    // The log is composed in memory and written in one checked, atomic write at the end: a
+    // full disk or an unwritable path is an error, never a truncated log reported as written.
+    std::ostringstream file;
     std::ostream& csv = options.output.empty() ? out : file;
     const int joint = functions->actuator_joint[actuator];
     csv << "# autoshovel plant step: machine " << machine.name << ", actuator " << options.actuator
@@ -135,6 +131,11 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
         motion_time = t - options.step_time;
       }
       if (i < samples) plant.Advance(dt);
+    }
+    if (options.output.empty()) {
+      core::FlushStandardOutput();
+    } else {
+      core::WriteFileAtomically(options.output, file.str());
     }
     // On standard error so that the CSV on standard output stays clean.
     if (!options.chirp) {

@@ -19,6 +19,7 @@
 #include "runtime/control/joint_pid.h"
 #include "runtime/control/path_follower.h"
 #include "runtime/control/speed_pid.h"
+#include "runtime/core/strings.h"
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/machine_footprint.h"
 #include "runtime/perception/map_render.h"
@@ -128,6 +129,37 @@ std::string SureCellReport(const perception::GridMap& map, const Eigen::Vector2d
   return text;
 }
 
+// The options a user can set, checked before anything is loaded, against the ranges documented in
+// `autoshovel run --help` and named as the user wrote them: the command line checks them while it
+// parses (cli_checks.h), this catches every other caller (campaign specs, tests, library users).
+// NaN fails every comparison, hence the negated forms.
+void CheckRange(double value, double low, double high, bool open_low, const char* name,
+                const char* unit) {
+  if (!std::isfinite(value) || value < low || value > high || (open_low && value == low)) {
+    throw std::invalid_argument(std::string(name) + " must be in " + (open_low ? "(" : "[") +
+                                core::FormatNumber(low) + ", " + core::FormatNumber(high) + "] " +
+                                unit + ", got " + core::FormatNumber(value));
+  }
+}
+
+const ShovelRunOptions& Validated(const ShovelRunOptions& o) {
+  if (o.cycles < 1) throw std::invalid_argument("--cycles must be >= 1");
+  // The seed is not checked here: a user's --seed is held to [0, 2^63 - 1] by the command line
+  // (cli_checks.h), while a campaign derives its jobs' seeds over all 64 bits (campaign_spec.cc).
+  CheckRange(o.attack_speed, 0, 3, true, "--attack-speed", "m/s");
+  CheckRange(o.scoop_deceleration, 0, 10, true, "--scoop-deceleration", "m/s^2");
+  CheckRange(o.pressure_threshold, 0, 420e5, true, "--pressure-bar (as Pa)", "Pa");
+  CheckRange(o.safety_distance, 0, 20, false, "--safety-distance", "m");
+  CheckRange(o.d_res, 0, 20, true, "--d-res", "m");
+  CheckRange(o.target_fill, 0.1, 1.5, false, "--target-fill", "");
+  CheckRange(o.yard_variation, 0, 0.9, false, "--yard-variation", "");
+  if (o.stairway_steps < 1 || o.stairway_steps > 20) {
+    throw std::invalid_argument("--stairway-steps must be in [1, 20], got " +
+                                std::to_string(o.stairway_steps));
+  }
+  return o;
+}
+
 }  // namespace
 
 struct ShovelJob::State {
@@ -161,26 +193,24 @@ struct ShovelJob::State {
   }
 };
 
-ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<State>(options)) {
+ShovelJob::ShovelJob(const ShovelRunOptions& options)
+    : state_(std::make_unique<State>(Validated(options))) {
   State& st = *state_;
   const plant::Scenario& scenario = st.setup.scenario;
   const model::MachineDescription& machine = st.setup.machine;
   if (machine.kind != model::MachineKind::kWheelLoader) {
-    throw std::invalid_argument("autoshovel run: machine '" + machine.name +
-                                "' is not a wheel loader");
+    throw std::invalid_argument("machine '" + machine.name + "' is not a wheel loader");
   }
-  if (options.cycles < 1) throw std::invalid_argument("autoshovel run: --cycles must be >= 1");
   if (options.sure_obstacle_growth_cells < 0 || options.sure_obstacle_growth_cells > 10) {
-    throw std::invalid_argument(
-        "autoshovel run: sure_obstacle_growth_cells must be in [0, 10], got " +
-        std::to_string(options.sure_obstacle_growth_cells));
+    throw std::invalid_argument("--sure-obstacle-growth must be in [0, 10], got " +
+                                std::to_string(options.sure_obstacle_growth_cells));
   }
   const double rates[] = {options.map_rate, options.decision_rate, options.control_rate};
   for (double r : rates) {
-    if (!(r > 0) || !std::isfinite(r)) throw std::invalid_argument("autoshovel run: bad rate");
+    if (!(r > 0) || !std::isfinite(r)) throw std::invalid_argument("bad rate");
   }
   if (options.map_rate > options.control_rate || options.decision_rate > options.control_rate) {
-    throw std::invalid_argument("autoshovel run: control must be the fastest rate");
+    throw std::invalid_argument("control must be the fastest rate");
   }
   // A fault that names a sensor must name one this machine has (else it would never strike).
   st.faults = scenario.faults;
@@ -235,18 +265,17 @@ ShovelJob::ShovelJob(const ShovelRunOptions& options) : state_(std::make_unique<
       if (found < 0) {
         std::string known;
         for (const plant::Bin& b : scenario.bins) known += " " + b.name;
-        throw std::invalid_argument("autoshovel run: scenario '" + scenario.name +
-                                    "' has no bin '" + name +
+        throw std::invalid_argument("scenario '" + scenario.name + "' has no bin '" + name +
                                     "' (bins:" + (known.empty() ? " none" : known) + ")");
       }
       if (!holds_pile(found)) {
-        throw std::invalid_argument("autoshovel run: bin '" + name + "' holds no pile");
+        throw std::invalid_argument("bin '" + name + "' holds no pile");
       }
       st.sites.push_back(bin_site(found));
     }
   }
   if (st.sites.empty()) {
-    throw std::invalid_argument("autoshovel run: scenario '" + scenario.name + "' has no pile");
+    throw std::invalid_argument("scenario '" + scenario.name + "' has no pile");
   }
   for (const Site& site : st.sites) st.site_names.push_back(site.name);
   st.loader = planning::LoaderGeometryFrom(machine, *st.setup.functions);

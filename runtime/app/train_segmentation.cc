@@ -11,6 +11,8 @@
 #include <sstream>
 #include <vector>
 
+#include "runtime/core/file_output.h"
+
 extern char** environ;
 
 namespace autoshovel::app {
@@ -101,8 +103,8 @@ int RunTrainSegmentation(const TrainSegmentationOptions& o, std::ostream& out, s
     }
   }
   const fs::path work = o.work_dir.empty() ? fs::path(o.out.string() + ".data") : o.work_dir;
-  fs::create_directories(work);
-  if (!o.out.parent_path().empty()) fs::create_directories(o.out.parent_path());
+  core::CreateFolders(work);
+  core::CreateFolders(o.out.parent_path());
   const fs::path python = "/usr/bin/python3";
   if (Run({python.string(), "-c", "import torch, onnx"}, work / "python_check.log") != 0) {
     err << kCommand << ": " << python.string()

@@ -1,9 +1,15 @@
 #include "runtime/core/yaml_reader.h"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
 #include <numbers>
+#include <sstream>
 
+#include "runtime/core/input_file.h"
 #include "runtime/core/strings.h"
 
 namespace autoshovel::core {
@@ -30,7 +36,152 @@ std::string Describe(const YAML::Node& node) {
   }
 }
 
+// Finds keys given twice in one mapping, from the parser's events: the loaded node tree cannot
+// tell (yaml-cpp keeps both pairs and `node[key]` returns the first), and walking the events
+// never expands an alias, so a file of nested aliases costs no more than its size.
+class DuplicateKeyFinder : public YAML::EventHandler {
+ public:
+  explicit DuplicateKeyFinder(std::string file) : file_(std::move(file)) {}
+
+  const std::vector<Diagnostic>& duplicates() const { return duplicates_; }
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { Leaf(mark, nullptr); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { Leaf(mark, nullptr); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string& value) override {
+    Leaf(mark, &value);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    Open(mark, /*is_map=*/false);
+  }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    Open(mark, /*is_map=*/true);
+  }
+  void OnSequenceEnd() override { Close(); }
+  void OnMapEnd() override { Close(); }
+
+ private:
+  struct Collection {
+    bool is_map = false;
+    std::string path;
+    bool expecting_key = true;                           // maps: the next node is a key
+    std::string key;                                     // maps: the key whose value comes next
+    std::size_t index = 0;                               // sequences: the next item's index
+    std::map<std::string, int, std::less<>> first_line;  // maps: key -> 1-based line
+  };
+
+  static std::string Join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+  // The key path of the node that starts now, or nullopt when it is a mapping's key.
+  std::optional<std::string> Begin(const YAML::Mark& mark, const std::string* scalar) {
+    if (stack_.empty()) return std::string();
+    Collection& parent = stack_.back();
+    if (!parent.is_map) return parent.path + "[" + std::to_string(parent.index++) + "]";
+    if (!parent.expecting_key) return Join(parent.path, parent.key);
+    // A key. Only names can repeat meaningfully; other keys MapReader::Finish() refuses.
+    parent.key = scalar != nullptr ? *scalar : "?";
+    if (scalar != nullptr) {
+      const auto [it, inserted] = parent.first_line.emplace(*scalar, mark.line + 1);
+      if (!inserted) {
+        duplicates_.push_back(
+            {{file_, mark.line + 1, mark.column + 1},
+             Join(parent.path, *scalar),
+             "duplicate key '" + *scalar + "' (first at line " + std::to_string(it->second) + ")"});
+      }
+    }
+    return std::nullopt;
+  }
+
+  // A node is complete: in a mapping, a key is followed by its value and a value by a key.
+  void End() {
+    if (!stack_.empty() && stack_.back().is_map) {
+      stack_.back().expecting_key = !stack_.back().expecting_key;
+    }
+  }
+
+  void Leaf(const YAML::Mark& mark, const std::string* scalar) {
+    Begin(mark, scalar);
+    End();
+  }
+
+  void Open(const YAML::Mark& mark, bool is_map) {
+    const std::optional<std::string> path = Begin(mark, nullptr);
+    Collection c;
+    c.is_map = is_map;
+    // A mapping or list used as a key has no name: its contents are named after the mapping.
+    c.path = path ? *path : Join(stack_.back().path, "?");
+    stack_.push_back(std::move(c));
+  }
+
+  void Close() {
+    if (!stack_.empty()) stack_.pop_back();
+    End();
+  }
+
+  std::string file_;
+  std::vector<Collection> stack_;
+  std::vector<Diagnostic> duplicates_;
+};
+
+std::string MebibyteText(std::uintmax_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1 << 20));
+  return text;
+}
+
 }  // namespace
+
+YAML::Node LoadYamlFile(const std::filesystem::path& path, DiagnosticSink& sink,
+                        std::uintmax_t max_bytes) {
+  const std::string file = path.string();
+  std::error_code error;
+  if (const std::string why = NotARegularFile(path); !why.empty()) {
+    sink.Add({file, 0, 0}, "", "cannot open: " + why);
+    return YAML::Node();
+  }
+  // Measured before anything is read: a huge file is refused in microseconds, not after
+  // gigabytes of parsing.
+  const std::uintmax_t bytes = std::filesystem::file_size(path, error);
+  if (!error && bytes > max_bytes) {
+    sink.Add({file, 0, 0}, "",
+             "the file is " + std::to_string(bytes) + " bytes (" + MebibyteText(bytes) +
+                 "), more than the " + MebibyteText(max_bytes) +
+                 " a YAML input may have (docs/robustness.md, \"Input size limits\"): not parsed");
+    return YAML::Node();
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    sink.Add({file, 0, 0}, "", "cannot open for reading");
+    return YAML::Node();
+  }
+  std::ostringstream bytes_read;
+  bytes_read << in.rdbuf();
+  const std::string text = bytes_read.str();
+  // Parsed twice, once for the events (duplicate keys) and once for the nodes: the file is
+  // small (the limit above) and the event pass is the only place a duplicate is still visible.
+  DuplicateKeyFinder finder(file);
+  YAML::Node root;
+  try {
+    std::istringstream events(text);
+    YAML::Parser parser(events);
+    parser.HandleNextDocument(finder);
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    sink.Add({file, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg);
+    return YAML::Node();
+  }
+  if (!finder.duplicates().empty()) {
+    for (const Diagnostic& d : finder.duplicates()) sink.Add(d.where, d.key_path, d.message);
+    return YAML::Node();
+  }
+  return root;
+}
 
 NumberRule NumberRule::Any(std::string unit) { return {0, Bound::kNone, 0, Bound::kNone, unit}; }
 NumberRule NumberRule::Positive(std::string unit) {
@@ -75,20 +226,10 @@ SourceLocation LocationOf(const std::string& file, const YAML::Node& node) {
 
 YamlFile::YamlFile(const std::filesystem::path& path, DiagnosticSink& sink)
     : file_(path.string()), sink_(&sink) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    sink.Add({file_, 0, 0}, "", "cannot open: no such file");
-    return;
-  }
-  try {
-    root_ = YAML::LoadFile(file_);
-  } catch (const YAML::ParserException& e) {
-    sink.Add({file_, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg);
-    return;
-  } catch (const YAML::BadFile&) {
-    sink.Add({file_, 0, 0}, "", "cannot open for reading");
-    return;
-  }
+  // The sink may already hold another file's problems: this file's are the ones added now.
+  const std::size_t problems_before = sink.diagnostics().size();
+  root_ = LoadYamlFile(path, sink);
+  if (sink.diagnostics().size() != problems_before) return;
   if (!root_.IsMap()) {
     sink.Add({file_, 1, 1}, "",
              "expected a mapping of keys at the top level, got " + Describe(root_));

@@ -6,6 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "runtime/plot/image_file.h"
+
 namespace autoshovel::perception {
 
 namespace {
@@ -98,7 +100,7 @@ void WriteSemanticMapPng(const GridMap& map, const std::vector<ExtractedPile>& p
   cv::hconcat(std::vector<cv::Mat>{panels[0], panels[1], panels[5]}, top_row);
   cv::hconcat(std::vector<cv::Mat>{panels[2], panels[3], panels[4]}, bottom_row);
   cv::vconcat(top_row, bottom_row, all);
-  if (!cv::imwrite(png_path, all)) throw std::runtime_error("cannot write " + png_path);
+  plot::WriteImageFile(png_path, all);
 }
 
 }  // namespace autoshovel::perception

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "runtime/perception/semantic_map.h"
+#include "runtime/plot/image_file.h"
 
 namespace autoshovel::planning {
 
@@ -179,7 +180,7 @@ void WriteCandidatePng(const GridMap& map, const ShovelPointResult& result,
     cv::Mat gap(left.rows, 6, CV_8UC3, cv::Scalar(255, 255, 255));
     cv::hconcat(std::vector<cv::Mat>{left, gap, right}, all);
   }
-  if (!cv::imwrite(png_path, all)) throw std::runtime_error("cannot write " + png_path);
+  plot::WriteImageFile(png_path, all);
 }
 
 }  // namespace autoshovel::planning

@@ -11,6 +11,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "runtime/core/input_file.h"
 #include "runtime/core/sha256.h"
 #include "runtime/core/strings.h"
 #include "runtime/core/yaml_reader.h"
@@ -703,6 +704,10 @@ std::vector<std::string> FindScenarios(const std::string& models_dir) {
 std::string ResolveScenario(const std::string& name_or_path, const std::string& models_dir) {
   std::error_code error;
   if (fs::is_regular_file(name_or_path, error)) return name_or_path;
+  // A name that exists but is no file (a folder, a named pipe) is said so, not "no such file".
+  if (fs::exists(name_or_path, error)) {
+    throw std::runtime_error(name_or_path + ": " + core::NotARegularFile(name_or_path));
+  }
   std::vector<std::string> names;
   for (const auto& file : FindScenarios(models_dir)) {
     const std::string stem = fs::path(file).stem().string();

@@ -6,6 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "runtime/plot/image_file.h"
+
 namespace autoshovel::plant {
 namespace {
 
@@ -119,13 +121,7 @@ void WriteTopView(const World& world, const std::string& png_path, const TopView
                 0.45, {0, 0, 0}, 1, cv::LINE_AA);
   }
 
-  bool written = false;
-  try {
-    written = cv::imwrite(png_path, image);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error("cannot write " + png_path + ": " + e.what());
-  }
-  if (!written) throw std::runtime_error("cannot write " + png_path);
+  plot::WriteImageFile(png_path, image);
 }
 
 }  // namespace autoshovel::plant

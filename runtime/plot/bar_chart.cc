@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "runtime/plot/image_file.h"
+
 namespace autoshovel::plot {
 
 namespace {
@@ -92,9 +94,7 @@ void WriteBarChartsPng(const std::vector<BarChart>& charts, const std::string& p
   }
   cv::Mat image;
   cv::vconcat(panels, image);
-  if (image.empty() || !cv::imwrite(path, image)) {
-    throw std::runtime_error("cannot write " + path);
-  }
+  WriteImageFile(path, image);
 }
 
 }  // namespace autoshovel::plot

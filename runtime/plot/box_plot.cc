@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "runtime/plot/image_file.h"
+
 namespace autoshovel::plot {
 namespace {
 
@@ -112,9 +114,7 @@ void WriteBoxPlotsPng(const std::vector<BoxPlot>& panels, const std::filesystem:
   }
   cv::Mat image;
   if (!images.empty()) cv::hconcat(images, image);
-  if (image.empty() || !cv::imwrite(path.string(), image)) {
-    throw std::runtime_error("cannot write " + path.string());
-  }
+  WriteImageFile(path, image);
 }
 
 }  // namespace autoshovel::plot

@@ -11,6 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "runtime/plot/image_file.h"
+
 namespace autoshovel::plot {
 namespace {
 
@@ -260,21 +262,9 @@ cv::Mat DrawLinePlot(const LinePlot& plot) {
   return image;
 }
 
-// Written to a temporary file and renamed, so a failed write leaves no half image.
+// Checked and atomic (image_file.h): a failed write leaves no half image.
 void WriteImage(const cv::Mat& image, const std::filesystem::path& path) {
-  const std::filesystem::path temporary = path.string() + ".tmp.png";
-  bool written = false;
-  try {
-    written = cv::imwrite(temporary.string(), image);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path.string() + ": cannot write the plot: " + e.what());
-  }
-  std::error_code error;
-  if (written) std::filesystem::rename(temporary, path, error);
-  if (!written || error) {
-    std::filesystem::remove(temporary, error);
-    throw std::runtime_error(path.string() + ": cannot write the plot");
-  }
+  WriteImageFile(path, image);
 }
 
 }  // namespace

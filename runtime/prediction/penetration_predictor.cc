@@ -12,6 +12,8 @@
 #include <utility>
 
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/input_file.h"
 
 namespace autoshovel::prediction {
 
@@ -38,6 +40,9 @@ bool ParseFinite(const std::string& word, double& value) {
 // here first, line by line: a header of known keys with finite numbers, "SV", then exactly
 // total_sv lines `coefficient index:value ...` with increasing indices and finite numbers.
 void CheckLibsvmModel(const std::string& path, int features) {
+  if (const std::string why = core::NotARegularFile(path); !why.empty()) {
+    Refuse(path, 0, "cannot open the libsvm model file (written by train_predictor): " + why);
+  }
   std::ifstream file(path);
   if (!file) Refuse(path, 0, "cannot open the libsvm model file (written by train_predictor)");
   std::string text;
@@ -212,8 +217,7 @@ PenetrationPrediction PenetrationPredictor::Predict(const PenetrationFeatures& f
 
 void PenetrationPredictor::SaveScaling(const std::string& path_stem, const FeatureScaling& s) {
   const std::string path = path_stem + ".scale";
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error("cannot write " + path);
+  std::ostringstream file;  // then one checked atomic write (core/file_output.h)
   file << std::setprecision(17);
   file << "format " << kFormat << " " << kFormatVersion << "\n";
   file << "machine " << s.machine << "\n";
@@ -233,11 +237,14 @@ void PenetrationPredictor::SaveScaling(const std::string& path_stem, const Featu
     file << "intake_factor " << material << " " << factor << "\n";
   }
   for (const std::string& note : s.notes) file << "note " << note << "\n";
-  if (!file) throw std::runtime_error("cannot write " + path);
+  core::WriteFileAtomically(path, file.str());
 }
 
 FeatureScaling PenetrationPredictor::LoadScaling(const std::string& path_stem) {
   const std::string path = path_stem + ".scale";
+  if (const std::string why = core::NotARegularFile(path); !why.empty()) {
+    Refuse(path, 0, "cannot open the feature scaling file (written by train_predictor): " + why);
+  }
   std::ifstream file(path);
   if (!file) Refuse(path, 0, "cannot open the feature scaling file (written by train_predictor)");
   FeatureScaling s;

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "runtime/core/file_output.h"
+
 namespace autoshovel::results {
 namespace fs = std::filesystem;
 
@@ -125,6 +127,8 @@ RunSummary Summarize(const std::vector<CycleRecord>& cycles) {
 
 void WriteReportHtml(const ResultsDb& db, const std::string& run_id,
                      const std::vector<ReportFigure>& figures, const fs::path& html_path) {
+  // No figure from a damaged file: integrity first, then every value through the typed reader.
+  db.CheckIntegrity();
   const std::optional<RunInfo> run = db.FindRun(run_id);
   if (!run) {
     throw ResultsDbError(db.file().string() + ": no run '" + run_id + "' to report");
@@ -222,18 +226,7 @@ void WriteReportHtml(const ResultsDb& db, const std::string& run_id,
   h << "<p style=\"color:#888;font-size:0.8em\">Database: " << HtmlEscape(db.file().string())
     << ". Empty cells (&ndash;) are NULL: not measured.</p>\n</body>\n</html>\n";
 
-  const fs::path temporary = html_path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << h.str();
-    out.flush();
-    if (!out) throw std::runtime_error(html_path.string() + ": cannot write the report");
-  }
-  std::error_code error;
-  fs::rename(temporary, html_path, error);
-  if (error) {
-    throw std::runtime_error(html_path.string() + ": cannot write the report: " + error.message());
-  }
+  core::WriteFileAtomically(html_path, h.str());
 }
 
 }  // namespace autoshovel::results

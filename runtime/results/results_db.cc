@@ -3,7 +3,10 @@
 #include <sqlite3.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <limits>
+#include <memory>
 
 #include "runtime/results/run_folder.h"
 
@@ -118,17 +121,229 @@ CREATE TABLE IF NOT EXISTS crowding_samples (
 ) WITHOUT ROWID;
 )sql";
 
-double ColumnDouble(sqlite3_stmt* statement, int column) {
-  if (sqlite3_column_type(statement, column) == SQLITE_NULL) return kNotMeasured;
-  return sqlite3_column_double(statement, column);
+// A short, printable excerpt of a refused text value.
+std::string Excerpt(const unsigned char* text, int bytes) {
+  std::string out;
+  for (int i = 0; i < bytes && out.size() < 40; ++i) {
+    const char c = static_cast<char>(text[i]);
+    out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  }
+  return bytes > 40 ? out + "..." : out;
 }
 
-std::string ColumnText(sqlite3_stmt* statement, int column) {
-  const unsigned char* text = sqlite3_column_text(statement, column);
-  return text == nullptr ? std::string() : std::string(reinterpret_cast<const char*>(text));
+std::string NotValid(const std::filesystem::path& file, const std::string& why) {
+  return file.string() + " is not a valid SQLite database: " + why;
 }
 
 }  // namespace
+
+void SqliteCloser::operator()(sqlite3* db) const { sqlite3_close(db); }
+
+void CheckIntegrity(sqlite3* db, const std::filesystem::path& file, IntegrityCheck how) {
+  // At most 3 problems: the first names the damage; the rest are usually its consequences.
+  const char* sql =
+      how == IntegrityCheck::kQuick ? "PRAGMA quick_check(3)" : "PRAGMA integrity_check(3)";
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(db, sql, -1, &statement, nullptr) != SQLITE_OK) {
+    const std::string why = sqlite3_errmsg(db);
+    sqlite3_finalize(statement);
+    throw ResultsDbError(NotValid(file, why));
+  }
+  // The check answers "ok", or up to 10 lines naming the damage.
+  std::string problems;
+  int rc = SQLITE_ROW;
+  while ((rc = sqlite3_step(statement)) == SQLITE_ROW) {
+    const unsigned char* line = sqlite3_column_text(statement, 0);
+    std::string text = line != nullptr ? reinterpret_cast<const char*>(line) : "";
+    if (text == "ok") continue;
+    // One line for the error: the answer may hold several, and a header naming the schema.
+    const std::string header = "*** in database main ***";
+    if (text.rfind(header, 0) == 0) text.erase(0, header.size());
+    for (std::size_t at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) {
+      text.replace(at, 1, "; ");
+    }
+    while (!text.empty() && (text.front() == ';' || text.front() == ' ')) text.erase(0, 1);
+    problems += (problems.empty() ? "" : "; ") + text;
+  }
+  const std::string error = rc == SQLITE_DONE ? "" : sqlite3_errmsg(db);
+  sqlite3_finalize(statement);
+  if (!error.empty()) throw ResultsDbError(NotValid(file, error));
+  if (!problems.empty()) {
+    throw ResultsDbError(
+        NotValid(file, std::string(how == IntegrityCheck::kQuick ? "PRAGMA quick_check: "
+                                                                 : "PRAGMA integrity_check: ") +
+                           problems));
+  }
+}
+
+SqliteConnection OpenCheckedReadOnly(const std::filesystem::path& file) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(file, error);
+  if (!std::filesystem::exists(status)) throw ResultsDbError(file.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(status)) {
+    throw ResultsDbError(file.string() + ": not a regular file (a results database is one file)");
+  }
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(file.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+  SqliteConnection db(raw);
+  if (rc != SQLITE_OK) {
+    throw ResultsDbError(file.string() + ": cannot open: " +
+                         (raw != nullptr ? sqlite3_errmsg(raw) : sqlite3_errstr(rc)));
+  }
+  sqlite3_extended_result_codes(raw, 1);
+  sqlite3_busy_timeout(raw, 10000);  // a campaign may be writing it
+  CheckIntegrity(raw, file, IntegrityCheck::kFull);
+  return db;
+}
+
+ColumnReader::ColumnReader(sqlite3_stmt* statement, std::filesystem::path file, std::string table)
+    : statement_(statement), file_(std::move(file)), table_(std::move(table)) {}
+
+void ColumnReader::Refuse(int column, const std::string& why) const {
+  const char* name = sqlite3_column_name(statement_, column);
+  throw ResultsDbError(file_.string() + ": table " + table_ + ", " +
+                       (row_.empty() ? std::string("a row") : row_) + ", column " +
+                       (name != nullptr ? name : std::to_string(column)) + ": " + why);
+}
+
+std::optional<double> ColumnReader::Real(int column, Infinity infinity) const {
+  switch (sqlite3_column_type(statement_, column)) {
+    case SQLITE_NULL:
+      return std::nullopt;
+    case SQLITE_INTEGER:
+      return static_cast<double>(sqlite3_column_int64(statement_, column));
+    case SQLITE_FLOAT: {
+      const double value = sqlite3_column_double(statement_, column);
+      if (std::isnan(value)) Refuse(column, "NaN where a number belongs (NULL means not measured)");
+      if (std::isinf(value) && !(value > 0 && infinity == Infinity::kPlusAllowed)) {
+        Refuse(column, std::string(value > 0 ? "+inf" : "-inf") + " where a finite number belongs");
+      }
+      return value;
+    }
+    case SQLITE_TEXT:
+      Refuse(column, "text '" +
+                         Excerpt(sqlite3_column_text(statement_, column),
+                                 sqlite3_column_bytes(statement_, column)) +
+                         "' where a number belongs");
+    default:
+      Refuse(column, "a blob of " + std::to_string(sqlite3_column_bytes(statement_, column)) +
+                         " bytes where a number belongs");
+  }
+}
+
+double ColumnReader::RealOrNotMeasured(int column, Infinity infinity) const {
+  return Real(column, infinity).value_or(kNotMeasured);
+}
+
+std::optional<std::int64_t> ColumnReader::Integer(int column) const {
+  switch (sqlite3_column_type(statement_, column)) {
+    case SQLITE_NULL:
+      return std::nullopt;
+    case SQLITE_INTEGER:
+      return sqlite3_column_int64(statement_, column);
+    case SQLITE_FLOAT: {
+      // INTEGER affinity stores 3.0 as 3: a REAL here is not a whole number (or out of range).
+      char text[40];
+      std::snprintf(text, sizeof text, "%.17g", sqlite3_column_double(statement_, column));
+      Refuse(column, std::string("the number ") + text + " where a whole number belongs");
+    }
+    case SQLITE_TEXT:
+      Refuse(column, "text '" +
+                         Excerpt(sqlite3_column_text(statement_, column),
+                                 sqlite3_column_bytes(statement_, column)) +
+                         "' where a whole number belongs");
+    default:
+      Refuse(column, "a blob of " + std::to_string(sqlite3_column_bytes(statement_, column)) +
+                         " bytes where a whole number belongs");
+  }
+}
+
+std::int64_t ColumnReader::RequiredInteger(int column) const {
+  const std::optional<std::int64_t> value = Integer(column);
+  if (!value) Refuse(column, "NULL where a whole number is required");
+  return *value;
+}
+
+bool ColumnReader::RequiredBool(int column) const {
+  const std::int64_t value = RequiredInteger(column);
+  if (value != 0 && value != 1) Refuse(column, std::to_string(value) + " where 0 or 1 belongs");
+  return value == 1;
+}
+
+std::optional<int> ColumnReader::SmallInteger(int column) const {
+  const std::optional<std::int64_t> value = Integer(column);
+  if (!value) return std::nullopt;
+  if (*value < std::numeric_limits<int>::min() || *value > std::numeric_limits<int>::max()) {
+    Refuse(column, std::to_string(*value) + " is out of range");
+  }
+  return static_cast<int>(*value);
+}
+
+std::string ColumnReader::Text(int column) const {
+  const int type = sqlite3_column_type(statement_, column);
+  if (type == SQLITE_NULL) return {};
+  if (type == SQLITE_BLOB) {
+    Refuse(column, "a blob of " + std::to_string(sqlite3_column_bytes(statement_, column)) +
+                       " bytes where text belongs");
+  }
+  const unsigned char* text = sqlite3_column_text(statement_, column);
+  return text == nullptr
+             ? std::string()
+             : std::string(reinterpret_cast<const char*>(text),
+                           static_cast<std::size_t>(sqlite3_column_bytes(statement_, column)));
+}
+
+namespace {
+
+// The numeric columns of `cycles`, and the one that may hold +inf.
+constexpr const char* kCycleRealColumns[] = {
+    "trigger_time_s",  "fill_rate",          "payload_m3",      "time_approach_s",
+    "time_crowd_s",    "time_scoop_s",       "time_level_s",    "time_retreat_s",
+    "time_total_s",    "energy_approach_kj", "energy_crowd_kj", "energy_scoop_kj",
+    "energy_level_kj", "energy_retreat_kj",  "energy_total_kj", "safety_margin_m"};
+constexpr const char* kCycleIntegerColumns[] = {"safety_violations", "completed", "safe_stops",
+                                                "recoveries", "refused_frames"};
+
+}  // namespace
+
+void CheckCycleValues(sqlite3* db, const std::filesystem::path& file) {
+  std::string sql = "SELECT rowid, run_id, cycle";
+  for (const char* c : kCycleRealColumns) sql += std::string(", ") + c;
+  for (const char* c : kCycleIntegerColumns) sql += std::string(", ") + c;
+  sql += " FROM cycles";
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) {
+    const std::string why = sqlite3_errmsg(db);
+    sqlite3_finalize(raw);
+    throw ResultsDbError(file.string() + ": cannot read the cycles table: " + why);
+  }
+  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> statement(raw, sqlite3_finalize);
+  ColumnReader read(raw, file, "cycles");
+  int rc = SQLITE_ROW;
+  while ((rc = sqlite3_step(raw)) == SQLITE_ROW) {
+    read.SetRow("rowid " + std::to_string(sqlite3_column_int64(raw, 0)));
+    read.SetRow("rowid " + std::to_string(sqlite3_column_int64(raw, 0)) + " (run '" + read.Text(1) +
+                "', cycle " + std::to_string(read.RequiredInteger(2)) + ")");
+    int i = 3;
+    for (const char* name : kCycleRealColumns) {
+      read.Real(i++, std::string(name) == "safety_margin_m" ? ColumnReader::Infinity::kPlusAllowed
+                                                            : ColumnReader::Infinity::kRefused);
+    }
+    for (const char* name : kCycleIntegerColumns) {
+      const std::string column = name;
+      if (column == "completed") {
+        read.RequiredBool(i++);
+      } else if (column == "safety_violations") {
+        read.RequiredInteger(i++);
+      } else {
+        read.SmallInteger(i++);
+      }
+    }
+  }
+  if (rc != SQLITE_DONE) {
+    throw ResultsDbError(NotValid(file, std::string(sqlite3_errmsg(db)) + " (reading cycles)"));
+  }
+}
 
 // A prepared statement; errors name the database file.
 class ResultsDb::Statement {
@@ -193,7 +408,18 @@ class ResultsDb::Statement {
   sqlite3_stmt* statement_ = nullptr;
 };
 
-ResultsDb::ResultsDb(const std::filesystem::path& file) : file_(file) {
+ResultsDb::ResultsDb(const std::filesystem::path& file, Access access) : file_(file) {
+  if (access == Access::kReadOnly) {
+    db_ = OpenCheckedReadOnly(file_).release();
+    try {
+      CheckSchemaReadOnly();
+    } catch (...) {
+      sqlite3_close(db_);
+      db_ = nullptr;
+      throw;
+    }
+    return;
+  }
   const int rc =
       sqlite3_open_v2(file_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   if (rc != SQLITE_OK) {
@@ -205,6 +431,9 @@ ResultsDb::ResultsDb(const std::filesystem::path& file) : file_(file) {
   try {
     sqlite3_extended_result_codes(db_, 1);
     sqlite3_busy_timeout(db_, 10000);  // campaigns: other processes may hold the write lock
+    // Before anything is read or written: a damaged file is refused, not extended (quick: this
+    // runs on every resume and merge; reports run the full check).
+    results::CheckIntegrity(db_, file_, IntegrityCheck::kQuick);
     CreateOrCheckSchema();
     Execute("PRAGMA foreign_keys = ON");
     Execute("PRAGMA synchronous = NORMAL");
@@ -223,15 +452,50 @@ ResultsDb::~ResultsDb() {
 void ResultsDb::Fail(const std::string& what) const {
   const int code = sqlite3_extended_errcode(db_);
   std::string message = file_.string() + ": " + what + ": " + sqlite3_errmsg(db_);
-  if ((code & 0xff) == SQLITE_NOTADB) {
-    message = file_.string() +
-              ": not an autoshovel results database (not a SQLite file: " + sqlite3_errmsg(db_) +
-              ")";
-  } else if ((code & 0xff) == SQLITE_CORRUPT) {
-    message = file_.string() + ": the results database is corrupt (" +
-              std::string(sqlite3_errmsg(db_)) + "); " + what;
+  if ((code & 0xff) == SQLITE_NOTADB || (code & 0xff) == SQLITE_CORRUPT) {
+    message = NotValid(file_, std::string(sqlite3_errmsg(db_)) + " (" + what + ")");
   }
   throw ResultsDbError(message);
+}
+
+void ResultsDb::CheckIntegrity() const { results::CheckIntegrity(db_, file_); }
+
+void ResultsDb::CheckSchemaReadOnly() {
+  has_crowding_samples_ = false;
+  bool has_version_table = false;
+  int tables = 0;
+  {
+    Statement list(*this, "SELECT name FROM sqlite_master WHERE type = 'table'");
+    ColumnReader read(list.get(), file_, "sqlite_master");
+    while (list.Step()) {
+      ++tables;
+      const std::string name = read.Text(0);
+      has_version_table |= name == "schema_version";
+      has_crowding_samples_ |= name == "crowding_samples";
+    }
+  }
+  if (!has_version_table) {
+    throw ResultsDbError(file_.string() +
+                         ": not an autoshovel results database (a SQLite file with " +
+                         std::to_string(tables) + " table(s) but no schema_version table)");
+  }
+  Statement version(*this, "SELECT version FROM schema_version");
+  ColumnReader read(version.get(), file_, "schema_version");
+  read.SetRow("its row");
+  if (!version.Step()) {
+    throw ResultsDbError(file_.string() + ": results database without a schema version row");
+  }
+  const std::int64_t found = read.RequiredInteger(0);
+  if (found == 1) {
+    throw ResultsDbError(file_.string() + ": results schema version 1; reading it needs a " +
+                         "migration to version 2, which a read-only open does not do (open it " +
+                         "once with a writer, e.g. resume its run)");
+  }
+  if (found != kSchemaVersion) {
+    throw ResultsDbError(file_.string() + ": results schema version " + std::to_string(found) +
+                         ", this build reads version " + std::to_string(kSchemaVersion) +
+                         " (written by another autoshovel version)");
+  }
 }
 
 void ResultsDb::Execute(const char* sql) const {
@@ -248,9 +512,10 @@ void ResultsDb::CreateOrCheckSchema() {
   bool has_version_table = false;
   {
     Statement list(*this, "SELECT name FROM sqlite_master WHERE type = 'table'");
+    ColumnReader read(list.get(), file_, "sqlite_master");
     while (list.Step()) {
       ++tables;
-      if (ColumnText(list.get(), 0) == "schema_version") has_version_table = true;
+      if (read.Text(0) == "schema_version") has_version_table = true;
     }
   }
   if (tables == 0) {
@@ -260,7 +525,7 @@ void ResultsDb::CreateOrCheckSchema() {
       // Another process may have created it between our read and the write lock.
       Statement again(*this, "SELECT count(*) FROM sqlite_master WHERE name = 'schema_version'");
       again.Step();
-      if (sqlite3_column_int(again.get(), 0) == 0) {
+      if (ColumnReader(again.get(), file_, "sqlite_master").RequiredInteger(0) == 0) {
         Execute(kSchema);
         Execute(kCrowdingSamplesSchema);
         Statement version(*this, "INSERT INTO schema_version (version) VALUES (?)");
@@ -282,10 +547,12 @@ void ResultsDb::CreateOrCheckSchema() {
   int found = 0;
   {
     Statement version(*this, "SELECT version FROM schema_version");
-    if (!version.Step() || sqlite3_column_type(version.get(), 0) != SQLITE_INTEGER) {
+    if (!version.Step()) {
       throw ResultsDbError(file_.string() + ": results database without a schema version row");
     }
-    found = sqlite3_column_int(version.get(), 0);
+    ColumnReader read(version.get(), file_, "schema_version");
+    read.SetRow("its row");
+    found = read.SmallInteger(0).value_or(0);
   }
   if (found == 1) {
     // Migrated in one transaction; a concurrent opener that migrated first is seen again here.
@@ -293,7 +560,9 @@ void ResultsDb::CreateOrCheckSchema() {
     try {
       Statement again(*this, "SELECT version FROM schema_version");
       again.Step();
-      if (sqlite3_column_int(again.get(), 0) == 1) Execute(kMigrateV1ToV2);
+      ColumnReader read(again.get(), file_, "schema_version");
+      read.SetRow("its row");
+      if (read.SmallInteger(0) == 1) Execute(kMigrateV1ToV2);
       Execute("COMMIT");
     } catch (...) {
       sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
@@ -343,16 +612,22 @@ std::vector<RunInfo> ResultsDb::Runs() const {
   std::vector<RunInfo> runs;
   Statement select(*this,
                    "SELECT run_id, scenario, machine, seed, cycles_planned, start_time_utc, "
-                   "git_describe FROM runs ORDER BY start_time_utc, run_id");
+                   "git_describe, rowid FROM runs ORDER BY start_time_utc, run_id");
+  ColumnReader read(select.get(), file_, "runs");
   while (select.Step()) {
     RunInfo run;
-    run.run_id = ColumnText(select.get(), 0);
-    run.scenario = ColumnText(select.get(), 1);
-    run.machine = ColumnText(select.get(), 2);
-    run.seed = static_cast<std::uint64_t>(sqlite3_column_int64(select.get(), 3));
-    run.cycles_planned = sqlite3_column_int(select.get(), 4);
-    run.start_time_utc = ColumnText(select.get(), 5);
-    run.git_describe = ColumnText(select.get(), 6);
+    read.SetRow("rowid " + std::to_string(sqlite3_column_int64(select.get(), 7)));
+    run.run_id = read.Text(0);
+    read.SetRow("rowid " + std::to_string(sqlite3_column_int64(select.get(), 7)) + " (run '" +
+                run.run_id + "')");
+    run.scenario = read.Text(1);
+    run.machine = read.Text(2);
+    run.seed = static_cast<std::uint64_t>(read.RequiredInteger(3));  // the same 64 bits
+    const std::optional<int> planned = read.SmallInteger(4);
+    if (!planned) read.Refuse(4, "NULL where the planned cycle count is required");
+    run.cycles_planned = *planned;
+    run.start_time_utc = read.Text(5);
+    run.git_describe = read.Text(6);
     runs.push_back(std::move(run));
   }
   return runs;
@@ -467,24 +742,27 @@ void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record)
 
 std::vector<ResultsDb::StoredCrowdingSample> ResultsDb::CrowdingSamples() const {
   std::vector<StoredCrowdingSample> out;
+  if (!has_crowding_samples_) return out;  // a read-only file from before the table
   Statement select(
       *this,
       "SELECT run_id, cycle, strategy, trigger_cause, material, speed_mps, v1_m3, h1_m, "
       "h2_m, h3_m, h4_m, h5_m, h6_m, penetration_m FROM crowding_samples "
       "ORDER BY run_id, cycle");
+  ColumnReader read(select.get(), file_, "crowding_samples");
   while (select.Step()) {
     StoredCrowdingSample s;
-    sqlite3_stmt* r = select.get();
-    s.run_id = ColumnText(r, 0);
-    s.cycle = sqlite3_column_int(r, 1);
+    s.run_id = read.Text(0);
+    read.SetRow("run '" + s.run_id + "'");
+    s.cycle = read.SmallInteger(1).value_or(-1);
+    read.SetRow("run '" + s.run_id + "', cycle " + std::to_string(s.cycle));
     s.sample.present = true;
-    s.sample.strategy = ColumnText(r, 2);
-    s.sample.trigger = ColumnText(r, 3);
-    s.sample.material = ColumnText(r, 4);
-    s.sample.speed = ColumnDouble(r, 5);
-    s.sample.v1 = ColumnDouble(r, 6);
-    for (int k = 0; k < 6; ++k) s.sample.heights[k] = ColumnDouble(r, 7 + k);
-    s.sample.penetration = ColumnDouble(r, 13);
+    s.sample.strategy = read.Text(2);
+    s.sample.trigger = read.Text(3);
+    s.sample.material = read.Text(4);
+    s.sample.speed = read.RealOrNotMeasured(5);
+    s.sample.v1 = read.RealOrNotMeasured(6);
+    for (int k = 0; k < 6; ++k) s.sample.heights[k] = read.RealOrNotMeasured(7 + k);
+    s.sample.penetration = read.RealOrNotMeasured(13);
     out.push_back(std::move(s));
   }
   return out;
@@ -494,7 +772,13 @@ std::vector<int> ResultsDb::CompletedCycles(const std::string& run_id) const {
   std::vector<int> cycles;
   Statement select(*this, "SELECT cycle FROM cycles WHERE run_id = ? ORDER BY cycle");
   select.Bind(1, run_id);
-  while (select.Step()) cycles.push_back(sqlite3_column_int(select.get(), 0));
+  ColumnReader read(select.get(), file_, "cycles");
+  read.SetRow("run '" + run_id + "'");
+  while (select.Step()) {
+    const std::optional<int> cycle = read.SmallInteger(0);
+    if (!cycle) read.Refuse(0, "NULL where the cycle index is required");
+    cycles.push_back(*cycle);
+  }
   return cycles;
 }
 
@@ -512,40 +796,49 @@ std::vector<int> ResultsDb::MissingCycles(const std::string& run_id, int cycles_
 std::vector<CycleRecord> ResultsDb::Cycles(const std::string& run_id, bool with_samples) const {
   std::vector<CycleRecord> records;
   {
-    Statement select(*this, std::string("SELECT cycle, ") + kCycleColumns +
+    Statement select(*this, std::string("SELECT rowid, cycle, ") + kCycleColumns +
                                 " FROM cycles WHERE run_id = ? ORDER BY cycle");
     select.Bind(1, run_id);
+    ColumnReader read(select.get(), file_, "cycles");
     while (select.Step()) {
-      sqlite3_stmt* s = select.get();
+      const std::string rowid = "rowid " + std::to_string(sqlite3_column_int64(select.get(), 0));
+      read.SetRow(rowid + " (run '" + run_id + "')");
       CycleRecord r;
-      int i = 0;
-      r.cycle = sqlite3_column_int(s, i++);
-      r.scenario = ColumnText(s, i++);
-      r.machine = ColumnText(s, i++);
-      r.bin = ColumnText(s, i++);
-      r.material = ColumnText(s, i++);
-      r.strategy = ColumnText(s, i++);
-      r.atomic_actions = ColumnText(s, i++);
-      r.trigger_time_s = ColumnDouble(s, i++);
-      r.fill_rate = ColumnDouble(s, i++);
-      r.payload_m3 = ColumnDouble(s, i++);
+      int i = 1;
+      const std::optional<int> cycle = read.SmallInteger(i);
+      if (!cycle) read.Refuse(i, "NULL where the cycle index is required");
+      r.cycle = *cycle;
+      ++i;
+      read.SetRow(rowid + " (run '" + run_id + "', cycle " + std::to_string(r.cycle) + ")");
+      r.scenario = read.Text(i++);
+      r.machine = read.Text(i++);
+      r.bin = read.Text(i++);
+      r.material = read.Text(i++);
+      r.strategy = read.Text(i++);
+      r.atomic_actions = read.Text(i++);
+      r.trigger_time_s = read.RealOrNotMeasured(i++);
+      r.fill_rate = read.RealOrNotMeasured(i++);
+      r.payload_m3 = read.RealOrNotMeasured(i++);
       for (PhaseValues* values : {&r.time_s, &r.energy_kj}) {
-        values->approach = ColumnDouble(s, i++);
-        values->crowd = ColumnDouble(s, i++);
-        values->scoop = ColumnDouble(s, i++);
-        values->level = ColumnDouble(s, i++);
-        values->retreat = ColumnDouble(s, i++);
-        values->total = ColumnDouble(s, i++);
+        values->approach = read.RealOrNotMeasured(i++);
+        values->crowd = read.RealOrNotMeasured(i++);
+        values->scoop = read.RealOrNotMeasured(i++);
+        values->level = read.RealOrNotMeasured(i++);
+        values->retreat = read.RealOrNotMeasured(i++);
+        values->total = read.RealOrNotMeasured(i++);
       }
-      r.safety_margin_m = ColumnDouble(s, i++);
-      r.safety_violations = sqlite3_column_int(s, i++);
-      r.completed = sqlite3_column_int(s, i++) != 0;
+      // +inf: nothing came within reach during the cycle (the writer's starting minimum).
+      r.safety_margin_m = read.RealOrNotMeasured(i++, ColumnReader::Infinity::kPlusAllowed);
+      const std::optional<int> violations = read.SmallInteger(i);
+      if (!violations) read.Refuse(i, "NULL where the violation count is required");
+      r.safety_violations = *violations;
+      ++i;
+      r.completed = read.RequiredBool(i++);
       for (int* count : {&r.safe_stops, &r.recoveries, &r.refused_frames}) {
-        *count = sqlite3_column_type(s, i) == SQLITE_NULL ? -1 : sqlite3_column_int(s, i);
-        ++i;
+        *count = read.SmallInteger(i++).value_or(-1);  // NULL: not recorded (before version 2)
       }
-      r.faults = ColumnText(s, i++);
-      r.failure = ColumnText(s, i++);
+      r.faults = read.Text(i++);
+      r.failure = read.Text(i++);
       records.push_back(std::move(r));
     }
   }
@@ -568,19 +861,23 @@ std::optional<CycleRecord> ResultsDb::Cycle(const std::string& run_id, int cycle
 std::vector<CycleSample> ResultsDb::Samples(const std::string& run_id, int cycle) const {
   std::vector<CycleSample> samples;
   Statement select(*this, std::string("SELECT ") + kSampleColumns +
-                              " FROM samples WHERE run_id = ? AND cycle = ? ORDER BY k");
+                              ", k FROM samples WHERE run_id = ? AND cycle = ? ORDER BY k");
   select.Bind(1, run_id).Bind(2, static_cast<std::int64_t>(cycle));
+  ColumnReader read(select.get(), file_, "samples");
   while (select.Step()) {
-    sqlite3_stmt* s = select.get();
+    read.SetRow("run '" + run_id + "', cycle " + std::to_string(cycle) + ", k " +
+                std::to_string(sqlite3_column_int64(select.get(), 8)));
     CycleSample sample;
-    sample.t = ColumnDouble(s, 0);
-    sample.v1 = ColumnDouble(s, 1);
-    sample.v1v2 = ColumnDouble(s, 2);
-    sample.triggered = sqlite3_column_int(s, 3) != 0;
-    sample.predicted_tip_x = ColumnDouble(s, 4);
-    sample.predicted_tip_z = ColumnDouble(s, 5);
-    sample.actual_tip_x = ColumnDouble(s, 6);
-    sample.actual_tip_z = ColumnDouble(s, 7);
+    const std::optional<double> t = read.Real(0);
+    if (!t) read.Refuse(0, "NULL where the sample time is required");
+    sample.t = *t;
+    sample.v1 = read.RealOrNotMeasured(1);
+    sample.v1v2 = read.RealOrNotMeasured(2);
+    sample.triggered = read.RequiredBool(3);
+    sample.predicted_tip_x = read.RealOrNotMeasured(4);
+    sample.predicted_tip_z = read.RealOrNotMeasured(5);
+    sample.actual_tip_x = read.RealOrNotMeasured(6);
+    sample.actual_tip_z = read.RealOrNotMeasured(7);
     samples.push_back(sample);
   }
   return samples;

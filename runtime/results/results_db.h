@@ -8,7 +8,15 @@
 // crash (never corrupting the file); a killed process loses nothing committed.
 //
 // NaN is stored as SQL NULL ("not measured / not applicable", e.g. the trigger time of a cycle
-// that never triggered) and read back as NaN. ±inf is stored as is.
+// that never triggered) and read back as NaN. +inf is stored as is where it has a meaning (the
+// safety margin of a cycle with nothing in reach).
+//
+// Reading back (issue 38): every reader of a results database goes through ColumnReader, which
+// keeps NULL as "not measured" and refuses what a careless edit or a damaged file leaves behind
+// (text or a blob in a numeric column, a non-integral number in an INTEGER column, infinities
+// where none belongs) with the file, table, row and column, instead of reading it as 0 the way
+// sqlite3_column_double does. Reports open the file read-only and run PRAGMA integrity_check
+// first, so a damaged file is refused before any figure is computed from it.
 //
 // Schema, units and example queries: docs/results_and_reports.md.
 #pragma once
@@ -17,6 +25,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -40,6 +49,71 @@ class DuplicateCycleError : public ResultsDbError {
  public:
   using ResultsDbError::ResultsDbError;
 };
+
+/// Closes a connection opened by OpenCheckedReadOnly.
+struct SqliteCloser {
+  void operator()(sqlite3* db) const;
+};
+using SqliteConnection = std::unique_ptr<sqlite3, SqliteCloser>;
+
+/// How thoroughly CheckIntegrity looks: `quick_check` is linear in the file (opening a campaign's
+/// databases to resume or merge them), `integrity_check` also checks every index against its
+/// table (before a report).
+enum class IntegrityCheck { kQuick, kFull };
+
+/// Runs PRAGMA quick_check or integrity_check on `db`. Throws ResultsDbError
+/// "FILE is not a valid SQLite database: WHY" when the file is not SQLite or is damaged.
+void CheckIntegrity(sqlite3* db, const std::filesystem::path& file,
+                    IntegrityCheck how = IntegrityCheck::kFull);
+
+/// Opens `file` with SQLITE_OPEN_READONLY (nothing in it is changed by reading it) and runs
+/// CheckIntegrity(kFull). Throws ResultsDbError naming the file when it does not exist, is not a
+/// regular file, is not SQLite or is damaged.
+SqliteConnection OpenCheckedReadOnly(const std::filesystem::path& file);
+
+/// The one typed reader of values in a results database (see the top of this file). A view over
+/// a statement whose current row comes from `table`; SetRow says how errors name that row.
+/// Errors: ResultsDbError "FILE: table T, ROW, column C: WHY".
+class ColumnReader {
+ public:
+  /// Whether +inf is a value of the column (only `safety_margin_m`: nothing was in reach).
+  enum class Infinity { kRefused, kPlusAllowed };
+
+  ColumnReader(sqlite3_stmt* statement, std::filesystem::path file, std::string table);
+
+  /// How errors name the current row, e.g. "rowid 17 (run 'w1s1-auto', cycle 3)".
+  void SetRow(std::string row) { row_ = std::move(row); }
+
+  /// A REAL (or INTEGER) column: nullopt for NULL ("not measured"). Refuses text, blobs and
+  /// non-finite values (+inf is let through with Infinity::kPlusAllowed).
+  std::optional<double> Real(int column, Infinity infinity = Infinity::kRefused) const;
+  /// Real() with NULL as kNotMeasured (NaN): the in-memory form of the record structs.
+  double RealOrNotMeasured(int column, Infinity infinity = Infinity::kRefused) const;
+  /// An INTEGER column: nullopt for NULL. Refuses text, blobs and non-integral numbers.
+  std::optional<std::int64_t> Integer(int column) const;
+  /// Integer() where NULL is refused too (NOT NULL columns, counts, keys).
+  std::int64_t RequiredInteger(int column) const;
+  /// Integer() of a 0/1 column; other values are refused.
+  bool RequiredBool(int column) const;
+  /// Integer() narrowed to int; values outside int's range are refused.
+  std::optional<int> SmallInteger(int column) const;
+  /// A TEXT column: "" for NULL. Refuses blobs; numbers are read as their text.
+  std::string Text(int column) const;
+
+  /// Throws ResultsDbError naming the file, table, row and column.
+  [[noreturn]] void Refuse(int column, const std::string& why) const;
+
+ private:
+  sqlite3_stmt* statement_;
+  std::filesystem::path file_;
+  std::string table_;
+  std::string row_;
+};
+
+/// Reads every numeric column of every `cycles` row through ColumnReader (throws on the first
+/// bad value), so that SQL aggregates over them (AVG, SUM in the campaign summary and the
+/// fault_summary view) cannot fold text into 0 or let an infinity through.
+void CheckCycleValues(sqlite3* db, const std::filesystem::path& file);
 
 /// One run: a row of `runs`.
 struct RunInfo {
@@ -119,17 +193,30 @@ class ResultsDb {
  public:
   static constexpr int kSchemaVersion = 2;
 
+  enum class Access {
+    kReadWrite,  ///< create or check the schema, migrate, write cycles (runs, campaigns)
+    kReadOnly,   ///< read back only (reports, retraining): nothing in the file is changed
+  };
+
   /// Opens `file`, creating it and the schema when it does not exist or is empty, and migrating
   /// a version-1 file to version 2 in place (one transaction; its rows keep their values and
   /// read −1 / "" for the new fields). Throws ResultsDbError naming the file when it is not a
   /// SQLite database, is a SQLite database without our schema_version table, or has another
-  /// schema version. A foreign file is not modified.
-  explicit ResultsDb(const std::filesystem::path& file);
+  /// schema version. A foreign file is not modified. An existing file is checked with
+  /// PRAGMA quick_check before anything is read or written ("FILE is not a valid SQLite
+  /// database: ...").
+  ///
+  /// Access::kReadOnly: the file must exist; it is opened read-only and checked with
+  /// PRAGMA integrity_check; a version-1 file is refused (migrating would write to it).
+  explicit ResultsDb(const std::filesystem::path& file, Access access = Access::kReadWrite);
   ~ResultsDb();
   ResultsDb(const ResultsDb&) = delete;
   ResultsDb& operator=(const ResultsDb&) = delete;
 
   const std::filesystem::path& file() const { return file_; }
+
+  /// PRAGMA integrity_check on the open file (before a report); throws ResultsDbError.
+  void CheckIntegrity() const;
 
   /// Inserts the run, or finds it when resuming. Returns true when it already existed; then
   /// scenario, machine and seed must match, else throws (the rows would not be comparable).
@@ -164,9 +251,11 @@ class ResultsDb {
   void Execute(const char* sql) const;
   [[noreturn]] void Fail(const std::string& what) const;
   void CreateOrCheckSchema();
+  void CheckSchemaReadOnly();
 
   std::filesystem::path file_;
   sqlite3* db_ = nullptr;
+  bool has_crowding_samples_ = true;  ///< false: a read-only file from before the table
 };
 
 }  // namespace autoshovel::results

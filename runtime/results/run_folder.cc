@@ -2,8 +2,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <limits>
@@ -11,6 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+
+#include "runtime/core/file_output.h"
 
 namespace autoshovel::results {
 namespace fs = std::filesystem;
@@ -102,9 +106,15 @@ void RunLog::Log(LogLevel level, std::string_view message) {
     std::snprintf(sim, sizeof(sim), "%10.3f", sim_time_s_);
   }
   const std::string name(LogLevelName(level));
-  std::fprintf(file_, "%s  sim=%s s  %-5s  %.*s\n", UtcTimestampIso().c_str(), sim, name.c_str(),
-               static_cast<int>(message.size()), message.data());
-  std::fflush(file_);
+  const int written =
+      std::fprintf(file_, "%s  sim=%s s  %-5s  %.*s\n", UtcTimestampIso().c_str(), sim,
+                   name.c_str(), static_cast<int>(message.size()), message.data());
+  // A log line lost to a full disk is a lost record: the run stops rather than go on unlogged.
+  if (written < 0 || std::fflush(file_) != 0) {
+    const int error_number = errno;
+    std::clearerr(file_);
+    throw core::OutputError(path_, std::strerror(error_number));
+  }
 }
 
 std::string KeyValuesToYaml(const KeyValues& key_values) {
@@ -166,8 +176,8 @@ RunFolder::RunFolder(const RunFolderOptions& options) {
       }
       if (!fs::is_empty(dir_)) {
         throw std::runtime_error(dir_.string() +
-                                 ": run folder is not empty; choose another, or resume the "
-                                 "interrupted run in it");
+                                 ": run folder is not empty; choose another (a run never "
+                                 "writes over earlier results)");
       }
     }
     fs::create_directories(dir_, error);
@@ -230,16 +240,7 @@ void RunFolder::WriteConfig(std::string_view yaml) {
     }
     return;
   }
-  const fs::path temporary = path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error(temporary.string() + ": cannot write");
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) throw std::runtime_error(path.string() + ": cannot write: " + error.message());
+  core::WriteFileAtomically(path, text);
 }
 
 void RunFolder::WriteConfig(const KeyValues& key_values) {

@@ -42,7 +42,7 @@ grep -q "has no actuator 'stick'; it has: boom_cylinders (joint boom)" "$tmp/err
   || fail "unexpected message: $(cat "$tmp/err")"
 "$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --amplitude 1.5 \
   2>"$tmp/err" >/dev/null && fail "amplitude 1.5 accepted"
-grep -q "amplitude must be in \[-1, 1\]" "$tmp/err" || fail "unexpected message: $(cat "$tmp/err")"
+grep -q -- "--amplitude: must be in \[-1, 1\], got 1.5" "$tmp/err" || fail "unexpected message: $(cat "$tmp/err")"
 # scenario: lists the yard, draws the top view, suggests the nearest name for a typo.
 "$autoshovel" --models "$source_dir/models" scenario cone_pile -o "$tmp/cone.png" >"$tmp/out" \
   || fail "scenario cone_pile"

@@ -22,6 +22,7 @@
 
 #include "identification/calibration/arm_calibration_csv.h"
 #include "identification/camera_lidar/camera_model.h"
+#include "identification/camera_lidar/image_header.h"
 #include "identification/camera_lidar/mask_io.h"
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "identification/hydraulics/log_reader.h"
@@ -151,6 +152,7 @@ const std::map<std::string, ReadFn>& Readers() {
          planning::ReadShovelWeights(p, config);
        }},
       {"camera_info", [](const std::string& p) { identification::ReadCameraInfoYaml(p); }},
+      {"image_header", [](const std::string& p) { identification::ReadImageHeader(p); }},
       {"log_format", [](const std::string& p) { identification::ReadLogFormatYaml(p); }},
       {"hydraulic_log",
        [](const std::string& p) {
@@ -226,7 +228,8 @@ INSTANTIATE_TEST_SUITE_P(Readers, BadInput,
                          ::testing::Values("description", "material", "overlay", "scenario",
                                            "campaign_spec", "shovel_weights", "camera_info",
                                            "log_format", "hydraulic_log", "arm_calibration", "pcd",
-                                           "kitti_bin", "masks", "onnx", "svr", "demonstrations"),
+                                           "kitti_bin", "masks", "image_header", "onnx", "svr",
+                                           "demonstrations"),
                          [](const auto& param_info) { return param_info.param; });
 
 // Every reader folder is exercised by the test above.

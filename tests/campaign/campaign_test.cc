@@ -320,6 +320,10 @@ TEST(Campaign, FaultCampaignPrintsAndStoresTheFaultTable) {
   EXPECT_NE(log.find("| fault | scenario | cycles | completed |"), std::string::npos) << log;
   EXPECT_NE(log.find("| none | cone_pile | 1 | 1 |"), std::string::npos) << log;
   EXPECT_NE(log.find("| lidar_dropout | mixing_station | 1 |"), std::string::npos) << log;
+  // Progress into a file (not a terminal): whole lines, never `\r` rewrites (issue 38 found one
+  // 100 KB line), ending with the final count on a line of its own.
+  EXPECT_EQ(log.find('\r'), std::string::npos) << log;
+  EXPECT_NE(log.find("\n[4/4 cycles] "), std::string::npos) << log;
 
   const results::ResultsDb db(out / "results.sqlite");
   int dropout_stops = 0, none_stops = 0;

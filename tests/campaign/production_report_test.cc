@@ -3,10 +3,13 @@
 #include "runtime/app/campaign/production_report.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <sstream>
 
 #include "runtime/app/campaign/campaign_spec.h"
@@ -122,6 +125,209 @@ TEST(ProductionReport, TablesAndTheComparisonFromKnownRows) {
   EXPECT_NE(err2.str().find("notes.sqlite"), std::string::npos) << err2.str();
   o.database = dir / "missing.sqlite";
   EXPECT_EQ(RunProductionReport(o, out2, err2), 2);
+  fs::remove_all(dir);
+}
+
+// A campaign database of one week, one shift and the two policies: 4 cycles each, written by
+// `write` (policy "auto" or "stairway_fixed", cycle index).
+fs::path SmallCampaign(const fs::path& dir,
+                       const std::function<results::CycleRecord(const std::string&, int)>& write) {
+  CampaignSpec spec;
+  spec.name = "t";
+  spec.weeks = 1;
+  spec.shifts_per_week = 1;
+  spec.cycles_per_shift = 4;
+  spec.policies = {"auto", "stairway_fixed"};
+  const std::vector<CampaignJob> jobs = CampaignJobs(spec);
+  const fs::path file = dir / "results.sqlite";
+  PrepareCampaignDatabase(file, spec, jobs);
+  results::ResultsDb db(file);
+  for (const CampaignJob& job : jobs) {
+    results::RunInfo info;
+    info.run_id = job.run_id;
+    info.scenario = "mixing_station";
+    info.machine = "xcmg_968ev";
+    info.cycles_planned = 4;
+    db.BeginRun(info);
+    for (int c = 0; c < 4; ++c) db.WriteCycle(job.run_id, write(job.policy, c));
+  }
+  return file;
+}
+
+// Fill 0.96 + 0.01 c, Just in & out, crowd 1 s + scoop (3 + c) s, 50 + 150 kJ.
+results::CycleRecord Plain(const std::string& policy, int c) {
+  return Cycle(c, "big_gravel", policy == "auto" ? "just_in_out" : "stairway_fixed",
+               "retract_bucket,lift_boom", 1, 3 + c, 50, 150, 0.96 + 0.01 * c);
+}
+
+void Exec(const fs::path& file, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK)
+      << (error != nullptr ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
+std::string Bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+struct Outcome {
+  int code;
+  std::string out, err;
+};
+Outcome Report(const fs::path& database) {
+  ProductionReportOptions o;
+  o.database = database;
+  o.png = database.parent_path() / "fig22.png";
+  std::ostringstream out, err;
+  const int code = RunProductionReport(o, out, err);
+  return {code, out.str(), err.str()};
+}
+
+TEST(ProductionReport, NullFillRatesAreNotMeasuredLeftOutOfTheMeanAndCounted) {
+  const fs::path dir = TempDir();
+  // Adaptive: cycles 1 and 3 did not measure their fill (NULL); 0 and 2 measured 0.96 and 0.98.
+  const fs::path file = SmallCampaign(dir, [](const std::string& policy, int c) {
+    results::CycleRecord r = Plain(policy, c);
+    if (policy == "auto" && c % 2 == 1) r.fill_rate = results::kNotMeasured;
+    return r;
+  });
+  const Outcome o = Report(file);
+  ASSERT_EQ(o.code, 0) << o.err;
+  // Mean of the measured rows (0.96 + 0.98) / 2 = 97.0 %; reading NULL as 0 gives 48.5 %.
+  EXPECT_NE(o.out.find("| auto | 4 | 100.0 % | 97.0 % |"), std::string::npos) << o.out;
+  // The baseline measured all four: (0.96 + 0.97 + 0.98 + 0.99) / 4 = 97.5 %.
+  EXPECT_NE(o.out.find("| stairway_fixed | 4 | 100.0 % | 97.5 % |"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("auto: fill_rate: 2 of 4 completed cycles not measured, left out of the "
+                       "mean"),
+            std::string::npos)
+      << o.out;
+  EXPECT_EQ(o.out.find("stairway_fixed: fill_rate"), std::string::npos) << o.out;
+  fs::remove_all(dir);
+}
+
+TEST(ProductionReport, TextInARealColumnIsRefusedNamingTheRowAndColumn) {
+  const fs::path dir = TempDir();
+  const fs::path file = SmallCampaign(dir, Plain);
+  // A hand edit: the unit typed into the cell. SQLite keeps it as text (REAL affinity converts
+  // only well-formed numbers), and sqlite3_column_double would read it as 0.
+  Exec(file, "UPDATE cycles SET time_scoop_s = '16.65 s' WHERE run_id LIKE '%auto%' AND cycle = 2");
+  const std::string rowid = [&] {
+    sqlite3* db = nullptr;
+    sqlite3_open(file.c_str(), &db);
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(db, "SELECT rowid FROM cycles WHERE typeof(time_scoop_s) = 'text'", -1, &s,
+                       nullptr);
+    std::string id = sqlite3_step(s) == SQLITE_ROW ? std::to_string(sqlite3_column_int64(s, 0))
+                                                   : std::string("?");
+    sqlite3_finalize(s);
+    sqlite3_close(db);
+    return id;
+  }();
+  const std::string before = Bytes(file);
+  const Outcome o = Report(file);
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_EQ(o.out, "");  // no table computed from the damaged row
+  EXPECT_NE(o.err.find(file.string() + ": table cycles, rowid " + rowid + " (run '"),
+            std::string::npos)
+      << o.err;
+  EXPECT_NE(o.err.find("cycle 2), column time_scoop_s: text '16.65 s' where a number belongs"),
+            std::string::npos)
+      << o.err;
+  EXPECT_EQ(Bytes(file), before);  // read-only: nothing changed
+  fs::remove_all(dir);
+}
+
+TEST(ProductionReport, InfinityIsRefusedNotDropped) {
+  const fs::path dir = TempDir();
+  const fs::path file = SmallCampaign(dir, Plain);
+  Exec(file, "UPDATE cycles SET fill_rate = 9e999 WHERE run_id LIKE '%auto%' AND cycle = 1");
+  const Outcome o = Report(file);
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.err.find("cycle 1), column fill_rate: +inf where a finite number belongs"),
+            std::string::npos)
+      << o.err;
+  Exec(file, "UPDATE cycles SET fill_rate = 0.97 WHERE fill_rate > 1e308");
+  ASSERT_EQ(Report(file).code, 0);
+  Exec(file,
+       "UPDATE cycles SET energy_crowd_kj = -9e999 WHERE run_id LIKE '%fixed%' AND cycle = 3");
+  const Outcome second = Report(file);
+  EXPECT_EQ(second.code, 2) << second.out;
+  EXPECT_NE(second.err.find("cycle 3), column energy_crowd_kj: -inf where a finite number belongs"),
+            std::string::npos)
+      << second.err;
+  fs::remove_all(dir);
+}
+
+TEST(ProductionReport, DatabaseFailingTheIntegrityCheckIsRefused) {
+  const fs::path dir = TempDir();
+  // Enough samples that the `samples` table, which the report does not read, spans pages.
+  const fs::path file = SmallCampaign(dir, [](const std::string& policy, int c) {
+    results::CycleRecord r = Plain(policy, c);
+    for (int k = 0; k < 200; ++k) {
+      results::CycleSample s;
+      s.t = 0.05 * k;
+      s.v1 = 0.01 * k;
+      r.samples.push_back(s);
+    }
+    return r;
+  });
+  ASSERT_EQ(Report(file).code, 0);
+  ASSERT_FALSE(fs::exists(file.string() + "-wal") && fs::file_size(file.string() + "-wal") > 0);
+  // Overwrite the b-tree header of the root page of `samples` in the file.
+  long long root = 0, page_size = 0;
+  {
+    sqlite3* db = nullptr;
+    sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(db, "SELECT rootpage FROM sqlite_master WHERE name = 'samples'", -1, &s,
+                       nullptr);
+    if (sqlite3_step(s) == SQLITE_ROW) root = sqlite3_column_int64(s, 0);
+    sqlite3_finalize(s);
+    sqlite3_prepare_v2(db, "PRAGMA page_size", -1, &s, nullptr);
+    if (sqlite3_step(s) == SQLITE_ROW) page_size = sqlite3_column_int64(s, 0);
+    sqlite3_finalize(s);
+    sqlite3_close(db);
+  }
+  ASSERT_GT(root, 1);
+  ASSERT_GT(page_size, 0);
+  {
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp((root - 1) * page_size);
+    const std::string garbage(64, '\x5a');
+    io.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  const std::string before = Bytes(file);
+  const Outcome o = Report(file);
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_EQ(o.out, "");
+  EXPECT_EQ(o.err.rfind("autoshovel report production: " + file.string() +
+                            " is not a valid SQLite database: ",
+                        0),
+            0u)
+      << o.err;
+  EXPECT_EQ(o.err.find("holds no campaign cycles"), std::string::npos) << o.err;
+  EXPECT_EQ(Bytes(file), before);
+  fs::remove_all(dir);
+}
+
+TEST(ProductionReport, TextFileNamedSqliteIsRefused) {
+  const fs::path dir = TempDir();
+  const fs::path file = dir / "results.sqlite";
+  {
+    std::ofstream out(file);
+    for (int i = 0; i < 50; ++i) out << "week,policy,fill_rate\n1,auto,0.98\n";
+  }
+  const std::string before = Bytes(file);
+  const Outcome o = Report(file);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_EQ(o.err, "autoshovel report production: " + file.string() +
+                       " is not a valid SQLite database: file is not a database\n");
+  EXPECT_EQ(Bytes(file), before);
   fs::remove_all(dir);
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "identification/calibration/arm_calibration_csv.h"
+#include "identification/camera_lidar/image_header.h"
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "identification/hydraulics/log_reader.h"
 #include "runtime/core/diagnostics.h"
@@ -125,6 +126,12 @@ TEST(FuzzRegressions, HydraulicLog) {
 TEST(FuzzRegressions, Pcd) {
   ExpectBothKinds(CheckTarget("pcd", [](const std::string& path) {
     return Refusal([&] { identification::ReadPointCloud(path, /*max_points=*/64); });
+  }));
+}
+
+TEST(FuzzRegressions, ImageHeader) {
+  ExpectBothKinds(CheckTarget("image_header", [](const std::string& path) {
+    return Refusal([&] { identification::ReadImageHeader(path); });
   }));
 }
 

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "tests/results/test_records.h"
@@ -224,7 +226,8 @@ TEST(ResultsDb, NonSqliteFileIsRefusedNamingIt) {
     FAIL() << "opened a text file";
   } catch (const ResultsDbError& e) {
     EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("not an autoshovel results database"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find(file.string() + " is not a valid SQLite database"),
+              std::string::npos)
         << e.what();
   }
   EXPECT_EQ(std::filesystem::file_size(file), size);  // untouched
@@ -349,6 +352,181 @@ TEST(ResultsDb, CorruptedPagesAreReportedNamingTheFile) {
   } catch (const ResultsDbError& e) {
     EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
   }
+}
+
+std::string Bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A database of one run with cycles 0..2, closed (the WAL checkpointed into the file).
+std::filesystem::path ThreeCycles() {
+  const auto file = ScratchDir("") / "results.sqlite";
+  ResultsDb db(file);
+  db.BeginRun(TestRun());
+  for (int c = 0; c < 3; ++c) db.WriteCycle("run-1", TestRecord(c, 4));
+  return file;
+}
+
+// The message of the ResultsDbError that `read` throws, or "" when it throws none.
+template <typename Read>
+std::string Refusal(Read read) {
+  try {
+    read();
+  } catch (const ResultsDbError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ResultsDb, NullIsNotMeasuredWhenReadBack) {
+  const auto file = ThreeCycles();
+  Exec(file, "UPDATE cycles SET fill_rate = NULL, safe_stops = NULL WHERE cycle = 1");
+  const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+  const std::vector<CycleRecord> cycles = db.Cycles("run-1");
+  ASSERT_EQ(cycles.size(), 3u);
+  EXPECT_TRUE(std::isnan(cycles[1].fill_rate));
+  EXPECT_EQ(cycles[1].safe_stops, -1);
+  EXPECT_EQ(cycles[0].fill_rate, TestRecord(0, 4).fill_rate);
+}
+
+TEST(ResultsDb, TextInARealColumnIsRefusedNamingFileTableRowAndColumn) {
+  const auto file = ThreeCycles();
+  Exec(file, "UPDATE cycles SET time_scoop_s = 'n/a' WHERE cycle = 2");
+  const std::string rowid = Query(file, "SELECT rowid FROM cycles WHERE cycle = 2");
+  for (const ResultsDb::Access access :
+       {ResultsDb::Access::kReadOnly, ResultsDb::Access::kReadWrite}) {
+    const ResultsDb db(file, access);
+    EXPECT_EQ(Refusal([&] { db.Cycles("run-1"); }),
+              file.string() + ": table cycles, rowid " + rowid +
+                  " (run 'run-1', cycle 2), column time_scoop_s: text 'n/a' where a number "
+                  "belongs");
+  }
+}
+
+TEST(ResultsDb, TextOrFractionInAnIntegerColumnIsRefused) {
+  const auto file = ThreeCycles();
+  Exec(file, "UPDATE cycles SET safety_violations = 'none' WHERE cycle = 0");
+  const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+  EXPECT_NE(Refusal([&] { db.Cycles("run-1"); })
+                .find("(run 'run-1', cycle 0), column safety_violations: text 'none' where a whole "
+                      "number belongs"),
+            std::string::npos);
+  Exec(file, "UPDATE cycles SET safety_violations = 0 WHERE cycle = 0");
+  Exec(file, "UPDATE cycles SET safe_stops = 1.5 WHERE cycle = 1");
+  EXPECT_NE(
+      Refusal([&] { db.Cycles("run-1"); })
+          .find("(run 'run-1', cycle 1), column safe_stops: the number 1.5 where a whole number "
+                "belongs"),
+      std::string::npos);
+}
+
+TEST(ResultsDb, InfinityIsRefusedExceptAnUnboundedSafetyMargin) {
+  const auto file = ThreeCycles();
+  // +inf clearance: nothing came within reach; the writer stores it and the reader keeps it.
+  Exec(file, "UPDATE cycles SET safety_margin_m = 9e999 WHERE cycle = 0");
+  {
+    const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+    EXPECT_EQ(db.Cycles("run-1")[0].safety_margin_m, std::numeric_limits<double>::infinity());
+  }
+  Exec(file, "UPDATE cycles SET energy_total_kj = -9e999 WHERE cycle = 1");
+  const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+  EXPECT_NE(Refusal([&] { db.Cycles("run-1"); })
+                .find("(run 'run-1', cycle 1), column energy_total_kj: -inf where a finite "
+                      "number belongs"),
+            std::string::npos);
+  Exec(file, "UPDATE cycles SET energy_total_kj = 1 WHERE cycle = 1");
+  Exec(file, "UPDATE samples SET v1_m3 = 9e999 WHERE cycle = 2 AND k = 3");
+  EXPECT_EQ(Refusal([&] { db.Samples("run-1", 2); }),
+            file.string() +
+                ": table samples, run 'run-1', cycle 2, k 3, column v1_m3: +inf where a finite "
+                "number belongs");
+}
+
+TEST(ResultsDb, ReadOnlyOpenChangesNothingAndRunsTheIntegrityCheck) {
+  const auto file = ThreeCycles();
+  const std::string before = Bytes(file);
+  const auto mtime = std::filesystem::last_write_time(file);
+  {
+    const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+    EXPECT_EQ(db.Cycles("run-1", true).size(), 3u);
+    EXPECT_EQ(db.Runs().size(), 1u);
+    EXPECT_NO_THROW(db.CheckIntegrity());
+  }
+  EXPECT_EQ(Bytes(file), before);
+  EXPECT_EQ(std::filesystem::last_write_time(file), mtime);
+}
+
+TEST(ResultsDb, ReadOnlyOpenRefusesMissingTextAndDamagedFiles) {
+  const auto dir = ScratchDir("");
+  EXPECT_EQ(Refusal([&] { ResultsDb(dir / "none.sqlite", ResultsDb::Access::kReadOnly); }),
+            (dir / "none.sqlite").string() + ": no such file");
+  EXPECT_FALSE(std::filesystem::exists(dir / "none.sqlite"));  // not created
+  const auto text = dir / "text.sqlite";
+  std::ofstream(text) << "run,cycle,fill_rate\nrun-1,0,0.98\n";
+  EXPECT_EQ(Refusal([&] { ResultsDb(text, ResultsDb::Access::kReadOnly); }),
+            text.string() + " is not a valid SQLite database: file is not a database");
+}
+
+TEST(ResultsDb, DamagedIndexPageFailsTheIntegrityCheckBeforeAnyRead) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  {
+    ResultsDb db(file);
+    db.BeginRun(TestRun());
+    for (int c = 0; c < 10; ++c) db.WriteCycle("run-1", TestRecord(c, 300));
+  }
+  // The unique (run_id, cycle) index of `cycles`: the readers never walk it for Cycles(), so
+  // only the integrity check sees the damage.
+  const long long root =
+      std::stoll(Query(file,
+                       "SELECT rootpage FROM sqlite_master WHERE type = 'index' AND "
+                       "tbl_name = 'cycles'"));
+  const long long page = std::stoll(Query(file, "PRAGMA page_size"));
+  {
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp((root - 1) * page);
+    const std::string garbage(32, '\x5a');
+    io.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  const std::string before = Bytes(file);
+  const std::string what =
+      Refusal([&] { ResultsDb(file, ResultsDb::Access::kReadOnly).Cycles("run-1"); });
+  EXPECT_EQ(what.rfind(file.string() + " is not a valid SQLite database: ", 0), 0u) << what;
+  EXPECT_EQ(Bytes(file), before);
+}
+
+TEST(ColumnReader, NamesTheFileTableRowAndColumn) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(":memory:", &db), SQLITE_OK);
+  sqlite3_stmt* s = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT NULL AS a, 2 AS b, 2.5 AS c, x'00ff' AS d, '7' AS e, "
+                               "9e999 AS f",
+                               -1, &s, nullptr),
+            SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(s), SQLITE_ROW);
+  ColumnReader read(s, "x.sqlite", "t");
+  read.SetRow("rowid 4");
+  EXPECT_FALSE(read.Real(0).has_value());
+  EXPECT_FALSE(read.Integer(0).has_value());
+  EXPECT_EQ(read.Text(0), "");
+  EXPECT_EQ(read.Real(1), 2.0);
+  EXPECT_EQ(read.Integer(1), 2);
+  EXPECT_EQ(read.Real(2), 2.5);
+  EXPECT_EQ(Refusal([&] { read.Integer(2); }),
+            "x.sqlite: table t, rowid 4, column c: the number 2.5 where a whole number belongs");
+  EXPECT_EQ(Refusal([&] { read.Real(3); }),
+            "x.sqlite: table t, rowid 4, column d: a blob of 2 bytes where a number belongs");
+  EXPECT_EQ(Refusal([&] { read.Real(4); }),
+            "x.sqlite: table t, rowid 4, column e: text '7' where a number belongs");
+  EXPECT_EQ(read.Real(5, ColumnReader::Infinity::kPlusAllowed),
+            std::numeric_limits<double>::infinity());
+  EXPECT_EQ(Refusal([&] { read.Real(5); }),
+            "x.sqlite: table t, rowid 4, column f: +inf where a finite number belongs");
+  EXPECT_EQ(Refusal([&] { read.RequiredInteger(0); }),
+            "x.sqlite: table t, rowid 4, column a: NULL where a whole number is required");
+  sqlite3_finalize(s);
+  sqlite3_close(db);
 }
 
 }  // namespace

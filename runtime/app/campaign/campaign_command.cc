@@ -24,6 +24,8 @@
 #include "runtime/app/campaign/campaign_spec.h"
 #include "runtime/app/campaign/campaign_store.h"
 #include "runtime/app/shovel_run.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/progress_line.h"
 #include "runtime/results/results_db.h"
 
 extern char** environ;
@@ -159,10 +161,10 @@ bool PrepareFolder(const CampaignOptions& o, const CampaignSpec& spec,
       err << kCommand << ": " << dir.string() << " exists and is not empty; choose another -o\n";
       return false;
     }
-    std::filesystem::create_directories(dir / "shards");
+    core::CreateFolders(dir / "shards");
     std::filesystem::copy_file(o.spec, stored_spec);
   }
-  std::filesystem::create_directories(dir / "shards");
+  core::CreateFolders(dir / "shards");
   PrepareCampaignDatabase(MergedPath(dir), spec, jobs);
   for (const auto& shard : ShardFiles(dir / "shards")) MergeShard(MergedPath(dir), shard);
   return true;
@@ -174,61 +176,28 @@ long long ShardRows(const std::filesystem::path& dir) {
   return rows;
 }
 
-void PrintProgress(std::ostream& out, long long done, long long total, long long fresh,
-                   double seconds, bool final) {
+// Progress goes to standard error (results and the summary stay on standard output), rewritten in
+// place on a terminal and one line per newly stored cycle anywhere else (core/progress_line.h).
+void PrintProgress(core::ProgressLine& progress, long long done, long long total, long long fresh,
+                   double seconds, bool final, long long& last_done) {
   const double rate = seconds > 0 ? fresh / seconds : 0;
   // No ETA before the first cycle of this session is stored (the rate is not known yet).
   char eta[32] = "?";
   if (rate > 0) std::snprintf(eta, sizeof eta, "%.0f s", (total - done) / rate);
   char line[200];
-  std::snprintf(line, sizeof line, "\r[%lld/%lld cycles] %.2f cycles/s, %.0f s elapsed, ETA %s   ",
-                done, total, rate, seconds, eta);
-  out << line << (final ? "\n" : "") << std::flush;
+  std::snprintf(line, sizeof line, "[%lld/%lld cycles] %.2f cycles/s, %.0f s elapsed, ETA %s", done,
+                total, rate, seconds, eta);
+  if (final) {
+    progress.Finish(line);
+  } else {
+    progress.Update(line, done != last_done);
+  }
+  last_done = done;
 }
 
-// Per policy: cycles, completed, mean fill, time and energy; safety.
+// Per policy: cycles, completed, mean fill, time and energy; safety (campaign_store.h).
 void PrintSummary(const std::filesystem::path& merged, std::ostream& out) {
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2(merged.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    sqlite3_close(db);
-    return;
-  }
-  const char* sql =
-      "SELECT r.policy, count(*), sum(c.completed), avg(c.fill_rate), avg(c.time_scoop_s), "
-      "avg(c.energy_scoop_kj), avg(c.time_total_s), avg(c.energy_total_kj), "
-      "sum(c.safety_violations), min(c.safety_margin_m) FROM cycles c JOIN campaign_runs r "
-      "USING (run_id) GROUP BY r.policy ORDER BY r.policy";
-  sqlite3_stmt* s = nullptr;
-  out << "| policy | cycles | completed | mean fill | scoop s | scoop kJ | cycle s | cycle kJ | "
-         "safety violations | min clearance m |\n| --- | --- | --- | --- | --- | --- | --- | --- "
-         "| --- | --- |\n";
-  if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) == SQLITE_OK) {
-    while (sqlite3_step(s) == SQLITE_ROW) {
-      char line[300];
-      std::snprintf(
-          line, sizeof line,
-          "| %s | %lld | %lld | %.1f %% | %.2f | %.1f | %.1f | %.0f | %lld | %.2f |\n",
-          reinterpret_cast<const char*>(sqlite3_column_text(s, 0)), sqlite3_column_int64(s, 1),
-          sqlite3_column_int64(s, 2), 100 * sqlite3_column_double(s, 3),
-          sqlite3_column_double(s, 4), sqlite3_column_double(s, 5), sqlite3_column_double(s, 6),
-          sqlite3_column_double(s, 7), sqlite3_column_int64(s, 8), sqlite3_column_double(s, 9));
-      out << line;
-    }
-  }
-  sqlite3_finalize(s);
-  // A fault campaign: the fault × scenario table too.
-  bool fault_campaign = false;
-  if (sqlite3_prepare_v2(db, "SELECT count(*) FROM campaign_runs WHERE fault_case <> ''", -1, &s,
-                         nullptr) == SQLITE_OK &&
-      sqlite3_step(s) == SQLITE_ROW) {
-    fault_campaign = sqlite3_column_int64(s, 0) > 0;
-  }
-  sqlite3_finalize(s);
-  sqlite3_close(db);
-  if (fault_campaign) {
-    out << "\nFaults x scenarios (view fault_summary):\n";
-    PrintFaultTable(merged, out);
-  }
+  PrintCampaignSummary(merged, out);
 }
 
 // Local: worker processes of this executable, progress from their shards.
@@ -290,6 +259,8 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
     pids.push_back(pid);
   }
   const auto t0 = std::chrono::steady_clock::now();
+  core::ProgressLine progress(err);
+  long long last_done = -1;
   int failed_workers = 0;
   std::vector<bool> running(pids.size(), true);
   for (int alive = workers; alive > 0;) {
@@ -301,8 +272,7 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
         --alive;
         if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
           ++failed_workers;
-          err << "\n"
-              << kCommand << ": worker " << k << " ended with "
+          err << (progress.terminal() ? "\n" : "") << kCommand << ": worker " << k << " ended with "
               << (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
                                       : "status " + std::to_string(WEXITSTATUS(status)))
               << " (log: " << (dir / ("worker-" + std::to_string(k) + ".log")).string() << ")\n";
@@ -312,13 +282,13 @@ int RunLocal(const CampaignOptions& o, const CampaignSpec& spec, const std::file
     const long long fresh = ShardRows(dir) - shard_rows_before;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    PrintProgress(out, base + fresh, total, fresh, seconds, false);
+    PrintProgress(progress, base + fresh, total, fresh, seconds, false, last_done);
   }
   for (const auto& shard : ShardFiles(dir / "shards")) MergeShard(MergedPath(dir), shard);
   const long long stored = CountCycles(MergedPath(dir));
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  PrintProgress(out, stored, total, stored - base, seconds, true);
+  PrintProgress(progress, stored, total, stored - base, seconds, true, last_done);
   PrintSummary(MergedPath(dir), out);
   out << "results: " << MergedPath(dir).string() << "\n";
   if (stored < total) {
@@ -360,11 +330,13 @@ int RunMpi(const CampaignOptions& o, const CampaignSpec& spec, const std::vector
   const auto t0 = std::chrono::steady_clock::now();
   const long long base = rank == 0 ? CountCycles(MergedPath(dir)) : 0;
   const long long shard_rows_before = rank == 0 ? ShardRows(dir) : 0;
+  core::ProgressLine progress_line(err);
+  long long last_done = -1;
   const auto progress = [&](bool final) {
     const long long fresh = ShardRows(dir) - shard_rows_before;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    PrintProgress(out, base + fresh, spec.cycles(), fresh, seconds, final);
+    PrintProgress(progress_line, base + fresh, spec.cycles(), fresh, seconds, final, last_done);
   };
   const int failed = RunWorker(
       spec, jobs, dir, o.models_dir, rank, size, log,

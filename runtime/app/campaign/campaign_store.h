@@ -47,6 +47,12 @@ long long CountCycles(const std::filesystem::path& file);
 /// (nothing printed) when the file has no such view.
 bool PrintFaultTable(const std::filesystem::path& merged, std::ostream& out);
 
+/// Prints the per-policy summary of a campaign database (cycles, completed, mean fill, scoop and
+/// cycle time and energy, safety) and, for a fault campaign, the fault table. The file is opened
+/// read-only and checked (integrity, then every value through results::ColumnReader); NULL
+/// values are left out of the means and counted in a note. Throws results::ResultsDbError.
+void PrintCampaignSummary(const std::filesystem::path& merged, std::ostream& out);
+
 /// The shard files under `dir`, sorted.
 std::vector<std::filesystem::path> ShardFiles(const std::filesystem::path& dir);
 

@@ -6,29 +6,35 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
+#include <optional>
 #include <ostream>
 #include <set>
+#include <stdexcept>
 #include <vector>
 
 #include "runtime/plot/box_plot.h"
+#include "runtime/results/results_db.h"
 
 namespace autoshovel::app {
 namespace {
 
 constexpr const char* kCommand = "autoshovel report production";
 
+// nullopt: not measured (NULL in the database), left out of every mean and box.
 struct Row {
   int week = 0;
   std::string policy, material, strategy;
   bool gravel = false;
-  double fill = NAN, time = NAN, energy = NAN;  ///< scooping: contact to end of scoop [s, kJ]
+  std::optional<double> fill, time, energy;  ///< scooping: contact to end of scoop [s, kJ]
   bool completed = false;
-  int violations = 0;
+  long long violations = 0;
 };
 
-std::string Text(sqlite3_stmt* s, int column) {
-  const unsigned char* t = sqlite3_column_text(s, column);
-  return t != nullptr ? reinterpret_cast<const char*>(t) : "";
+// Scooping is the crowd and scoop phases together: not measured when either is not.
+std::optional<double> Sum(const std::optional<double>& a, const std::optional<double>& b) {
+  if (!a || !b) return std::nullopt;
+  return *a + *b;
 }
 
 // "Just in & out", or "Stairway #N" with N the bucket retractions (its atomic actions).
@@ -42,11 +48,17 @@ std::string StrategyLabel(const std::string& strategy, const std::string& action
   return "Stairway #" + std::to_string(steps);
 }
 
+// The reader refuses non-finite values, so every value that reaches a mean is finite; NULL
+// ("not measured") is counted, so the report can say how many cycles a mean leaves out.
 struct Mean {
   double sum = 0;
-  int n = 0;
-  void Add(double v) {
-    if (std::isfinite(v)) sum += v, ++n;
+  int n = 0, not_measured = 0;
+  void Add(const std::optional<double>& v) {
+    if (v) {
+      sum += *v, ++n;
+    } else {
+      ++not_measured;
+    }
   }
   double value() const { return n > 0 ? sum / n : NAN; }
 };
@@ -68,53 +80,75 @@ std::string Num(double v, const char* format) {
   return text;
 }
 
+// Every cycle of the campaign through the typed reader: the database is opened read-only and
+// checked (PRAGMA integrity_check) first; text, blobs or infinities in a numeric column are
+// refused naming the row and column, NULL stays "not measured".
+std::vector<Row> ReadRows(const std::filesystem::path& file) {
+  const results::SqliteConnection db = results::OpenCheckedReadOnly(file);
+  const char* sql =
+      "SELECT c.rowid, c.run_id, c.cycle, r.week, r.policy, c.material, c.strategy, "
+      "c.atomic_actions, c.fill_rate, c.completed, c.time_crowd_s, c.time_scoop_s, "
+      "c.energy_crowd_kj, c.energy_scoop_kj, c.safety_violations "
+      "FROM cycles c JOIN campaign_runs r USING (run_id) ORDER BY r.week, c.run_id, c.cycle";
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db.get(), sql, -1, &raw, nullptr) != SQLITE_OK) {
+    const std::string why = sqlite3_errmsg(db.get());
+    sqlite3_finalize(raw);
+    throw std::runtime_error(file.string() +
+                             ": not a campaign database (no cycles or campaign_runs table: " + why +
+                             ")");
+  }
+  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> statement(raw, sqlite3_finalize);
+  results::ColumnReader cycles(raw, file, "cycles");
+  results::ColumnReader runs(raw, file, "campaign_runs");
+  std::vector<Row> rows;
+  int rc = SQLITE_ROW;
+  while ((rc = sqlite3_step(raw)) == SQLITE_ROW) {
+    const std::string run_id = cycles.Text(1);
+    cycles.SetRow("rowid " + std::to_string(cycles.RequiredInteger(0)) + " (run '" + run_id +
+                  "', cycle " + std::to_string(cycles.RequiredInteger(2)) + ")");
+    runs.SetRow("run '" + run_id + "'");
+    Row r;
+    const std::optional<int> week = runs.SmallInteger(3);
+    if (!week) runs.Refuse(3, "NULL where the week is required");
+    r.week = *week;
+    r.policy = runs.Text(4);
+    r.material = cycles.Text(5);
+    r.gravel = r.material.find("gravel") != std::string::npos;
+    r.completed = cycles.RequiredBool(9);
+    // Every value is read (and checked) whether or not the cycle completed: a damaged row is
+    // refused, not skipped.
+    const std::string strategy = cycles.Text(6), actions = cycles.Text(7);
+    const std::optional<double> fill = cycles.Real(8);
+    const std::optional<double> time = Sum(cycles.Real(10), cycles.Real(11));
+    const std::optional<double> energy = Sum(cycles.Real(12), cycles.Real(13));
+    if (r.completed) {
+      r.strategy = StrategyLabel(strategy, actions);
+      r.fill = fill, r.time = time, r.energy = energy;
+    }
+    r.violations = cycles.RequiredInteger(14);
+    rows.push_back(r);
+  }
+  if (rc != SQLITE_DONE) {
+    throw std::runtime_error(file.string() + " is not a valid SQLite database: " +
+                             sqlite3_errmsg(db.get()) + " (reading cycles)");
+  }
+  return rows;
+}
+
 }  // namespace
 
 int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std::ostream& err) {
-  if (!std::filesystem::is_regular_file(o.database)) {
-    err << kCommand << ": " << o.database.string() << ": no such file\n";
-    return 2;
-  }
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2(o.database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    err << kCommand << ": " << o.database.string() << ": " << sqlite3_errmsg(db) << "\n";
-    sqlite3_close(db);
-    return 2;
-  }
-  const char* sql =
-      "SELECT r.week, r.policy, c.material, c.strategy, c.atomic_actions, c.fill_rate, "
-      "c.completed, c.time_crowd_s + c.time_scoop_s, c.energy_crowd_kj + c.energy_scoop_kj, "
-      "c.safety_violations FROM cycles c JOIN campaign_runs r USING (run_id) "
-      "ORDER BY r.week, c.run_id, c.cycle";
-  sqlite3_stmt* s = nullptr;
-  if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) != SQLITE_OK) {
-    err << kCommand << ": " << o.database.string()
-        << ": not a campaign database (no cycles or campaign_runs table: " << sqlite3_errmsg(db)
-        << ")\n";
-    sqlite3_close(db);
-    return 2;
-  }
   std::vector<Row> rows;
-  while (sqlite3_step(s) == SQLITE_ROW) {
-    Row r;
-    r.week = sqlite3_column_int(s, 0);
-    r.policy = Text(s, 1);
-    r.material = Text(s, 2);
-    r.gravel = r.material.find("gravel") != std::string::npos;
-    r.completed = sqlite3_column_int(s, 6) != 0;
-    if (r.completed) {
-      r.strategy = StrategyLabel(Text(s, 3), Text(s, 4));
-      r.fill = sqlite3_column_double(s, 5);
-      r.time = sqlite3_column_double(s, 7);
-      r.energy = sqlite3_column_double(s, 8);
-    }
-    r.violations = sqlite3_column_int(s, 9);
-    rows.push_back(r);
+  try {
+    rows = ReadRows(o.database);
+  } catch (const std::exception& e) {
+    err << kCommand << ": " << e.what() << "\n";
+    return 2;
   }
-  sqlite3_finalize(s);
-  sqlite3_close(db);
   if (rows.empty()) {
-    err << kCommand << ": " << o.database.string() << " holds no campaign cycles\n";
+    err << kCommand << ": " << o.database.string()
+        << " holds no campaign cycles (its cycles table is empty)\n";
     return 2;
   }
 
@@ -171,7 +205,8 @@ int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std
 
   // The seed's comparison: adaptive against the fixed Stairway #3 on the same shifts.
   struct PolicyStats {
-    int cycles = 0, completed = 0, violations = 0;
+    int cycles = 0, completed = 0;
+    long long violations = 0;
     Mean fill, time, energy;
   };
   std::map<std::string, PolicyStats> policies;
@@ -206,14 +241,31 @@ int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std
         << Num(100 * df, "%+.1f") << " points\n";
   }
 
+  // What the means above leave out: NULL is "not measured" (docs/results_and_reports.md), so a
+  // mean is over the measured cycles only, and the reader is told how many those are.
+  bool noted = false;
+  for (const auto& [name, p] : policies) {
+    const std::pair<const char*, const Mean*> columns[] = {
+        {"fill_rate", &p.fill},
+        {"scooping time (time_crowd_s + time_scoop_s)", &p.time},
+        {"scooping energy (energy_crowd_kj + energy_scoop_kj)", &p.energy}};
+    for (const auto& [column, mean] : columns) {
+      if (mean->not_measured == 0) continue;
+      if (!noted) out << "\nNot measured (NULL), left out of the means:\n";
+      noted = true;
+      out << "- " << name << ": " << column << ": " << mean->not_measured << " of " << p.completed
+          << " completed cycles not measured, left out of the mean\n";
+    }
+  }
+
   // Fig. 22.
   std::vector<plot::BoxGroup> time_groups, energy_groups;
   for (const std::string& l : labels) {
     plot::BoxGroup t{l, {}}, e{l, {}};
     for (const Row& r : rows) {
       if (r.policy == o.adaptive_policy && r.completed && r.strategy == l) {
-        t.samples.push_back(r.time);
-        e.samples.push_back(r.energy);
+        if (r.time) t.samples.push_back(*r.time);
+        if (r.energy) e.samples.push_back(*r.energy);
       }
     }
     time_groups.push_back(t);
@@ -223,8 +275,8 @@ int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std
     plot::BoxGroup t{"fixed #3", {}}, e{"fixed #3", {}};
     for (const Row& r : rows) {
       if (r.policy == o.baseline_policy && r.completed) {
-        t.samples.push_back(r.time);
-        e.samples.push_back(r.energy);
+        if (r.time) t.samples.push_back(*r.time);
+        if (r.energy) e.samples.push_back(*r.energy);
       }
     }
     time_groups.push_back(t);

@@ -13,6 +13,7 @@
 
 #include "runtime/app/truck_loading/truck_loading_job.h"
 #include "runtime/plot/bar_chart.h"
+#include "runtime/plot/image_file.h"
 #include "runtime/results/report.h"
 #include "runtime/results/results_db.h"
 #include "runtime/results/run_folder.h"
@@ -90,9 +91,7 @@ void TruckLoadingJob::WriteBedPng(const std::filesystem::path& path) const {
                 fill.mean_height_m, fill.std_height_m, rim);
   cv::putText(framed, title, {10, 26}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
               cv::LINE_AA);
-  if (!cv::imwrite(path.string(), framed)) {
-    throw std::runtime_error("cannot write " + path.string());
-  }
+  plot::WriteImageFile(path, framed);
 }
 
 int RunTruckLoadingCommand(const TruckLoadingOptions& options, const std::filesystem::path& out_dir,

@@ -71,3 +71,33 @@ write("demonstrations/text.sqlite", b"SQLite format 2\x00 but not really a datab
 # More KITTI .bin: a PCD renamed .bin (its header decodes to absurd floats), a lone partial point.
 write("kitti_bin/pcd_renamed.bin", open("pcd/short_ascii_row.pcd", "rb").read()[:64])
 write("kitti_bin/one_partial_point.bin", floats(1.0, 2.0, 3.0)[:11])
+
+# Image headers (identification/camera_lidar/image_header.h): dimensions are read before any
+# decoding, so a bomb is refused from its first 24 bytes.
+def png_header_only(width, height, first=b"IHDR", length=13):
+    body = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + struct.pack(">I", length) + first + body +
+            struct.pack(">I", zlib.crc32(first + body) & 0xFFFFFFFF))
+
+
+# 20000 x 20000 px in 45 bytes (IHDR, IEND): cv::imread would allocate 400 MB (grey) or more.
+write("image_header/png_bomb.png",
+      png_header_only(20000, 20000) +
+      struct.pack(">I", 0) + b"IEND" + struct.pack(">I", zlib.crc32(b"IEND") & 0xFFFFFFFF))
+write("image_header/png_zero_width.png", png_header_only(0, 480))
+write("image_header/png_truncated_ihdr.png", png_header_only(640, 480)[:20])
+write("image_header/png_first_chunk_not_ihdr.png", png_header_only(640, 480, first=b"IDAT"))
+write("image_header/empty.png", b"")
+write("image_header/text_named_png.png", b"this is not an image, it is text\n")
+# JPEG: SOI, an APP0 segment, then the scan (SOS) with no frame header before it.
+app0 = b"\xff\xe0" + struct.pack(">H", 16) + b"JFIF\x00\x01\x01\x00\x00\x01\x00\x01\x00\x00"
+write("image_header/jpeg_no_frame_header.jpg", b"\xff\xd8" + app0 + b"\xff\xda\x00\x08" + b"\x00" * 6)
+# A segment whose length runs past the end of the file.
+write("image_header/jpeg_segment_past_end.jpg", b"\xff\xd8\xff\xe1\x40\x00Exif\x00\x00")
+# SOF0 with height 0 (the height would come later in a DNL marker).
+write("image_header/jpeg_zero_height.jpg",
+      b"\xff\xd8" + app0 + b"\xff\xc0" + struct.pack(">HBHHB", 11, 8, 0, 640, 1) + b"\x01\x11\x00")
+# SOF2 (progressive) claiming 65000 x 65000 px.
+write("image_header/jpeg_bomb.jpg",
+      b"\xff\xd8" + app0 + b"\xff\xc2" + struct.pack(">HBHHB", 11, 8, 65000, 65000, 1) +
+      b"\x01\x11\x00")

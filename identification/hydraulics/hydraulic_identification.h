@@ -18,6 +18,11 @@
 // Start: a scan of τ_d (10 ms steps) × a few τ_s and d, with Q_rated and the segment offsets
 // solved linearly in the cylinder-length domain at each point; output-error costs have local
 // minima in τ_d (a chirp repeats itself) and this scan starts the solver in the right basin.
+// On long logs (over 20000 rows in all) the scan looks at the most active 2000-row windows up
+// to that many rows, so that the whole identification stays linear in the log length. The
+// least-squares problem has one residual block per segment (θ, τ_m, its start angle) and per
+// chunk of spool rows (θ), solved by a Schur complement over the start angles: linear in the
+// rows however many segments a log has (hydraulic_identification.cc, docs).
 // Confidence: covariance σ² (JᵀJ)⁻¹ at the optimum, the nuisance parameters included (so the
 // reported σ is marginal over them), each channel's rows weighted down by its residuals'
 // lag-1 autocorrelation ρ, n_eff = n (1 − ρ)/(1 + ρ): unmodelled dynamics make neighbouring
@@ -30,6 +35,7 @@
 // The reported 1σ combines both.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -49,6 +55,8 @@ struct HydraulicIdentificationOptions {
   double delay_scan_step = 0.01;  ///< of the starting scan [s]
   bool cross_validate = true;
   int max_iterations = 200;
+  /// Called with one short line per stage of the fit ("fit pass 2 of 3"); empty: silent.
+  std::function<void(const std::string&)> progress;
 };
 
 /// The fit seen on one file.
@@ -90,6 +98,12 @@ struct ActuatorIdentification {
   double angle_sigma = 0;    ///< residual RMS [rad]
   double spool_sigma = 0;    ///< [-]
   int iterations = 0;
+  /// Shape of the fit's least-squares problem: its residual blocks (one per segment of the
+  /// angle term, one per chunk of the spool term) and the most parameters any one block
+  /// depends on (nonzeros per Jacobian row). Bounded per block whatever the number of
+  /// segments, which keeps the fit's time and memory linear in the log length.
+  std::size_t residual_blocks = 0;
+  int largest_block_parameters = 0;
   double seconds = 0;  ///< wall time of the fit, cross-validation apart
   std::vector<FileFit> files;
   std::vector<CrossValidationFold> cross_validation;

@@ -4,10 +4,14 @@
 // (`hydraulics.actuators[]` dead_zone, transport_delay, spool_time_constant, rated_flow_lpm)
 // and as a PNG of the fits and residuals. `--simulate DIR` writes plant logs to try it on.
 //
-// How each log is read (log_reader.h): a log `X.csv` with a `X.columns.yaml` beside it is read
-// with that column map alone; the others with `--column-map` (if given) overridden by
-// `--columns`, the unit options, `--header-lines` and `--actuator`. Every log is read and every
-// actuator fitted before anything is written: a bad file leaves no overlay and no figure.
+// How each log is read (log_reader.h): with `--column-map` (if given) overridden by `--columns`,
+// the unit options, `--header-lines` and `--actuator`. A sibling `X.columns.yaml` beside a log
+// `X.csv` stands in for the column map of that log alone when neither `--columns` nor
+// `--column-map` is given (the other options still override its fields); an explicit map
+// beats it. Either case is noted on stderr in one line. An explicit map is checked against
+// every log (names in the header, numbers within the row, one column per quantity). Every log
+// is read and every actuator fitted before anything is written: a bad file leaves no overlay
+// and no figure. Big logs report progress on stderr, one whole line per stage.
 #pragma once
 
 #include <iosfwd>

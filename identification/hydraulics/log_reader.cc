@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/input_file.h"
 #include "runtime/core/strings.h"
 #include "runtime/core/yaml_reader.h"
 
@@ -170,6 +171,25 @@ std::string ActuatorFromComment(const std::string& line) {
                      end == std::string::npos ? std::string::npos : end - at - tag.size());
 }
 
+// One column read as two quantities (`command=Time` with time in Time too) would fit a model
+// to nonsense without a word: refused, naming both quantities and the column.
+template <typename Origin>
+void CheckDistinctColumns(const std::string& path, const std::map<std::string, int>& column_of,
+                          const std::vector<std::string>& header_names, const Origin& origin,
+                          int line) {
+  std::map<int, std::string> quantity_of;  // cell index → the first quantity reading it
+  for (const auto& [key, c] : column_of) {
+    const auto [it, inserted] = quantity_of.emplace(c, key);
+    if (inserted) continue;
+    const std::string column =
+        std::to_string(c + 1) +
+        (c < static_cast<int>(header_names.size()) ? " ('" + header_names[c] + "')" : "");
+    Fail(path, line, 1,
+         origin(key) + it->second + " and " + key + " both read column " + column +
+             "; each quantity needs its own column");
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& LogQuantityKeys() {
@@ -207,6 +227,7 @@ LogFormat ParseColumnsSpec(const std::string& spec, LogFormat format) {
   format.source = "--columns";
   std::stringstream stream(spec);
   std::string pair;
+  std::map<std::string, std::string> given;  // in this spec (a --column-map may come before)
   while (std::getline(stream, pair, ',')) {
     pair = Trim(pair);
     if (pair.empty()) continue;
@@ -215,9 +236,18 @@ LogFormat ParseColumnsSpec(const std::string& spec, LogFormat format) {
       Fail("--columns", 0, 0, "expected quantity=column, got '" + pair + "'");
     }
     const std::string key = Trim(pair.substr(0, eq));
+    const std::string column = Trim(pair.substr(eq + 1));
     CheckKey(key, "--columns");
-    format.columns[key] = Trim(pair.substr(eq + 1));
+    // The last of two would silently win: the user meant one of them.
+    if (given.count(key)) {
+      Fail("--columns", 0, 0,
+           key + " is given twice ('" + given[key] + "' and '" + column + "'); give it once");
+    }
+    given[key] = column;
+    format.columns[key] = column;
+    format.column_sources[key] = "--columns";
   }
+  if (given.empty()) Fail("--columns", 0, 0, "no quantity=column pair in '" + spec + "'");
   return format;
 }
 
@@ -230,7 +260,10 @@ LogFormat ReadLogFormatYaml(const std::string& path) {
     core::MapReader root = core::MapReader::Root(file, nullptr);
     core::MapReader columns = root.Map("columns");
     for (const std::string& key : LogQuantityKeys()) {
-      if (IsRequired(key) || columns.Has(key)) format.columns[key] = columns.String(key);
+      if (IsRequired(key) || columns.Has(key)) {
+        format.columns[key] = columns.String(key);
+        format.column_sources[key] = path;
+      }
     }
     columns.Finish();
     if (auto units = root.OptionalMap("units")) {
@@ -258,6 +291,10 @@ LogFormat ReadLogFormatYaml(const std::string& path) {
 
 HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
                               std::size_t min_samples) {
+  // Checked before opening: a named pipe would block the open, a folder would read as empty.
+  if (const std::string why = core::NotARegularFile(path); !why.empty()) {
+    Fail(path, 0, 0, "cannot open the log: " + why);
+  }
   std::ifstream in(path);
   if (!in) Fail(path, 0, 0, "cannot open the log");
   std::vector<std::string> lines;
@@ -298,16 +335,24 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
   std::map<std::string, std::string> wanted = format.columns;
   const bool defaults = wanted.empty();
   std::map<std::string, int> column_of;  // key → 0-based cell index
+  // "--columns: " before a problem with an entry of an explicit map: the user sees which of
+  // their options (or which sibling file) to correct.
+  const auto origin = [&](const std::string& key) {
+    const auto it = format.column_sources.find(key);
+    const std::string& source = it != format.column_sources.end() ? it->second : format.source;
+    return source.empty() ? std::string() : source + ": ";
+  };
   for (const auto& [key, name] : wanted) {
     CheckKey(key, format.source.empty() ? path : format.source);
     if (IsColumnNumber(name)) {
-      const int index = std::stoi(name) - 1;
-      if (index < 0 || index >= static_cast<int>(num_cells)) {
+      // Digits only, so the one failure left is overflow: a number that large is out of range.
+      const long number = name.size() > 9 ? 0 : std::stol(name);
+      if (number < 1 || number > static_cast<long>(num_cells)) {
         Fail(path, static_cast<int>(first_data) + 1, 1,
-             key + ": column " + name + " does not exist; the rows have " +
+             origin(key) + key + ": column " + name + " does not exist; the rows have " +
                  std::to_string(num_cells) + " cells");
       }
-      column_of[key] = index;
+      column_of[key] = static_cast<int>(number) - 1;
     }
   }
   // The header line: the last line before the data that has as many cells as a data row and
@@ -353,7 +398,7 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
       if (column_of.count(key)) continue;
       const int c = find_cell(name);
       if (c < 0) {
-        std::string message = key + ": no column '" + name + "'";
+        std::string message = origin(key) + key + ": no column '" + name + "'";
         if (header_line < 0) {
           message += " (no header line found before the first sample row)";
           Fail(path, static_cast<int>(first_data) + 1, 1, message);
@@ -365,6 +410,8 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
       column_of[key] = c;
     }
   }
+  CheckDistinctColumns(path, column_of, header_names, origin,
+                       header_line >= 0 ? header_line + 1 : static_cast<int>(first_data) + 1);
   for (const char* key : {"time", "command", "joint_angle"}) {
     if (column_of.count(key)) continue;
     const int line = header_line >= 0 ? header_line + 1 : static_cast<int>(first_data) + 1;

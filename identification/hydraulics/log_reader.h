@@ -48,13 +48,17 @@ struct LogFormat {
   std::string actuator;
   /// Where the format came from, for messages ("--columns", a YAML file); empty: defaults.
   std::string source;
+  /// Where each entry of `columns` came from ("--columns", "--column-map FILE", a sibling
+  /// `.columns.yaml`): an explicit map is checked against the log and its errors name it.
+  std::map<std::string, std::string> column_sources;
 };
 
 /// The quantity keys, in the order above.
 const std::vector<std::string>& LogQuantityKeys();
 
 /// Parses `time=t_s,command=cmd_pct,...` into `format.columns` (other fields kept). Throws
-/// core::InputError naming `--columns` on an unknown key or a malformed pair.
+/// core::InputError naming `--columns` on an unknown key, a malformed pair, a quantity given
+/// twice, or a spec with no pair at all.
 LogFormat ParseColumnsSpec(const std::string& spec, LogFormat format = {});
 
 /// Reads a column-map YAML file:
@@ -90,7 +94,9 @@ struct HydraulicLog {
 };
 
 /// Reads and checks one log. Throws core::InputError (`file:row: message`) on bad input, and
-/// when the log has fewer than `min_samples` rows.
+/// when the log has fewer than `min_samples` rows. An explicit column map is checked against
+/// the log: a name not in the header, a number beyond the row's cells and one column read as
+/// two quantities are refused, naming where the map came from (`--columns: ...`).
 HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
                               std::size_t min_samples = 20);
 

@@ -3,11 +3,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
+#include "runtime/core/file_output.h"
 #include "runtime/plant/plant.h"
 
 namespace autoshovel::identification {
@@ -80,8 +81,8 @@ LogFormat DataLoggerFormat() {
 
 void WriteLog(const HydraulicLog& log, const std::string& path, LogStyle style,
               const std::string& machine_name) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
+  // Composed in memory, then one checked atomic write (core/file_output.h).
+  std::ostringstream out;
   char line[256];
   if (style == LogStyle::kPlantStep) {
     out << "# simulated plant log: machine " << machine_name << ", actuator " << log.actuator
@@ -92,6 +93,7 @@ void WriteLog(const HydraulicLog& log, const std::string& path, LogStyle style,
                     log.spool[j], log.pressure_a[j], log.joint_angle[j]);
       out << line;
     }
+    core::WriteFileAtomically(path, out.str());
     return;
   }
   // A data logger: its own banner, names then units, a different order, semicolons.
@@ -105,6 +107,7 @@ void WriteLog(const HydraulicLog& log, const std::string& path, LogStyle style,
                   log.pressure_b[j] * 1e-5, log.pressure_a[j] * 1e-5);
     out << line;
   }
+  core::WriteFileAtomically(path, out.str());
 }
 
 std::function<double(double)> StepCommand(double level, double t0, double t1) {
@@ -125,7 +128,7 @@ std::vector<std::string> WriteSimulatedCampaign(const model::MachineDescription&
                                                 const generated::MachineFunctions& functions,
                                                 int actuator, const std::string& dir,
                                                 unsigned long long seed) {
-  std::filesystem::create_directories(dir);
+  core::CreateFolders(dir);
   const std::string name = machine.hydraulics.actuators[actuator].name;
   std::vector<std::string> paths;
   PlantLogOptions options;
@@ -148,13 +151,13 @@ std::vector<std::string> WriteSimulatedCampaign(const model::MachineDescription&
   const std::string stem = (std::filesystem::path(dir) / (name + "_chirp_060")).string();
   paths.push_back(stem + ".csv");
   WriteLog(chirp, paths.back(), LogStyle::kDataLogger, machine.name);
-  std::ofstream map(stem + ".columns.yaml");
-  if (!map) throw std::runtime_error("cannot write " + stem + ".columns.yaml");
+  std::ostringstream map;
   map << "# Column map of " << name << "_chirp_060.csv (autoshovel identify hydraulics)\n"
       << "columns:\n  time: Time\n  command: Valve cmd\n  spool: Spool pos\n"
       << "  joint_angle: Angle\n  pressure_a: P cap\n  pressure_b: P rod\n"
       << "units: {time: ms, command: percent, spool: percent, angle: deg, pressure: bar}\n"
       << "actuator: " << name << "\n";
+  core::WriteFileAtomically(stem + ".columns.yaml", map.str());
   return paths;
 }
 

@@ -12,6 +12,7 @@
 
 #include "generated/registry.h"
 #include "identification/hydraulics/plant_logs.h"
+#include "tests/hydraulics/synthetic_cycle_log.h"
 
 namespace autoshovel::identification {
 namespace {
@@ -217,6 +218,65 @@ TEST(HydraulicIdentification, EndStopSamplesAreLeftOut) {
   Print(blind);
   EXPECT_EQ(blind.excluded, 0u);
   EXPECT_GT(blind.files.back().angle_rms, 3 * r.files.back().angle_rms);
+}
+
+// A long log of steps into the end stops has a segment between each pair of contacts, each
+// with its own start angle. The fit must keep every residual block on a bounded number of
+// parameters (θ, τ_m and one start angle): one block over the whole file would depend on all
+// the start angles, its Jacobian rows × segments, and the fit superlinear in the log (out of
+// memory at a million rows). The model-made log is noise apart the model: the truth comes back.
+TEST(HydraulicIdentification, ManyEndStopSegmentsKeepBlocksSmall) {
+  const model::MachineDescription machine = Loader();
+  const int actuator = FindActuator(machine, "boom");
+  const auto& functions = Functions(machine);
+  const ActuatorKinematics kinematics(machine, functions, actuator);
+  const Truth truth;
+  const ValveParameters valve{truth.dead_zone, truth.transport_delay, truth.spool_time_constant,
+                              truth.rated_flow};
+  const std::size_t rows = 12000;  // 120 s, 15 cycles
+  const std::vector<HydraulicLog> logs = {testing::SyntheticCycleLog(kinematics, valve, rows)};
+  HydraulicIdentificationOptions options;
+  options.cross_validate = false;
+  const ActuatorIdentification r = IdentifyActuator(machine, functions, actuator, logs, options);
+  Print(r);
+  // Segments: runs of samples off the stops.
+  const std::vector<char>& excluded = r.files.front().excluded;
+  std::size_t segments = 0;
+  for (std::size_t j = 0; j < excluded.size(); ++j) {
+    segments += !excluded[j] && (j == 0 || excluded[j - 1]);
+  }
+  EXPECT_GE(segments, 10u);
+  EXPECT_GT(r.excluded, rows / 10);
+  EXPECT_LE(r.largest_block_parameters, 4 + 1 + 1);  // θ, τ_m, one start angle
+  const std::size_t spool_blocks = r.residual_blocks - segments;
+  EXPECT_GE(spool_blocks, 1u);
+  EXPECT_LE(spool_blocks, rows / 1000);  // chunks of thousands of rows, not one per row
+  EXPECT_NEAR(r.params.transport_delay, truth.transport_delay, 0.002);
+  EXPECT_NEAR(r.params.spool_time_constant, truth.spool_time_constant,
+              0.02 * truth.spool_time_constant);
+  EXPECT_NEAR(r.params.dead_zone, truth.dead_zone, 0.003);
+  EXPECT_NEAR(r.params.rated_flow, truth.rated_flow, 0.01 * truth.rated_flow);
+  EXPECT_LT(r.files.front().angle_rms, 0.1 * std::numbers::pi / 180);
+}
+
+// The tabulated inverse kinematics the fit uses at every row against the generated inverse
+// (a Newton iteration), over the boom's whole range, between the table's nodes too.
+TEST(ValveModel, TabulatedInverseMatchesTheGeneratedOne) {
+  const model::MachineDescription machine = Loader();
+  const auto& functions = Functions(machine);
+  for (const char* name : {"boom", "bucket"}) {
+    const ActuatorKinematics kinematics(machine, functions, FindActuator(machine, name));
+    const int joint = kinematics.joint();
+    const double low = kinematics.Length(functions.joint_min[joint]);
+    const double high = kinematics.Length(functions.joint_max[joint]);
+    for (int i = 1; i < 997; ++i) {
+      const double length = low + (high - low) * i / 997.0;
+      double slope = 0;
+      const double q = kinematics.Angle(length, &slope);
+      EXPECT_NEAR(q, kinematics.ExactAngle(length), 1e-9) << name << " " << length;
+      EXPECT_NEAR(slope * kinematics.Lever(q), 1.0, 1e-6) << name << " " << length;
+    }
+  }
 }
 
 // The closed-form spool response against a fine explicit integration of τ_s ẋ = r − x, and

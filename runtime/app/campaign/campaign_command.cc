@@ -338,9 +338,17 @@ int RunMpi(const CampaignOptions& o, const CampaignSpec& spec, const std::vector
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     PrintProgress(progress_line, base + fresh, spec.cycles(), fresh, seconds, final, last_done);
   };
-  const int failed = RunWorker(
+  int failed = RunWorker(
       spec, jobs, dir, o.models_dir, rank, size, log,
       rank == 0 ? std::function<void()>([&] { progress(false); }) : std::function<void()>());
+  // The rank's log is the only record of why a job failed: losing it (a full disk) is a
+  // failure of the rank, said on its standard error, not a silent success.
+  log.flush();
+  if (!log) {
+    err << kCommand << ": " << (dir / ("rank-" + std::to_string(rank) + ".log")).string()
+        << ": cannot write the rank's log\n";
+    ++failed;
+  }
   // Rank 0 keeps reporting from the shards until every rank is done (a non-blocking barrier:
   // collectives must match in kind on every rank).
   MPI_Request done;

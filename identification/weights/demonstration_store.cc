@@ -8,6 +8,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "runtime/core/input_file.h"
 #include "runtime/perception/semantic_map.h"
 
 namespace autoshovel::identification {
@@ -130,8 +131,8 @@ void WriteDemonstrations(const std::filesystem::path& file,
 
 std::vector<Demonstration> ReadDemonstrations(const std::filesystem::path& file,
                                               std::map<std::string, std::string>* meta) {
-  if (!std::filesystem::is_regular_file(file)) {
-    throw std::runtime_error(file.string() + ": no such demonstrations file");
+  if (const std::string why = core::NotARegularFile(file); !why.empty()) {
+    throw std::runtime_error(file.string() + ": cannot read the demonstrations: " + why);
   }
   Db db = Open(file, SQLITE_OPEN_READONLY);
   std::map<std::string, std::string> values;

@@ -121,6 +121,7 @@ refuses hydraulics-log-missing "no_such.csv" -- "${models[@]}" identify hydrauli
 # train
 refuses weights-threads "--threads" -- "${models[@]}" train weights --threads -1
 refuses weights-evaluations "--evaluations" -- "${models[@]}" train weights --evaluations 5
+refuses weights-demos-fifo "is a named pipe" -- "${models[@]}" train weights --demos "$tmp/fifo.yaml" --out "$tmp/w.yaml"
 refuses predictor-threads "--threads" -- "${models[@]}" train predictor "$tmp/text.sqlite" -o "$tmp/svr" --threads -2
 refuses predictor-database-missing "no_such.sqlite" -- "${models[@]}" train predictor "$tmp/no_such.sqlite" -o "$tmp/svr"
 refuses segmentation-lr "--lr" -- "${models[@]}" train segmentation cone_pile -o "$tmp/n.onnx" --lr nan

@@ -172,7 +172,7 @@ int RunCalibrateArm(const CalibrateArmOptions& options, std::ostream& out, std::
     out << "overlay: " << overlay << "\n";
     return 0;
   } catch (const core::InputError& e) {
-    err << e.what();
+    err << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     err << "autoshovel calibrate arm: " << e.what() << "\n";

@@ -52,7 +52,8 @@ int FinishOutput(int status) {
   try {
     autoshovel::core::FlushStandardOutput();
   } catch (const autoshovel::core::OutputError& e) {
-    std::cerr << "autoshovel: " << e.what() << "\n";
+    // A command that failed has said why already (often this very error): one line only.
+    if (status == 0) std::cerr << "autoshovel: " << e.what() << "\n";
     return status == 0 ? 1 : status;
   }
   return status;

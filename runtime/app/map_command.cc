@@ -88,7 +88,7 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     out << "six layers: " << options.png << "\n";
     return 0;
   } catch (const core::InputError& e) {
-    err << e.what();
+    err << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     err << "autoshovel map: " << e.what() << "\n";

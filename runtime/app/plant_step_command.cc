@@ -147,7 +147,7 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
     }
     return 0;
   } catch (const core::InputError& e) {
-    err << e.what();
+    err << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     err << "autoshovel plant step: " << e.what() << "\n";

@@ -48,7 +48,7 @@ int RunScenario(const ScenarioOptions& options, std::ostream& out, std::ostream&
     }
     return 0;
   } catch (const core::InputError& e) {
-    err << e.what();
+    err << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     err << "autoshovel scenario: " << e.what() << "\n";

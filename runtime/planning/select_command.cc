@@ -205,7 +205,7 @@ int RunSelect(const SelectOptions& options, std::ostream& out, std::ostream& err
     out << "candidates: " << options.png << "\n";
     return result.status == SelectionStatus::kSelected ? 0 : 1;
   } catch (const core::InputError& e) {
-    err << e.what();
+    err << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     err << "autoshovel select: " << e.what() << "\n";

@@ -34,6 +34,8 @@ refuses() {
     problem="exit $status (signal or sanitizer abort)"
   elif [ "$lines" -ne 1 ]; then
     problem="$lines lines on stderr"
+  elif [ -n "$(tail -c1 "$tmp/err")" ]; then
+    problem="the error line has no final newline"
   elif ! grep -qF -- "$expected" "$tmp/err"; then
     problem="stderr lacks '$expected'"
   elif grep -qE '(autoshovel [a-z -]+: )\1' "$tmp/err"; then
@@ -81,7 +83,8 @@ refuses step-into-folder "a_folder" -- "${models[@]}" plant step --machine xcmg_
 # plant step to a full standard output
 "$autoshovel" "${models[@]}" plant step --machine xcmg_968ev --duration 0.5 >/dev/full 2>"$tmp/err"
 status=$?
-if [ "$status" -ne 0 ] && [ "$status" -le 125 ] && grep -q "standard output" "$tmp/err"; then
+if [ "$status" -ne 0 ] && [ "$status" -le 125 ] && grep -q "standard output" "$tmp/err" &&
+  [ "$(grep -c '' "$tmp/err")" -eq 1 ]; then
   passed=$((passed + 1))
 else
   failed=$((failed + 1))

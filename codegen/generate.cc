@@ -1,6 +1,12 @@
 #include "codegen/generate.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
 #include <ostream>
 #include <set>
 
@@ -15,6 +21,51 @@ namespace fs = std::filesystem;
 std::vector<std::string> FindDescriptions(const std::string& models_dir) {
   return model::FindMachineDescriptions(models_dir);
 }
+
+namespace {
+
+// Emits one machine in a child process that starts from the parent's state, which has built
+// no GiNaC expression. Why: GiNaC numbers symbols from a process-wide counter and orders the
+// operands of sums and products by it, and it folds numeric coefficients in that order, so the
+// same description printed after another machine was built in the same process came out in a
+// different term order and, for some constants, rounded differently (issue 39). A fresh child
+// per machine makes the output a function of the description (and the generator binary) alone.
+// Returns the child's exit status; errors are written by the child to standard error.
+int EmitInChild(const model::MachineDescription& machine, const EmitOptions& options) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  const pid_t child = fork();
+  if (child < 0) {
+    throw std::runtime_error(std::string("cannot start a generator process: ") +
+                             std::strerror(errno));
+  }
+  if (child == 0) {
+    int status = 0;
+    try {
+      EmitMachine(machine, options);
+    } catch (const fs::filesystem_error& e) {
+      std::cerr << "codegen: " << e.path1().string() << ": cannot write: " << e.code().message()
+                << '\n';
+      status = 1;
+    } catch (const std::exception& e) {
+      std::cerr << "codegen: " << e.what() << '\n';
+      status = 1;
+    }
+    std::cerr.flush();
+    _exit(status);
+  }
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error("cannot wait for the generator process");
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  std::cerr << "codegen: generating " << machine.name << " was killed by signal "
+            << (WIFSIGNALED(status) ? WTERMSIG(status) : 0) << '\n';
+  return 2;
+}
+
+}  // namespace
 
 int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& err) {
   std::vector<std::string> descriptions = request.descriptions;
@@ -56,7 +107,7 @@ int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& er
     EmitOptions options{request.output_dir, ""};
     for (const auto& m : machines) {
       // Said once the files are written, never before (a failed write is not a success).
-      EmitMachine(m, options);
+      if (const int status = EmitInChild(m, options); status != 0) return status;
       out << "codegen: " << m.source_file << " -> " << (request.output_dir / m.name).string() << "/"
           << std::endl;
     }

@@ -154,25 +154,25 @@ double CylinderLength(int actuator, const double* q) {
       return length;
     }
     case 1: {
-      const double t0 = cos(q[0]);
-      const double t1 = (q[0] + q[1]);
-      const double t2 = sin(t1);
-      const double t3 = cos(t1);
+      const double t0 = (q[0] + q[1]);
+      const double t1 = sin(t0);
+      const double t2 = cos(q[0]);
+      const double t3 = cos(t0);
       const double t4 = sin(q[0]);
-      const double t5 = (-0.389 * t2 + t0 * 0.5249999999999999 + 0.159 * t3 + 0.365 * t4);
+      const double t5 = (-0.389 * t1 + t2 * 0.5249999999999999 + 0.159 * t3 + 0.365 * t4);
       const double t6 = (t5 * t5);
-      const double t7 = (0.159 * t2 - 0.365 * t0 + t4 * 0.5249999999999999 + 0.389 * t3);
+      const double t7 = (0.159 * t1 - 0.365 * t2 + t4 * 0.5249999999999999 + 0.389 * t3);
       const double t8 = (t7 * t7);
       const double t9 = (t6 + t8);
       const double t10 = (1.0 / sqrt(t9));
       const double t11 = (t6 + t8 - 0.38752);
       const double t12 = sqrt((-(t11 * t11) * 0.25 / (t9) + 0.567009));
       const double t13 = atan2(t10 * 0.5 * ((t12 * t5 * 2.0 + t10 * t11 * t7)),
-                               t10 * ((-t10 * t5 * t11 + t12 * 2.0 * t7)) * (-0.5));
+                               t10 * ((t10 * t5 * t11 - t12 * 2.0 * t7)) * 0.5);
       const double t14 = cos(t13);
       const double t15 = sin(t13);
-      const double t16 = (-t0 * 0.15500000000000003 - 0.141 * t14 - 0.853 * t15 + 2.093 * t4);
-      const double t17 = (-0.853 * t14 + t0 * 2.093 + 0.15500000000000003 * t4 + 0.141 * t15);
+      const double t16 = (-0.853 * t14 + t2 * 2.093 + 0.15500000000000003 * t4 + 0.141 * t15);
+      const double t17 = (-t2 * 0.15500000000000003 - 0.141 * t14 - 0.853 * t15 + 2.093 * t4);
       const double length = sqrt(((t16 * t16) + (t17 * t17)));
       return length;
     }
@@ -201,16 +201,16 @@ double LeverArm(int actuator, const double* q) {
       return lever;
     }
     case 1: {
-      const double t0 = cos(q[0]);
-      const double t1 = (q[0] + q[1]);
-      const double t2 = sin(t1);
-      const double t3 = (-0.389) * t2;
-      const double t4 = cos(t1);
+      const double t0 = (q[0] + q[1]);
+      const double t1 = sin(t0);
+      const double t2 = (-0.389) * t1;
+      const double t3 = cos(q[0]);
+      const double t4 = cos(t0);
       const double t5 = 0.159 * t4;
       const double t6 = sin(q[0]);
-      const double t7 = (t3 + t0 * 0.5249999999999999 + t5 + 0.365 * t6);
+      const double t7 = (t2 + t3 * 0.5249999999999999 + t5 + 0.365 * t6);
       const double t8 = (t7 * t7);
-      const double t9 = (0.159 * t2 - 0.365 * t0 + t6 * 0.5249999999999999 + 0.389 * t4);
+      const double t9 = (0.159 * t1 - 0.365 * t3 + t6 * 0.5249999999999999 + 0.389 * t4);
       const double t10 = (t9 * t9);
       const double t11 = (t8 + t10);
       const double t12 = (1.0 / sqrt(t11));
@@ -220,32 +220,33 @@ double LeverArm(int actuator, const double* q) {
       const double t16 = (-t14 * t15 * 0.25 + 0.567009);
       const double t17 = sqrt(t16);
       const double t18 = (t17 * t7 * 2.0 + t12 * t13 * t9);
-      const double t19 = (-t12 * t7 * t13 + t17 * 2.0 * t9);
-      const double t20 = atan2(t12 * 0.5 * t18, t12 * t19 * (-0.5));
+      const double t19 = (t12 * t7 * t13 - t17 * 2.0 * t9);
+      const double t20 = atan2(t12 * 0.5 * t18, t12 * t19 * 0.5);
       const double t21 = cos(t20);
       const double t22 = sin(t20);
-      const double t23 = (-t0 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
-      const double t24 = (-0.853 * t21 + t0 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
-      const double t25 = (1.0 / (((t15 * (t19 * t19) + (t18 * t18) * t15))));
-      const double t26 = (-0.389 * t4 - 0.159 * t2);
-      const double t27 = (t3 + t5);
-      const double t28 = (t26 * t7 + t9 * t27);
-      const double t29 = pow(t11, (-1.5));
-      const double t30 = (1.0 / sqrt(t16));
-      const double t31 = (t28 * t13 * 2.0 * t15 - t28 * t14 / (t11 * t11));
+      const double t23 = (-0.853 * t21 + t3 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
+      const double t24 = (-t3 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
+      const double t25 = (-0.389 * t4 - 0.159 * t1);
+      const double t26 = (t2 + t5);
+      const double t27 = (t25 * t7 + t9 * t26);
+      const double t28 = (t27 * t14 / (t11 * t11) - t27 * t13 * 2.0 * t15);
+      const double t29 = (1.0 / sqrt(t16));
+      const double t30 = pow(t11, (-1.5));
+      const double t31 = (1.0 / ((((t19 * t19) * t15 + (t18 * t18) * t15))));
       const double t32 =
-          (t12 * t25 *
-               ((t28 * t19 * 2.0 * t29 +
-                 t12 * ((t28 * t12 * t7 * 4.0 + t26 * t12 * t13 * 2.0 - t17 * 4.0 * t27 +
-                         t9 * t30 * t31 - t28 * t7 * t13 * 2.0 * t29)))) *
-               t18 +
-           t12 * t19 * t25 *
-               ((-t28 * 2.0 * t29 * t18 +
-                 t12 * ((t12 * t13 * 2.0 * t27 + t28 * t12 * 4.0 * t9 - t28 * t13 * 2.0 * t29 * t9 -
-                         t7 * t30 * t31 + t17 * t26 * 4.0)))));
+          (-t12 * t19 *
+               ((t12 * ((-t17 * t25 * 4.0 - t27 * t12 * 4.0 * t9 - t12 * t13 * 2.0 * t26 -
+                         t7 * t28 * t29 + t27 * t13 * 2.0 * t30 * t9)) +
+                 t27 * 2.0 * t30 * t18)) *
+               t31 +
+           t12 *
+               ((t27 * t19 * 2.0 * t30 +
+                 t12 * ((-t25 * t12 * t13 * 2.0 + t17 * 4.0 * t26 + t27 * t7 * t13 * 2.0 * t30 -
+                         t27 * t12 * t7 * 4.0 + t28 * t9 * t29)))) *
+               t31 * t18);
       const double lever = (1.0 / sqrt(((t23 * t23) + (t24 * t24)))) *
-                           ((t23 * ((t32 * 0.4265 * t21 - 0.0705 * t32 * t22)) +
-                             t24 * ((-0.0705 * t32 * t21 - t32 * 0.4265 * t22))));
+                           ((t24 * ((0.0705 * t32 * t22 - t32 * 0.4265 * t21)) +
+                             ((0.0705 * t32 * t21 + t32 * 0.4265 * t22)) * t23));
       return lever;
     }
     default:
@@ -291,185 +292,187 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t0 = sin(x[0]);
   const double t1 = cos(x[0]);
   const double t2 = (-t0 * 0.1 + 1.55 * t1);
-  const double t3 = (x[0] + x[1]);
-  const double t4 = sin(t3);
-  const double t5 = t4 * (-0.55);
-  const double t6 = cos(t3);
-  const double t7 = (-0.25) * t6;
-  const double t8 = t0 * (-3.11);
-  const double t9 = (t5 + t7 + t8);
-  const double t10 = t4 * (-0.16343387866394005);
-  const double t11 = 3.11 * t1;
-  const double t12 = 0.4011545671438309 * t6;
-  const double t13 = (t10 + t11 + t12);
-  const double t14 = t4 * (-0.4011545671438309);
-  const double t15 = (-0.16343387866394005) * t6;
-  const double t16 = (t14 + t15 + t8);
-  const double t17 = t4 * (-0.25);
-  const double t18 = 0.55 * t6;
-  const double t19 = (t11 + t17 + t18);
-  const double t20 = (-1.55 * t0 - 0.1 * t1);
-  const double t21 = cos(u[5]);
-  const double t22 = (0.194 * t1 + 1.595 + t0 * 0.857);
-  const double t23 = (-0.194) * t0;
-  const double t24 = 0.857 * t1;
-  const double t25 = (t23 + t24 - 1.339);
-  const double t26 = (t22 * ((t23 + t24)) + ((-t0 * 0.857 - 0.194 * t1)) * t25);
-  const double t27 = ((t22 * t22) + (t25 * t25));
-  const double t28 = (1.0 / sqrt(t27));
-  const double t29 = sqrt(t27);
-  const double t30 = (-2.51 + t29);
-  const double t31 = (1e-06 + (t30 * t30));
-  const double t32 = (t29 - 1.4);
-  const double t33 = (1e-06 + (t32 * t32));
-  const double t34 = sin(u[5]);
-  const double t35 = (0.389 * t6 + t0 * 0.5249999999999999 - 0.365 * t1 + t4 * 0.159);
-  const double t36 = 0.159 * t6;
-  const double t37 = t4 * (-0.389);
-  const double t38 = (0.365 * t0 + t36 + t37 + t1 * 0.5249999999999999);
-  const double t39 = (t38 * t38);
-  const double t40 = (t35 * t35);
-  const double t41 = (t39 + t40 - 0.38752);
-  const double t42 = (t39 + t40);
-  const double t43 = (1.0 / sqrt(t42));
-  const double t44 = (t41 * t41);
-  const double t45 = (1.0 / (t42));
-  const double t46 = (0.567009 - 0.25 * t44 * t45);
-  const double t47 = sqrt(t46);
-  const double t48 = (t35 * t41 * t43 + 2.0 * t38 * t47);
-  const double t49 = (-t35 * 2.0 * t47 + t41 * t38 * t43);
-  const double t50 = atan2(0.5 * t48 * t43, t49 * 0.5 * t43);
-  const double t51 = cos(t50);
-  const double t52 = sin(t50);
-  const double t53 = (-0.15500000000000003 * t1 - 0.141 * t51 + t0 * 2.093 - t52 * 0.853);
-  const double t54 = t0 * 0.15500000000000003;
-  const double t55 = 2.093 * t1;
-  const double t56 = (0.141 * t52 + t54 - 0.853 * t51 + t55);
-  const double t57 = ((t53 * t53) + (t56 * t56));
-  const double t58 = (1.0 / sqrt(t57));
-  const double t59 = sqrt(t57);
-  const double t60 = (-1.59 + t59);
-  const double t61 = ((t60 * t60) + 1e-06);
-  const double t62 = (1.0 / sqrt(t46));
-  const double t63 = (1.0 / (t42 * t42));
-  const double t64 = (t36 + t37);
-  const double t65 = (-0.389) * t6;
-  const double t66 = t4 * (-0.159);
-  const double t67 = (t65 + t66);
-  const double t68 = (t64 * t35 + t67 * t38);
-  const double t69 = (-t63 * t44 * t68 + 2.0 * t41 * t45 * t68);
-  const double t70 = pow(t42, (-1.5));
-  const double t71 = (1.0 / ((((t48 * t48) * t45 + (t49 * t49) * t45))));
-  const double t72 = (((((-t35 * t62 * t69 - 2.0 * t41 * t67 * t43 - 4.0 * t38 * t68 * t43 +
-                          2.0 * t41 * t38 * t70 * t68 + t64 * 4.0 * t47)) *
-                            t43 +
-                        t49 * 2.0 * t70 * t68)) *
-                          t48 * t71 * t43 +
-                      t49 * t71 *
-                          ((((-t35 * 2.0 * t41 * t70 * t68 + t64 * 2.0 * t41 * t43 +
-                              t35 * 4.0 * t68 * t43 - t62 * t38 * t69 + 4.0 * t67 * t47)) *
-                                t43 -
-                            2.0 * t48 * t70 * t68)) *
-                          t43);
-  const double t73 = (t53 * ((-t72 * 0.4265 * t51 + 0.0705 * t72 * t52)) +
-                      ((0.0705 * t72 * t51 + t72 * t52 * 0.4265)) * t56);
-  const double t74 = (t65 - t0 * 0.5249999999999999 + 0.365 * t1 + t66);
-  const double t75 = (t74 * t38 + t35 * t38);
-  const double t76 = (-2.0 * t41 * t75 * t45 + t63 * t75 * t44);
-  const double t77 = (((((2.0 * t41 * t38 * t75 * t70 + t35 * t62 * t76 - 4.0 * t38 * t75 * t43 +
-                          4.0 * t38 * t47 - t74 * 2.0 * t41 * t43)) *
-                            t43 +
-                        t49 * 2.0 * t75 * t70)) *
-                          t48 * t71 * t43 +
-                      t49 *
-                          ((((t74 * 4.0 * t47 + t62 * t76 * t38 - t35 * 2.0 * t41 * t75 * t70 +
-                              t35 * 4.0 * t75 * t43 + 2.0 * t41 * t38 * t43)) *
-                                t43 -
-                            2.0 * t75 * t48 * t70)) *
-                          t71 * t43);
-  const double t78 =
-      (((-t0 * 2.093 + 0.15500000000000003 * t1 + t52 * 0.4265 * t77 + 0.0705 * t51 * t77)) * t56 +
-       t53 * ((t54 + 0.0705 * t52 * t77 + t55 - 0.4265 * t51 * t77)));
-  const double t79 = (t59 - 2.9000000000000004);
-  const double t80 = ((t79 * t79) + 1e-06);
-  const double t81 = (-sqrt(t61) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] +
-                      ((t58 * t73 * 2e+06 * x[3] + t58 * 2e+06 * x[2] * t78)) *
-                          ((2.0 + t79 * (1.0 / sqrt(t80)) - t60 * (1.0 / sqrt(t61)))) +
-                      sqrt(t80) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t59);
-  const double t82 = (t10 + t12);
-  const double t83 = (t14 + t15);
-  const double t84 = (t17 + t18);
-  const double t85 = (t5 + t7);
+  const double t3 = cos(u[5]);
+  const double t4 = (x[0] + x[1]);
+  const double t5 = cos(t4);
+  const double t6 = sin(t4);
+  const double t7 = (0.389 * t5 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
+  const double t8 = 0.159 * t5;
+  const double t9 = t6 * (-0.389);
+  const double t10 = (0.365 * t0 + t8 + t9 + t1 * 0.5249999999999999);
+  const double t11 = (t10 * t10);
+  const double t12 = (t7 * t7);
+  const double t13 = (t11 + t12 - 0.38752);
+  const double t14 = (t11 + t12);
+  const double t15 = (1.0 / sqrt(t14));
+  const double t16 = (t13 * t13);
+  const double t17 = (1.0 / (t14));
+  const double t18 = (0.567009 - 0.25 * t16 * t17);
+  const double t19 = sqrt(t18);
+  const double t20 = (t7 * t13 * t15 + 2.0 * t10 * t19);
+  const double t21 = (t7 * 2.0 * t19 - t13 * t10 * t15);
+  const double t22 = atan2(0.5 * t20 * t15, t21 * (-0.5) * t15);
+  const double t23 = cos(t22);
+  const double t24 = sin(t22);
+  const double t25 = (-0.141 * t23 - t24 * 0.853 - 0.15500000000000003 * t1 + t0 * 2.093);
+  const double t26 = t0 * 0.15500000000000003;
+  const double t27 = 2.093 * t1;
+  const double t28 = (t26 + t24 * 0.141 - 0.853 * t23 + t27);
+  const double t29 = ((t25 * t25) + (t28 * t28));
+  const double t30 = sqrt(t29);
+  const double t31 = (-2.9000000000000004 + t30);
+  const double t32 = ((t31 * t31) + 1e-06);
+  const double t33 = (-1.59 + t30);
+  const double t34 = (1e-06 + (t33 * t33));
+  const double t35 = (1.0 / ((((t21 * t21) * t17 + (t20 * t20) * t17))));
+  const double t36 = (-0.389) * t5;
+  const double t37 = t6 * (-0.159);
+  const double t38 = (t36 - t0 * 0.5249999999999999 + 0.365 * t1 + t37);
+  const double t39 = (t38 * t10 + t7 * t10);
+  const double t40 = (1.0 / sqrt(t18));
+  const double t41 = (1.0 / (t14 * t14));
+  const double t42 = (-2.0 * t13 * t39 * t17 + t41 * t39 * t16);
+  const double t43 = pow(t14, (-1.5));
+  const double t44 =
+      (t35 *
+           ((((t38 * 2.0 * t13 * t15 - 4.0 * t10 * t19 + 4.0 * t10 * t39 * t15 - t7 * t40 * t42 -
+               2.0 * t13 * t10 * t39 * t43)) *
+                 t15 +
+             2.0 * t21 * t39 * t43)) *
+           t20 * t15 -
+       ((2.0 * t39 * t20 * t43 - ((t38 * 4.0 * t19 + t40 * t42 * t10 - t7 * 2.0 * t13 * t39 * t43 +
+                                   t7 * 4.0 * t39 * t15 + 2.0 * t13 * t10 * t15)) *
+                                     t15)) *
+           t35 * t21 * t15);
+  const double t45 =
+      (t25 * ((t26 - t24 * 0.0705 * t44 + 0.4265 * t23 * t44 + t27)) +
+       ((-0.0705 * t23 * t44 - t24 * 0.4265 * t44 - t0 * 2.093 + 0.15500000000000003 * t1)) * t28);
+  const double t46 = (1.0 / sqrt(t29));
+  const double t47 = (t8 + t9);
+  const double t48 = (t36 + t37);
+  const double t49 = (t47 * t7 + t48 * t10);
+  const double t50 = (-2.0 * t13 * t17 * t49 + t41 * t16 * t49);
+  const double t51 = (t35 *
+                          ((((-t7 * t50 * t40 - 2.0 * t13 * t10 * t43 * t49 +
+                              2.0 * t13 * t48 * t15 + 4.0 * t10 * t49 * t15 - t47 * 4.0 * t19)) *
+                                t15 +
+                            2.0 * t21 * t43 * t49)) *
+                          t20 * t15 +
+                      ((((-t7 * 2.0 * t13 * t43 * t49 + t50 * t40 * t10 + t47 * 2.0 * t13 * t15 +
+                          t7 * 4.0 * t49 * t15 + 4.0 * t48 * t19)) *
+                            t15 -
+                        2.0 * t20 * t43 * t49)) *
+                          t35 * t21 * t15);
+  const double t52 = (((-0.0705 * t23 * t51 - t24 * 0.4265 * t51)) * t28 +
+                      t25 * ((-t24 * 0.0705 * t51 + 0.4265 * t23 * t51)));
+  const double t53 = (sqrt(t32) * 2e+08 - sqrt(t34) * 2e+08 - 8.98e+08 -
+                      0.06283185307179587 * x[7] + 4e+08 * t30 + 0.04712388980384691 * x[9] +
+                      ((-t33 * (1.0 / sqrt(t34)) + (1.0 / sqrt(t32)) * t31 + 2.0)) *
+                          ((t45 * 2e+06 * x[2] * t46 + 2e+06 * x[3] * t52 * t46)));
+  const double t54 = 3.11 * t1;
+  const double t55 = t6 * (-0.25);
+  const double t56 = 0.55 * t5;
+  const double t57 = (t54 + t55 + t56);
+  const double t58 = (0.194 * t1 + 1.595 + t0 * 0.857);
+  const double t59 = (-0.194) * t0;
+  const double t60 = 0.857 * t1;
+  const double t61 = (t59 + t60 - 1.339);
+  const double t62 = (t58 * ((t59 + t60)) + ((-t0 * 0.857 - 0.194 * t1)) * t61);
+  const double t63 = ((t58 * t58) + (t61 * t61));
+  const double t64 = (1.0 / sqrt(t63));
+  const double t65 = sqrt(t63);
+  const double t66 = (-2.51 + t65);
+  const double t67 = (1e-06 + (t66 * t66));
+  const double t68 = (t65 - 1.4);
+  const double t69 = (1e-06 + (t68 * t68));
+  const double t70 = sin(u[5]);
+  const double t71 = t6 * (-0.55);
+  const double t72 = (-0.25) * t5;
+  const double t73 = t0 * (-3.11);
+  const double t74 = (t71 + t72 + t73);
+  const double t75 = (-1.55 * t0 - 0.1 * t1);
+  const double t76 = t6 * (-0.4011545671438309);
+  const double t77 = (-0.16343387866394005) * t5;
+  const double t78 = (t76 + t77 + t73);
+  const double t79 = t6 * (-0.16343387866394005);
+  const double t80 = 0.4011545671438309 * t5;
+  const double t81 = (t79 + t54 + t80);
+  const double t82 = (t71 + t72);
+  const double t83 = (t76 + t77);
+  const double t84 = (t79 + t80);
+  const double t85 = (t55 + t56);
   const double t86 = (-2.8e+07 + x[6]);
   const double t87 = sqrt(((x[4] * x[4]) + 1e-06));
   const double t88 = (x[4] + t87);
   const double t89 = (x[6] - u[6]);
   const double t90 = (x[6] - 2e+05);
   const double t91 = (t90 * t90);
-  const double t92 = (-t87 + x[4]);
+  const double t92 = (-x[4] + t87);
   const double t93 = sqrt(((x[5] * x[5]) + 1e-06));
   const double t94 = (t93 + x[5]);
   const double t95 = (x[7] - u[7]);
   const double t96 = (x[7] - 2e+05);
   const double t97 = (t96 * t96);
-  const double t98 = (-t93 + x[5]);
+  const double t98 = (t93 - x[5]);
   const double t99 = (-2.8e+07 + x[7]);
-  const double t100 = (x[8] - u[6]);
-  const double t101 = (x[8] - 2e+05);
-  const double t102 = (t101 * t101);
+  const double t100 = (x[8] - 2e+05);
+  const double t101 = (t100 * t100);
+  const double t102 = (-x[8] + u[6]);
   const double t103 = (-2.8e+07 + x[8]);
   const double t104 = (x[9] - 2e+05);
   const double t105 = (t104 * t104);
-  const double t106 = (-2.8e+07 + x[9]);
-  const double t107 = (-x[9] + u[7]);
+  const double t106 = (-u[7] + x[9]);
+  const double t107 = (-2.8e+07 + x[9]);
   xdot[0] = x[2];
   xdot[1] = x[3];
-  xdot[2] = 0.5 *
-            ((-t2 * 50994.579999999994 * t21 - t19 * t21 * 30400.614999999998 - x[2] * 4000.0 +
-              2.0 * u[2] +
-              t26 * t28 * 2.0 *
-                  ((-2e+08 * sqrt(t31) + x[6] * 0.04021238596594936 -
-                    ((-(1.0 / sqrt(t33)) * t32 + 2.0 + (1.0 / sqrt(t31)) * t30)) * t26 * t28 *
+  xdot[2] = ((-t2 * 50994.579999999994 * t3 - t53 * t45 * t46 - t57 * t3 * 30400.614999999998 -
+              x[2] * 4000.0 + 2.0 * u[2] +
+              t62 * t64 * 2.0 *
+                  ((-2e+08 * sqrt(t67) + x[6] * 0.04021238596594936 -
+                    ((-(1.0 / sqrt(t69)) * t68 + 2.0 + (1.0 / sqrt(t67)) * t66)) * t62 * t64 *
                         2e+06 * x[2] +
-                    7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t33) - 4e+08 * t29)) -
-              t34 * t9 * 30400.614999999998 - t20 * 50994.579999999994 * t34 +
-              2.0 * ((-t34 * t16 * 9.80665 - t13 * t21 * 9.80665)) * u[4] - t58 * t81 * t78)) /
-            (((2600.0 * (t2 * t2) + 1550.0 * (t9 * t9) + (((t13 * t13) + (t16 * t16))) * u[4] +
-               1550.0 * (t19 * t19) + 2600.0 * (t20 * t20) + 2900.0)));
-  xdot[3] = ((t58 * t73 * t81 - 2.0 * ((-t82 * t21 * 9.80665 - t34 * t83 * 9.80665)) * u[4] +
-              t84 * t21 * 30400.614999999998 - 2.0 * u[3] + 1600.0 * x[3] +
-              t34 * 30400.614999999998 * t85)) *
-            (-0.5) /
-            ((((t85 * t85) * 1550.0 + 600.0 + (((t83 * t83) + (t82 * t82))) * u[4] +
-               1550.0 * (t84 * t84))));
+                    7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t69) - 4e+08 * t65)) -
+              t70 * t74 * 30400.614999999998 - t75 * 50994.579999999994 * t70 +
+              2.0 * ((-t70 * t78 * 9.80665 - t81 * t3 * 9.80665)) * u[4])) *
+            0.5 /
+            (((2600.0 * (t2 * t2) + 1550.0 * (t74 * t74) + (((t81 * t81) + (t78 * t78))) * u[4] +
+               1550.0 * (t57 * t57) + 2600.0 * (t75 * t75) + 2900.0)));
+  xdot[3] = (-0.5) *
+            ((-2.0 * ((-t84 * t3 * 9.80665 - t70 * t83 * 9.80665)) * u[4] +
+              t85 * t3 * 30400.614999999998 - 2.0 * u[3] + t53 * t52 * t46 + 1600.0 * x[3] +
+              t70 * 30400.614999999998 * t82)) /
+            ((((t82 * t82) * 1550.0 + 600.0 + (((t83 * t83) + (t84 * t84))) * u[4] +
+               1550.0 * (t85 * t85))));
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
   xdot[6] = 1.2e+09 *
             ((-3.3333333333333334e-09 * sqrt((1e+10 + (t86 * t86))) + 0.094 -
-              6.666666666666667e-09 * x[6] - t26 * t28 * x[2] * 0.04021238596594936 -
+              6.666666666666667e-09 * x[6] - t62 * t64 * x[2] * 0.04021238596594936 -
               t88 * 2.721655269759087e-06 * pow((4e+10 + (t89 * t89)), (-0.25)) * t89 +
-              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) +
+              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) -
               t92 * pow((4e+10 + t91), (-0.25)) * 2.721655269759087e-06 * t90)) /
-            (((t29 * 0.04021238596594936 - 0.0522973403523291)));
+            (((t65 * 0.04021238596594936 - 0.0522973403523291)));
   xdot[7] = ((-t94 * pow((4e+10 + (t95 * t95)), (-0.25)) * 2.0412414523193154e-06 * t95 -
-              x[7] * 5e-09 + 0.07050000000000001 - t58 * 0.031415926535897934 * x[2] * t78 +
-              sqrt((1e+10 + t97)) * 2.5e-09 +
+              0.031415926535897934 * t45 * x[2] * t46 - x[7] * 5e-09 -
+              0.031415926535897934 * x[3] * t52 * t46 + 0.07050000000000001 +
+              sqrt((1e+10 + t97)) * 2.5e-09 -
               t98 * 2.0412414523193154e-06 * t96 * pow((4e+10 + t97), (-0.25)) -
-              2.5e-09 * sqrt((1e+10 + (t99 * t99))) - t58 * 0.031415926535897934 * t73 * x[3])) *
-            1.2e+09 / (((0.031415926535897934 * t59 - 0.04695132319207772)));
-  xdot[8] = ((t92 * pow((4e+10 + (t100 * t100)), (-0.25)) * 2.721655269759087e-06 * t100 + 0.094 -
-              6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t102 + 1e+10)) +
-              t26 * t28 * x[2] * 0.027488935718910694 -
-              pow((4e+10 + t102), (-0.25)) * t88 * 2.721655269759087e-06 * t101 -
-              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) *
-            1.2e+09 / (((-t29 * 0.027488935718910694 + 0.07299722865446584)));
+              2.5e-09 * sqrt((1e+10 + (t99 * t99))))) *
+            1.2e+09 / (((0.031415926535897934 * t30 - 0.04695132319207772)));
+  xdot[8] = 1.2e+09 *
+            ((0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t101 + 1e+10)) +
+              t62 * t64 * x[2] * 0.027488935718910694 +
+              t102 * t92 * 2.721655269759087e-06 * pow((4e+10 + (t102 * t102)), (-0.25)) -
+              pow((4e+10 + t101), (-0.25)) * t88 * 2.721655269759087e-06 * t100 -
+              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) /
+            (((-t65 * 0.027488935718910694 + 0.07299722865446584)));
   xdot[9] = 1.2e+09 *
-            ((t58 * 0.023561944901923454 * x[2] * t78 + sqrt((1e+10 + t105)) * 2.5e-09 -
-              x[9] * 5e-09 - t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
-              0.07050000000000001 - 2.5e-09 * sqrt(((t106 * t106) + 1e+10)) -
-              t107 * t98 * pow(((t107 * t107) + 4e+10), (-0.25)) * 2.0412414523193154e-06 +
-              t58 * t73 * 0.023561944901923454 * x[3])) /
-            (((0.07132964021557801 - 0.023561944901923454 * t59)));
+            ((sqrt((1e+10 + t105)) * 2.5e-09 - x[9] * 5e-09 -
+              t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
+              t45 * 0.023561944901923454 * x[2] * t46 + 0.07050000000000001 -
+              pow(((t106 * t106) + 4e+10), (-0.25)) * t98 * 2.0412414523193154e-06 * t106 -
+              2.5e-09 * sqrt(((t107 * t107) + 1e+10)) + 0.023561944901923454 * x[3] * t52 * t46)) /
+            (((0.07132964021557801 - 0.023561944901923454 * t30)));
 }
 
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
@@ -480,312 +483,312 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   using std::sin;
   using std::sqrt;
   std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);
-  const double t0 = cos(x[0]);
-  const double t1 = (x[0] + x[1]);
-  const double t2 = cos(t1);
-  const double t3 = sin(x[0]);
-  const double t4 = sin(t1);
-  const double t5 = (0.389 * t2 + t3 * 0.5249999999999999 - 0.365 * t0 + t4 * 0.159);
-  const double t6 = 0.159 * t2;
-  const double t7 = t4 * (-0.389);
-  const double t8 = (0.365 * t3 + t6 + t7 + t0 * 0.5249999999999999);
-  const double t9 = (t8 * t8);
-  const double t10 = (t5 * t5);
-  const double t11 = (t9 + t10 - 0.38752);
-  const double t12 = (t9 + t10);
-  const double t13 = (1.0 / sqrt(t12));
-  const double t14 = (t11 * t11);
-  const double t15 = (1.0 / (t12));
-  const double t16 = (0.567009 - 0.25 * t14 * t15);
-  const double t17 = sqrt(t16);
-  const double t18 = (t5 * t11 * t13 + 2.0 * t8 * t17);
-  const double t19 = (-t5 * 2.0 * t17 + t11 * t8 * t13);
-  const double t20 = atan2(0.5 * t18 * t13, t19 * 0.5 * t13);
-  const double t21 = cos(t20);
-  const double t22 = sin(t20);
-  const double t23 = (-0.15500000000000003 * t0 - 0.141 * t21 + t3 * 2.093 - t22 * 0.853);
-  const double t24 = t3 * 0.15500000000000003;
-  const double t25 = 2.093 * t0;
-  const double t26 = (0.141 * t22 + t24 - 0.853 * t21 + t25);
-  const double t27 = ((t23 * t23) + (t26 * t26));
-  const double t28 = (1.0 / sqrt(t27));
-  const double t29 = sqrt(t27);
-  const double t30 = (-1.59 + t29);
-  const double t31 = (t30 * t30);
-  const double t32 = (t31 + 1e-06);
-  const double t33 = (1.0 / sqrt(t16));
-  const double t34 = (1.0 / (t12 * t12));
-  const double t35 = (t6 + t7);
-  const double t36 = (-0.389) * t2;
-  const double t37 = t4 * (-0.159);
-  const double t38 = (t36 + t37);
-  const double t39 = (t35 * t5 + t38 * t8);
-  const double t40 = (-t34 * t14 * t39 + 2.0 * t11 * t15 * t39);
-  const double t41 = pow(t12, (-1.5));
-  const double t42 = (-t5 * t33 * t40 - 2.0 * t11 * t38 * t13 - 4.0 * t8 * t39 * t13 +
-                      2.0 * t11 * t8 * t41 * t39 + t35 * 4.0 * t17);
-  const double t43 = (t42 * t13 + t19 * 2.0 * t41 * t39);
-  const double t44 = (t18 * t18);
-  const double t45 = (t19 * t19);
-  const double t46 = (t44 * t15 + t45 * t15);
-  const double t47 = (1.0 / (t46));
-  const double t48 = (-t5 * 2.0 * t11 * t41 * t39 + t35 * 2.0 * t11 * t13 + t5 * 4.0 * t39 * t13 -
-                      t33 * t8 * t40 + 4.0 * t38 * t17);
-  const double t49 = (t48 * t13 - 2.0 * t18 * t41 * t39);
-  const double t50 = (t43 * t18 * t47 * t13 + t19 * t47 * t49 * t13);
-  const double t51 = (-t50 * 0.4265 * t21 + 0.0705 * t50 * t22);
-  const double t52 = (0.0705 * t50 * t21 + t50 * t22 * 0.4265);
-  const double t53 = (t23 * t51 + t52 * t26);
-  const double t54 = t3 * (-2.093);
-  const double t55 = 0.15500000000000003 * t0;
-  const double t56 = (t36 - t3 * 0.5249999999999999 + 0.365 * t0 + t37);
-  const double t57 = (t56 * t8 + t5 * t8);
-  const double t58 = (-2.0 * t11 * t57 * t15 + t34 * t57 * t14);
-  const double t59 = (2.0 * t11 * t8 * t57 * t41 + t5 * t33 * t58 - 4.0 * t8 * t57 * t13 +
-                      4.0 * t8 * t17 - t56 * 2.0 * t11 * t13);
-  const double t60 = (t59 * t13 + t19 * 2.0 * t57 * t41);
-  const double t61 = (t56 * 4.0 * t17 + t33 * t58 * t8 - t5 * 2.0 * t11 * t57 * t41 +
-                      t5 * 4.0 * t57 * t13 + 2.0 * t11 * t8 * t13);
-  const double t62 = (t61 * t13 - 2.0 * t57 * t18 * t41);
-  const double t63 = (t60 * t18 * t47 * t13 + t19 * t62 * t47 * t13);
-  const double t64 = (t54 + t55 + t22 * 0.4265 * t63 + 0.0705 * t21 * t63);
-  const double t65 = (t24 + 0.0705 * t22 * t63 + t25 - 0.4265 * t21 * t63);
-  const double t66 = (t64 * t26 + t23 * t65);
-  const double t67 = (t28 * t53 * 2e+06 * x[3] + t28 * 2e+06 * x[2] * t66);
-  const double t68 = (t29 - 2.9000000000000004);
-  const double t69 = (t68 * t68);
-  const double t70 = (t69 + 1e-06);
-  const double t71 = (1.0 / sqrt(t70));
-  const double t72 = (1.0 / sqrt(t32));
-  const double t73 = (2.0 + t68 * t71 - t30 * t72);
-  const double t74 = (-sqrt(t32) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + t67 * t73 +
-                      sqrt(t70) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t29);
-  const double t75 =
-      (-2.0 * t45 * t34 * t57 - 2.0 * t44 * t34 * t57 - t19 * t59 * t15 + t18 * t15 * t61);
-  const double t76 = (1.0 / (t46 * t46));
-  const double t77 = (-0.159) * t2;
-  const double t78 = t4 * 0.389;
-  const double t79 = (t77 - t0 * 0.5249999999999999 - 0.365 * t3 + t78);
-  const double t80 = (t79 * t8 + t9 + (t56 * t56) + t56 * t5);
-  const double t81 = (t57 * t57);
-  const double t82 = pow(t12, (-2.5));
-  const double t83 = (1.0 / (t12 * t12 * t12));
-  const double t84 = (-t11 * t81 * t34 * 8.0 - t34 * t80 * t14 + 2.0 * t11 * t80 * t15 +
-                      4.0 * t81 * t15 + 4.0 * t83 * t81 * t14);
-  const double t85 = pow(t16, (-1.5));
-  const double t86 = (t58 * t58);
-  const double t87 =
-      (-t19 * t62 * t75 * 4.0 * t76 * t13 - t19 * t62 * 4.0 * t57 * t41 * t47 +
-       t60 * 2.0 * t47 * t61 * t13 - t75 * t60 * 4.0 * t76 * t18 * t13 -
-       t62 * 2.0 * t59 * t47 * t13 +
-       t19 *
-           ((-8.0 * t80 * t18 * t41 -
-             ((-t5 * 24.0 * t11 * t81 * t82 - t56 * t11 * 8.0 * t13 - t79 * 16.0 * t17 -
-               32.0 * t8 * t57 * t13 + 4.0 * t33 * t84 * t8 + t85 * t8 * t86 +
-               t5 * t11 * 8.0 * t80 * t41 + 16.0 * t11 * t8 * t57 * t41 - t5 * 16.0 * t80 * t13 +
-               t5 * 32.0 * t81 * t41 - t56 * t33 * 8.0 * t58)) *
-                 t13 +
-             24.0 * t81 * t82 * t18 - 8.0 * t57 * t41 * t61)) *
-           t47 * t13 +
-       ((t19 * 8.0 * t80 * t41 +
-         ((-t5 * 4.0 * t33 * t84 - 24.0 * t11 * t81 * t82 * t8 + t56 * 16.0 * t11 * t57 * t41 -
-           16.0 * t80 * t8 * t13 + t56 * 16.0 * t17 + t11 * 8.0 * t80 * t8 * t41 -
-           t79 * t11 * 8.0 * t13 + 32.0 * t81 * t8 * t41 - t5 * t85 * t86 + t33 * 8.0 * t58 * t8 -
-           t56 * 32.0 * t57 * t13)) *
-             t13 -
-         t19 * 24.0 * t81 * t82 - 8.0 * t57 * t59 * t41)) *
-           t18 * t47 * t13 -
-       t60 * 4.0 * t57 * t18 * t41 * t47);
-  const double t88 = (t63 * t63);
-  const double t89 = (t23 * ((t87 * t22 * 0.017625 - t87 * 0.106625 * t21 + t54 + t55 +
-                              t21 * t88 * 0.03525 + 0.21325 * t22 * t88)) +
-                      ((t87 * t22 * 0.106625 - t22 * t88 * 0.03525 - t25 - t24 +
-                        t87 * 0.017625 * t21 + 0.21325 * t21 * t88)) *
-                          t26 +
-                      (t65 * t65) + (t64 * t64));
-  const double t90 = (0.194 * t0 + 1.595 + t3 * 0.857);
-  const double t91 = (-0.194) * t3;
-  const double t92 = 0.857 * t0;
-  const double t93 = (t91 + t92 - 1.339);
-  const double t94 = ((t90 * t90) + (t93 * t93));
-  const double t95 = pow(t94, (-1.5));
-  const double t96 = sqrt(t94);
-  const double t97 = (-2.51 + t96);
-  const double t98 = (t97 * t97);
-  const double t99 = (1e-06 + t98);
-  const double t100 = (t96 - 1.4);
-  const double t101 = (t100 * t100);
-  const double t102 = (1e-06 + t101);
-  const double t103 = (1.0 / sqrt(t102));
-  const double t104 = (1.0 / sqrt(t99));
-  const double t105 = (-t103 * t100 + 2.0 + t104 * t97);
-  const double t106 = (t91 + t92);
-  const double t107 = (-t3 * 0.857 - 0.194 * t0);
-  const double t108 = (t90 * t106 + t107 * t93);
-  const double t109 = (1.0 / sqrt(t94));
-  const double t110 =
-      (-2e+08 * sqrt(t99) + x[6] * 0.04021238596594936 - t105 * t108 * t109 * 2e+06 * x[2] +
-       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t102) - 4e+08 * t96);
-  const double t111 = (t108 * t108);
-  const double t112 = (-1.55 * t3 - 0.1 * t0);
-  const double t113 = cos(u[5]);
-  const double t114 = sin(u[5]);
-  const double t115 = t4 * 0.25;
-  const double t116 = (-3.11) * t0;
-  const double t117 = (-0.55) * t2;
-  const double t118 = (t115 + t116 + t117);
-  const double t119 = (t3 * 0.1 - 1.55 * t0);
-  const double t120 = t65 * t51;
-  const double t121 = t52 * t64;
-  const double t122 = 0.21325 * t50 * t21 * t63;
-  const double t123 = t5 * t38;
-  const double t124 = (t77 + t78);
-  const double t125 = t124 * t8;
-  const double t126 = (t56 * t38 + t35 * t8 + t123 + t125);
-  const double t127 = (-2.0 * t126 * t11 * t15 - 4.0 * t83 * t57 * t14 * t39 + t126 * t34 * t14 -
-                       4.0 * t57 * t15 * t39 + t11 * t34 * 8.0 * t57 * t39);
-  const double t128 = t11 * (-8.0) * t38 * t13;
-  const double t129 = (-16.0) * t124 * t17;
-  const double t130 =
-      ((((t5 * t126 * t11 * 8.0 * t41 - t5 * 16.0 * t126 * t13 - t85 * t58 * t8 * t40 +
-          t5 * 32.0 * t57 * t41 * t39 - 16.0 * t8 * t39 * t13 + t11 * 8.0 * t8 * t41 * t39 -
-          4.0 * t33 * t8 * t127 - t5 * 24.0 * t11 * t82 * t57 * t39 + t56 * 4.0 * t33 * t40 +
-          t35 * t11 * 8.0 * t57 * t41 + t128 + t129 - t35 * 16.0 * t57 * t13 -
-          4.0 * t38 * t33 * t58)) *
-            t13 +
-        t126 * 8.0 * t18 * t41 + 4.0 * t48 * t57 * t41 + 4.0 * t41 * t39 * t61 -
-        24.0 * t82 * t57 * t18 * t39)) *
-      t19 * t47 * t13;
-  const double t131 =
-      ((-((t35 * 4.0 * t33 * t58 + t5 * 4.0 * t33 * t127 + t56 * t11 * 8.0 * t41 * t39 -
-           24.0 * t11 * t82 * t8 * t57 * t39 - t124 * t11 * 8.0 * t13 +
-           32.0 * t8 * t57 * t41 * t39 - 16.0 * t38 * t57 * t13 + t5 * t85 * t58 * t40 -
-           4.0 * t33 * t8 * t40 + 16.0 * t38 * t17 - 16.0 * t126 * t8 * t13 +
-           t11 * t38 * 8.0 * t57 * t41 + t126 * t11 * 8.0 * t8 * t41 - t56 * 16.0 * t39 * t13)) *
-            t13 +
-        t19 * 24.0 * t82 * t57 * t39 - t19 * t126 * 8.0 * t41 + 4.0 * t59 * t41 * t39 +
-        4.0 * t42 * t57 * t41)) *
-      t18 * t47 * t13;
-  const double t132 =
-      (t19 * t75 * 4.0 * t76 * t49 * t13 + 2.0 * t59 * t47 * t49 * t13 +
-       t75 * 4.0 * t76 * t43 * t18 * t13 + t130 + 4.0 * t43 * t57 * t18 * t41 * t47 +
-       t19 * 4.0 * t57 * t41 * t47 * t49 + t131 - 2.0 * t43 * t47 * t61 * t13);
-  const double t133 = t50 * t22 * t63 * (-0.03525);
-  const double t134 = 0.21325 * t50 * t22 * t63;
-  const double t135 = t50 * t21 * t63 * 0.03525;
-  const double t136 =
-      (t120 + t121 + ((t122 - t22 * 0.106625 * t132 + t133 - 0.017625 * t21 * t132)) * t26 +
-       ((t134 + 0.106625 * t21 * t132 + t135 - t22 * 0.017625 * t132)) * t23);
-  const double t137 = pow(t27, (-1.5));
-  const double t138 = (t66 * t66);
-  const double t139 = pow(t70, (-1.5));
-  const double t140 = pow(t32, (-1.5));
-  const double t141 =
-      (((t28 * t136 * 2e+06 * x[3] + t28 * 2e+06 * t89 * x[2] - t137 * 2e+06 * x[2] * t138 -
-         t137 * t53 * 2e+06 * x[3] * t66)) *
-           t73 +
-       t28 * 4e+08 * t66 + t28 * t68 * 2e+08 * t71 * t66 - t30 * t28 * t72 * 2e+08 * t66 +
-       t67 * ((-t28 * t72 * t66 - t28 * t69 * t139 * t66 + t28 * t71 * t66 +
-               t28 * t31 * t140 * t66)));
-  const double t142 = t4 * (-0.4011545671438309);
-  const double t143 = (-0.16343387866394005) * t2;
-  const double t144 = t3 * (-3.11);
-  const double t145 = (t142 + t143 + t144);
-  const double t146 = t4 * 0.16343387866394005;
-  const double t147 = (-0.4011545671438309) * t2;
-  const double t148 = (t116 + t146 + t147);
-  const double t149 = ((t107 * t107) + (t106 * t106) + t93 * ((0.194 * t3 - t92)) + t107 * t90);
-  const double t150 = t4 * (-0.55);
-  const double t151 = (-0.25) * t2;
-  const double t152 = (t150 + t151 + t144);
-  const double t153 = (-t3 * 0.1 + 1.55 * t0);
-  const double t154 = t4 * (-0.16343387866394005);
-  const double t155 = 3.11 * t0;
-  const double t156 = 0.4011545671438309 * t2;
-  const double t157 = (t154 + t155 + t156);
-  const double t158 = t4 * (-0.25);
-  const double t159 = 0.55 * t2;
-  const double t160 = (t155 + t158 + t159);
-  const double t161 =
-      (2600.0 * (t153 * t153) + 1550.0 * (t152 * t152) + (((t157 * t157) + (t145 * t145))) * u[4] +
-       1550.0 * (t160 * t160) + 2600.0 * (t112 * t112) + 2900.0);
-  const double t162 = (1.0 / (t161));
-  const double t163 = (1.0 / (t161 * t161));
-  const double t164 =
-      (-t153 * 50994.579999999994 * t113 - t160 * t113 * 30400.614999999998 - x[2] * 4000.0 +
-       2.0 * u[2] + t108 * t109 * 2.0 * t110 - t114 * t152 * 30400.614999999998 -
-       t112 * 50994.579999999994 * t114 +
-       2.0 * ((-t114 * t145 * 9.80665 - t157 * t113 * 9.80665)) * u[4] - t28 * t74 * t66);
-  const double t165 = (t142 + t143);
-  const double t166 = (t146 + t147);
-  const double t167 = (t115 + t117);
-  const double t168 = (t150 + t151);
-  const double t169 = t113 * (-30400.614999999998) * t168;
-  const double t170 = t114 * (-30400.614999999998) * t167;
-  const double t171 = t137 * t53 * t74 * t66;
-  const double t172 =
-      (-t19 * t42 * t15 - 2.0 * t44 * t34 * t39 - 2.0 * t45 * t34 * t39 + t48 * t18 * t15);
-  const double t173 =
-      (t172 * t60 * 4.0 * t76 * t18 * t13 + t19 * t62 * t172 * 4.0 * t76 * t13 + t130 +
-       t60 * 4.0 * t18 * t41 * t47 * t39 + t131 + t62 * 2.0 * t42 * t47 * t13 -
-       t60 * 2.0 * t48 * t47 * t13 + t19 * t62 * 4.0 * t41 * t47 * t39);
+  const double t0 = sin(x[0]);
+  const double t1 = cos(x[0]);
+  const double t2 = (-1.55 * t0 - 0.1 * t1);
+  const double t3 = (t0 * 0.1 - 1.55 * t1);
+  const double t4 = (x[0] + x[1]);
+  const double t5 = sin(t4);
+  const double t6 = t5 * 0.25;
+  const double t7 = (-3.11) * t1;
+  const double t8 = cos(t4);
+  const double t9 = (-0.55) * t8;
+  const double t10 = (t6 + t7 + t9);
+  const double t11 = t5 * (-0.55);
+  const double t12 = (-0.25) * t8;
+  const double t13 = t0 * (-3.11);
+  const double t14 = (t11 + t12 + t13);
+  const double t15 = t5 * (-0.4011545671438309);
+  const double t16 = (-0.16343387866394005) * t8;
+  const double t17 = (t15 + t16 + t13);
+  const double t18 = t5 * 0.16343387866394005;
+  const double t19 = (-0.4011545671438309) * t8;
+  const double t20 = (t7 + t18 + t19);
+  const double t21 = t5 * (-0.16343387866394005);
+  const double t22 = 3.11 * t1;
+  const double t23 = 0.4011545671438309 * t8;
+  const double t24 = (t21 + t22 + t23);
+  const double t25 = t5 * (-0.25);
+  const double t26 = 0.55 * t8;
+  const double t27 = (t22 + t25 + t26);
+  const double t28 = (-t0 * 0.1 + 1.55 * t1);
+  const double t29 =
+      (2600.0 * (t28 * t28) + 1550.0 * (t14 * t14) + (((t24 * t24) + (t17 * t17))) * u[4] +
+       1550.0 * (t27 * t27) + 2600.0 * (t2 * t2) + 2900.0);
+  const double t30 = (1.0 / (t29 * t29));
+  const double t31 = cos(u[5]);
+  const double t32 = (0.389 * t8 + t0 * 0.5249999999999999 - 0.365 * t1 + t5 * 0.159);
+  const double t33 = 0.159 * t8;
+  const double t34 = t5 * (-0.389);
+  const double t35 = (0.365 * t0 + t33 + t34 + t1 * 0.5249999999999999);
+  const double t36 = (t35 * t35);
+  const double t37 = (t32 * t32);
+  const double t38 = (t36 + t37 - 0.38752);
+  const double t39 = (t36 + t37);
+  const double t40 = (1.0 / sqrt(t39));
+  const double t41 = (t38 * t38);
+  const double t42 = (1.0 / (t39));
+  const double t43 = (0.567009 - 0.25 * t41 * t42);
+  const double t44 = sqrt(t43);
+  const double t45 = (t32 * t38 * t40 + 2.0 * t35 * t44);
+  const double t46 = (t32 * 2.0 * t44 - t38 * t35 * t40);
+  const double t47 = atan2(0.5 * t45 * t40, t46 * (-0.5) * t40);
+  const double t48 = cos(t47);
+  const double t49 = sin(t47);
+  const double t50 = (-0.141 * t48 - t49 * 0.853 - 0.15500000000000003 * t1 + t0 * 2.093);
+  const double t51 = t0 * 0.15500000000000003;
+  const double t52 = 2.093 * t1;
+  const double t53 = (t51 + t49 * 0.141 - 0.853 * t48 + t52);
+  const double t54 = ((t50 * t50) + (t53 * t53));
+  const double t55 = sqrt(t54);
+  const double t56 = (-2.9000000000000004 + t55);
+  const double t57 = (t56 * t56);
+  const double t58 = (t57 + 1e-06);
+  const double t59 = (-1.59 + t55);
+  const double t60 = (t59 * t59);
+  const double t61 = (1e-06 + t60);
+  const double t62 = (1.0 / sqrt(t61));
+  const double t63 = (1.0 / sqrt(t58));
+  const double t64 = (-t59 * t62 + t63 * t56 + 2.0);
+  const double t65 = (t46 * t46);
+  const double t66 = (t45 * t45);
+  const double t67 = (t65 * t42 + t66 * t42);
+  const double t68 = (1.0 / (t67));
+  const double t69 = (-0.389) * t8;
+  const double t70 = t5 * (-0.159);
+  const double t71 = (t69 - t0 * 0.5249999999999999 + 0.365 * t1 + t70);
+  const double t72 = (t71 * t35 + t32 * t35);
+  const double t73 = (1.0 / sqrt(t43));
+  const double t74 = (1.0 / (t39 * t39));
+  const double t75 = (-2.0 * t38 * t72 * t42 + t74 * t72 * t41);
+  const double t76 = pow(t39, (-1.5));
+  const double t77 = (t71 * 2.0 * t38 * t40 - 4.0 * t35 * t44 + 4.0 * t35 * t72 * t40 -
+                      t32 * t73 * t75 - 2.0 * t38 * t35 * t72 * t76);
+  const double t78 = (t77 * t40 + 2.0 * t46 * t72 * t76);
+  const double t79 = (t71 * 4.0 * t44 + t73 * t75 * t35 - t32 * 2.0 * t38 * t72 * t76 +
+                      t32 * 4.0 * t72 * t40 + 2.0 * t38 * t35 * t40);
+  const double t80 = (2.0 * t72 * t45 * t76 - t79 * t40);
+  const double t81 = (t68 * t78 * t45 * t40 - t80 * t68 * t46 * t40);
+  const double t82 = (t51 - t49 * 0.0705 * t81 + 0.4265 * t48 * t81 + t52);
+  const double t83 = t0 * (-2.093);
+  const double t84 = 0.15500000000000003 * t1;
+  const double t85 = (-0.0705 * t48 * t81 - t49 * 0.4265 * t81 + t83 + t84);
+  const double t86 = (t50 * t82 + t85 * t53);
+  const double t87 = (1.0 / sqrt(t54));
+  const double t88 = (t33 + t34);
+  const double t89 = (t69 + t70);
+  const double t90 = (t88 * t32 + t89 * t35);
+  const double t91 = (-2.0 * t38 * t42 * t90 + t74 * t41 * t90);
+  const double t92 = (-t32 * t91 * t73 - 2.0 * t38 * t35 * t76 * t90 + 2.0 * t38 * t89 * t40 +
+                      4.0 * t35 * t90 * t40 - t88 * 4.0 * t44);
+  const double t93 = (t92 * t40 + 2.0 * t46 * t76 * t90);
+  const double t94 = (-t32 * 2.0 * t38 * t76 * t90 + t91 * t73 * t35 + t88 * 2.0 * t38 * t40 +
+                      t32 * 4.0 * t90 * t40 + 4.0 * t89 * t44);
+  const double t95 = (t94 * t40 - 2.0 * t45 * t76 * t90);
+  const double t96 = (t68 * t93 * t45 * t40 + t95 * t68 * t46 * t40);
+  const double t97 = (-0.0705 * t48 * t96 - t49 * 0.4265 * t96);
+  const double t98 = (-t49 * 0.0705 * t96 + 0.4265 * t48 * t96);
+  const double t99 = (t97 * t53 + t50 * t98);
+  const double t100 = (t86 * 2e+06 * x[2] * t87 + 2e+06 * x[3] * t99 * t87);
+  const double t101 =
+      (sqrt(t58) * 2e+08 - sqrt(t61) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + 4e+08 * t55 +
+       0.04712388980384691 * x[9] + t64 * t100);
+  const double t102 = (0.194 * t1 + 1.595 + t0 * 0.857);
+  const double t103 = (-0.194) * t0;
+  const double t104 = 0.857 * t1;
+  const double t105 = (t103 + t104);
+  const double t106 = (-t0 * 0.857 - 0.194 * t1);
+  const double t107 = (t103 + t104 - 1.339);
+  const double t108 = (t102 * t105 + t106 * t107);
+  const double t109 = ((t102 * t102) + (t107 * t107));
+  const double t110 = (1.0 / sqrt(t109));
+  const double t111 = sqrt(t109);
+  const double t112 = (-2.51 + t111);
+  const double t113 = (t112 * t112);
+  const double t114 = (1e-06 + t113);
+  const double t115 = (t111 - 1.4);
+  const double t116 = (t115 * t115);
+  const double t117 = (1e-06 + t116);
+  const double t118 = (1.0 / sqrt(t117));
+  const double t119 = (1.0 / sqrt(t114));
+  const double t120 = (-t118 * t115 + 2.0 + t119 * t112);
+  const double t121 =
+      (-2e+08 * sqrt(t114) + x[6] * 0.04021238596594936 - t120 * t108 * t110 * 2e+06 * x[2] +
+       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t117) - 4e+08 * t111);
+  const double t122 = sin(u[5]);
+  const double t123 =
+      (-t28 * 50994.579999999994 * t31 - t101 * t86 * t87 - t27 * t31 * 30400.614999999998 -
+       x[2] * 4000.0 + 2.0 * u[2] + t108 * t110 * 2.0 * t121 - t122 * t14 * 30400.614999999998 -
+       t2 * 50994.579999999994 * t122 +
+       2.0 * ((-t122 * t17 * 9.80665 - t24 * t31 * 9.80665)) * u[4]);
+  const double t124 = pow(t109, (-1.5));
+  const double t125 = (t108 * t108);
+  const double t126 = (t81 * t81);
+  const double t127 = (t72 * t72);
+  const double t128 = pow(t39, (-2.5));
+  const double t129 = (-0.159) * t8;
+  const double t130 = t5 * 0.389;
+  const double t131 = (t129 - t1 * 0.5249999999999999 - 0.365 * t0 + t130);
+  const double t132 = (t131 * t35 + t36 + (t71 * t71) + t71 * t32);
+  const double t133 = (1.0 / (t39 * t39 * t39));
+  const double t134 = (-4.0 * t133 * t127 * t41 + t38 * t127 * t74 * 8.0 - 2.0 * t38 * t132 * t42 +
+                       t74 * t132 * t41 - 4.0 * t127 * t42);
+  const double t135 = pow(t43, (-1.5));
+  const double t136 = (t75 * t75);
+  const double t137 = (1.0 / (t67 * t67));
+  const double t138 =
+      (2.0 * t74 * t65 * t72 + t77 * t46 * t42 + 2.0 * t66 * t74 * t72 - t45 * t42 * t79);
+  const double t139 =
+      (2.0 * t68 * t78 * t79 * t40 - t68 * 4.0 * t78 * t72 * t45 * t76 +
+       t80 * t68 * 4.0 * t46 * t72 * t76 -
+       t68 *
+           ((24.0 * t127 * t128 * t46 - t46 * 8.0 * t132 * t76 + t77 * 8.0 * t72 * t76 -
+             ((-t71 * 16.0 * t44 - t71 * 16.0 * t38 * t72 * t76 + t71 * 32.0 * t72 * t40 -
+               t38 * 8.0 * t132 * t35 * t76 - t73 * 8.0 * t75 * t35 + 16.0 * t132 * t35 * t40 -
+               t32 * 4.0 * t73 * t134 - 32.0 * t127 * t35 * t76 + 24.0 * t38 * t127 * t128 * t35 +
+               t131 * t38 * 8.0 * t40 + t32 * t135 * t136)) *
+                 t40)) *
+           t45 * t40 -
+       t137 * t80 * 4.0 * t46 * t138 * t40 + t137 * 4.0 * t78 * t138 * t45 * t40 +
+       ((-8.0 * t132 * t45 * t76 +
+         ((-t32 * t38 * 8.0 * t132 * t76 - 16.0 * t38 * t35 * t72 * t76 - t32 * 32.0 * t127 * t76 +
+           t32 * 16.0 * t132 * t40 + t71 * t38 * 8.0 * t40 + t32 * 24.0 * t38 * t127 * t128 +
+           4.0 * t73 * t134 * t35 + 32.0 * t35 * t72 * t40 - t135 * t35 * t136 + t131 * 16.0 * t44 +
+           t71 * t73 * 8.0 * t75)) *
+             t40 +
+         24.0 * t127 * t128 * t45 - 8.0 * t72 * t76 * t79)) *
+           t68 * t46 * t40 +
+       2.0 * t80 * t68 * t77 * t40);
+  const double t140 = ((t85 * t85) +
+                       t50 * ((t49 * 0.21325 * t126 + t139 * 0.106625 * t48 + t83 + t84 +
+                               t126 * t48 * 0.03525 - t49 * t139 * 0.017625)) +
+                       (t82 * t82) +
+                       t53 * ((0.21325 * t126 * t48 - t139 * 0.017625 * t48 -
+                               t49 * t139 * 0.106625 - t52 - t51 - t49 * t126 * 0.03525)));
+  const double t141 = ((t106 * t106) + (t105 * t105) + t107 * ((0.194 * t0 - t104)) + t106 * t102);
+  const double t142 = pow(t54, (-1.5));
+  const double t143 = (t86 * t86);
+  const double t144 = pow(t61, (-1.5));
+  const double t145 = pow(t58, (-1.5));
+  const double t146 = t85 * t97;
+  const double t147 = t98 * t82;
+  const double t148 = t32 * t89;
+  const double t149 = (t129 + t130);
+  const double t150 = t149 * t35;
+  const double t151 = (t71 * t89 + t88 * t35 + t148 + t150);
+  const double t152 = (2.0 * t151 * t38 * t42 + 4.0 * t133 * t72 * t41 * t90 +
+                       4.0 * t72 * t42 * t90 - t151 * t74 * t41 - t38 * t74 * 8.0 * t72 * t90);
+  const double t153 =
+      (24.0 * t128 * t72 * t45 * t90 +
+       ((t38 * t89 * 8.0 * t40 + t32 * 16.0 * t151 * t40 - t38 * 8.0 * t35 * t76 * t90 -
+         t32 * 32.0 * t72 * t76 * t90 + t71 * t91 * 4.0 * t73 +
+         t32 * 24.0 * t38 * t128 * t72 * t90 + 16.0 * t35 * t90 * t40 + 16.0 * t149 * t44 +
+         4.0 * t89 * t73 * t75 - t152 * 4.0 * t73 * t35 - t91 * t135 * t75 * t35 +
+         t88 * 16.0 * t72 * t40 - t88 * t38 * 8.0 * t72 * t76 - t32 * t151 * t38 * 8.0 * t76)) *
+           t40 -
+       4.0 * t94 * t72 * t76 - t151 * 8.0 * t45 * t76 - 4.0 * t76 * t90 * t79);
+  const double t154 = t149 * t38 * 8.0 * t40;
+  const double t155 = (-16.0) * t89 * t44;
+  const double t156 =
+      (4.0 * t72 * t92 * t76 - t151 * t46 * 8.0 * t76 + 24.0 * t128 * t46 * t72 * t90 +
+       4.0 * t77 * t76 * t90 -
+       ((t154 + t155 - t38 * t89 * 8.0 * t72 * t76 - t88 * 4.0 * t73 * t75 +
+         t71 * 16.0 * t90 * t40 - t91 * 4.0 * t73 * t35 + t32 * t152 * 4.0 * t73 -
+         32.0 * t35 * t72 * t76 * t90 + 16.0 * t89 * t72 * t40 - t71 * t38 * 8.0 * t76 * t90 +
+         16.0 * t151 * t35 * t40 + 24.0 * t38 * t128 * t35 * t72 * t90 + t32 * t91 * t135 * t75 -
+         t151 * t38 * 8.0 * t35 * t76)) *
+           t40);
+  const double t157 =
+      (-t95 * 2.0 * t68 * t77 * t40 + t137 * 4.0 * t93 * t138 * t45 * t40 + t153 * t68 * t46 * t40 -
+       t68 * 4.0 * t93 * t72 * t45 * t76 - t95 * t68 * 4.0 * t46 * t72 * t76 -
+       t68 * t45 * t156 * t40 + t95 * t137 * 4.0 * t46 * t138 * t40 + 2.0 * t68 * t93 * t79 * t40);
+  const double t158 = t48 * 0.03525 * t81 * t96;
+  const double t159 = t49 * 0.21325 * t81 * t96;
+  const double t160 = 0.21325 * t48 * t81 * t96;
+  const double t161 = t49 * (-0.03525) * t81 * t96;
+  const double t162 =
+      (t146 + t147 + t50 * ((-t49 * 0.017625 * t157 + 0.106625 * t48 * t157 + t158 + t159)) +
+       t53 * ((t160 + t161 - t49 * 0.106625 * t157 - 0.017625 * t48 * t157)));
+  const double t163 =
+      (-t86 * 2e+08 * t59 * t62 * t87 +
+       ((-t86 * t62 * t87 + t86 * t63 * t87 + t86 * t144 * t87 * t60 - t57 * t86 * t145 * t87)) *
+           t100 +
+       t86 * 2e+08 * t63 * t87 * t56 +
+       t64 * ((2e+06 * x[2] * t87 * t140 + 2e+06 * x[3] * t162 * t87 -
+               t86 * 2e+06 * x[3] * t99 * t142 - 2e+06 * x[2] * t142 * t143)) +
+       4e+08 * t86 * t87);
+  const double t164 = (1.0 / (t29));
+  const double t165 = (t15 + t16);
+  const double t166 = (t18 + t19);
+  const double t167 = (t6 + t9);
+  const double t168 = (t11 + t12);
+  const double t169 =
+      (-t94 * t45 * t42 + 2.0 * t66 * t74 * t90 + 2.0 * t74 * t65 * t90 + t46 * t92 * t42);
+  const double t170 = ((t89 * t89) + (t88 * t88) + t148 + t150);
+  const double t171 = (t90 * t90);
+  const double t172 = (2.0 * t170 * t38 * t42 + 4.0 * t171 * t42 - t170 * t74 * t41 -
+                       t38 * t74 * t171 * 8.0 + 4.0 * t133 * t171 * t41);
+  const double t173 = (t91 * t91);
   const double t174 =
-      (((-t173 * t22 * 0.106625 - t173 * 0.017625 * t21 + t122 + t133)) * t26 +
-       ((t173 * 0.106625 * t21 + t134 + t135 - t173 * t22 * 0.017625)) * t23 + t120 + t121);
-  const double t175 = 2.0 * u[4] * ((-t165 * t113 * 9.80665 - t114 * t166 * 9.80665));
-  const double t176 = (t53 * t53);
-  const double t177 = (t39 * t39);
-  const double t178 = ((t38 * t38) + (t35 * t35) + t123 + t125);
-  const double t179 = (t11 * t34 * t177 * 8.0 - 4.0 * t83 * t177 * t14 - 4.0 * t177 * t15 -
-                       2.0 * t178 * t11 * t15 + t178 * t34 * t14);
-  const double t180 = (t40 * t40);
-  const double t181 =
-      (t19 * 4.0 * t41 * t47 * t39 * t49 +
-       ((t13 * ((t124 * t11 * 8.0 * t13 - 16.0 * t38 * t17 + 32.0 * t38 * t39 * t13 -
-                 t5 * t179 * 4.0 * t33 - 16.0 * t11 * t38 * t41 * t39 - 32.0 * t177 * t8 * t41 +
-                 t35 * t33 * 8.0 * t40 + 24.0 * t11 * t82 * t177 * t8 -
-                 t178 * t11 * 8.0 * t8 * t41 + t5 * t85 * t180 + 16.0 * t178 * t8 * t13)) +
-         t19 * 24.0 * t82 * t177 - t19 * t178 * 8.0 * t41 + t42 * 8.0 * t41 * t39)) *
-           t18 * t47 * t13 -
-       2.0 * t48 * t43 * t47 * t13 +
-       t19 *
-           ((-24.0 * t82 * t177 * t18 + t48 * 8.0 * t41 * t39 + t178 * 8.0 * t18 * t41 +
-             ((-t35 * 32.0 * t39 * t13 - t179 * 4.0 * t33 * t8 + t128 + t129 -
-               t5 * 16.0 * t178 * t13 + t85 * t180 * t8 + t35 * 16.0 * t11 * t41 * t39 +
-               t38 * t33 * 8.0 * t40 + t5 * t178 * t11 * 8.0 * t41 + t5 * 32.0 * t177 * t41 -
-               t5 * 24.0 * t11 * t82 * t177)) *
-                 t13)) *
-           t47 * t13 +
-       2.0 * t42 * t47 * t49 * t13 + t19 * t172 * 4.0 * t76 * t49 * t13 +
-       t172 * 4.0 * t76 * t43 * t18 * t13 + 4.0 * t43 * t18 * t41 * t47 * t39);
-  const double t182 = (t50 * t50);
-  const double t183 = ((t52 * t52) +
-                       ((-t22 * 0.106625 * t181 - t22 * t182 * 0.03525 - 0.017625 * t21 * t181 +
-                         0.21325 * t21 * t182)) *
-                           t26 +
-                       (t51 * t51) +
-                       ((-t22 * 0.017625 * t181 + 0.21325 * t22 * t182 + 0.106625 * t21 * t181 +
-                         t21 * t182 * 0.03525)) *
-                           t23);
-  const double t184 =
-      (t73 * ((-t137 * t53 * 2e+06 * x[2] * t66 - t137 * t176 * 2e+06 * x[3] +
-               t28 * 2e+06 * x[3] * t183 + t28 * 2e+06 * x[2] * t174)) +
-       ((t28 * t53 * t71 - t28 * t53 * t69 * t139 - t28 * t53 * t72 + t28 * t53 * t31 * t140)) *
-           t67 +
-       t28 * t53 * t68 * 2e+08 * t71 - t30 * t28 * t53 * t72 * 2e+08 + t28 * t53 * 4e+08);
-  const double t185 = (1.0 / (t27));
-  const double t186 = (t154 + t156);
-  const double t187 = (t158 + t159);
+      (t137 * 4.0 * t169 * t93 * t45 * t40 - t68 * 4.0 * t93 * t45 * t76 * t90 +
+       t95 * t137 * 4.0 * t169 * t46 * t40 + 2.0 * t68 * t94 * t93 * t40 -
+       t68 * t46 *
+           ((((-t88 * 32.0 * t90 * t40 - t38 * t89 * 8.0 * t40 - 16.0 * t149 * t44 -
+               t91 * t89 * t73 * 8.0 - t32 * 16.0 * t170 * t40 + t88 * 16.0 * t38 * t76 * t90 +
+               4.0 * t73 * t35 * t172 + t32 * t170 * t38 * 8.0 * t76 + t32 * 32.0 * t171 * t76 +
+               t173 * t135 * t35 - t32 * 24.0 * t38 * t128 * t171)) *
+                 t40 -
+             24.0 * t128 * t171 * t45 + t94 * 8.0 * t76 * t90 + t170 * 8.0 * t45 * t76)) *
+           t40 -
+       t95 * 2.0 * t68 * t92 * t40 - t95 * t68 * 4.0 * t46 * t76 * t90 -
+       ((-t170 * t46 * 8.0 * t76 -
+         ((t154 + t155 + t32 * 4.0 * t73 * t172 + 32.0 * t89 * t90 * t40 -
+           16.0 * t38 * t89 * t76 * t90 - t88 * t91 * t73 * 8.0 - 32.0 * t171 * t35 * t76 +
+           24.0 * t38 * t128 * t171 * t35 - t170 * t38 * 8.0 * t35 * t76 + 16.0 * t170 * t35 * t40 +
+           t32 * t173 * t135)) *
+             t40 +
+         8.0 * t92 * t76 * t90 + 24.0 * t128 * t46 * t171)) *
+           t68 * t45 * t40);
+  const double t175 = (t96 * t96);
+  const double t176 = (t50 * ((-t49 * 0.017625 * t174 + 0.106625 * t48 * t174 +
+                               t49 * 0.21325 * t175 + t175 * t48 * 0.03525)) +
+                       (t97 * t97) + (t98 * t98) +
+                       t53 * ((-t49 * 0.106625 * t174 - 0.017625 * t48 * t174 -
+                               t49 * t175 * 0.03525 + 0.21325 * t175 * t48)));
+  const double t177 = (t99 * t99);
+  const double t178 = (-2.0 * t68 * t78 * t94 * t40 + t137 * t80 * 4.0 * t169 * t46 * t40 +
+                       t68 * 4.0 * t78 * t45 * t76 * t90 - t80 * t68 * 4.0 * t46 * t76 * t90 -
+                       t153 * t68 * t46 * t40 + t68 * t45 * t156 * t40 -
+                       t137 * 4.0 * t78 * t169 * t45 * t40 - 2.0 * t80 * t68 * t92 * t40);
+  const double t179 =
+      (t50 * ((t49 * t178 * 0.017625 - t178 * 0.106625 * t48 + t158 + t159)) + t146 + t147 +
+       ((t178 * 0.017625 * t48 + t49 * t178 * 0.106625 + t160 + t161)) * t53);
+  const double t180 =
+      (-2e+08 * t59 * t99 * t62 * t87 +
+       t64 * ((t176 * 2e+06 * x[3] * t87 - t86 * 2e+06 * x[2] * t99 * t142 -
+               2e+06 * t177 * x[3] * t142 + t179 * 2e+06 * x[2] * t87)) +
+       2e+08 * t63 * t99 * t87 * t56 -
+       ((t57 * t145 * t99 * t87 - t99 * t144 * t87 * t60 - t63 * t99 * t87 + t99 * t62 * t87)) *
+           t100 +
+       4e+08 * t99 * t87);
+  const double t181 = (-2.0) * u[4] * ((-t165 * t31 * 9.80665 - t122 * t166 * 9.80665));
+  const double t182 = t31 * 30400.614999999998 * t168;
+  const double t183 = t101 * t86 * t99 * t142 * (-1.0);
+  const double t184 = t122 * 30400.614999999998 * t167;
+  const double t185 = (1.0 / (t54));
+  const double t186 = (t21 + t23);
+  const double t187 = (t25 + t26);
   const double t188 = ((t168 * t168) * 1550.0 + 600.0 + (((t165 * t165) + (t186 * t186))) * u[4] +
                        1550.0 * (t187 * t187));
   const double t189 =
       ((2.0 * ((t165 * t166 + t165 * t186)) * u[4] + t187 * 3100.0 * t168 + 3100.0 * t167 * t168)) *
-      ((t28 * t53 * t74 - 2.0 * ((-t186 * t113 * 9.80665 - t114 * t165 * 9.80665)) * u[4] +
-        t187 * t113 * 30400.614999999998 - 2.0 * u[3] + 1600.0 * x[3] +
-        t114 * 30400.614999999998 * t168)) *
-      0.5 / (t188 * t188);
+      0.5 *
+      ((-2.0 * ((-t186 * t31 * 9.80665 - t122 * t165 * 9.80665)) * u[4] +
+        t187 * t31 * 30400.614999999998 - 2.0 * u[3] + t101 * t99 * t87 + 1600.0 * x[3] +
+        t122 * 30400.614999999998 * t168)) /
+      (t188 * t188);
   const double t190 = (1.0 / (t188));
-  const double t191 = (t96 * 0.04021238596594936 - 0.0522973403523291);
+  const double t191 = (t111 * 0.04021238596594936 - 0.0522973403523291);
   const double t192 = (1.0 / (t191));
   const double t193 = (-2.8e+07 + x[6]);
   const double t194 = (1e+10 + (t193 * t193));
@@ -799,7 +802,7 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t202 = (x[6] - 2e+05);
   const double t203 = (t202 * t202);
   const double t204 = (t203 + 1e+10);
-  const double t205 = (-t196 + x[4]);
+  const double t205 = (-x[4] + t196);
   const double t206 = (4e+10 + t203);
   const double t207 = pow(t206, (-0.25));
   const double t208 = (1.0 / sqrt(t195)) * x[4];
@@ -807,194 +810,195 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t210 = (t208 - 1.0);
   const double t211 = 2.0 * x[6];
   const double t212 = (-4e+05 + t211);
-  const double t213 = ((x[5] * x[5]) + 1e-06);
-  const double t214 = sqrt(t213);
-  const double t215 = (t214 + x[5]);
-  const double t216 = (x[7] - u[7]);
-  const double t217 = (t216 * t216);
-  const double t218 = (4e+10 + t217);
-  const double t219 = pow(t218, (-0.25));
-  const double t220 = (x[7] - 2e+05);
-  const double t221 = (t220 * t220);
-  const double t222 = (1e+10 + t221);
-  const double t223 = (-t214 + x[5]);
-  const double t224 = (4e+10 + t221);
-  const double t225 = pow(t224, (-0.25));
-  const double t226 = (-2.8e+07 + x[7]);
-  const double t227 = (1e+10 + (t226 * t226));
-  const double t228 = (-t215 * t219 * 2.0412414523193154e-06 * t216 - x[7] * 5e-09 +
-                       0.07050000000000001 - t28 * 0.031415926535897934 * x[2] * t66 +
-                       sqrt(t222) * 2.5e-09 + t223 * 2.0412414523193154e-06 * t220 * t225 -
-                       2.5e-09 * sqrt(t227) - t28 * 0.031415926535897934 * t53 * x[3]);
-  const double t229 = (0.031415926535897934 * t29 - 0.04695132319207772);
-  const double t230 = (1.0 / (t229 * t229));
-  const double t231 = (1.0 / (t229));
-  const double t232 = (1.0 / sqrt(t213)) * x[5];
+  const double t213 = (0.031415926535897934 * t55 - 0.04695132319207772);
+  const double t214 = (1.0 / (t213));
+  const double t215 = (1.0 / (t213 * t213));
+  const double t216 = ((x[5] * x[5]) + 1e-06);
+  const double t217 = sqrt(t216);
+  const double t218 = (t217 + x[5]);
+  const double t219 = (x[7] - u[7]);
+  const double t220 = (t219 * t219);
+  const double t221 = (4e+10 + t220);
+  const double t222 = pow(t221, (-0.25));
+  const double t223 = (x[7] - 2e+05);
+  const double t224 = (t223 * t223);
+  const double t225 = (1e+10 + t224);
+  const double t226 = (t217 - x[5]);
+  const double t227 = (4e+10 + t224);
+  const double t228 = pow(t227, (-0.25));
+  const double t229 = (-2.8e+07 + x[7]);
+  const double t230 = (1e+10 + (t229 * t229));
+  const double t231 =
+      (-t218 * t222 * 2.0412414523193154e-06 * t219 - 0.031415926535897934 * t86 * x[2] * t87 -
+       x[7] * 5e-09 - 0.031415926535897934 * x[3] * t99 * t87 + 0.07050000000000001 +
+       sqrt(t225) * 2.5e-09 - t226 * 2.0412414523193154e-06 * t223 * t228 - 2.5e-09 * sqrt(t230));
+  const double t232 = (1.0 / sqrt(t216)) * x[5];
   const double t233 = (t232 - 1.0);
   const double t234 = (t232 + 1.0);
   const double t235 = 2.0 * x[7];
   const double t236 = (-4e+05 + t235);
-  const double t237 = (-t96 * 0.027488935718910694 + 0.07299722865446584);
+  const double t237 = (-t111 * 0.027488935718910694 + 0.07299722865446584);
   const double t238 = (1.0 / (t237));
-  const double t239 = (x[8] - u[6]);
+  const double t239 = (x[8] - 2e+05);
   const double t240 = (t239 * t239);
-  const double t241 = (4e+10 + t240);
-  const double t242 = pow(t241, (-0.25));
-  const double t243 = (x[8] - 2e+05);
-  const double t244 = (t243 * t243);
-  const double t245 = (t244 + 1e+10);
-  const double t246 = (4e+10 + t244);
+  const double t241 = (t240 + 1e+10);
+  const double t242 = (-x[8] + u[6]);
+  const double t243 = (t242 * t242);
+  const double t244 = (4e+10 + t243);
+  const double t245 = pow(t244, (-0.25));
+  const double t246 = (4e+10 + t240);
   const double t247 = pow(t246, (-0.25));
   const double t248 = (-2.8e+07 + x[8]);
   const double t249 = ((t248 * t248) + 1e+10);
   const double t250 = 2.0 * x[8];
   const double t251 = (-4e+05 + t250);
-  const double t252 = (0.07132964021557801 - 0.023561944901923454 * t29);
-  const double t253 = (1.0 / (t252));
-  const double t254 = (1.0 / (t252 * t252));
-  const double t255 = (x[9] - 2e+05);
-  const double t256 = (t255 * t255);
-  const double t257 = (1e+10 + t256);
-  const double t258 = (4e+10 + t256);
-  const double t259 = pow(t258, (-0.25));
-  const double t260 = (-2.8e+07 + x[9]);
-  const double t261 = ((t260 * t260) + 1e+10);
-  const double t262 = (-x[9] + u[7]);
-  const double t263 = (t262 * t262);
-  const double t264 = (t263 + 4e+10);
-  const double t265 = pow(t264, (-0.25));
-  const double t266 =
-      (t28 * 0.023561944901923454 * x[2] * t66 + sqrt(t257) * 2.5e-09 - x[9] * 5e-09 -
-       t215 * 2.0412414523193154e-06 * t259 * t255 + 0.07050000000000001 - 2.5e-09 * sqrt(t261) -
-       t262 * t223 * t265 * 2.0412414523193154e-06 + t28 * t53 * 0.023561944901923454 * x[3]);
+  const double t252 = (0.07132964021557801 - 0.023561944901923454 * t55);
+  const double t253 = (1.0 / (t252 * t252));
+  const double t254 = (x[9] - 2e+05);
+  const double t255 = (t254 * t254);
+  const double t256 = (1e+10 + t255);
+  const double t257 = (4e+10 + t255);
+  const double t258 = pow(t257, (-0.25));
+  const double t259 = (-u[7] + x[9]);
+  const double t260 = (t259 * t259);
+  const double t261 = (t260 + 4e+10);
+  const double t262 = pow(t261, (-0.25));
+  const double t263 = (-2.8e+07 + x[9]);
+  const double t264 = ((t263 * t263) + 1e+10);
+  const double t265 =
+      (sqrt(t256) * 2.5e-09 - x[9] * 5e-09 - t218 * 2.0412414523193154e-06 * t258 * t254 +
+       t86 * 0.023561944901923454 * x[2] * t87 + 0.07050000000000001 -
+       t262 * t226 * 2.0412414523193154e-06 * t259 - 2.5e-09 * sqrt(t264) +
+       0.023561944901923454 * x[3] * t99 * t87);
+  const double t266 = (1.0 / (t252));
   const double t267 = 2.0 * x[9];
   const double t268 = (-4e+05 + t267);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[20] =
-      (((-t28 * t74 * t89 - 2.0 * t95 * t110 * t111 - t112 * 50994.579999999994 * t113 -
-         t114 * t118 * 30400.614999999998 - 50994.579999999994 * t114 * t119 - t28 * t141 * t66 +
-         2.0 * u[4] * ((-t145 * t113 * 9.80665 - t114 * t148 * 9.80665)) +
-         t108 * t109 * 2.0 *
-             ((-t108 * 4e+08 * t109 - t108 * t109 * 2e+08 * t104 * t97 +
-               t108 * t109 * 2e+08 * t103 * t100 +
+      (-((t2 * 5200.0 * t3 + t10 * 3100.0 * t14 + 2.0 * ((t17 * t20 + t24 * t17)) * u[4] +
+          3100.0 * t14 * t27 + t28 * t2 * 5200.0)) *
+           t30 * t123 * 0.5 -
+       ((t2 * 50994.579999999994 * t31 + 2.0 * t124 * t121 * t125 -
+         2.0 * u[4] * ((-t17 * t31 * 9.80665 - t122 * t20 * 9.80665)) + t101 * t87 * t140 -
+         t108 * t110 * 2.0 *
+             ((-t108 * 4e+08 * t110 - t108 * t110 * 2e+08 * t119 * t112 +
+               t108 * t110 * 2e+08 * t118 * t115 +
                t108 *
-                   ((t108 * t109 * t103 - t108 * t109 * t101 * pow(t102, (-1.5)) +
-                     t108 * pow(t99, (-1.5)) * t109 * t98 - t108 * t109 * t104)) *
-                   t109 * 2e+06 * x[2] -
-               t105 * t109 * 2e+06 * t149 * x[2] + t105 * 2e+06 * t95 * x[2] * t111)) +
-         t109 * 2.0 * t149 * t110 - t152 * t113 * 30400.614999999998 + t137 * t74 * t138)) *
-           0.5 * t162 -
-       ((t112 * 5200.0 * t119 + t118 * 3100.0 * t152 + 2.0 * ((t145 * t148 + t157 * t145)) * u[4] +
-         3100.0 * t152 * t160 + t153 * t112 * 5200.0)) *
-           t163 * 0.5 * t164);
-  jacobian[21] = (-((((t157 * t165 + t145 * t166)) * 2.0 * u[4] + 3100.0 * t152 * t167 +
-                     3100.0 * t160 * t168)) *
-                      t163 * 0.5 * t164 +
-                  ((t169 + t170 + t171 - t28 * t74 * t174 + t175 - t28 * t66 * t184)) * 0.5 * t162);
-  jacobian[22] = ((-t185 * 2e+06 * t73 * t138 - 4000.0 - t105 * 4e+06 * t111 / (t94))) * 0.5 * t162;
-  jacobian[23] = t185 * t53 * (-1e+06) * t73 * t162 * t66;
-  jacobian[26] = t108 * t109 * 0.04021238596594936 * t162;
-  jacobian[27] = t28 * 0.031415926535897934 * t162 * t66;
-  jacobian[28] = t108 * (-0.027488935718910694) * t109 * t162;
-  jacobian[29] = t28 * (-0.023561944901923454) * t162 * t66;
+                   ((t108 * t110 * t118 - t108 * t110 * t116 * pow(t117, (-1.5)) +
+                     t108 * pow(t114, (-1.5)) * t110 * t113 - t108 * t110 * t119)) *
+                   t110 * 2e+06 * x[2] -
+               t120 * t110 * 2e+06 * t141 * x[2] + t120 * 2e+06 * t124 * x[2] * t125)) +
+         50994.579999999994 * t122 * t3 - t101 * t142 * t143 - t110 * 2.0 * t141 * t121 +
+         t122 * t10 * 30400.614999999998 + t86 * t87 * t163 + t14 * t31 * 30400.614999999998)) *
+           0.5 * t164);
+  jacobian[21] =
+      (-((((t24 * t165 + t17 * t166)) * 2.0 * u[4] + 3100.0 * t14 * t167 + 3100.0 * t27 * t168)) *
+           t30 * t123 * 0.5 -
+       0.5 * t164 * ((t86 * t180 * t87 + t181 + t182 + t101 * t179 * t87 + t183 + t184)));
+  jacobian[22] = ((-4000.0 - t120 * 4e+06 * t125 / (t109)-t64 * 2e+06 * t185 * t143)) * 0.5 * t164;
+  jacobian[23] = t64 * t86 * (-1e+06) * t99 * t185 * t164;
+  jacobian[26] = t108 * t110 * 0.04021238596594936 * t164;
+  jacobian[27] = 0.031415926535897934 * t86 * t164 * t87;
+  jacobian[28] = t108 * (-0.027488935718910694) * t110 * t164;
+  jacobian[29] = t86 * (-0.023561944901923454) * t164 * t87;
   jacobian[30] =
-      (t189 + ((-t28 * t136 * t74 + t169 + t170 + t171 + t175 - t28 * t53 * t141)) * t190 * 0.5);
+      (t189 - t190 * 0.5 * ((t99 * t87 * t163 + t181 + t182 + t183 + t101 * t162 * t87 + t184)));
   jacobian[31] =
-      (t189 + ((t169 - t28 * t53 * t184 + t170 + t137 * t176 * t74 - t28 * t74 * t183 + t175)) *
-                  t190 * 0.5);
-  jacobian[32] = t185 * t53 * (-1e+06) * t190 * t73 * t66;
-  jacobian[33] = ((1600.0 + t185 * t176 * 2e+06 * t73)) * t190 * (-0.5);
-  jacobian[37] = t28 * 0.031415926535897934 * t53 * t190;
-  jacobian[39] = t28 * t53 * (-0.023561944901923454) * t190;
+      (-t190 * 0.5 *
+           ((t181 + t182 + t180 * t99 * t87 - t101 * t177 * t142 + t101 * t176 * t87 + t184)) +
+       t189);
+  jacobian[32] = t64 * t86 * (-1e+06) * t190 * t99 * t185;
+  jacobian[33] = ((1600.0 + t64 * 2e+06 * t177 * t185)) * t190 * (-0.5);
+  jacobian[37] = 0.031415926535897934 * t190 * t99 * t87;
+  jacobian[39] = (-0.023561944901923454) * t190 * t99 * t87;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
       (1.2e+09 * t192 *
-           ((t95 * x[2] * 0.04021238596594936 * t111 - t109 * t149 * x[2] * 0.04021238596594936)) -
-       t108 * t109 *
+           ((t124 * x[2] * 0.04021238596594936 * t125 - t110 * t141 * x[2] * 0.04021238596594936)) -
+       t108 * t110 *
            ((-3.3333333333333334e-09 * sqrt(t194) + 0.094 - 6.666666666666667e-09 * x[6] -
-             t108 * t109 * x[2] * 0.04021238596594936 - t197 * 2.721655269759087e-06 * t201 * t198 +
-             3.3333333333333334e-09 * sqrt(t204) + t205 * t207 * 2.721655269759087e-06 * t202)) *
+             t108 * t110 * x[2] * 0.04021238596594936 - t197 * 2.721655269759087e-06 * t201 * t198 +
+             3.3333333333333334e-09 * sqrt(t204) - t205 * t207 * 2.721655269759087e-06 * t202)) *
            48254863.15913923 / (t191 * t191));
-  jacobian[62] = t108 * (-48254863.15913923) * t192 * t109;
+  jacobian[62] = t108 * (-48254863.15913923) * t192 * t110;
   jacobian[64] =
       ((-2.721655269759087e-06 * t201 * t198 * t209 - t210 * t207 * 2.721655269759087e-06 * t202)) *
       1.2e+09 * t192;
   jacobian[66] = 1.2e+09 * t192 *
-                 ((-t197 * 2.721655269759087e-06 * t201 -
+                 ((-t205 * t207 * 2.721655269759087e-06 - t197 * 2.721655269759087e-06 * t201 +
                    t212 * pow(t206, (-1.25)) * t205 * t202 * 6.804138174397718e-07 +
                    t212 * 1.6666666666666667e-09 * (1.0 / sqrt(t204)) - 6.666666666666667e-09 -
                    1.6666666666666667e-09 * ((-5.6e+07 + t211)) * (1.0 / sqrt(t194)) +
-                   t205 * t207 * 2.721655269759087e-06 +
                    pow(t200, (-1.25)) * 1.3608276348795436e-06 * t199 * t197));
   jacobian[70] =
-      (-t28 * t228 * 37699111.84307752 * t66 * t230 +
-       ((t137 * 0.031415926535897934 * x[2] * t138 - t28 * 0.031415926535897934 * t89 * x[2] -
-         t28 * 0.031415926535897934 * t136 * x[3] +
-         t137 * 0.031415926535897934 * t53 * x[3] * t66)) *
-           t231 * 1.2e+09);
-  jacobian[71] = (-t28 * t53 * t228 * 37699111.84307752 * t230 +
-                  t231 * 1.2e+09 *
-                      ((-t28 * 0.031415926535897934 * x[3] * t183 +
-                        t137 * 0.031415926535897934 * t53 * x[2] * t66 +
-                        t137 * 0.031415926535897934 * t176 * x[3] -
-                        t28 * 0.031415926535897934 * x[2] * t174)));
-  jacobian[72] = t28 * (-37699111.84307752) * t231 * t66;
-  jacobian[73] = t28 * t53 * (-37699111.84307752) * t231;
-  jacobian[75] = t231 * 1.2e+09 *
-                 ((-2.0412414523193154e-06 * t233 * t220 * t225 -
-                   t234 * t219 * 2.0412414523193154e-06 * t216));
-  jacobian[77] = t231 * 1.2e+09 *
-                 ((-t215 * t219 * 2.0412414523193154e-06 -
-                   t236 * 5.103103630798288e-07 * pow(t224, (-1.25)) * t223 * t220 +
-                   (1.0 / sqrt(t222)) * t236 * 1.25e-09 + t223 * 2.0412414523193154e-06 * t225 +
-                   pow(t218, (-1.25)) * t215 * t217 * 1.0206207261596577e-06 -
-                   (1.0 / sqrt(t227)) * 1.25e-09 * ((-5.6e+07 + t235)) - 5e-09));
+      (t214 * 1.2e+09 *
+           ((-0.031415926535897934 * x[3] * t162 * t87 - 0.031415926535897934 * x[2] * t87 * t140 +
+             0.031415926535897934 * x[2] * t142 * t143 +
+             0.031415926535897934 * t86 * x[3] * t99 * t142)) -
+       t215 * t231 * t86 * 37699111.84307752 * t87);
+  jacobian[71] =
+      (t214 * 1.2e+09 *
+           ((-0.031415926535897934 * t176 * x[3] * t87 + 0.031415926535897934 * t177 * x[3] * t142 +
+             0.031415926535897934 * t86 * x[2] * t99 * t142 -
+             0.031415926535897934 * t179 * x[2] * t87)) -
+       t215 * t231 * 37699111.84307752 * t99 * t87);
+  jacobian[72] = (-37699111.84307752) * t214 * t86 * t87;
+  jacobian[73] = (-37699111.84307752) * t214 * t99 * t87;
+  jacobian[75] = t214 * 1.2e+09 *
+                 ((-2.0412414523193154e-06 * t233 * t223 * t228 -
+                   t234 * t222 * 2.0412414523193154e-06 * t219));
+  jacobian[77] = ((-t218 * t222 * 2.0412414523193154e-06 +
+                   t236 * 5.103103630798288e-07 * pow(t227, (-1.25)) * t226 * t223 -
+                   t226 * 2.0412414523193154e-06 * t228 + (1.0 / sqrt(t225)) * t236 * 1.25e-09 +
+                   pow(t221, (-1.25)) * t218 * t220 * 1.0206207261596577e-06 -
+                   (1.0 / sqrt(t230)) * 1.25e-09 * ((-5.6e+07 + t235)) - 5e-09)) *
+                 t214 * 1.2e+09;
   jacobian[80] =
       (1.2e+09 * t238 *
-           ((-t95 * x[2] * t111 * 0.027488935718910694 +
-             t109 * t149 * x[2] * 0.027488935718910694)) +
-       t108 *
-           ((t205 * t242 * 2.721655269759087e-06 * t239 + 0.094 - 6.666666666666667e-09 * x[8] +
-             3.3333333333333334e-09 * sqrt(t245) + t108 * t109 * x[2] * 0.027488935718910694 -
-             t247 * t197 * 2.721655269759087e-06 * t243 - 3.3333333333333334e-09 * sqrt(t249))) *
-           t109 * 32986722.862692833 / (t237 * t237));
-  jacobian[82] = t108 * t109 * 32986722.862692833 * t238;
+           ((-t124 * x[2] * t125 * 0.027488935718910694 +
+             t110 * t141 * x[2] * 0.027488935718910694)) +
+       t108 * t110 * 32986722.862692833 *
+           ((0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt(t241) +
+             t108 * t110 * x[2] * 0.027488935718910694 +
+             t242 * t205 * 2.721655269759087e-06 * t245 -
+             t247 * t197 * 2.721655269759087e-06 * t239 - 3.3333333333333334e-09 * sqrt(t249))) /
+           (t237 * t237));
+  jacobian[82] = t108 * t110 * 32986722.862692833 * t238;
   jacobian[84] =
       1.2e+09 *
-      ((-t247 * 2.721655269759087e-06 * t209 * t243 - t242 * t210 * 2.721655269759087e-06 * t239)) *
+      ((-t247 * 2.721655269759087e-06 * t209 * t239 + t242 * t210 * 2.721655269759087e-06 * t245)) *
       t238;
-  jacobian[88] =
-      1.2e+09 * t238 *
-      ((-1.3608276348795436e-06 * t205 * t240 * pow(t241, (-1.25)) -
-        1.6666666666666667e-09 * (1.0 / sqrt(t249)) * ((-5.6e+07 + t250)) -
-        t247 * t197 * 2.721655269759087e-06 + t251 * 1.6666666666666667e-09 * (1.0 / sqrt(t245)) +
-        t205 * t242 * 2.721655269759087e-06 - 6.666666666666667e-09 +
-        t251 * t197 * t243 * pow(t246, (-1.25)) * 6.804138174397718e-07));
-  jacobian[90] =
-      (((-t137 * t53 * 0.023561944901923454 * x[3] * t66 -
-         t137 * 0.023561944901923454 * x[2] * t138 + t28 * 0.023561944901923454 * t89 * x[2] +
-         t28 * 0.023561944901923454 * t136 * x[3])) *
-           t253 * 1.2e+09 +
-       t28 * 28274333.882308144 * t254 * t66 * t266);
+  jacobian[88] = ((-1.6666666666666667e-09 * (1.0 / sqrt(t249)) * ((-5.6e+07 + t250)) -
+                   t247 * t197 * 2.721655269759087e-06 - t205 * 2.721655269759087e-06 * t245 +
+                   1.3608276348795436e-06 * pow(t244, (-1.25)) * t205 * t243 +
+                   t251 * 1.6666666666666667e-09 * (1.0 / sqrt(t241)) - 6.666666666666667e-09 +
+                   t251 * t197 * t239 * pow(t246, (-1.25)) * 6.804138174397718e-07)) *
+                 1.2e+09 * t238;
+  jacobian[90] = (t86 * 28274333.882308144 * t253 * t265 * t87 +
+                  t266 * 1.2e+09 *
+                      ((0.023561944901923454 * x[2] * t87 * t140 -
+                        t86 * 0.023561944901923454 * x[3] * t99 * t142 +
+                        0.023561944901923454 * x[3] * t162 * t87 -
+                        0.023561944901923454 * x[2] * t142 * t143)));
   jacobian[91] =
-      (t28 * t53 * 28274333.882308144 * t254 * t266 +
-       t253 * 1.2e+09 *
-           ((-t137 * t53 * 0.023561944901923454 * x[2] * t66 +
-             t28 * 0.023561944901923454 * x[2] * t174 + t28 * 0.023561944901923454 * x[3] * t183 -
-             t137 * 0.023561944901923454 * t176 * x[3])));
-  jacobian[92] = t28 * t253 * 28274333.882308144 * t66;
-  jacobian[93] = t28 * t53 * t253 * 28274333.882308144;
-  jacobian[95] = ((-t234 * 2.0412414523193154e-06 * t259 * t255 +
-                   t262 * t265 * 2.0412414523193154e-06 * t233)) *
-                 t253 * 1.2e+09;
-  jacobian[99] =
-      ((t268 * t215 * 5.103103630798288e-07 * pow(t258, (-1.25)) * t255 -
-        t263 * pow(t264, (-1.25)) * t223 * 1.0206207261596577e-06 -
-        (1.0 / sqrt(t261)) * 1.25e-09 * ((-5.6e+07 + t267)) + t268 * (1.0 / sqrt(t257)) * 1.25e-09 +
-        t223 * t265 * 2.0412414523193154e-06 - t215 * 2.0412414523193154e-06 * t259 - 5e-09)) *
-      t253 * 1.2e+09;
+      (t266 * 1.2e+09 *
+           ((0.023561944901923454 * t179 * x[2] * t87 + t176 * 0.023561944901923454 * x[3] * t87 -
+             0.023561944901923454 * t177 * x[3] * t142 -
+             t86 * 0.023561944901923454 * x[2] * t99 * t142)) +
+       28274333.882308144 * t253 * t99 * t265 * t87);
+  jacobian[92] = t86 * t266 * 28274333.882308144 * t87;
+  jacobian[93] = t266 * 28274333.882308144 * t99 * t87;
+  jacobian[95] = t266 * 1.2e+09 *
+                 ((-t262 * 2.0412414523193154e-06 * t233 * t259 -
+                   t234 * 2.0412414523193154e-06 * t258 * t254));
+  jacobian[99] = t266 * 1.2e+09 *
+                 ((-t262 * t226 * 2.0412414523193154e-06 +
+                   t268 * t218 * 5.103103630798288e-07 * pow(t257, (-1.25)) * t254 -
+                   (1.0 / sqrt(t264)) * 1.25e-09 * ((-5.6e+07 + t267)) +
+                   t268 * (1.0 / sqrt(t256)) * 1.25e-09 - t218 * 2.0412414523193154e-06 * t258 +
+                   t260 * t226 * pow(t261, (-1.25)) * 1.0206207261596577e-06 - 5e-09));
 }
 
 namespace {

@@ -83,45 +83,46 @@ int InverseKinematics(const double* target, const double* params, double* q) {
   using std::pow;
   using std::sin;
   using std::sqrt;
-  const double t0 = (target[0] - 1.1);
-  const double t1 = (target[2] - 2.0);
+  const double t0 = (target[2] - 2.0);
+  const double t1 = (target[0] - 1.1);
   const double cos_elbow =
-      (((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) * 0.5 /
+      (-0.5) * ((-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1))) /
       (params[1] * params[0]);
   if (!(cos_elbow >= -1.0 && cos_elbow <= 1.0)) return 1;
   double branch[2][kNumJoints];
   {
     double* solution = branch[0];
-    const double t0 = (target[0] - 1.1);
-    const double t1 = (target[2] - 2.0);
-    const double t2 = ((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]));
+    const double t0 = (target[2] - 2.0);
+    const double t1 = (target[0] - 1.1);
+    const double t2 = (-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1));
     const double t3 = (1.0 / (params[0]));
     solution[0] =
-        (-atan2(sqrt((-0.25 * (t2 * t2) / (params[0] * params[0] * params[1] * params[1]) + 1.0)) *
+        (-atan2(sqrt((1.0 - (t2 * t2) * 0.25 / (params[0] * params[0] * params[1] * params[1]))) *
                     params[1],
-                (t2 * t3 * 0.5 + params[0])) +
-         atan2(t1, t0));
-    solution[1] = acos(t2 * t3 * 0.5 / (params[1]));
+                (params[0] - t3 * 0.5 * t2)) +
+         atan2(t0, t1));
+    solution[1] = acos(t3 * (-0.5) * t2 / (params[1]));
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
   }
   {
     double* solution = branch[1];
-    const double t0 = (target[0] - 1.1);
-    const double t1 = (target[2] - 2.0);
+    const double t0 = (target[2] - 2.0);
+    const double t1 = (target[0] - 1.1);
     solution[0] =
-        (-atan2(
-             sin(acos(
-                     (((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) *
-                     0.5 / (params[1] * params[0])) *
-                 (-1.0)) *
-                 params[1],
-             (params[0] + params[1] * cos(acos((((t0 * t0) + (t1 * t1) - (params[0] * params[0]) -
-                                                 (params[1] * params[1]))) *
-                                               0.5 / (params[1] * params[0])) *
-                                          (-1.0)))) +
-         atan2(t1, t0));
+        (-atan2(params[1] * sin(acos((-0.5) *
+                                     ((-(t0 * t0) + (params[0] * params[0]) +
+                                       (params[1] * params[1]) - (t1 * t1))) /
+                                     (params[1] * params[0])) *
+                                (-1.0)),
+                (params[0] + params[1] * cos(acos((-0.5) *
+                                                  ((-(t0 * t0) + (params[0] * params[0]) +
+                                                    (params[1] * params[1]) - (t1 * t1))) /
+                                                  (params[1] * params[0])) *
+                                             (-1.0)))) +
+         atan2(t0, t1));
     solution[1] =
-        acos((((t0 * t0) + (t1 * t1) - (params[0] * params[0]) - (params[1] * params[1]))) * 0.5 /
+        acos((-0.5) *
+             ((-(t0 * t0) + (params[0] * params[0]) + (params[1] * params[1]) - (t1 * t1))) /
              (params[1] * params[0])) *
         (-1.0);
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
@@ -218,32 +219,34 @@ double LeverArm(int actuator, const double* q) {
       const double t15 = (1.0 / (t11));
       const double t16 = (-t14 * t15 * 0.25 + 0.567009);
       const double t17 = sqrt(t16);
-      const double t18 = (t12 * t7 * t13 - t17 * 2.0 * t9);
-      const double t19 = (t17 * t7 * 2.0 + t12 * t13 * t9);
-      const double t20 = (1.0 / ((((t18 * t18) * t15 + (t19 * t19) * t15))));
-      const double t21 = (-0.389 * t4 - 0.159 * t1);
-      const double t22 = (t2 + t5);
-      const double t23 = (t21 * t7 + t9 * t22);
-      const double t24 = pow(t11, (-1.5));
-      const double t25 = (1.0 / sqrt(t16));
-      const double t26 = (t23 * t13 * 2.0 * t15 - t23 * t14 / (t11 * t11));
-      const double t27 =
-          (t12 * t18 * t20 *
-               ((t12 * ((-t17 * t21 * 4.0 - t23 * t12 * 4.0 * t9 - t12 * t13 * 2.0 * t22 +
-                         t23 * t13 * 2.0 * t24 * t9 + t7 * t25 * t26)) +
-                 t23 * 2.0 * t24 * t19)) +
-           ((-t23 * t18 * 2.0 * t24 +
-             t12 * ((t23 * t12 * t7 * 4.0 + t21 * t12 * t13 * 2.0 - t17 * 4.0 * t22 +
-                     t9 * t25 * t26 - t23 * t7 * t13 * 2.0 * t24)))) *
-               t12 * t20 * t19);
-      const double t28 = atan2(t12 * 0.5 * t19, t12 * t18 * 0.5);
-      const double t29 = cos(t28);
-      const double t30 = sin(t28);
-      const double t31 = (-0.853 * t29 + t3 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t30);
-      const double t32 = (-t3 * 0.15500000000000003 - 0.141 * t29 - 0.853 * t30 + 2.093 * t6);
-      const double lever = ((((-t27 * 0.0705 * t29 - t27 * 0.4265 * t30)) * t31 +
-                             t32 * ((t27 * 0.4265 * t29 - t27 * 0.0705 * t30)))) *
-                           (1.0 / sqrt(((t31 * t31) + (t32 * t32))));
+      const double t18 = (t17 * t7 * 2.0 + t12 * t13 * t9);
+      const double t19 = (t12 * t7 * t13 - t17 * 2.0 * t9);
+      const double t20 = atan2(t12 * 0.5 * t18, t12 * t19 * 0.5);
+      const double t21 = cos(t20);
+      const double t22 = sin(t20);
+      const double t23 = (-0.853 * t21 + t3 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
+      const double t24 = (-t3 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
+      const double t25 = (-0.389 * t4 - 0.159 * t1);
+      const double t26 = (t2 + t5);
+      const double t27 = (t25 * t7 + t9 * t26);
+      const double t28 = (t27 * t14 / (t11 * t11) - t27 * t13 * 2.0 * t15);
+      const double t29 = (1.0 / sqrt(t16));
+      const double t30 = pow(t11, (-1.5));
+      const double t31 = (1.0 / ((((t19 * t19) * t15 + (t18 * t18) * t15))));
+      const double t32 =
+          (-t12 * t19 *
+               ((t12 * ((-t17 * t25 * 4.0 - t27 * t12 * 4.0 * t9 - t12 * t13 * 2.0 * t26 -
+                         t7 * t28 * t29 + t27 * t13 * 2.0 * t30 * t9)) +
+                 t27 * 2.0 * t30 * t18)) *
+               t31 +
+           t12 *
+               ((t27 * t19 * 2.0 * t30 +
+                 t12 * ((-t25 * t12 * t13 * 2.0 + t17 * 4.0 * t26 + t27 * t7 * t13 * 2.0 * t30 -
+                         t27 * t12 * t7 * 4.0 + t28 * t9 * t29)))) *
+               t31 * t18);
+      const double lever = (1.0 / sqrt(((t23 * t23) + (t24 * t24)))) *
+                           ((t24 * ((0.0705 * t32 * t22 - t32 * 0.4265 * t21)) +
+                             ((0.0705 * t32 * t21 + t32 * 0.4265 * t22)) * t23));
       return lever;
     }
     default:
@@ -290,86 +293,86 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t1 = cos(x[0]);
   const double t2 = (-t0 * 0.1 + 1.55 * t1);
   const double t3 = cos(u[5]);
-  const double t4 = 3.11 * t1;
-  const double t5 = (x[0] + x[1]);
-  const double t6 = sin(t5);
-  const double t7 = t6 * (-0.25);
-  const double t8 = cos(t5);
-  const double t9 = 0.55 * t8;
-  const double t10 = (t4 + t7 + t9);
-  const double t11 = (0.389 * t8 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
-  const double t12 = 0.159 * t8;
-  const double t13 = t6 * (-0.389);
-  const double t14 = (0.365 * t0 + t12 + t13 + t1 * 0.5249999999999999);
-  const double t15 = (t14 * t14);
-  const double t16 = (t11 * t11);
-  const double t17 = (t15 + t16 - 0.38752);
-  const double t18 = (t15 + t16);
-  const double t19 = (1.0 / sqrt(t18));
-  const double t20 = (t17 * t17);
-  const double t21 = (1.0 / (t18));
-  const double t22 = (0.567009 - 0.25 * t20 * t21);
-  const double t23 = sqrt(t22);
-  const double t24 = (t11 * t17 * t19 + 2.0 * t14 * t23);
-  const double t25 = (-t11 * 2.0 * t23 + t17 * t14 * t19);
-  const double t26 = atan2(0.5 * t24 * t19, t25 * 0.5 * t19);
-  const double t27 = cos(t26);
-  const double t28 = sin(t26);
-  const double t29 = (-0.15500000000000003 * t1 - 0.141 * t27 + t0 * 2.093 - t28 * 0.853);
-  const double t30 = t0 * 0.15500000000000003;
-  const double t31 = 2.093 * t1;
-  const double t32 = (0.141 * t28 + t30 - 0.853 * t27 + t31);
-  const double t33 = ((t29 * t29) + (t32 * t32));
-  const double t34 = (1.0 / sqrt(t33));
-  const double t35 = sqrt(t33);
-  const double t36 = (-1.59 + t35);
-  const double t37 = ((t36 * t36) + 1e-06);
-  const double t38 = (t35 - 2.9000000000000004);
-  const double t39 = ((t38 * t38) + 1e-06);
-  const double t40 = (t12 + t13);
-  const double t41 = (-0.389) * t8;
-  const double t42 = t6 * (-0.159);
-  const double t43 = (t41 + t42);
-  const double t44 = (t40 * t11 + t43 * t14);
-  const double t45 = (1.0 / (t18 * t18));
-  const double t46 = (-2.0 * t17 * t21 * t44 + t45 * t20 * t44);
-  const double t47 = (1.0 / sqrt(t22));
-  const double t48 = pow(t18, (-1.5));
-  const double t49 = (1.0 / ((((t24 * t24) * t21 + (t25 * t25) * t21))));
-  const double t50 = (((-((-t11 * t46 * t47 - 2.0 * t17 * t14 * t48 * t44 + 2.0 * t17 * t43 * t19 +
-                           4.0 * t14 * t44 * t19 - t40 * 4.0 * t23)) *
-                            t19 +
-                        t25 * 2.0 * t48 * t44)) *
-                          t24 * t49 * t19 -
-                      t25 *
-                          ((-((-t11 * 2.0 * t17 * t48 * t44 + t46 * t47 * t14 +
-                               t40 * 2.0 * t17 * t19 + t11 * 4.0 * t44 * t19 + 4.0 * t43 * t23)) *
-                                t19 +
-                            2.0 * t24 * t48 * t44)) *
-                          t49 * t19);
-  const double t51 = (t29 * ((0.0705 * t50 * t28 - t50 * 0.4265 * t27)) +
-                      ((t50 * t28 * 0.4265 + 0.0705 * t50 * t27)) * t32);
-  const double t52 = (t41 - t0 * 0.5249999999999999 + 0.365 * t1 + t42);
-  const double t53 = (t52 * t14 + t11 * t14);
-  const double t54 = (-2.0 * t17 * t53 * t21 + t45 * t53 * t20);
-  const double t55 =
-      (((2.0 * t53 * t24 * t48 + ((-t47 * t54 * t14 - t52 * 4.0 * t23 - t11 * 4.0 * t53 * t19 +
-                                   t11 * 2.0 * t17 * t53 * t48 - 2.0 * t17 * t14 * t19)) *
-                                     t19)) *
-           t25 * t49 * t19 -
-       ((((2.0 * t17 * t14 * t53 * t48 + t11 * t47 * t54 - 4.0 * t14 * t53 * t19 + 4.0 * t14 * t23 -
-           t52 * 2.0 * t17 * t19)) *
-             t19 +
-         t25 * 2.0 * t53 * t48)) *
-           t24 * t49 * t19);
-  const double t56 =
-      (t29 * ((t30 + 0.4265 * t27 * t55 - 0.0705 * t28 * t55 + t31)) +
-       ((-t28 * 0.4265 * t55 - t0 * 2.093 + 0.15500000000000003 * t1 - 0.0705 * t27 * t55)) * t32);
-  const double t57 =
-      (-sqrt(t37) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + sqrt(t39) * 2e+08 +
-       ((t34 * 2e+06 * t51 * x[3] + t34 * 2e+06 * x[2] * t56)) *
-           ((2.0 + t38 * (1.0 / sqrt(t39)) - t36 * (1.0 / sqrt(t37)))) +
-       0.04712388980384691 * x[9] + 4e+08 * t35);
+  const double t4 = (x[0] + x[1]);
+  const double t5 = cos(t4);
+  const double t6 = sin(t4);
+  const double t7 = (0.389 * t5 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
+  const double t8 = 0.159 * t5;
+  const double t9 = t6 * (-0.389);
+  const double t10 = (0.365 * t0 + t8 + t9 + t1 * 0.5249999999999999);
+  const double t11 = (t10 * t10);
+  const double t12 = (t7 * t7);
+  const double t13 = (t11 + t12 - 0.38752);
+  const double t14 = (t11 + t12);
+  const double t15 = (1.0 / sqrt(t14));
+  const double t16 = (t13 * t13);
+  const double t17 = (1.0 / (t14));
+  const double t18 = (0.567009 - 0.25 * t16 * t17);
+  const double t19 = sqrt(t18);
+  const double t20 = (t7 * t13 * t15 + 2.0 * t10 * t19);
+  const double t21 = (t7 * 2.0 * t19 - t13 * t10 * t15);
+  const double t22 = atan2(0.5 * t20 * t15, t21 * (-0.5) * t15);
+  const double t23 = cos(t22);
+  const double t24 = sin(t22);
+  const double t25 = (-0.141 * t23 - t24 * 0.853 - 0.15500000000000003 * t1 + t0 * 2.093);
+  const double t26 = t0 * 0.15500000000000003;
+  const double t27 = 2.093 * t1;
+  const double t28 = (t26 + t24 * 0.141 - 0.853 * t23 + t27);
+  const double t29 = ((t25 * t25) + (t28 * t28));
+  const double t30 = sqrt(t29);
+  const double t31 = (-2.9000000000000004 + t30);
+  const double t32 = ((t31 * t31) + 1e-06);
+  const double t33 = (-1.59 + t30);
+  const double t34 = (1e-06 + (t33 * t33));
+  const double t35 = (1.0 / ((((t21 * t21) * t17 + (t20 * t20) * t17))));
+  const double t36 = (-0.389) * t5;
+  const double t37 = t6 * (-0.159);
+  const double t38 = (t36 - t0 * 0.5249999999999999 + 0.365 * t1 + t37);
+  const double t39 = (t38 * t10 + t7 * t10);
+  const double t40 = (1.0 / sqrt(t18));
+  const double t41 = (1.0 / (t14 * t14));
+  const double t42 = (-2.0 * t13 * t39 * t17 + t41 * t39 * t16);
+  const double t43 = pow(t14, (-1.5));
+  const double t44 =
+      (t35 *
+           ((((t38 * 2.0 * t13 * t15 - 4.0 * t10 * t19 + 4.0 * t10 * t39 * t15 - t7 * t40 * t42 -
+               2.0 * t13 * t10 * t39 * t43)) *
+                 t15 +
+             2.0 * t21 * t39 * t43)) *
+           t20 * t15 -
+       ((2.0 * t39 * t20 * t43 - ((t38 * 4.0 * t19 + t40 * t42 * t10 - t7 * 2.0 * t13 * t39 * t43 +
+                                   t7 * 4.0 * t39 * t15 + 2.0 * t13 * t10 * t15)) *
+                                     t15)) *
+           t35 * t21 * t15);
+  const double t45 =
+      (t25 * ((t26 - t24 * 0.0705 * t44 + 0.4265 * t23 * t44 + t27)) +
+       ((-0.0705 * t23 * t44 - t24 * 0.4265 * t44 - t0 * 2.093 + 0.15500000000000003 * t1)) * t28);
+  const double t46 = (1.0 / sqrt(t29));
+  const double t47 = (t8 + t9);
+  const double t48 = (t36 + t37);
+  const double t49 = (t47 * t7 + t48 * t10);
+  const double t50 = (-2.0 * t13 * t17 * t49 + t41 * t16 * t49);
+  const double t51 = (t35 *
+                          ((((-t7 * t50 * t40 - 2.0 * t13 * t10 * t43 * t49 +
+                              2.0 * t13 * t48 * t15 + 4.0 * t10 * t49 * t15 - t47 * 4.0 * t19)) *
+                                t15 +
+                            2.0 * t21 * t43 * t49)) *
+                          t20 * t15 +
+                      ((((-t7 * 2.0 * t13 * t43 * t49 + t50 * t40 * t10 + t47 * 2.0 * t13 * t15 +
+                          t7 * 4.0 * t49 * t15 + 4.0 * t48 * t19)) *
+                            t15 -
+                        2.0 * t20 * t43 * t49)) *
+                          t35 * t21 * t15);
+  const double t52 = (((-0.0705 * t23 * t51 - t24 * 0.4265 * t51)) * t28 +
+                      t25 * ((-t24 * 0.0705 * t51 + 0.4265 * t23 * t51)));
+  const double t53 = (sqrt(t32) * 2e+08 - sqrt(t34) * 2e+08 - 8.98e+08 -
+                      0.06283185307179587 * x[7] + 4e+08 * t30 + 0.04712388980384691 * x[9] +
+                      ((-t33 * (1.0 / sqrt(t34)) + (1.0 / sqrt(t32)) * t31 + 2.0)) *
+                          ((t45 * 2e+06 * x[2] * t46 + 2e+06 * x[3] * t52 * t46)));
+  const double t54 = 3.11 * t1;
+  const double t55 = t6 * (-0.25);
+  const double t56 = 0.55 * t5;
+  const double t57 = (t54 + t55 + t56);
   const double t58 = (0.194 * t1 + 1.595 + t0 * 0.857);
   const double t59 = (-0.194) * t0;
   const double t60 = 0.857 * t1;
@@ -385,18 +388,18 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t70 = (-1.55 * t0 - 0.1 * t1);
   const double t71 = sin(u[5]);
   const double t72 = t6 * (-0.4011545671438309);
-  const double t73 = (-0.16343387866394005) * t8;
+  const double t73 = (-0.16343387866394005) * t5;
   const double t74 = t0 * (-3.11);
   const double t75 = (t72 + t73 + t74);
   const double t76 = t6 * (-0.16343387866394005);
-  const double t77 = 0.4011545671438309 * t8;
-  const double t78 = (t76 + t4 + t77);
+  const double t77 = 0.4011545671438309 * t5;
+  const double t78 = (t76 + t54 + t77);
   const double t79 = t6 * (-0.55);
-  const double t80 = (-0.25) * t8;
+  const double t80 = (-0.25) * t5;
   const double t81 = (t79 + t80 + t74);
   const double t82 = (t76 + t77);
   const double t83 = (t72 + t73);
-  const double t84 = (t7 + t9);
+  const double t84 = (t55 + t56);
   const double t85 = (t79 + t80);
   const double t86 = (-2.8e+07 + x[6]);
   const double t87 = sqrt(((x[4] * x[4]) + 1e-06));
@@ -404,7 +407,7 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t89 = (x[6] - u[6]);
   const double t90 = (x[6] - 2e+05);
   const double t91 = (t90 * t90);
-  const double t92 = (-t87 + x[4]);
+  const double t92 = (-x[4] + t87);
   const double t93 = sqrt(((x[5] * x[5]) + 1e-06));
   const double t94 = (t93 + x[5]);
   const double t95 = (x[7] - u[7]);
@@ -418,12 +421,12 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t103 = (-2.8e+07 + x[8]);
   const double t104 = (x[9] - 2e+05);
   const double t105 = (t104 * t104);
-  const double t106 = (-x[9] + u[7]);
+  const double t106 = (-u[7] + x[9]);
   const double t107 = (-2.8e+07 + x[9]);
   xdot[0] = x[2];
   xdot[1] = x[3];
-  xdot[2] = ((-t2 * 50994.579999999994 * t3 - t10 * t3 * 35303.939999999995 - x[2] * 4000.0 +
-              2.0 * u[2] - t34 * t57 * t56 +
+  xdot[2] = ((-t2 * 50994.579999999994 * t3 - t53 * t45 * t46 - t57 * t3 * 35303.939999999995 -
+              x[2] * 4000.0 + 2.0 * u[2] +
               t62 * t64 * 2.0 *
                   ((-2e+08 * sqrt(t67) - x[8] * 0.03817035074111599 -
                     ((-(1.0 / sqrt(t69)) * t68 + 2.0 + (1.0 / sqrt(t67)) * t66)) * t62 * t64 *
@@ -434,10 +437,10 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
               t71 * t81 * 35303.939999999995)) *
             0.5 /
             (((2600.0 * (t2 * t2) + 1800.0 * (t81 * t81) + (((t78 * t78) + (t75 * t75))) * u[4] +
-               (t10 * t10) * 1800.0 + 2600.0 * (t70 * t70) + 2900.0)));
+               (t57 * t57) * 1800.0 + 2600.0 * (t70 * t70) + 2900.0)));
   xdot[3] = ((-2.0 * ((-t82 * t3 * 9.80665 - t71 * t83 * 9.80665)) * u[4] +
               t84 * t3 * 35303.939999999995 + t71 * t85 * 35303.939999999995 - 2.0 * u[3] +
-              1600.0 * x[3] + t34 * t51 * t57)) *
+              t53 * t52 * t46 + 1600.0 * x[3])) *
             (-0.5) /
             ((((t84 * t84) * 1800.0 + 600.0 + (((t83 * t83) + (t82 * t82))) * u[4] +
                (t85 * t85) * 1800.0)));
@@ -447,30 +450,29 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
             ((-3.3333333333333334e-09 * sqrt((1e+10 + (t86 * t86))) + 0.094 -
               6.666666666666667e-09 * x[6] - t62 * t64 * 0.05089380098815465 * x[2] -
               t88 * 2.721655269759087e-06 * pow((4e+10 + (t89 * t89)), (-0.25)) * t89 +
-              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) +
+              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) -
               t92 * pow((4e+10 + t91), (-0.25)) * 2.721655269759087e-06 * t90)) /
             (((t65 * 0.05089380098815465 - 0.06725132138341651)));
-  xdot[7] = 1.2e+09 *
-            ((-t94 * pow((4e+10 + (t95 * t95)), (-0.25)) * 2.0412414523193154e-06 * t95 -
-              t34 * 0.031415926535897934 * t51 * x[3] - x[7] * 5e-09 + 0.07050000000000001 +
+  xdot[7] = ((-t94 * pow((4e+10 + (t95 * t95)), (-0.25)) * 2.0412414523193154e-06 * t95 -
+              0.031415926535897934 * t45 * x[2] * t46 - x[7] * 5e-09 -
+              0.031415926535897934 * x[3] * t52 * t46 + 0.07050000000000001 +
               sqrt((1e+10 + t97)) * 2.5e-09 -
               t98 * 2.0412414523193154e-06 * t96 * pow((4e+10 + t97), (-0.25)) -
-              2.5e-09 * sqrt((1e+10 + (t99 * t99))) - t34 * 0.031415926535897934 * x[2] * t56)) /
-            (((0.031415926535897934 * t35 - 0.04695132319207772)));
-  xdot[8] = 1.2e+09 *
-            ((t62 * t64 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
-              3.3333333333333334e-09 * sqrt((t101 + 1e+10)) -
+              2.5e-09 * sqrt((1e+10 + (t99 * t99))))) *
+            1.2e+09 / (((0.031415926535897934 * t30 - 0.04695132319207772)));
+  xdot[8] = ((t62 * t64 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
+              3.3333333333333334e-09 * sqrt((t101 + 1e+10)) +
               t102 * t92 * 2.721655269759087e-06 * pow((4e+10 + (t102 * t102)), (-0.25)) -
               pow((4e+10 + t101), (-0.25)) * t88 * 2.721655269759087e-06 * t100 -
-              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) /
-            (((-t65 * 0.03817035074111599 + 0.09980758036020113)));
+              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) *
+            1.2e+09 / (((-t65 * 0.03817035074111599 + 0.09980758036020113)));
   xdot[9] = 1.2e+09 *
-            ((sqrt((1e+10 + t105)) * 2.5e-09 +
-              t106 * t98 * pow(((t106 * t106) + 4e+10), (-0.25)) * 2.0412414523193154e-06 -
-              x[9] * 5e-09 - t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
-              0.07050000000000001 - 2.5e-09 * sqrt(((t107 * t107) + 1e+10)) +
-              t34 * 0.023561944901923454 * t51 * x[3] + t34 * 0.023561944901923454 * x[2] * t56)) /
-            (((0.07132964021557801 - 0.023561944901923454 * t35)));
+            ((sqrt((1e+10 + t105)) * 2.5e-09 - x[9] * 5e-09 -
+              t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
+              t45 * 0.023561944901923454 * x[2] * t46 + 0.07050000000000001 -
+              pow(((t106 * t106) + 4e+10), (-0.25)) * t98 * 2.0412414523193154e-06 * t106 -
+              2.5e-09 * sqrt(((t107 * t107) + 1e+10)) + 0.023561944901923454 * x[3] * t52 * t46)) /
+            (((0.07132964021557801 - 0.023561944901923454 * t30)));
 }
 
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
@@ -484,529 +486,519 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t0 = sin(x[0]);
   const double t1 = cos(x[0]);
   const double t2 = (-t0 * 0.1 + 1.55 * t1);
-  const double t3 = cos(u[5]);
-  const double t4 = 3.11 * t1;
-  const double t5 = (x[0] + x[1]);
-  const double t6 = sin(t5);
-  const double t7 = t6 * (-0.25);
-  const double t8 = cos(t5);
-  const double t9 = 0.55 * t8;
-  const double t10 = (t4 + t7 + t9);
-  const double t11 = (0.389 * t8 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
-  const double t12 = 0.159 * t8;
-  const double t13 = t6 * (-0.389);
-  const double t14 = (0.365 * t0 + t12 + t13 + t1 * 0.5249999999999999);
-  const double t15 = (t14 * t14);
-  const double t16 = (t11 * t11);
-  const double t17 = (t15 + t16 - 0.38752);
-  const double t18 = (t15 + t16);
-  const double t19 = (1.0 / sqrt(t18));
-  const double t20 = (t17 * t17);
-  const double t21 = (1.0 / (t18));
-  const double t22 = (0.567009 - 0.25 * t20 * t21);
-  const double t23 = sqrt(t22);
-  const double t24 = (t11 * t17 * t19 + 2.0 * t14 * t23);
-  const double t25 = (-t11 * 2.0 * t23 + t17 * t14 * t19);
-  const double t26 = atan2(0.5 * t24 * t19, t25 * 0.5 * t19);
-  const double t27 = cos(t26);
-  const double t28 = sin(t26);
-  const double t29 = (-0.15500000000000003 * t1 - 0.141 * t27 + t0 * 2.093 - t28 * 0.853);
-  const double t30 = t0 * 0.15500000000000003;
-  const double t31 = 2.093 * t1;
-  const double t32 = (0.141 * t28 + t30 - 0.853 * t27 + t31);
-  const double t33 = ((t29 * t29) + (t32 * t32));
-  const double t34 = (1.0 / sqrt(t33));
-  const double t35 = sqrt(t33);
-  const double t36 = (-1.59 + t35);
-  const double t37 = (t36 * t36);
-  const double t38 = (t37 + 1e-06);
-  const double t39 = (t35 - 2.9000000000000004);
-  const double t40 = (t39 * t39);
-  const double t41 = (t40 + 1e-06);
-  const double t42 = (t12 + t13);
-  const double t43 = (-0.389) * t8;
-  const double t44 = t6 * (-0.159);
-  const double t45 = (t43 + t44);
-  const double t46 = (t42 * t11 + t45 * t14);
-  const double t47 = (1.0 / (t18 * t18));
-  const double t48 = (-2.0 * t17 * t21 * t46 + t47 * t20 * t46);
-  const double t49 = (1.0 / sqrt(t22));
-  const double t50 = pow(t18, (-1.5));
-  const double t51 = (-t11 * t48 * t49 - 2.0 * t17 * t14 * t50 * t46 + 2.0 * t17 * t45 * t19 +
-                      4.0 * t14 * t46 * t19 - t42 * 4.0 * t23);
-  const double t52 = (-t51 * t19 + t25 * 2.0 * t50 * t46);
-  const double t53 = (t24 * t24);
-  const double t54 = (t25 * t25);
-  const double t55 = (t53 * t21 + t54 * t21);
-  const double t56 = (1.0 / (t55));
-  const double t57 = (-t11 * 2.0 * t17 * t50 * t46 + t48 * t49 * t14 + t42 * 2.0 * t17 * t19 +
-                      t11 * 4.0 * t46 * t19 + 4.0 * t45 * t23);
-  const double t58 = (-t57 * t19 + 2.0 * t24 * t50 * t46);
-  const double t59 = (t52 * t24 * t56 * t19 - t25 * t58 * t56 * t19);
-  const double t60 = (0.0705 * t59 * t28 - t59 * 0.4265 * t27);
-  const double t61 = (t59 * t28 * 0.4265 + 0.0705 * t59 * t27);
-  const double t62 = (t29 * t60 + t61 * t32);
-  const double t63 = (t43 - t0 * 0.5249999999999999 + 0.365 * t1 + t44);
-  const double t64 = (t63 * t14 + t11 * t14);
-  const double t65 = (-2.0 * t17 * t64 * t21 + t47 * t64 * t20);
-  const double t66 = (-t49 * t65 * t14 - t63 * 4.0 * t23 - t11 * 4.0 * t64 * t19 +
-                      t11 * 2.0 * t17 * t64 * t50 - 2.0 * t17 * t14 * t19);
-  const double t67 = (2.0 * t64 * t24 * t50 + t66 * t19);
-  const double t68 = (2.0 * t17 * t14 * t64 * t50 + t11 * t49 * t65 - 4.0 * t14 * t64 * t19 +
-                      4.0 * t14 * t23 - t63 * 2.0 * t17 * t19);
-  const double t69 = (t68 * t19 + t25 * 2.0 * t64 * t50);
-  const double t70 = (t67 * t25 * t56 * t19 - t69 * t24 * t56 * t19);
-  const double t71 = (t30 + 0.4265 * t27 * t70 - 0.0705 * t28 * t70 + t31);
-  const double t72 = t0 * (-2.093);
-  const double t73 = 0.15500000000000003 * t1;
-  const double t74 = (-t28 * 0.4265 * t70 + t72 + t73 - 0.0705 * t27 * t70);
-  const double t75 = (t29 * t71 + t74 * t32);
-  const double t76 = (t34 * 2e+06 * t62 * x[3] + t34 * 2e+06 * x[2] * t75);
-  const double t77 = (1.0 / sqrt(t41));
-  const double t78 = (1.0 / sqrt(t38));
-  const double t79 = (2.0 + t39 * t77 - t36 * t78);
-  const double t80 = (-sqrt(t38) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] +
-                      sqrt(t41) * 2e+08 + t76 * t79 + 0.04712388980384691 * x[9] + 4e+08 * t35);
-  const double t81 = (0.194 * t1 + 1.595 + t0 * 0.857);
-  const double t82 = (-0.194) * t0;
-  const double t83 = 0.857 * t1;
-  const double t84 = (t82 + t83);
-  const double t85 = (-t0 * 0.857 - 0.194 * t1);
-  const double t86 = (t82 + t83 - 1.339);
-  const double t87 = (t81 * t84 + t85 * t86);
-  const double t88 = ((t81 * t81) + (t86 * t86));
-  const double t89 = (1.0 / sqrt(t88));
-  const double t90 = sqrt(t88);
-  const double t91 = (-2.51 + t90);
-  const double t92 = (t91 * t91);
-  const double t93 = (1e-06 + t92);
-  const double t94 = (t90 - 1.4);
-  const double t95 = (t94 * t94);
-  const double t96 = (1e-06 + t95);
-  const double t97 = (1.0 / sqrt(t96));
-  const double t98 = (1.0 / sqrt(t93));
-  const double t99 = (-t97 * t94 + 2.0 + t98 * t91);
-  const double t100 =
-      (-2e+08 * sqrt(t93) - x[8] * 0.03817035074111599 - t99 * t87 * t89 * 2e+06 * x[2] + 7.82e+08 +
-       2e+08 * sqrt(t96) - 4e+08 * t90 + 0.05089380098815465 * x[6]);
-  const double t101 = (-1.55 * t0 - 0.1 * t1);
-  const double t102 = sin(u[5]);
-  const double t103 = t6 * (-0.4011545671438309);
-  const double t104 = (-0.16343387866394005) * t8;
-  const double t105 = t0 * (-3.11);
-  const double t106 = (t103 + t104 + t105);
-  const double t107 = t6 * (-0.16343387866394005);
-  const double t108 = 0.4011545671438309 * t8;
-  const double t109 = (t107 + t4 + t108);
-  const double t110 = t6 * (-0.55);
-  const double t111 = (-0.25) * t8;
-  const double t112 = (t110 + t111 + t105);
+  const double t3 = (x[0] + x[1]);
+  const double t4 = sin(t3);
+  const double t5 = t4 * (-0.55);
+  const double t6 = cos(t3);
+  const double t7 = (-0.25) * t6;
+  const double t8 = t0 * (-3.11);
+  const double t9 = (t5 + t7 + t8);
+  const double t10 = t4 * (-0.16343387866394005);
+  const double t11 = 3.11 * t1;
+  const double t12 = 0.4011545671438309 * t6;
+  const double t13 = (t10 + t11 + t12);
+  const double t14 = t4 * (-0.4011545671438309);
+  const double t15 = (-0.16343387866394005) * t6;
+  const double t16 = (t14 + t15 + t8);
+  const double t17 = t4 * (-0.25);
+  const double t18 = 0.55 * t6;
+  const double t19 = (t11 + t17 + t18);
+  const double t20 = (-1.55 * t0 - 0.1 * t1);
+  const double t21 =
+      (2600.0 * (t2 * t2) + 1800.0 * (t9 * t9) + (((t13 * t13) + (t16 * t16))) * u[4] +
+       (t19 * t19) * 1800.0 + 2600.0 * (t20 * t20) + 2900.0);
+  const double t22 = (1.0 / (t21 * t21));
+  const double t23 = cos(u[5]);
+  const double t24 = (0.389 * t6 + t0 * 0.5249999999999999 - 0.365 * t1 + t4 * 0.159);
+  const double t25 = 0.159 * t6;
+  const double t26 = t4 * (-0.389);
+  const double t27 = (0.365 * t0 + t25 + t26 + t1 * 0.5249999999999999);
+  const double t28 = (t27 * t27);
+  const double t29 = (t24 * t24);
+  const double t30 = (t28 + t29 - 0.38752);
+  const double t31 = (t28 + t29);
+  const double t32 = (1.0 / sqrt(t31));
+  const double t33 = (t30 * t30);
+  const double t34 = (1.0 / (t31));
+  const double t35 = (0.567009 - 0.25 * t33 * t34);
+  const double t36 = sqrt(t35);
+  const double t37 = (t24 * t30 * t32 + 2.0 * t27 * t36);
+  const double t38 = (t24 * 2.0 * t36 - t30 * t27 * t32);
+  const double t39 = atan2(0.5 * t37 * t32, t38 * (-0.5) * t32);
+  const double t40 = cos(t39);
+  const double t41 = sin(t39);
+  const double t42 = (-0.141 * t40 - t41 * 0.853 - 0.15500000000000003 * t1 + t0 * 2.093);
+  const double t43 = t0 * 0.15500000000000003;
+  const double t44 = 2.093 * t1;
+  const double t45 = (t43 + t41 * 0.141 - 0.853 * t40 + t44);
+  const double t46 = ((t42 * t42) + (t45 * t45));
+  const double t47 = sqrt(t46);
+  const double t48 = (-2.9000000000000004 + t47);
+  const double t49 = (t48 * t48);
+  const double t50 = (t49 + 1e-06);
+  const double t51 = (-1.59 + t47);
+  const double t52 = (t51 * t51);
+  const double t53 = (1e-06 + t52);
+  const double t54 = (1.0 / sqrt(t53));
+  const double t55 = (1.0 / sqrt(t50));
+  const double t56 = (-t51 * t54 + t55 * t48 + 2.0);
+  const double t57 = (t38 * t38);
+  const double t58 = (t37 * t37);
+  const double t59 = (t57 * t34 + t58 * t34);
+  const double t60 = (1.0 / (t59));
+  const double t61 = (-0.389) * t6;
+  const double t62 = t4 * (-0.159);
+  const double t63 = (t61 - t0 * 0.5249999999999999 + 0.365 * t1 + t62);
+  const double t64 = (t63 * t27 + t24 * t27);
+  const double t65 = (1.0 / sqrt(t35));
+  const double t66 = (1.0 / (t31 * t31));
+  const double t67 = (-2.0 * t30 * t64 * t34 + t66 * t64 * t33);
+  const double t68 = pow(t31, (-1.5));
+  const double t69 = (t63 * 2.0 * t30 * t32 - 4.0 * t27 * t36 + 4.0 * t27 * t64 * t32 -
+                      t24 * t65 * t67 - 2.0 * t30 * t27 * t64 * t68);
+  const double t70 = (t69 * t32 + 2.0 * t38 * t64 * t68);
+  const double t71 = (t63 * 4.0 * t36 + t65 * t67 * t27 - t24 * 2.0 * t30 * t64 * t68 +
+                      t24 * 4.0 * t64 * t32 + 2.0 * t30 * t27 * t32);
+  const double t72 = (2.0 * t64 * t37 * t68 - t71 * t32);
+  const double t73 = (t60 * t70 * t37 * t32 - t72 * t60 * t38 * t32);
+  const double t74 = (t43 - t41 * 0.0705 * t73 + 0.4265 * t40 * t73 + t44);
+  const double t75 = t0 * (-2.093);
+  const double t76 = 0.15500000000000003 * t1;
+  const double t77 = (-0.0705 * t40 * t73 - t41 * 0.4265 * t73 + t75 + t76);
+  const double t78 = (t42 * t74 + t77 * t45);
+  const double t79 = (1.0 / sqrt(t46));
+  const double t80 = (t25 + t26);
+  const double t81 = (t61 + t62);
+  const double t82 = (t80 * t24 + t81 * t27);
+  const double t83 = (-2.0 * t30 * t34 * t82 + t66 * t33 * t82);
+  const double t84 = (-t24 * t83 * t65 - 2.0 * t30 * t27 * t68 * t82 + 2.0 * t30 * t81 * t32 +
+                      4.0 * t27 * t82 * t32 - t80 * 4.0 * t36);
+  const double t85 = (t84 * t32 + 2.0 * t38 * t68 * t82);
+  const double t86 = (-t24 * 2.0 * t30 * t68 * t82 + t83 * t65 * t27 + t80 * 2.0 * t30 * t32 +
+                      t24 * 4.0 * t82 * t32 + 4.0 * t81 * t36);
+  const double t87 = (t86 * t32 - 2.0 * t37 * t68 * t82);
+  const double t88 = (t60 * t85 * t37 * t32 + t87 * t60 * t38 * t32);
+  const double t89 = (-0.0705 * t40 * t88 - t41 * 0.4265 * t88);
+  const double t90 = (-t41 * 0.0705 * t88 + 0.4265 * t40 * t88);
+  const double t91 = (t89 * t45 + t42 * t90);
+  const double t92 = (t78 * 2e+06 * x[2] * t79 + 2e+06 * x[3] * t91 * t79);
+  const double t93 =
+      (sqrt(t50) * 2e+08 - sqrt(t53) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + 4e+08 * t47 +
+       0.04712388980384691 * x[9] + t56 * t92);
+  const double t94 = (0.194 * t1 + 1.595 + t0 * 0.857);
+  const double t95 = (-0.194) * t0;
+  const double t96 = 0.857 * t1;
+  const double t97 = (t95 + t96);
+  const double t98 = (-t0 * 0.857 - 0.194 * t1);
+  const double t99 = (t95 + t96 - 1.339);
+  const double t100 = (t94 * t97 + t98 * t99);
+  const double t101 = ((t94 * t94) + (t99 * t99));
+  const double t102 = (1.0 / sqrt(t101));
+  const double t103 = sqrt(t101);
+  const double t104 = (-2.51 + t103);
+  const double t105 = (t104 * t104);
+  const double t106 = (1e-06 + t105);
+  const double t107 = (t103 - 1.4);
+  const double t108 = (t107 * t107);
+  const double t109 = (1e-06 + t108);
+  const double t110 = (1.0 / sqrt(t109));
+  const double t111 = (1.0 / sqrt(t106));
+  const double t112 = (-t110 * t107 + 2.0 + t111 * t104);
   const double t113 =
-      (-t2 * 50994.579999999994 * t3 - t10 * t3 * 35303.939999999995 - x[2] * 4000.0 + 2.0 * u[2] -
-       t34 * t80 * t75 + t87 * t89 * 2.0 * t100 - t101 * 50994.579999999994 * t102 +
-       2.0 * ((-t102 * t106 * 9.80665 - t109 * t3 * 9.80665)) * u[4] -
-       t102 * t112 * 35303.939999999995);
-  const double t114 =
-      (2600.0 * (t2 * t2) + 1800.0 * (t112 * t112) + (((t109 * t109) + (t106 * t106))) * u[4] +
-       (t10 * t10) * 1800.0 + 2600.0 * (t101 * t101) + 2900.0);
-  const double t115 = (1.0 / (t114 * t114));
+      (-2e+08 * sqrt(t106) - x[8] * 0.03817035074111599 - t112 * t100 * t102 * 2e+06 * x[2] +
+       7.82e+08 + 2e+08 * sqrt(t109) - 4e+08 * t103 + 0.05089380098815465 * x[6]);
+  const double t114 = sin(u[5]);
+  const double t115 =
+      (-t2 * 50994.579999999994 * t23 - t93 * t78 * t79 - t19 * t23 * 35303.939999999995 -
+       x[2] * 4000.0 + 2.0 * u[2] + t100 * t102 * 2.0 * t113 - t20 * 50994.579999999994 * t114 +
+       2.0 * ((-t114 * t16 * 9.80665 - t13 * t23 * 9.80665)) * u[4] -
+       t114 * t9 * 35303.939999999995);
   const double t116 = (t0 * 0.1 - 1.55 * t1);
   const double t117 = (-3.11) * t1;
-  const double t118 = t6 * 0.16343387866394005;
-  const double t119 = (-0.4011545671438309) * t8;
+  const double t118 = t4 * 0.16343387866394005;
+  const double t119 = (-0.4011545671438309) * t6;
   const double t120 = (t117 + t118 + t119);
-  const double t121 = t6 * 0.25;
-  const double t122 = (-0.55) * t8;
+  const double t121 = t4 * 0.25;
+  const double t122 = (-0.55) * t6;
   const double t123 = (t121 + t117 + t122);
-  const double t124 = (1.0 / (t114));
-  const double t125 = pow(t33, (-1.5));
-  const double t126 = (t75 * t75);
-  const double t127 = (t70 * t70);
-  const double t128 =
-      (2.0 * t54 * t47 * t64 + t25 * t68 * t21 + 2.0 * t53 * t47 * t64 + t66 * t24 * t21);
-  const double t129 = (1.0 / (t55 * t55));
-  const double t130 = (-0.159) * t8;
-  const double t131 = t6 * 0.389;
-  const double t132 = (t130 - t1 * 0.5249999999999999 - 0.365 * t0 + t131);
-  const double t133 = (t132 * t14 + t15 + (t63 * t63) + t63 * t11);
-  const double t134 = (t64 * t64);
-  const double t135 = pow(t18, (-2.5));
-  const double t136 = (1.0 / (t18 * t18 * t18));
-  const double t137 = (-4.0 * t136 * t134 * t20 + t17 * t134 * t47 * 8.0 - 2.0 * t17 * t133 * t21 +
-                       t47 * t133 * t20 - 4.0 * t134 * t21);
-  const double t138 = pow(t22, (-1.5));
-  const double t139 = (t65 * t65);
-  const double t140 =
-      (-t67 * t25 * t128 * 4.0 * t129 * t19 + t128 * t69 * 4.0 * t129 * t24 * t19 +
-       t67 * 2.0 * t68 * t56 * t19 +
-       ((t25 * 8.0 * t133 * t50 - t25 * 24.0 * t134 * t135 - 8.0 * t64 * t68 * t50 +
-         ((-24.0 * t17 * t134 * t135 * t14 + t11 * 4.0 * t49 * t137 + t63 * 16.0 * t17 * t64 * t50 -
-           16.0 * t133 * t14 * t19 + t63 * 16.0 * t23 + t17 * 8.0 * t133 * t14 * t50 -
-           t132 * t17 * 8.0 * t19 + 32.0 * t134 * t14 * t50 - t11 * t138 * t139 +
-           t49 * 8.0 * t65 * t14 - t63 * 32.0 * t64 * t19)) *
-             t19)) *
-           t24 * t56 * t19 +
-       t67 * t25 * 4.0 * t64 * t50 * t56 +
-       t25 * t56 *
-           ((t66 * 8.0 * t64 * t50 - 8.0 * t133 * t24 * t50 -
-             ((-t11 * 24.0 * t17 * t134 * t135 - t63 * t17 * 8.0 * t19 - t132 * 16.0 * t23 -
-               32.0 * t14 * t64 * t19 - 4.0 * t49 * t137 * t14 + t138 * t14 * t139 +
-               t11 * t17 * 8.0 * t133 * t50 + 16.0 * t17 * t14 * t64 * t50 -
-               t11 * 16.0 * t133 * t19 + t11 * 32.0 * t134 * t50 - t63 * t49 * 8.0 * t65)) *
-                 t19 +
-             24.0 * t134 * t135 * t24)) *
-           t19 -
-       t69 * 4.0 * t64 * t24 * t50 * t56 - t66 * t69 * 2.0 * t56 * t19);
-  const double t141 = (((-t28 * t127 * 0.03525 + t28 * 0.106625 * t140 + 0.017625 * t27 * t140 -
-                         t31 - t30 + 0.21325 * t27 * t127)) *
-                           t32 +
-                       (t71 * t71) +
-                       t29 * ((t27 * t127 * 0.03525 + t28 * 0.017625 * t140 + t72 + t73 +
-                               0.21325 * t28 * t127 - 0.106625 * t27 * t140)) +
-                       (t74 * t74));
-  const double t142 = pow(t88, (-1.5));
-  const double t143 = (t87 * t87);
-  const double t144 = ((t85 * t85) + (t84 * t84) + t86 * ((0.194 * t0 - t83)) + t85 * t81);
-  const double t145 = t71 * t60;
-  const double t146 = t61 * t74;
-  const double t147 = (-0.21325) * t59 * t27 * t70;
-  const double t148 = t59 * t28 * t70 * 0.03525;
-  const double t149 = t11 * t45;
-  const double t150 = (t130 + t131);
-  const double t151 = t150 * t14;
-  const double t152 = (t63 * t45 + t42 * t14 + t149 + t151);
-  const double t153 = (2.0 * t152 * t17 * t21 + 4.0 * t136 * t64 * t20 * t46 +
-                       4.0 * t64 * t21 * t46 - t152 * t47 * t20 - t17 * t47 * 8.0 * t64 * t46);
-  const double t154 =
-      t25 *
-      ((((t48 * t138 * t65 * t14 + t11 * t152 * t17 * 8.0 * t50 - t11 * 16.0 * t152 * t19 +
-          t11 * 32.0 * t64 * t50 * t46 - 16.0 * t14 * t46 * t19 + t17 * 8.0 * t14 * t50 * t46 -
-          t11 * 24.0 * t17 * t135 * t64 * t46 + t42 * t17 * 8.0 * t64 * t50 -
-          t17 * t45 * 8.0 * t19 - 16.0 * t150 * t23 - t42 * 16.0 * t64 * t19 -
-          t63 * t48 * 4.0 * t49 - 4.0 * t45 * t49 * t65 + t153 * 4.0 * t49 * t14)) *
-            t19 +
-        4.0 * t57 * t64 * t50 + t152 * 8.0 * t24 * t50 - t66 * 4.0 * t50 * t46 -
-        24.0 * t135 * t64 * t24 * t46)) *
-      t56 * t19;
-  const double t155 =
-      ((t25 * 24.0 * t135 * t64 * t46 -
-        ((t48 * 4.0 * t49 * t14 + t42 * 4.0 * t49 * t65 - t11 * t153 * 4.0 * t49 +
-          t63 * t17 * 8.0 * t50 * t46 - 24.0 * t17 * t135 * t14 * t64 * t46 -
-          t150 * t17 * 8.0 * t19 + 32.0 * t14 * t64 * t50 * t46 - t11 * t48 * t138 * t65 -
-          16.0 * t45 * t64 * t19 + 16.0 * t45 * t23 - 16.0 * t152 * t14 * t19 +
-          t17 * t45 * 8.0 * t64 * t50 + t152 * t17 * 8.0 * t14 * t50 - t63 * 16.0 * t46 * t19)) *
-            t19 -
-        t25 * t152 * 8.0 * t50 - 4.0 * t64 * t51 * t50 + 4.0 * t68 * t50 * t46)) *
-      t24 * t56 * t19;
-  const double t156 =
-      (t52 * 4.0 * t64 * t24 * t50 * t56 + t66 * t52 * 2.0 * t56 * t19 -
-       2.0 * t58 * t68 * t56 * t19 + t154 + t155 + t25 * t128 * 4.0 * t58 * t129 * t19 -
-       t25 * 4.0 * t58 * t64 * t50 * t56 - t128 * t52 * 4.0 * t129 * t24 * t19);
-  const double t157 = t59 * t27 * t70 * (-0.03525);
-  const double t158 = (-0.21325) * t59 * t28 * t70;
-  const double t159 =
-      (t145 + t146 + ((t147 + t148 - 0.017625 * t27 * t156 - t28 * 0.106625 * t156)) * t32 +
-       t29 * ((t157 - t28 * 0.017625 * t156 + 0.106625 * t27 * t156 + t158)));
-  const double t160 = pow(t38, (-1.5));
-  const double t161 = pow(t41, (-1.5));
-  const double t162 = (t79 * ((t34 * t159 * 2e+06 * x[3] - t125 * 2e+06 * t62 * x[3] * t75 +
-                               t34 * 2e+06 * x[2] * t141 - t125 * 2e+06 * x[2] * t126)) -
-                       t36 * t34 * t78 * 2e+08 * t75 -
-                       t76 * ((-t34 * t77 * t75 + t34 * t78 * t75 - t34 * t37 * t160 * t75 +
-                               t34 * t40 * t161 * t75)) +
-                       t34 * 4e+08 * t75 + t34 * t39 * 2e+08 * t77 * t75);
-  const double t163 =
-      (t25 * t51 * t21 - 2.0 * t53 * t47 * t46 - 2.0 * t54 * t47 * t46 + t57 * t24 * t21);
-  const double t164 =
-      (-t67 * t25 * t163 * 4.0 * t129 * t19 + t154 + t69 * 4.0 * t24 * t50 * t56 * t46 + t155 -
-       t69 * 2.0 * t57 * t56 * t19 - t67 * t25 * 4.0 * t50 * t56 * t46 +
-       t163 * t69 * 4.0 * t129 * t24 * t19 + t67 * 2.0 * t51 * t56 * t19);
-  const double t165 =
-      (t145 + t29 * ((t157 + t158 + t164 * 0.106625 * t27 - t164 * t28 * 0.017625)) + t146 +
-       ((t147 + t148 - t164 * t28 * 0.106625 - t164 * 0.017625 * t27)) * t32);
-  const double t166 = (t110 + t111);
-  const double t167 = (t121 + t122);
-  const double t168 = (t103 + t104);
-  const double t169 = (t118 + t119);
-  const double t170 = (-t168 * t3 * 9.80665 - t102 * t169 * 9.80665);
-  const double t171 = (t62 * t62);
-  const double t172 = (t46 * t46);
-  const double t173 = ((t45 * t45) + (t42 * t42) + t149 + t151);
-  const double t174 = (t17 * t47 * t172 * 8.0 - 4.0 * t136 * t172 * t20 - 4.0 * t172 * t21 -
-                       2.0 * t173 * t17 * t21 + t173 * t47 * t20);
-  const double t175 = (t48 * t48);
-  const double t176 =
-      (t163 * t52 * 4.0 * t129 * t24 * t19 +
-       t25 *
-           ((-24.0 * t135 * t172 * t24 + t57 * 8.0 * t50 * t46 + t173 * 8.0 * t24 * t50 -
-             ((t11 * 24.0 * t17 * t135 * t172 + t17 * t45 * 8.0 * t19 + t174 * 4.0 * t49 * t14 +
-               t48 * t45 * t49 * 8.0 - t11 * 32.0 * t172 * t50 - t11 * t173 * t17 * 8.0 * t50 +
-               16.0 * t150 * t23 - t175 * t138 * t14 - t42 * 16.0 * t17 * t50 * t46 +
-               t11 * 16.0 * t173 * t19 + t42 * 32.0 * t46 * t19)) *
-                 t19)) *
-           t56 * t19 +
-       2.0 * t58 * t51 * t56 * t19 +
-       ((((t150 * t17 * 8.0 * t19 - 16.0 * t45 * t23 + 32.0 * t45 * t46 * t19 -
-           t11 * t174 * 4.0 * t49 - 16.0 * t17 * t45 * t50 * t46 - t42 * t48 * t49 * 8.0 -
-           32.0 * t172 * t14 * t50 + 24.0 * t17 * t135 * t172 * t14 - t173 * t17 * 8.0 * t14 * t50 +
-           16.0 * t173 * t14 * t19 + t11 * t175 * t138)) *
-             t19 +
-         t25 * 24.0 * t135 * t172 - t25 * t173 * 8.0 * t50 - 8.0 * t51 * t50 * t46)) *
-           t24 * t56 * t19 -
-       t25 * 4.0 * t58 * t50 * t56 * t46 - t25 * t163 * 4.0 * t58 * t129 * t19 -
-       t52 * 2.0 * t57 * t56 * t19 + t52 * 4.0 * t24 * t50 * t56 * t46);
-  const double t177 = (t59 * t59);
-  const double t178 = (t29 * ((0.106625 * t27 * t176 + t27 * t177 * 0.03525 -
-                               t28 * 0.017625 * t176 + 0.21325 * t28 * t177)) +
-                       (t61 * t61) +
-                       ((-t28 * 0.106625 * t176 - t28 * t177 * 0.03525 + 0.21325 * t27 * t177 -
-                         0.017625 * t27 * t176)) *
-                           t32 +
-                       (t60 * t60));
+  const double t124 = (t73 * t73);
+  const double t125 = (t64 * t64);
+  const double t126 = pow(t31, (-2.5));
+  const double t127 = (-0.159) * t6;
+  const double t128 = t4 * 0.389;
+  const double t129 = (t127 - t1 * 0.5249999999999999 - 0.365 * t0 + t128);
+  const double t130 = (t129 * t27 + t28 + (t63 * t63) + t63 * t24);
+  const double t131 = (1.0 / (t31 * t31 * t31));
+  const double t132 = (-4.0 * t131 * t125 * t33 + t30 * t125 * t66 * 8.0 - 2.0 * t30 * t130 * t34 +
+                       t66 * t130 * t33 - 4.0 * t125 * t34);
+  const double t133 = pow(t35, (-1.5));
+  const double t134 = (t67 * t67);
+  const double t135 = (1.0 / (t59 * t59));
+  const double t136 =
+      (2.0 * t66 * t57 * t64 + t69 * t38 * t34 + 2.0 * t58 * t66 * t64 - t37 * t34 * t71);
+  const double t137 =
+      (2.0 * t60 * t70 * t71 * t32 - t60 * 4.0 * t70 * t64 * t37 * t68 +
+       t72 * t60 * 4.0 * t38 * t64 * t68 -
+       t60 *
+           ((24.0 * t125 * t126 * t38 - t38 * 8.0 * t130 * t68 + t69 * 8.0 * t64 * t68 -
+             ((-t63 * 16.0 * t36 - t63 * 16.0 * t30 * t64 * t68 + t63 * 32.0 * t64 * t32 -
+               t30 * 8.0 * t130 * t27 * t68 - t65 * 8.0 * t67 * t27 + 16.0 * t130 * t27 * t32 -
+               t24 * 4.0 * t65 * t132 - 32.0 * t125 * t27 * t68 + 24.0 * t30 * t125 * t126 * t27 +
+               t129 * t30 * 8.0 * t32 + t24 * t133 * t134)) *
+                 t32)) *
+           t37 * t32 -
+       t135 * t72 * 4.0 * t38 * t136 * t32 + t135 * 4.0 * t70 * t136 * t37 * t32 +
+       ((-8.0 * t130 * t37 * t68 +
+         ((-t24 * t30 * 8.0 * t130 * t68 - 16.0 * t30 * t27 * t64 * t68 - t24 * 32.0 * t125 * t68 +
+           t24 * 16.0 * t130 * t32 + t63 * t30 * 8.0 * t32 + t24 * 24.0 * t30 * t125 * t126 +
+           4.0 * t65 * t132 * t27 + 32.0 * t27 * t64 * t32 - t133 * t27 * t134 + t129 * 16.0 * t36 +
+           t63 * t65 * 8.0 * t67)) *
+             t32 +
+         24.0 * t125 * t126 * t37 - 8.0 * t64 * t68 * t71)) *
+           t60 * t38 * t32 +
+       2.0 * t72 * t60 * t69 * t32);
+  const double t138 = ((t77 * t77) +
+                       t42 * ((t41 * 0.21325 * t124 + t137 * 0.106625 * t40 + t75 + t76 +
+                               t124 * t40 * 0.03525 - t41 * t137 * 0.017625)) +
+                       (t74 * t74) +
+                       t45 * ((0.21325 * t124 * t40 - t137 * 0.017625 * t40 -
+                               t41 * t137 * 0.106625 - t44 - t43 - t41 * t124 * 0.03525)));
+  const double t139 = pow(t53, (-1.5));
+  const double t140 = pow(t50, (-1.5));
+  const double t141 = t77 * t89;
+  const double t142 = t90 * t74;
+  const double t143 = t24 * t81;
+  const double t144 = (t127 + t128);
+  const double t145 = t144 * t27;
+  const double t146 = (t63 * t81 + t80 * t27 + t143 + t145);
+  const double t147 = (2.0 * t146 * t30 * t34 + 4.0 * t131 * t64 * t33 * t82 +
+                       4.0 * t64 * t34 * t82 - t146 * t66 * t33 - t30 * t66 * 8.0 * t64 * t82);
+  const double t148 =
+      (24.0 * t126 * t64 * t37 * t82 +
+       ((t30 * t81 * 8.0 * t32 + t24 * 16.0 * t146 * t32 - t30 * 8.0 * t27 * t68 * t82 -
+         t24 * 32.0 * t64 * t68 * t82 + t63 * t83 * 4.0 * t65 +
+         t24 * 24.0 * t30 * t126 * t64 * t82 + 16.0 * t27 * t82 * t32 + 16.0 * t144 * t36 +
+         4.0 * t81 * t65 * t67 - t147 * 4.0 * t65 * t27 - t83 * t133 * t67 * t27 +
+         t80 * 16.0 * t64 * t32 - t80 * t30 * 8.0 * t64 * t68 - t24 * t146 * t30 * 8.0 * t68)) *
+           t32 -
+       4.0 * t86 * t64 * t68 - t146 * 8.0 * t37 * t68 - 4.0 * t68 * t82 * t71);
+  const double t149 = t144 * t30 * 8.0 * t32;
+  const double t150 = (-16.0) * t81 * t36;
+  const double t151 =
+      (4.0 * t64 * t84 * t68 - t146 * t38 * 8.0 * t68 + 24.0 * t126 * t38 * t64 * t82 +
+       4.0 * t69 * t68 * t82 -
+       ((t149 + t150 - t30 * t81 * 8.0 * t64 * t68 - t80 * 4.0 * t65 * t67 +
+         t63 * 16.0 * t82 * t32 - t83 * 4.0 * t65 * t27 + t24 * t147 * 4.0 * t65 -
+         32.0 * t27 * t64 * t68 * t82 + 16.0 * t81 * t64 * t32 - t63 * t30 * 8.0 * t68 * t82 +
+         16.0 * t146 * t27 * t32 + 24.0 * t30 * t126 * t27 * t64 * t82 + t24 * t83 * t133 * t67 -
+         t146 * t30 * 8.0 * t27 * t68)) *
+           t32);
+  const double t152 =
+      (-t87 * 2.0 * t60 * t69 * t32 + t135 * 4.0 * t85 * t136 * t37 * t32 + t148 * t60 * t38 * t32 -
+       t60 * 4.0 * t85 * t64 * t37 * t68 - t87 * t60 * 4.0 * t38 * t64 * t68 -
+       t60 * t37 * t151 * t32 + t87 * t135 * 4.0 * t38 * t136 * t32 + 2.0 * t60 * t85 * t71 * t32);
+  const double t153 = t40 * 0.03525 * t73 * t88;
+  const double t154 = t41 * 0.21325 * t73 * t88;
+  const double t155 = 0.21325 * t40 * t73 * t88;
+  const double t156 = t41 * (-0.03525) * t73 * t88;
+  const double t157 =
+      (t141 + t142 + t42 * ((-t41 * 0.017625 * t152 + 0.106625 * t40 * t152 + t153 + t154)) +
+       t45 * ((t155 + t156 - t41 * 0.106625 * t152 - 0.017625 * t40 * t152)));
+  const double t158 = pow(t46, (-1.5));
+  const double t159 = (t78 * t78);
+  const double t160 =
+      (-t78 * 2e+08 * t51 * t54 * t79 +
+       ((-t78 * t54 * t79 + t78 * t55 * t79 + t78 * t139 * t79 * t52 - t49 * t78 * t140 * t79)) *
+           t92 +
+       t78 * 2e+08 * t55 * t79 * t48 +
+       t56 * ((2e+06 * x[2] * t79 * t138 + 2e+06 * x[3] * t157 * t79 -
+               t78 * 2e+06 * x[3] * t91 * t158 - 2e+06 * x[2] * t158 * t159)) +
+       4e+08 * t78 * t79);
+  const double t161 = pow(t101, (-1.5));
+  const double t162 = (t100 * t100);
+  const double t163 = ((t98 * t98) + (t97 * t97) + t99 * ((0.194 * t0 - t96)) + t98 * t94);
+  const double t164 = (1.0 / (t21));
+  const double t165 = (t121 + t122);
+  const double t166 = (t14 + t15);
+  const double t167 = (t118 + t119);
+  const double t168 = (t5 + t7);
+  const double t169 =
+      (-t86 * t37 * t34 + 2.0 * t58 * t66 * t82 + 2.0 * t66 * t57 * t82 + t38 * t84 * t34);
+  const double t170 = ((t81 * t81) + (t80 * t80) + t143 + t145);
+  const double t171 = (t82 * t82);
+  const double t172 = (2.0 * t170 * t30 * t34 + 4.0 * t171 * t34 - t170 * t66 * t33 -
+                       t30 * t66 * t171 * 8.0 + 4.0 * t131 * t171 * t33);
+  const double t173 = (t83 * t83);
+  const double t174 =
+      (t135 * 4.0 * t169 * t85 * t37 * t32 - t60 * 4.0 * t85 * t37 * t68 * t82 +
+       t87 * t135 * 4.0 * t169 * t38 * t32 + 2.0 * t60 * t86 * t85 * t32 -
+       t60 * t38 *
+           ((((-t80 * 32.0 * t82 * t32 - t30 * t81 * 8.0 * t32 - 16.0 * t144 * t36 -
+               t83 * t81 * t65 * 8.0 - t24 * 16.0 * t170 * t32 + t80 * 16.0 * t30 * t68 * t82 +
+               4.0 * t65 * t27 * t172 + t24 * t170 * t30 * 8.0 * t68 + t24 * 32.0 * t171 * t68 +
+               t173 * t133 * t27 - t24 * 24.0 * t30 * t126 * t171)) *
+                 t32 -
+             24.0 * t126 * t171 * t37 + t86 * 8.0 * t68 * t82 + t170 * 8.0 * t37 * t68)) *
+           t32 -
+       t87 * 2.0 * t60 * t84 * t32 - t87 * t60 * 4.0 * t38 * t68 * t82 -
+       ((-t170 * t38 * 8.0 * t68 -
+         ((t149 + t150 + t24 * 4.0 * t65 * t172 + 32.0 * t81 * t82 * t32 -
+           16.0 * t30 * t81 * t68 * t82 - t80 * t83 * t65 * 8.0 - 32.0 * t171 * t27 * t68 +
+           24.0 * t30 * t126 * t171 * t27 - t170 * t30 * 8.0 * t27 * t68 + 16.0 * t170 * t27 * t32 +
+           t24 * t173 * t133)) *
+             t32 +
+         8.0 * t84 * t68 * t82 + 24.0 * t126 * t38 * t171)) *
+           t60 * t37 * t32);
+  const double t175 = (t88 * t88);
+  const double t176 = (t42 * ((-t41 * 0.017625 * t174 + 0.106625 * t40 * t174 +
+                               t41 * 0.21325 * t175 + t175 * t40 * 0.03525)) +
+                       (t89 * t89) + (t90 * t90) +
+                       t45 * ((-t41 * 0.106625 * t174 - 0.017625 * t40 * t174 -
+                               t41 * t175 * 0.03525 + 0.21325 * t175 * t40)));
+  const double t177 = (t91 * t91);
+  const double t178 = (-2.0 * t60 * t70 * t86 * t32 + t135 * t72 * 4.0 * t169 * t38 * t32 +
+                       t60 * 4.0 * t70 * t37 * t68 * t82 - t72 * t60 * 4.0 * t38 * t68 * t82 -
+                       t148 * t60 * t38 * t32 + t60 * t37 * t151 * t32 -
+                       t135 * 4.0 * t70 * t169 * t37 * t32 - 2.0 * t72 * t60 * t84 * t32);
   const double t179 =
-      (t76 * ((-t34 * t37 * t160 * t62 - t34 * t77 * t62 + t34 * t40 * t161 * t62 +
-               t34 * t78 * t62)) +
-       t36 * t34 * t78 * 2e+08 * t62 - t34 * t39 * 2e+08 * t77 * t62 - t34 * 4e+08 * t62 -
-       ((-t125 * t171 * 2e+06 * x[3] - t125 * 2e+06 * t62 * x[2] * t75 + t34 * 2e+06 * x[2] * t165 +
-         t34 * 2e+06 * x[3] * t178)) *
-           t79);
-  const double t180 = (1.0 / (t33));
-  const double t181 = (t7 + t9);
-  const double t182 = (t107 + t108);
-  const double t183 = ((t181 * t181) * 1800.0 + 600.0 + (((t168 * t168) + (t182 * t182))) * u[4] +
-                       (t166 * t166) * 1800.0);
-  const double t184 =
-      ((-2.0 * ((-t182 * t3 * 9.80665 - t102 * t168 * 9.80665)) * u[4] +
-        t181 * t3 * 35303.939999999995 + t102 * t166 * 35303.939999999995 - 2.0 * u[3] +
-        1600.0 * x[3] + t34 * t62 * t80)) *
+      (t42 * ((t41 * t178 * 0.017625 - t178 * 0.106625 * t40 + t153 + t154)) + t141 + t142 +
+       ((t178 * 0.017625 * t40 + t41 * t178 * 0.106625 + t155 + t156)) * t45);
+  const double t180 =
+      (-2e+08 * t51 * t91 * t54 * t79 +
+       t56 * ((t176 * 2e+06 * x[3] * t79 - t78 * 2e+06 * x[2] * t91 * t158 -
+               2e+06 * t177 * x[3] * t158 + t179 * 2e+06 * x[2] * t79)) +
+       2e+08 * t55 * t91 * t79 * t48 -
+       ((t49 * t140 * t91 * t79 - t91 * t139 * t79 * t52 - t55 * t91 * t79 + t91 * t54 * t79)) *
+           t92 +
+       4e+08 * t91 * t79);
+  const double t181 = t114 * t165 * 35303.939999999995;
+  const double t182 = (-2.0) * u[4] * ((-t166 * t23 * 9.80665 - t114 * t167 * 9.80665));
+  const double t183 = t23 * t168 * 35303.939999999995;
+  const double t184 = t93 * t78 * t91 * t158 * (-1.0);
+  const double t185 = (1.0 / (t46));
+  const double t186 = (t17 + t18);
+  const double t187 = (t10 + t12);
+  const double t188 = ((t186 * t186) * 1800.0 + 600.0 + (((t166 * t166) + (t187 * t187))) * u[4] +
+                       (t168 * t168) * 1800.0);
+  const double t189 = (1.0 / (t188));
+  const double t190 =
+      ((-2.0 * ((-t187 * t23 * 9.80665 - t114 * t166 * 9.80665)) * u[4] +
+        t186 * t23 * 35303.939999999995 + t114 * t168 * 35303.939999999995 - 2.0 * u[3] +
+        t93 * t91 * t79 + 1600.0 * x[3])) *
       0.5 *
-      ((2.0 * ((t168 * t169 + t168 * t182)) * u[4] + 3600.0 * t167 * t166 + 3600.0 * t181 * t166)) /
-      (t183 * t183);
-  const double t185 = t102 * t167 * 35303.939999999995;
-  const double t186 = (-2.0) * u[4] * t170;
-  const double t187 = t3 * t166 * 35303.939999999995;
-  const double t188 = (1.0 / (t183));
-  const double t189 = (t90 * 0.05089380098815465 - 0.06725132138341651);
-  const double t190 = (-2.8e+07 + x[6]);
-  const double t191 = (1e+10 + (t190 * t190));
-  const double t192 = ((x[4] * x[4]) + 1e-06);
-  const double t193 = sqrt(t192);
-  const double t194 = (x[4] + t193);
-  const double t195 = (x[6] - u[6]);
-  const double t196 = (t195 * t195);
-  const double t197 = (4e+10 + t196);
-  const double t198 = pow(t197, (-0.25));
-  const double t199 = (x[6] - 2e+05);
-  const double t200 = (t199 * t199);
-  const double t201 = (t200 + 1e+10);
-  const double t202 = (-t193 + x[4]);
-  const double t203 = (4e+10 + t200);
-  const double t204 = pow(t203, (-0.25));
-  const double t205 = (1.0 / (t189));
-  const double t206 = (1.0 / sqrt(t192)) * x[4];
-  const double t207 = (1.0 + t206);
-  const double t208 = (t206 - 1.0);
-  const double t209 = 2.0 * x[6];
-  const double t210 = (-4e+05 + t209);
-  const double t211 = ((x[5] * x[5]) + 1e-06);
-  const double t212 = sqrt(t211);
-  const double t213 = (t212 + x[5]);
-  const double t214 = (x[7] - u[7]);
-  const double t215 = (t214 * t214);
-  const double t216 = (4e+10 + t215);
-  const double t217 = pow(t216, (-0.25));
-  const double t218 = (x[7] - 2e+05);
-  const double t219 = (t218 * t218);
-  const double t220 = (1e+10 + t219);
-  const double t221 = (t212 - x[5]);
-  const double t222 = (4e+10 + t219);
-  const double t223 = pow(t222, (-0.25));
-  const double t224 = (-2.8e+07 + x[7]);
-  const double t225 = (1e+10 + (t224 * t224));
-  const double t226 =
-      (-t213 * t217 * 2.0412414523193154e-06 * t214 - t34 * 0.031415926535897934 * t62 * x[3] -
-       x[7] * 5e-09 + 0.07050000000000001 + sqrt(t220) * 2.5e-09 -
-       t221 * 2.0412414523193154e-06 * t218 * t223 - 2.5e-09 * sqrt(t225) -
-       t34 * 0.031415926535897934 * x[2] * t75);
-  const double t227 = (0.031415926535897934 * t35 - 0.04695132319207772);
-  const double t228 = (1.0 / (t227 * t227));
-  const double t229 = (1.0 / (t227));
-  const double t230 = (1.0 / sqrt(t211)) * x[5];
-  const double t231 = (t230 - 1.0);
-  const double t232 = (t230 + 1.0);
-  const double t233 = 2.0 * x[7];
-  const double t234 = (-4e+05 + t233);
-  const double t235 = (x[8] - 2e+05);
-  const double t236 = (t235 * t235);
-  const double t237 = (t236 + 1e+10);
-  const double t238 = (-x[8] + u[6]);
-  const double t239 = (t238 * t238);
-  const double t240 = (4e+10 + t239);
-  const double t241 = pow(t240, (-0.25));
-  const double t242 = (4e+10 + t236);
+      ((2.0 * ((t166 * t167 + t166 * t187)) * u[4] + 3600.0 * t165 * t168 + 3600.0 * t186 * t168)) /
+      (t188 * t188);
+  const double t191 = (t103 * 0.05089380098815465 - 0.06725132138341651);
+  const double t192 = (-2.8e+07 + x[6]);
+  const double t193 = (1e+10 + (t192 * t192));
+  const double t194 = ((x[4] * x[4]) + 1e-06);
+  const double t195 = sqrt(t194);
+  const double t196 = (x[4] + t195);
+  const double t197 = (x[6] - u[6]);
+  const double t198 = (t197 * t197);
+  const double t199 = (4e+10 + t198);
+  const double t200 = pow(t199, (-0.25));
+  const double t201 = (x[6] - 2e+05);
+  const double t202 = (t201 * t201);
+  const double t203 = (t202 + 1e+10);
+  const double t204 = (-x[4] + t195);
+  const double t205 = (4e+10 + t202);
+  const double t206 = pow(t205, (-0.25));
+  const double t207 = (1.0 / (t191));
+  const double t208 = (1.0 / sqrt(t194)) * x[4];
+  const double t209 = (1.0 + t208);
+  const double t210 = (t208 - 1.0);
+  const double t211 = 2.0 * x[6];
+  const double t212 = (-4e+05 + t211);
+  const double t213 = (0.031415926535897934 * t47 - 0.04695132319207772);
+  const double t214 = (1.0 / (t213));
+  const double t215 = (1.0 / (t213 * t213));
+  const double t216 = ((x[5] * x[5]) + 1e-06);
+  const double t217 = sqrt(t216);
+  const double t218 = (t217 + x[5]);
+  const double t219 = (x[7] - u[7]);
+  const double t220 = (t219 * t219);
+  const double t221 = (4e+10 + t220);
+  const double t222 = pow(t221, (-0.25));
+  const double t223 = (x[7] - 2e+05);
+  const double t224 = (t223 * t223);
+  const double t225 = (1e+10 + t224);
+  const double t226 = (t217 - x[5]);
+  const double t227 = (4e+10 + t224);
+  const double t228 = pow(t227, (-0.25));
+  const double t229 = (-2.8e+07 + x[7]);
+  const double t230 = (1e+10 + (t229 * t229));
+  const double t231 =
+      (-t218 * t222 * 2.0412414523193154e-06 * t219 - 0.031415926535897934 * t78 * x[2] * t79 -
+       x[7] * 5e-09 - 0.031415926535897934 * x[3] * t91 * t79 + 0.07050000000000001 +
+       sqrt(t225) * 2.5e-09 - t226 * 2.0412414523193154e-06 * t223 * t228 - 2.5e-09 * sqrt(t230));
+  const double t232 = (1.0 / sqrt(t216)) * x[5];
+  const double t233 = (t232 - 1.0);
+  const double t234 = (t232 + 1.0);
+  const double t235 = 2.0 * x[7];
+  const double t236 = (-4e+05 + t235);
+  const double t237 = (x[8] - 2e+05);
+  const double t238 = (t237 * t237);
+  const double t239 = (t238 + 1e+10);
+  const double t240 = (-x[8] + u[6]);
+  const double t241 = (t240 * t240);
+  const double t242 = (4e+10 + t241);
   const double t243 = pow(t242, (-0.25));
-  const double t244 = (-2.8e+07 + x[8]);
-  const double t245 = ((t244 * t244) + 1e+10);
-  const double t246 = (-t90 * 0.03817035074111599 + 0.09980758036020113);
-  const double t247 = (1.0 / (t246));
-  const double t248 = 2.0 * x[8];
-  const double t249 = (-4e+05 + t248);
-  const double t250 = (x[9] - 2e+05);
-  const double t251 = (t250 * t250);
-  const double t252 = (1e+10 + t251);
-  const double t253 = (-x[9] + u[7]);
-  const double t254 = (t253 * t253);
-  const double t255 = (t254 + 4e+10);
-  const double t256 = pow(t255, (-0.25));
-  const double t257 = (4e+10 + t251);
+  const double t244 = (4e+10 + t238);
+  const double t245 = pow(t244, (-0.25));
+  const double t246 = (-2.8e+07 + x[8]);
+  const double t247 = ((t246 * t246) + 1e+10);
+  const double t248 = (-t103 * 0.03817035074111599 + 0.09980758036020113);
+  const double t249 = (1.0 / (t248));
+  const double t250 = 2.0 * x[8];
+  const double t251 = (-4e+05 + t250);
+  const double t252 = (0.07132964021557801 - 0.023561944901923454 * t47);
+  const double t253 = (1.0 / (t252 * t252));
+  const double t254 = (x[9] - 2e+05);
+  const double t255 = (t254 * t254);
+  const double t256 = (1e+10 + t255);
+  const double t257 = (4e+10 + t255);
   const double t258 = pow(t257, (-0.25));
-  const double t259 = (-2.8e+07 + x[9]);
-  const double t260 = ((t259 * t259) + 1e+10);
-  const double t261 =
-      (sqrt(t252) * 2.5e-09 + t253 * t221 * t256 * 2.0412414523193154e-06 - x[9] * 5e-09 -
-       t213 * 2.0412414523193154e-06 * t258 * t250 + 0.07050000000000001 - 2.5e-09 * sqrt(t260) +
-       t34 * 0.023561944901923454 * t62 * x[3] + t34 * 0.023561944901923454 * x[2] * t75);
-  const double t262 = (0.07132964021557801 - 0.023561944901923454 * t35);
-  const double t263 = (1.0 / (t262 * t262));
-  const double t264 = (1.0 / (t262));
-  const double t265 = 2.0 * x[9];
-  const double t266 = (-4e+05 + t265);
+  const double t259 = (-u[7] + x[9]);
+  const double t260 = (t259 * t259);
+  const double t261 = (t260 + 4e+10);
+  const double t262 = pow(t261, (-0.25));
+  const double t263 = (-2.8e+07 + x[9]);
+  const double t264 = ((t263 * t263) + 1e+10);
+  const double t265 =
+      (sqrt(t256) * 2.5e-09 - x[9] * 5e-09 - t218 * 2.0412414523193154e-06 * t258 * t254 +
+       t78 * 0.023561944901923454 * x[2] * t79 + 0.07050000000000001 -
+       t262 * t226 * 2.0412414523193154e-06 * t259 - 2.5e-09 * sqrt(t264) +
+       0.023561944901923454 * x[3] * t91 * t79);
+  const double t266 = (1.0 / (t252));
+  const double t267 = 2.0 * x[9];
+  const double t268 = (-4e+05 + t267);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[20] =
-      (-t113 * t115 *
-           ((t101 * 5200.0 * t116 + 3600.0 * t112 * t10 +
-             2.0 * ((t106 * t120 + t109 * t106)) * u[4] + t2 * t101 * 5200.0 +
-             3600.0 * t123 * t112)) *
+      (-t22 * t115 *
+           ((t20 * 5200.0 * t116 + 3600.0 * t9 * t19 + 2.0 * ((t16 * t120 + t13 * t16)) * u[4] +
+             t2 * t20 * 5200.0 + 3600.0 * t123 * t9)) *
            0.5 +
-       t124 * 0.5 *
-           ((t125 * t80 * t126 - t101 * 50994.579999999994 * t3 - t102 * t123 * 35303.939999999995 -
-             t34 * t80 * t141 - 50994.579999999994 * t102 * t116 +
-             2.0 * u[4] * ((-t106 * t3 * 9.80665 - t102 * t120 * 9.80665)) -
-             t112 * t3 * 35303.939999999995 - 2.0 * t142 * t100 * t143 +
-             t87 * t89 * 2.0 *
-                 ((-t87 * t89 * 2e+06 *
-                       ((t87 * t89 * t98 + t87 * t89 * t95 * pow(t96, (-1.5)) - t87 * t89 * t97 -
-                         t87 * pow(t93, (-1.5)) * t89 * t92)) *
-                       x[2] -
-                   t87 * 4e+08 * t89 - t87 * t89 * 2e+08 * t98 * t91 +
-                   t87 * t89 * 2e+08 * t97 * t94 - t99 * t89 * 2e+06 * t144 * x[2] +
-                   t99 * 2e+06 * t142 * x[2] * t143)) +
-             t89 * 2.0 * t144 * t100 - t34 * t162 * t75)));
-  jacobian[21] = (t124 *
-                      ((-t34 * t80 * t165 - t187 - t185 + t125 * t62 * t80 * t75 +
-                        2.0 * u[4] * t170 + t34 * t179 * t75)) *
-                      0.5 -
-                  t113 * t115 *
-                      ((3600.0 * t112 * t167 + ((t109 * t168 + t106 * t169)) * 2.0 * u[4] +
-                        3600.0 * t10 * t166)) *
-                      0.5);
-  jacobian[22] = ((-t180 * 2e+06 * t79 * t126 - 4000.0 - t99 * 4e+06 * t143 / (t88))) * t124 * 0.5;
-  jacobian[23] = t180 * (-1e+06) * t124 * t79 * t62 * t75;
-  jacobian[26] = t87 * t89 * t124 * 0.05089380098815465;
-  jacobian[27] = t34 * 0.031415926535897934 * t124 * t75;
-  jacobian[28] = t87 * t89 * t124 * (-0.03817035074111599);
-  jacobian[29] = t34 * t124 * (-0.023561944901923454) * t75;
+       ((-t20 * 50994.579999999994 * t23 - t114 * t123 * 35303.939999999995 -
+         50994.579999999994 * t114 * t116 - t93 * t79 * t138 - t78 * t79 * t160 +
+         t93 * t158 * t159 + 2.0 * u[4] * ((-t16 * t23 * 9.80665 - t114 * t120 * 9.80665)) -
+         t9 * t23 * 35303.939999999995 - 2.0 * t161 * t113 * t162 +
+         t100 * t102 * 2.0 *
+             ((-t100 * 4e+08 * t102 - t100 * t102 * 2e+08 * t111 * t104 +
+               t100 * t102 * 2e+08 * t110 * t107 +
+               t100 *
+                   ((t100 * t102 * t110 - t100 * t102 * t108 * pow(t109, (-1.5)) +
+                     t100 * pow(t106, (-1.5)) * t102 * t105 - t100 * t102 * t111)) *
+                   t102 * 2e+06 * x[2] -
+               t112 * t102 * 2e+06 * t163 * x[2] + t112 * 2e+06 * t161 * x[2] * t162)) +
+         t102 * 2.0 * t163 * t113)) *
+           t164 * 0.5);
+  jacobian[21] =
+      (-t22 * t115 *
+           ((3600.0 * t9 * t165 + ((t13 * t166 + t16 * t167)) * 2.0 * u[4] + 3600.0 * t19 * t168)) *
+           0.5 -
+       t164 * 0.5 * ((t78 * t180 * t79 + t181 + t182 + t183 + t93 * t179 * t79 + t184)));
+  jacobian[22] = ((-4000.0 - t112 * 4e+06 * t162 / (t101)-t56 * 2e+06 * t185 * t159)) * t164 * 0.5;
+  jacobian[23] = t56 * t78 * (-1e+06) * t164 * t91 * t185;
+  jacobian[26] = t100 * t102 * t164 * 0.05089380098815465;
+  jacobian[27] = 0.031415926535897934 * t78 * t164 * t79;
+  jacobian[28] = t100 * t102 * t164 * (-0.03817035074111599);
+  jacobian[29] = t78 * t164 * (-0.023561944901923454) * t79;
   jacobian[30] =
-      (t184 -
-       ((t185 + t34 * t159 * t80 + t186 + t187 + t34 * t162 * t62 - t125 * t62 * t80 * t75)) * 0.5 *
-           t188);
+      (-((t91 * t79 * t160 + t181 + t182 + t183 + t184 + t93 * t157 * t79)) * 0.5 * t189 + t190);
   jacobian[31] =
-      (t184 - 0.5 * t188 *
-                  ((t185 + t186 + t187 - t34 * t62 * t179 + t34 * t80 * t178 - t125 * t171 * t80)));
-  jacobian[32] = t180 * (-1e+06) * t79 * t62 * t188 * t75;
-  jacobian[33] = ((1600.0 + t180 * t171 * 2e+06 * t79)) * t188 * (-0.5);
-  jacobian[37] = t34 * 0.031415926535897934 * t62 * t188;
-  jacobian[39] = t34 * (-0.023561944901923454) * t62 * t188;
+      (-((t181 + t182 + t180 * t91 * t79 + t183 - t93 * t177 * t158 + t93 * t176 * t79)) * 0.5 *
+           t189 +
+       t190);
+  jacobian[32] = t56 * t78 * (-1e+06) * t91 * t185 * t189;
+  jacobian[33] = ((1600.0 + t56 * 2e+06 * t177 * t185)) * t189 * (-0.5);
+  jacobian[37] = 0.031415926535897934 * t91 * t189 * t79;
+  jacobian[39] = (-0.023561944901923454) * t91 * t189 * t79;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
-      (-t87 * 61072561.185785584 * t89 *
-           ((-3.3333333333333334e-09 * sqrt(t191) + 0.094 - 6.666666666666667e-09 * x[6] -
-             t87 * t89 * 0.05089380098815465 * x[2] - t194 * 2.721655269759087e-06 * t198 * t195 +
-             3.3333333333333334e-09 * sqrt(t201) + t202 * t204 * 2.721655269759087e-06 * t199)) /
-           (t189 * t189) +
-       ((t142 * 0.05089380098815465 * x[2] * t143 - t89 * 0.05089380098815465 * t144 * x[2])) *
-           1.2e+09 * t205);
-  jacobian[62] = t87 * t89 * (-61072561.185785584) * t205;
+      (-t100 * 61072561.185785584 * t102 *
+           ((-3.3333333333333334e-09 * sqrt(t193) + 0.094 - 6.666666666666667e-09 * x[6] -
+             t100 * t102 * 0.05089380098815465 * x[2] - t196 * 2.721655269759087e-06 * t200 * t197 +
+             3.3333333333333334e-09 * sqrt(t203) - t204 * t206 * 2.721655269759087e-06 * t201)) /
+           (t191 * t191) +
+       ((t161 * 0.05089380098815465 * x[2] * t162 - t102 * 0.05089380098815465 * t163 * x[2])) *
+           1.2e+09 * t207);
+  jacobian[62] = t100 * t102 * (-61072561.185785584) * t207;
   jacobian[64] =
-      ((-2.721655269759087e-06 * t198 * t195 * t207 - t208 * t204 * 2.721655269759087e-06 * t199)) *
-      1.2e+09 * t205;
-  jacobian[66] = 1.2e+09 *
-                 ((-t194 * 2.721655269759087e-06 * t198 -
-                   t210 * pow(t203, (-1.25)) * t202 * t199 * 6.804138174397718e-07 +
-                   t210 * 1.6666666666666667e-09 * (1.0 / sqrt(t201)) - 6.666666666666667e-09 -
-                   1.6666666666666667e-09 * ((-5.6e+07 + t209)) * (1.0 / sqrt(t191)) +
-                   t202 * t204 * 2.721655269759087e-06 +
-                   pow(t197, (-1.25)) * 1.3608276348795436e-06 * t196 * t194)) *
-                 t205;
-  jacobian[70] = (-t34 * 37699111.84307752 * t226 * t228 * t75 +
-                  t229 * 1.2e+09 *
-                      ((-t34 * 0.031415926535897934 * t159 * x[3] +
-                        t125 * 0.031415926535897934 * t62 * x[3] * t75 +
-                        t125 * 0.031415926535897934 * x[2] * t126 -
-                        t34 * 0.031415926535897934 * x[2] * t141)));
+      ((-2.721655269759087e-06 * t200 * t197 * t209 - t210 * t206 * 2.721655269759087e-06 * t201)) *
+      1.2e+09 * t207;
+  jacobian[66] = 1.2e+09 * t207 *
+                 ((-t204 * t206 * 2.721655269759087e-06 - t196 * 2.721655269759087e-06 * t200 +
+                   t212 * pow(t205, (-1.25)) * t204 * t201 * 6.804138174397718e-07 +
+                   t212 * 1.6666666666666667e-09 * (1.0 / sqrt(t203)) - 6.666666666666667e-09 -
+                   1.6666666666666667e-09 * ((-5.6e+07 + t211)) * (1.0 / sqrt(t193)) +
+                   pow(t199, (-1.25)) * 1.3608276348795436e-06 * t198 * t196));
+  jacobian[70] =
+      (t214 * 1.2e+09 *
+           ((-0.031415926535897934 * x[3] * t157 * t79 - 0.031415926535897934 * x[2] * t79 * t138 +
+             0.031415926535897934 * x[2] * t158 * t159 +
+             0.031415926535897934 * t78 * x[3] * t91 * t158)) -
+       t215 * t231 * t78 * 37699111.84307752 * t79);
   jacobian[71] =
-      (t229 * 1.2e+09 *
-           ((t125 * 0.031415926535897934 * t62 * x[2] * t75 -
-             t34 * 0.031415926535897934 * x[2] * t165 - t34 * 0.031415926535897934 * x[3] * t178 +
-             t125 * 0.031415926535897934 * t171 * x[3])) -
-       t34 * 37699111.84307752 * t226 * t62 * t228);
-  jacobian[72] = t34 * (-37699111.84307752) * t229 * t75;
-  jacobian[73] = t34 * (-37699111.84307752) * t229 * t62;
-  jacobian[75] = t229 * 1.2e+09 *
-                 ((-2.0412414523193154e-06 * t231 * t218 * t223 -
-                   t232 * t217 * 2.0412414523193154e-06 * t214));
-  jacobian[77] = ((-t213 * t217 * 2.0412414523193154e-06 +
-                   t234 * 5.103103630798288e-07 * pow(t222, (-1.25)) * t221 * t218 -
-                   t221 * 2.0412414523193154e-06 * t223 + (1.0 / sqrt(t220)) * t234 * 1.25e-09 +
-                   pow(t216, (-1.25)) * t213 * t215 * 1.0206207261596577e-06 -
-                   (1.0 / sqrt(t225)) * 1.25e-09 * ((-5.6e+07 + t233)) - 5e-09)) *
-                 t229 * 1.2e+09;
+      (t214 * 1.2e+09 *
+           ((-0.031415926535897934 * t176 * x[3] * t79 + 0.031415926535897934 * t177 * x[3] * t158 +
+             0.031415926535897934 * t78 * x[2] * t91 * t158 -
+             0.031415926535897934 * t179 * x[2] * t79)) -
+       t215 * t231 * 37699111.84307752 * t91 * t79);
+  jacobian[72] = (-37699111.84307752) * t214 * t78 * t79;
+  jacobian[73] = (-37699111.84307752) * t214 * t91 * t79;
+  jacobian[75] = t214 * 1.2e+09 *
+                 ((-2.0412414523193154e-06 * t233 * t223 * t228 -
+                   t234 * t222 * 2.0412414523193154e-06 * t219));
+  jacobian[77] = ((-t218 * t222 * 2.0412414523193154e-06 +
+                   t236 * 5.103103630798288e-07 * pow(t227, (-1.25)) * t226 * t223 -
+                   t226 * 2.0412414523193154e-06 * t228 + (1.0 / sqrt(t225)) * t236 * 1.25e-09 +
+                   pow(t221, (-1.25)) * t218 * t220 * 1.0206207261596577e-06 -
+                   (1.0 / sqrt(t230)) * 1.25e-09 * ((-5.6e+07 + t235)) - 5e-09)) *
+                 t214 * 1.2e+09;
   jacobian[80] =
-      (t87 * t89 * 45804420.889339186 *
-           ((t87 * t89 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
-             3.3333333333333334e-09 * sqrt(t237) - t238 * t202 * 2.721655269759087e-06 * t241 -
-             t243 * t194 * 2.721655269759087e-06 * t235 - 3.3333333333333334e-09 * sqrt(t245))) /
-           (t246 * t246) +
-       1.2e+09 * t247 *
-           ((t89 * t144 * x[2] * 0.03817035074111599 - t142 * x[2] * 0.03817035074111599 * t143)));
-  jacobian[82] = t87 * t89 * 45804420.889339186 * t247;
+      (t100 *
+           ((t100 * t102 * x[2] * 0.03817035074111599 + 0.094 - 6.666666666666667e-09 * x[8] +
+             3.3333333333333334e-09 * sqrt(t239) + t240 * t204 * 2.721655269759087e-06 * t243 -
+             t245 * t196 * 2.721655269759087e-06 * t237 - 3.3333333333333334e-09 * sqrt(t247))) *
+           t102 * 45804420.889339186 / (t248 * t248) +
+       1.2e+09 * t249 *
+           ((t102 * t163 * x[2] * 0.03817035074111599 - t161 * x[2] * 0.03817035074111599 * t162)));
+  jacobian[82] = t100 * t102 * 45804420.889339186 * t249;
   jacobian[84] =
-      1.2e+09 * t247 *
-      ((-t243 * 2.721655269759087e-06 * t207 * t235 + t238 * t208 * 2.721655269759087e-06 * t241));
-  jacobian[88] =
-      1.2e+09 *
-      ((t202 * 2.721655269759087e-06 * t241 -
-        1.6666666666666667e-09 * (1.0 / sqrt(t245)) * ((-5.6e+07 + t248)) -
-        t243 * t194 * 2.721655269759087e-06 + t249 * 1.6666666666666667e-09 * (1.0 / sqrt(t237)) -
-        6.666666666666667e-09 - 1.3608276348795436e-06 * t202 * pow(t240, (-1.25)) * t239 +
-        t249 * t194 * t235 * pow(t242, (-1.25)) * 6.804138174397718e-07)) *
-      t247;
-  jacobian[90] =
-      (t34 * 28274333.882308144 * t261 * t263 * t75 +
-       t264 * 1.2e+09 *
-           ((t34 * 0.023561944901923454 * x[2] * t141 - t125 * 0.023561944901923454 * x[2] * t126 -
-             t125 * 0.023561944901923454 * t62 * x[3] * t75 +
-             t34 * 0.023561944901923454 * t159 * x[3])));
+      1.2e+09 * t249 *
+      ((-t245 * 2.721655269759087e-06 * t209 * t237 + t240 * t210 * 2.721655269759087e-06 * t243));
+  jacobian[88] = ((-1.6666666666666667e-09 * (1.0 / sqrt(t247)) * ((-5.6e+07 + t250)) -
+                   t245 * t196 * 2.721655269759087e-06 - t204 * 2.721655269759087e-06 * t243 +
+                   1.3608276348795436e-06 * pow(t242, (-1.25)) * t204 * t241 +
+                   t251 * 1.6666666666666667e-09 * (1.0 / sqrt(t239)) - 6.666666666666667e-09 +
+                   t251 * t196 * t237 * pow(t244, (-1.25)) * 6.804138174397718e-07)) *
+                 1.2e+09 * t249;
+  jacobian[90] = (t78 * 28274333.882308144 * t253 * t265 * t79 +
+                  t266 * 1.2e+09 *
+                      ((0.023561944901923454 * x[2] * t79 * t138 -
+                        t78 * 0.023561944901923454 * x[3] * t91 * t158 +
+                        0.023561944901923454 * x[3] * t157 * t79 -
+                        0.023561944901923454 * x[2] * t158 * t159)));
   jacobian[91] =
-      (t34 * 28274333.882308144 * t261 * t263 * t62 +
-       t264 *
-           ((t34 * 0.023561944901923454 * x[2] * t165 + t34 * 0.023561944901923454 * x[3] * t178 -
-             t125 * 0.023561944901923454 * t62 * x[2] * t75 -
-             t125 * t171 * 0.023561944901923454 * x[3])) *
-           1.2e+09);
-  jacobian[92] = t34 * t264 * 28274333.882308144 * t75;
-  jacobian[93] = t34 * t264 * 28274333.882308144 * t62;
-  jacobian[95] = ((-t232 * 2.0412414523193154e-06 * t258 * t250 +
-                   t253 * t256 * 2.0412414523193154e-06 * t231)) *
-                 t264 * 1.2e+09;
-  jacobian[99] =
-      t264 * 1.2e+09 *
-      ((t266 * t213 * 5.103103630798288e-07 * pow(t257, (-1.25)) * t250 -
-        (1.0 / sqrt(t260)) * 1.25e-09 * ((-5.6e+07 + t265)) - t221 * t256 * 2.0412414523193154e-06 +
-        t254 * pow(t255, (-1.25)) * t221 * 1.0206207261596577e-06 +
-        t266 * (1.0 / sqrt(t252)) * 1.25e-09 - t213 * 2.0412414523193154e-06 * t258 - 5e-09));
+      (t266 * 1.2e+09 *
+           ((0.023561944901923454 * t179 * x[2] * t79 + t176 * 0.023561944901923454 * x[3] * t79 -
+             0.023561944901923454 * t177 * x[3] * t158 -
+             t78 * 0.023561944901923454 * x[2] * t91 * t158)) +
+       28274333.882308144 * t253 * t91 * t265 * t79);
+  jacobian[92] = t78 * t266 * 28274333.882308144 * t79;
+  jacobian[93] = t266 * 28274333.882308144 * t91 * t79;
+  jacobian[95] = t266 * 1.2e+09 *
+                 ((-t262 * 2.0412414523193154e-06 * t233 * t259 -
+                   t234 * 2.0412414523193154e-06 * t258 * t254));
+  jacobian[99] = t266 * 1.2e+09 *
+                 ((-t262 * t226 * 2.0412414523193154e-06 +
+                   t268 * t218 * 5.103103630798288e-07 * pow(t257, (-1.25)) * t254 -
+                   (1.0 / sqrt(t264)) * 1.25e-09 * ((-5.6e+07 + t267)) +
+                   t268 * (1.0 / sqrt(t256)) * 1.25e-09 - t218 * 2.0412414523193154e-06 * t258 +
+                   t260 * t226 * pow(t261, (-1.25)) * 1.0206207261596577e-06 - 5e-09));
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <ostream>
 #include <set>
 
+#include "codegen/compile_library.h"
 #include "codegen/emitter.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
@@ -129,6 +130,12 @@ int Generate(const GenerateRequest& request, std::ostream& out, std::ostream& er
   } catch (const std::exception& e) {
     err << "codegen: " << e.what() << '\n';
     return 1;
+  }
+  if (request.compile) {
+    CompileOptions options;
+    options.cache_root = request.cache_root;
+    options.expected_abi = request.expected_abi;
+    return CompileGenerated(machines, request.output_dir, options, out, err);
   }
   return 0;
 }

@@ -16,6 +16,11 @@ struct GenerateRequest {
   /// Remove machine folders of `output_dir` that no requested description produced (used by
   /// the `regen` target so that a deleted description leaves no stale code behind).
   bool clean = false;
+  /// Also compile each machine into a machine library in the per-user cache (`autoshovel gen`;
+  /// codegen/compile_library.h). The `regen` target does not: generated/ is compiled in.
+  bool compile = false;
+  std::filesystem::path cache_root;  ///< empty: the default cache (machine_cache.h)
+  std::string expected_abi;          ///< CompileOptions::expected_abi
 };
 
 /// Machine descriptions under a models/ folder: every `*.yaml` except in materials/ and

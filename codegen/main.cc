@@ -13,13 +13,18 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: autoshovel-codegen [--clean] [--materials DIR] -o OUTPUT_DIR "
+    "usage: autoshovel-codegen [--clean] [--compile [--cache DIR]] [--materials DIR] -o OUTPUT_DIR "
     "(--models MODELS_DIR | DESCRIPTION.yaml...)\n"
     "  Validates machine descriptions and writes their generated C++ to OUTPUT_DIR/<machine>/,\n"
     "  then rewrites OUTPUT_DIR's registry and CMakeLists.txt.\n"
     "  --models DIR     every description under DIR (except materials/ and scenarios/)\n"
     "  --materials DIR  material files (default: <description dir>/../materials)\n"
-    "  --clean          remove machine folders no description produced\n";
+    "  --clean          remove machine folders no description produced\n"
+    "  --compile        also compile each machine into a machine library in the per-user cache\n"
+    "                   ($CXX or c++; see runtime/machines/machine_cache.h), as `autoshovel gen`\n"
+    "  --cache DIR      machine library cache (default: $AUTOSHOVEL_MACHINE_CACHE, else\n"
+    "                   ${XDG_CACHE_HOME:-~/.cache}/autoshovel/machines)\n"
+    "  --expect-abi TAG the ABI tag of the autoshovel that will load the library (gen passes it)\n";
 
 // GiNaC orders the terms of sums and products by hashes that mix in the addresses of its type
 // information, so with address-space randomisation every run prints a different (equivalent)
@@ -62,6 +67,12 @@ int main(int argc, char** argv) {
       request.materials_dir = value("--materials");
     } else if (arg == "--clean") {
       request.clean = true;
+    } else if (arg == "--compile") {
+      request.compile = true;
+    } else if (arg == "--cache") {
+      request.cache_root = value("--cache");
+    } else if (arg == "--expect-abi") {
+      request.expected_abi = value("--expect-abi");
     } else if (!arg.empty() && arg[0] == '-') {
       std::cerr << "unknown option " << arg << "\n" << kUsage;
       return 2;

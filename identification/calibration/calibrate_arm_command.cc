@@ -13,6 +13,7 @@
 #include "identification/common/overlay_file.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/file_output.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 #include "runtime/model/interpreted_model.h"
 #include "runtime/plot/bar_chart.h"
@@ -84,9 +85,11 @@ int RunCalibrateArm(const CalibrateArmOptions& options, std::ostream& out, std::
       out << "simulated measurements: " << options.simulate << "\n";
       return 0;
     }
-    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-    if (functions == nullptr) {
-      err << "autoshovel calibrate arm: machine '" << machine.name << "' has no generated code\n";
+    const generated::MachineFunctions* functions = nullptr;
+    try {
+      functions = &machines::MachineFunctionsFor(machine);
+    } catch (const machines::MachineCodeError& e) {
+      err << "autoshovel calibrate arm: " << e.what() << "\n";
       return 2;
     }
     if (machine.swing) {

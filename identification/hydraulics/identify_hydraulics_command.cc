@@ -18,6 +18,7 @@
 #include "identification/hydraulics/plant_logs.h"
 #include "identification/hydraulics/residual_plot.h"
 #include "runtime/core/diagnostics.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 
 namespace autoshovel::identification {
@@ -244,11 +245,11 @@ int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream
   try {
     const model::MachineDescription machine = model::LoadMachineDescription(
         model::ResolveMachineDescription(options.machine, options.models_dir));
-    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-    if (functions == nullptr) {
-      err << kName << ": machine '" << machine.name
-          << "' has no generated code: run `autoshovel gen " << machine.source_file
-          << "` and rebuild\n";
+    const generated::MachineFunctions* functions = nullptr;
+    try {
+      functions = &machines::MachineFunctionsFor(machine);
+    } catch (const machines::MachineCodeError& e) {
+      err << kName << ": " << e.what() << "\n";
       return 2;
     }
     if (!options.actuator.empty() && FindActuator(machine, options.actuator) < 0) {

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "generated/registry.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/scenario.h"
@@ -309,8 +310,12 @@ YardViewSampler::YardViewSampler(const std::string& models_dir,
   for (const std::string& path : model::FindMachineDescriptions(models_dir)) {
     model::MachineDescription d = model::LoadMachineDescription(path);
     if (d.kind != model::MachineKind::kWheelLoader) continue;
-    const generated::MachineFunctions* f = generated::FindMachine(d.name);
-    if (f == nullptr || d.sha256 != f->source_sha256) continue;  // Plant would refuse it
+    const generated::MachineFunctions* f = nullptr;
+    try {
+      f = &machines::MachineFunctionsFor(d);  // compiled in, its library, or interpreted
+    } catch (const machines::MachineCodeError&) {
+      continue;  // no code it may run: not a yard this sampler can simulate
+    }
     data_->machines.push_back({std::move(d), f});
   }
   std::vector<std::string> files;

@@ -16,6 +16,7 @@
 #include "identification/weights/weight_tuning.h"
 #include "runtime/core/file_output.h"
 #include "runtime/core/progress_line.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 
 namespace autoshovel::identification {
@@ -125,10 +126,16 @@ int RunTrainWeights(const TrainWeightsOptions& o, std::ostream& out, std::ostrea
     }
     const model::MachineDescription machine =
         model::LoadMachineDescription(model::ResolveMachineDescription(o.machine, o.models_dir));
-    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-    if (functions == nullptr || machine.swing) {
+    if (machine.swing) {
       err << kCommand << ": '" << machine.name
-          << "' is not a wheel loader with generated code; shovel points are for loaders\n";
+          << "' is not a wheel loader; shovel points are for loaders\n";
+      return 2;
+    }
+    const generated::MachineFunctions* functions = nullptr;
+    try {
+      functions = &machines::MachineFunctionsFor(machine);
+    } catch (const machines::MachineCodeError& e) {
+      err << kCommand << ": " << e.what() << "\n";
       return 2;
     }
     const planning::LoaderGeometry loader = planning::LoaderGeometryFrom(machine, *functions);

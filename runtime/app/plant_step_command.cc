@@ -11,6 +11,7 @@
 #include "generated/registry.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/file_output.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 #include "runtime/plant/plant.h"
 
@@ -37,11 +38,11 @@ int RunPlantStep(const PlantStepOptions& options, std::ostream& out, std::ostrea
   try {
     const model::MachineDescription machine = model::LoadMachineDescription(
         model::ResolveMachineDescription(options.machine, options.models_dir));
-    const generated::MachineFunctions* functions = generated::FindMachine(machine.name);
-    if (functions == nullptr) {
-      err << "autoshovel plant step: machine '" << machine.name
-          << "' has no generated code: run `autoshovel gen " << machine.source_file
-          << "` and rebuild\n";
+    const generated::MachineFunctions* functions = nullptr;
+    try {
+      functions = &machines::MachineFunctionsFor(machine);
+    } catch (const machines::MachineCodeError& e) {
+      err << "autoshovel plant step: " << e.what() << "\n";
       return 2;
     }
     int actuator = -1;

@@ -4,6 +4,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "runtime/machines/machine_code.h"
+
 namespace autoshovel::plant {
 
 std::vector<double> BucketOnFloor(const model::MachineDescription& machine, double tip_height) {
@@ -32,12 +34,8 @@ ScenarioWithMachine LoadScenarioWithMachine(const std::string& scenario_name_or_
   if (!machine_name_or_path.empty()) out.scenario.machine = machine_name_or_path;
   out.machine = model::LoadMachineDescription(
       model::ResolveMachineDescription(out.scenario.machine, models_dir));
-  out.functions = generated::FindMachine(out.machine.name);
-  if (out.functions == nullptr) {
-    throw std::runtime_error("machine '" + out.machine.name +
-                             "' has no generated code (run: autoshovel gen " +
-                             out.machine.source_file + ", then rebuild)");
-  }
+  // Compiled in, else its machine library, else interpreted (runtime/machines/machine_code.h).
+  out.functions = &machines::MachineFunctionsFor(out.machine);
   return out;
 }
 

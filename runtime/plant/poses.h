@@ -25,9 +25,10 @@ struct ScenarioWithMachine {
 };
 
 /// Loads a scenario (name under `<models_dir>/scenarios` or a path) and its machine, or the
-/// machine `machine_name_or_path` instead when it is not empty. Throws
-/// core::InputError for bad files and std::runtime_error when the machine has no generated
-/// code (naming the command that generates it).
+/// machine `machine_name_or_path` instead when it is not empty. The machine's functions come
+/// from machines::MachineFunctionsFor (compiled in, its machine library, or interpreted). Throws
+/// core::InputError for bad files and std::runtime_error (machines::MachineCodeError) when the
+/// machine has no code it may run (naming the command that builds it).
 ScenarioWithMachine LoadScenarioWithMachine(const std::string& scenario_name_or_path,
                                             const std::string& models_dir,
                                             const std::string& machine_name_or_path = "");

@@ -13,8 +13,23 @@ cp -r "$source_dir/models/materials" "$work/models/"
 sed -e 's/^name: xcmg_968ev/name: test_loader_new/' \
     -e 's/length: 1.295 .*/length: 1.40/' \
     "$source_dir/models/loaders/xcmg_968ev.yaml" > "$work/models/loaders/test_loader_new.yaml"
+# gen also compiles a machine library (issue 39): into a cache of this test's own.
+export AUTOSHOVEL_MACHINE_CACHE="$work/cache"
 "$autoshovel" gen "$work/models/loaders/test_loader_new.yaml" -o "$work/generated"
 test -f "$work/generated/test_loader_new/test_loader_new.cc"
+# ... which every command loads, given the file: no rebuild.
+described=$("$autoshovel" describe "$work/models/loaders/test_loader_new.yaml")
+grep -q "generated     machine library $work/cache/[0-9a-f]\{64\}/libtest_loader_new.so" <<<"$described"
+"$autoshovel" plant step --machine "$work/models/loaders/test_loader_new.yaml" \
+  --duration 1 -o "$work/step.csv" >/dev/null
+grep -q "machine test_loader_new" "$work/step.csv"
+# A library whose bytes changed since gen is refused with the reason.
+printf 'x' >> "$work"/cache/*/libtest_loader_new.so
+if "$autoshovel" plant step --machine "$work/models/loaders/test_loader_new.yaml" \
+     -o "$work/step2.csv" 2>"$work/refused.txt"; then
+  echo "a tampered machine library was loaded"; exit 1
+fi
+grep -q "refused: tampered" "$work/refused.txt"
 head -1 "$work/generated/test_loader_new/test_loader_new.h" | grep -q "models/loaders/test_loader_new.yaml"
 cat > "$work/driver.cc" <<'CPP'
 #include <cmath>

@@ -26,6 +26,7 @@
 #include "runtime/control/excavator/loading_script.h"
 #include "runtime/control/excavator/obstacle_lookahead.h"
 #include "runtime/control/excavator/script_parameters.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 #include "runtime/planning/dig/coarse_dig_planner.h"
 #include "runtime/planning/dig/refined_dig_planner.h"
@@ -334,11 +335,7 @@ TruckLoadingJob::TruckLoadingJob(const TruckLoadingOptions& options)
     throw std::invalid_argument("truck_loading: scenario " + s.scenario.name + " names " +
                                 s.machine.name + ", which is not an excavator");
   }
-  s.functions = generated::FindMachine(s.machine.name);
-  if (s.functions == nullptr) {
-    throw std::runtime_error("truck_loading: no generated code for " + s.machine.name +
-                             " (run `autoshovel gen`)");
-  }
+  s.functions = &machines::MachineFunctionsFor(s.machine);  // throws naming what to run
   s.kinematics = std::make_unique<control::ExcavatorKinematics>(s.machine, *s.functions);
   s.derivation = control::DeriveJointModels(
       s.machine, *s.functions, control::DefaultReferencePose(), s.machine.bucket.rated_load);

@@ -193,6 +193,14 @@ MachineTexts MachineCode(const model::MachineDescription& m) {
        "/// Plant right-hand side xdot = f(t, x, u) and its Jacobian df/dx (row-major).\n"
        "void PlantRhs(double t, const double* x, const double* u, double* xdot);\n"
        "void PlantJacobian(double t, const double* x, const double* u, double* jacobian);\n"
+       "/// Mass matrix M(q) (J x J, row-major) with a payload [kg] in the bucket.\n"
+       "void MassMatrix(const double* q, double payload, double* mass);\n"
+       "/// Coriolis and centrifugal terms minus gravity: M q'' + bias = actuator + external.\n"
+       "void BiasForces(const double* q, const double* qd, double payload, double pitch, "
+       "double* bias);\n"
+       "/// [kinetic, potential] energy of the arm [J].\n"
+       "void MechanicalEnergy(const double* q, const double* qd, double payload, double pitch, "
+       "double* energy);\n"
        "/// Everything above behind the common interface of the registry.\n"
        "const MachineFunctions& Functions();\n\n"
     << "}  // namespace autoshovel::generated::" << ns << "\n";
@@ -275,11 +283,84 @@ MachineTexts MachineCode(const model::MachineDescription& m) {
        "    if (high - low < 1e-15) break;\n  }\n"
        "  q_out[joint] = angle;\n  return 0;\n}\n\n";
 
-  c << "void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {\n"
-    << kUsingMath << PrintAssignments(Assign("xdot", s.rhs), "double") << "}\n\n";
-  c << "void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {\n"
-    << kUsingMath << "  std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);\n"
-    << PrintAssignments(Assign("jacobian", s.jacobian, /*skip_zero=*/true), "double") << "}\n\n";
+  // The accelerations solve M q̈ = force with the symmetric positive definite mass matrix of
+  // the chain: a J ≤ 4 Cholesky factorisation, cheaper and smaller than a symbolic inverse.
+  c << "namespace {\n\n"
+       "// In place: the lower triangle of `mass` becomes L with M = L L^T.\n"
+       "void Factor(double* mass) {\n"
+       "  for (int j = 0; j < kNumJoints; ++j) {\n"
+       "    double d = mass[j * kNumJoints + j];\n"
+       "    for (int k = 0; k < j; ++k) d -= mass[j * kNumJoints + k] * mass[j * kNumJoints + k];\n"
+       "    const double l = std::sqrt(d);\n    mass[j * kNumJoints + j] = l;\n"
+       "    for (int i = j + 1; i < kNumJoints; ++i) {\n"
+       "      double v = mass[i * kNumJoints + j];\n"
+       "      for (int k = 0; k < j; ++k) v -= mass[i * kNumJoints + k] * mass[j * kNumJoints + "
+       "k];\n"
+       "      mass[i * kNumJoints + j] = v / l;\n    }\n  }\n}\n\n"
+       "// Solves L L^T y = b in place.\n"
+       "void Solve(const double* factor, double* b) {\n"
+       "  for (int i = 0; i < kNumJoints; ++i) {\n"
+       "    for (int k = 0; k < i; ++k) b[i] -= factor[i * kNumJoints + k] * b[k];\n"
+       "    b[i] /= factor[i * kNumJoints + i];\n  }\n"
+       "  for (int i = kNumJoints - 1; i >= 0; --i) {\n"
+       "    for (int k = i + 1; k < kNumJoints; ++k) b[i] -= factor[k * kNumJoints + i] * b[k];\n"
+       "    b[i] /= factor[i * kNumJoints + i];\n  }\n}\n\n}  // namespace\n\n";
+  {
+    std::vector<Assignment> all;
+    for (int i = 0; i < s.num_states; ++i) {
+      if (i >= s.num_joints && i < 2 * s.num_joints) continue;
+      all.push_back({"xdot[" + std::to_string(i) + "]", s.rhs[i]});
+    }
+    for (auto& a : Assign("mass", s.mass_matrix)) all.push_back(a);
+    for (auto& a : Assign("acceleration", s.force)) all.push_back(a);
+    c << "void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {\n"
+      << kUsingMath << "  double mass[kNumJoints * kNumJoints];\n"
+      << "  double acceleration[kNumJoints];\n"
+      << PrintAssignments(all, "double") << "  Factor(mass);\n  Solve(mass, acceleration);\n"
+      << "  std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);\n}\n\n";
+  }
+  {
+    // d q̈/dx = M⁻¹ (∂force/∂x − Σ_k ∂M/∂q_k q̈ [x = q_k]).
+    std::vector<Assignment> all = Assign("jacobian", s.jacobian, /*skip_zero=*/true);
+    for (auto& a : Assign("mass", s.mass_matrix)) all.push_back(a);
+    for (auto& a : Assign("acceleration", s.force)) all.push_back(a);
+    for (auto& a : Assign("d_force", s.d_force_d_x, /*skip_zero=*/true)) all.push_back(a);
+    for (auto& a : Assign("d_mass", s.d_mass_d_q, /*skip_zero=*/true)) all.push_back(a);
+    c << "void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {\n"
+      << kUsingMath << "  std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);\n"
+      << "  double mass[kNumJoints * kNumJoints];\n  double acceleration[kNumJoints];\n"
+      << "  double d_force[kNumJoints * kNumStates] = {};\n"
+      << "  double d_mass[kNumJoints * kNumJoints * kNumJoints] = {};\n"
+      << PrintAssignments(all, "double") << "  Factor(mass);\n  Solve(mass, acceleration);\n"
+      << "  for (int c = 0; c < kNumStates; ++c) {\n"
+         "    double column[kNumJoints];\n"
+         "    for (int j = 0; j < kNumJoints; ++j) {\n"
+         "      column[j] = d_force[j * kNumStates + c];\n"
+         "      if (c < kNumJoints) {\n"
+         "        for (int k = 0; k < kNumJoints; ++k) {\n"
+         "          column[j] -= d_mass[(c * kNumJoints + j) * kNumJoints + k] * acceleration[k];\n"
+         "        }\n      }\n    }\n"
+         "    Solve(mass, column);\n"
+         "    for (int j = 0; j < kNumJoints; ++j) jacobian[(kNumJoints + j) * kNumStates + c] = "
+         "column[j];\n  }\n}\n\n";
+  }
+  // The rigid-body terms on their own, for controllers and the dynamics tests.
+  c << "void MassMatrix(const double* q, double payload, double* mass) {\n"
+    << kUsingMath << "  double x[kNumStates] = {};\n  double u[kNumInputs] = {};\n"
+    << "  std::copy(q, q + kNumJoints, x);\n  u[2 * kNumJoints] = payload;\n"
+    << PrintAssignments(Assign("mass", s.mass_matrix), "double") << "}\n\n";
+  c << "void BiasForces(const double* q, const double* qd, double payload, double pitch, "
+       "double* bias) {\n"
+    << kUsingMath << "  double x[kNumStates] = {};\n  double u[kNumInputs] = {};\n"
+    << "  std::copy(q, q + kNumJoints, x);\n  std::copy(qd, qd + kNumJoints, x + kNumJoints);\n"
+    << "  u[2 * kNumJoints] = payload;\n  u[2 * kNumJoints + 1] = pitch;\n"
+    << PrintAssignments(Assign("bias", s.bias), "double") << "}\n\n";
+  c << "void MechanicalEnergy(const double* q, const double* qd, double payload, double pitch, "
+       "double* energy) {\n"
+    << kUsingMath << "  double x[kNumStates] = {};\n  double u[kNumInputs] = {};\n"
+    << "  std::copy(q, q + kNumJoints, x);\n  std::copy(qd, qd + kNumJoints, x + kNumJoints);\n"
+    << "  u[2 * kNumJoints] = payload;\n  u[2 * kNumJoints + 1] = pitch;\n"
+    << PrintAssignments(Assign("energy", s.energy), "double") << "}\n\n";
 
   c << "namespace {\n\nvoid Residual(const double* angles_i, const double* angles_j, const double* "
        "measured,\n              const double* params, double* residual) {\n"
@@ -295,7 +376,8 @@ MachineTexts MachineCode(const model::MachineDescription& m) {
        "kNumActuators,\n"
     << "      kNominalParams, kJointMin, kJointMax, kActuatorJoint,\n"
     << "      &Forward, &ForwardKinematicsJacobians, &InverseKinematics, &CylinderLength, "
-       "&LeverArm,\n      &JointFromCylinderLength, &PlantRhs, &PlantJacobian, &Residual};\n"
+       "&LeverArm,\n      &JointFromCylinderLength, &PlantRhs, &PlantJacobian, &Residual, "
+       "&MassMatrix,\n      &BiasForces, &MechanicalEnergy};\n"
     << "  return functions;\n}\n\n"
     << "}  // namespace autoshovel::generated::" << ns << "\n";
   return {h.str(), c.str()};
@@ -331,6 +413,15 @@ std::string InterfaceHeader() {
          "  void (*tip_displacement_residual)(const double* angles_i, const double* angles_j,\n"
          "                                    const double* measured, const double* params,\n"
          "                                    double* residual);\n"
+         "  // Rigid-body dynamics of the arm: M(q) q'' + bias(q, q') = actuator + external "
+         "forces.\n"
+         "  void (*mass_matrix)(const double* q, double payload, double* mass);  // J x J\n"
+         "  void (*bias_forces)(const double* q, const double* qd, double payload, double "
+         "pitch,\n"
+         "                      double* bias);  // Coriolis, centrifugal, minus gravity\n"
+         "  void (*mechanical_energy)(const double* q, const double* qd, double payload, double "
+         "pitch,\n"
+         "                            double* energy);  // [kinetic, potential]\n"
          "};\n\n}  // namespace autoshovel::generated\n";
 }
 

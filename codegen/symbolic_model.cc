@@ -56,23 +56,33 @@ Frames LinkFrames(const MachineDescription& m, const std::vector<ex>& q) {
   return f;
 }
 
+// The rocker of link `link`'s four-bar: its pivot E in M and its angle (towards F). Four-bar
+// closure: F lies at distance r from E and c from the child's coupler point G.
+struct RockerPose {
+  P2 pivot, far_end, coupler_point;
+  ex angle;
+};
+
+RockerPose Rocker(const MachineDescription& m, int link, const Frames& f) {
+  const model::FourBarLinkage& bar = *m.links[link].linkage;
+  const P2 e = f.origins[link - 1] + Rotate(f.angles[link - 1], bar.rocker_pivot);
+  const P2 g = f.origins[link] + Rotate(f.angles[link], bar.child_coupler_point);
+  const P2 eg = g - e;
+  const ex d2 = eg.x * eg.x + eg.z * eg.z;
+  const ex d = GiNaC::sqrt(d2);
+  const double r = bar.rocker_length, c = bar.coupler_length;
+  const ex a = (r * r - c * c + d2) / (2 * d);
+  const ex h = bar.assembly_branch * GiNaC::sqrt(r * r - a * a);
+  const P2 f_point{e.x + (a * eg.x - h * eg.z) / d, e.z + (a * eg.z + h * eg.x) / d};
+  return {e, f_point, g, GiNaC::atan2(f_point.z - e.z, f_point.x - e.x)};
+}
+
 P2 MountPoint(const MachineDescription& m, const model::Mount& mount, int joint_link,
               const Frames& f) {
   if (mount.body == "chassis") return Constant(mount.point);
   if (mount.body == "rocker") {
-    // Four-bar closure: F at distance r from the rocker pivot E and c from the bucket point G.
-    const model::FourBarLinkage& bar = *m.links[joint_link].linkage;
-    const P2 e = f.origins[joint_link - 1] + Rotate(f.angles[joint_link - 1], bar.rocker_pivot);
-    const P2 g = f.origins[joint_link] + Rotate(f.angles[joint_link], bar.child_coupler_point);
-    const P2 eg = g - e;
-    const ex d2 = eg.x * eg.x + eg.z * eg.z;
-    const ex d = GiNaC::sqrt(d2);
-    const double r = bar.rocker_length, c = bar.coupler_length;
-    const ex a = (r * r - c * c + d2) / (2 * d);
-    const ex h = bar.assembly_branch * GiNaC::sqrt(r * r - a * a);
-    const P2 f_point{e.x + (a * eg.x - h * eg.z) / d, e.z + (a * eg.z + h * eg.x) / d};
-    const ex rocker_angle = GiNaC::atan2(f_point.z - e.z, f_point.x - e.x);
-    return e + Rotate(rocker_angle, mount.point);
+    const RockerPose rocker = Rocker(m, joint_link, f);
+    return rocker.pivot + Rotate(rocker.angle, mount.point);
   }
   const int k = m.LinkIndex(mount.body);
   return f.origins[k] + Rotate(f.angles[k], mount.point);
@@ -167,55 +177,153 @@ void BuildCylinders(const MachineDescription& m, SymbolicMachine& s) {
   }
 }
 
-void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
-  const int J = s.num_joints, n = s.num_links;
-  std::vector<ex> q(s.x.begin(), s.x.begin() + J);
-  const std::vector<ex> qd(s.x.begin() + J, s.x.begin() + 2 * J);
-  const ex payload = s.u[2 * J], pitch = s.u[2 * J + 1];
-  const Frames f = LinkFrames(m, q);
-  const Eigen::Vector2d payload_center = model::BucketPayloadCenter(m);
+// Every moving body of the arm as a planar rigid body: its centre of mass in M, its angle,
+// mass and inertia about the centre of mass. Links, the payload riding on the last link, the
+// rocker and coupler of each four-bar, and each cylinder's barrel and rod (a body without mass
+// is left out). Positions are functions of the driven joints q alone: the passive angles of the
+// closed chains are solved in closed form (Rocker), so the Lagrangian below is already
+// projected onto the independent coordinates.
+struct Body {
+  P2 center;
+  ex angle;
+  ex mass;
+  double inertia;
+};
 
-  // Bodies: link centres of mass and the payload point on the last link.
-  struct Body {
-    P2 center;
-    ex angle;
-    ex mass;
-    double inertia;
-  };
+std::vector<Body> MovingBodies(const MachineDescription& m, const std::vector<ex>& q,
+                               const ex& payload) {
+  const int n = static_cast<int>(m.links.size());
+  const Frames f = LinkFrames(m, q);
   std::vector<Body> bodies;
   for (int k = 0; k < n; ++k) {
-    bodies.push_back({f.origins[k] + Rotate(f.angles[k], m.links[k].center_of_mass), f.angles[k],
-                      m.links[k].mass, m.links[k].inertia});
+    const model::Link& link = m.links[k];
+    bodies.push_back({f.origins[k] + Rotate(f.angles[k], link.center_of_mass), f.angles[k],
+                      link.mass, link.inertia});
   }
-  bodies.push_back(
-      {f.origins[n - 1] + Rotate(f.angles[n - 1], payload_center), f.angles[n - 1], payload, 0.0});
+  bodies.push_back({f.origins[n - 1] + Rotate(f.angles[n - 1], model::BucketPayloadCenter(m)),
+                    f.angles[n - 1], payload, 0.0});
+  for (int k = 1; k < n; ++k) {
+    if (!m.links[k].linkage) continue;
+    const model::FourBarLinkage& bar = *m.links[k].linkage;
+    const RockerPose rocker = Rocker(m, k, f);
+    if (bar.rocker_mass > 0) {
+      bodies.push_back({rocker.pivot + Rotate(rocker.angle, bar.rocker_center_of_mass),
+                        rocker.angle, bar.rocker_mass, bar.rocker_inertia});
+    }
+    if (bar.coupler_mass > 0) {
+      const P2 fg = rocker.coupler_point - rocker.far_end;
+      bodies.push_back({Scale(ex(1) / 2, rocker.far_end + rocker.coupler_point),
+                        GiNaC::atan2(fg.z, fg.x), bar.coupler_mass, bar.coupler_inertia});
+    }
+  }
+  for (const model::Actuator& a : m.hydraulics.actuators) {
+    if (a.kind != ActuatorKind::kCylinder || (a.barrel_mass <= 0 && a.rod_mass <= 0)) continue;
+    const int joint_link = m.LinkIndex(a.joint);
+    const P2 base = MountPoint(m, a.base_mount, joint_link, f);
+    const P2 rod = MountPoint(m, a.rod_mount, joint_link, f);
+    const P2 axis = rod - base;
+    const ex length = Norm(axis);
+    const ex angle = GiNaC::atan2(axis.z, axis.x);
+    // Each part as a slender uniform bar of twice its centre's distance from its pin.
+    if (a.barrel_mass > 0) {
+      bodies.push_back({base + Scale(a.barrel_center / length, axis), angle,
+                        a.count * a.barrel_mass,
+                        a.count * a.barrel_mass * a.barrel_center * a.barrel_center / 3});
+    }
+    if (a.rod_mass > 0) {
+      bodies.push_back({rod - Scale(a.rod_center / length, axis), angle, a.count * a.rod_mass,
+                        a.count * a.rod_mass * a.rod_center * a.rod_center / 3});
+    }
+  }
+  return bodies;
+}
 
-  // Potential energy V = −Σ m g_M·c, gravity in M for a frame pitched by `pitch`.
+// Rigid-body dynamics from the Lagrangian L = T − V of every moving body:
+//   T = ½ Σ_b (m_b |ċ_b|² + I_b φ̇_b²) [+ ½ (I_swing + Σ_b m_b r_b²) ψ̇² on an excavator, with
+//   r_b the body's distance from the swing axis], V = −Σ_b m_b g_M·c_b,
+// gives M(q) q̈ + h(q, q̇) − Q_g(q) = τ with M = Σ m J_cᵀJ_c + I J_φᵀJ_φ, the velocity-product
+// terms h = Σ m J_cᵀ(J̇_c q̇) + I J_φᵀ(J̇_φ q̇) (Coriolis and centrifugal; J̇q̇ is the second
+// directional derivative of the position along q̇) plus the swing's centrifugal and Coriolis
+// couplings, and Q_g = −∂V/∂q.
+void BuildRigidBodyDynamics(const MachineDescription& m, SymbolicMachine& s,
+                            std::vector<ex>& gravity_force) {
+  const int J = s.num_joints, n = s.num_links;
+  const std::vector<ex> q(s.x.begin(), s.x.begin() + J);
+  const std::vector<ex> qd(s.x.begin() + J, s.x.begin() + 2 * J);
+  const ex payload = s.u[2 * J], pitch = s.u[2 * J + 1];
+  const std::vector<Body> bodies = MovingBodies(m, q, payload);
+
   const P2 gravity{-model::plant::kGravity * GiNaC::sin(pitch),
                    -model::plant::kGravity * GiNaC::cos(pitch)};
   ex potential = 0;
   for (const Body& b : bodies)
     potential -= b.mass * (gravity.x * b.center.x + gravity.z * b.center.z);
 
-  std::vector<ex> generalized(J), inertia(J);
-  for (int j = 0; j < J; ++j) {
-    generalized[j] = j < n ? -potential.diff(s.x[j]) : ex(0);
-    // Diagonal of the mass matrix from T = ½ Σ (m |ċ|² + I φ̇²).
-    ex mjj = 0;
-    if (j < n) {
-      for (const Body& b : bodies) {
-        const ex dx = b.center.x.diff(s.x[j]), dz = b.center.z.diff(s.x[j]);
-        mjj += b.mass * (dx * dx + dz * dz) + b.inertia * GiNaC::pow(b.angle.diff(s.x[j]), 2);
-      }
-    } else {
-      mjj = m.swing->inertia;
-      for (const Body& b : bodies) {
-        const ex radial = b.center.x + m.arm_pivot.x();
-        mjj += b.mass * radial * radial;
-      }
+  s.mass_matrix.assign(J * J, ex(0));
+  std::vector<ex> h(J, ex(0));
+  ex swing_inertia = 0, swing_momentum_rate = 0;
+  for (const Body& b : bodies) {
+    std::vector<ex> jx(n), jz(n), jphi(n);
+    for (int k = 0; k < n; ++k) {
+      jx[k] = b.center.x.diff(s.x[k]);
+      jz[k] = b.center.z.diff(s.x[k]);
+      jphi[k] = b.angle.diff(s.x[k]);
     }
-    inertia[j] = mjj;
+    // J̇q̇ = Σ_k Σ_l ∂²c/∂q_k∂q_l q̇_k q̇_l.
+    ex ax = 0, az = 0, aphi = 0;
+    for (int k = 0; k < n; ++k) {
+      ex vx = 0, vz = 0, vphi = 0;
+      for (int l = 0; l < n; ++l) {
+        vx += jx[l].diff(s.x[k]) * qd[l];
+        vz += jz[l].diff(s.x[k]) * qd[l];
+        vphi += jphi[l].diff(s.x[k]) * qd[l];
+      }
+      ax += vx * qd[k];
+      az += vz * qd[k];
+      aphi += vphi * qd[k];
+    }
+    for (int i = 0; i < n; ++i) {
+      for (int j = i; j < n; ++j) {
+        s.mass_matrix[i * J + j] +=
+            b.mass * (jx[i] * jx[j] + jz[i] * jz[j]) + b.inertia * jphi[i] * jphi[j];
+      }
+      h[i] += b.mass * (jx[i] * ax + jz[i] * az) + b.inertia * jphi[i] * aphi;
+    }
+    if (m.swing) {
+      const ex radial = b.center.x + m.arm_pivot.x();
+      ex radial_rate = 0;
+      for (int k = 0; k < n; ++k) radial_rate += jx[k] * qd[k];
+      swing_inertia += b.mass * radial * radial;
+      swing_momentum_rate += 2 * b.mass * radial * radial_rate * qd[n];
+      // ∂T/∂q_i holds m r ∂r/∂q_i ψ̇²: the centrifugal pull of the swing on the arm.
+      for (int i = 0; i < n; ++i) h[i] -= b.mass * radial * jx[i] * qd[n] * qd[n];
+    }
   }
+  if (m.swing) {
+    s.mass_matrix[n * J + n] = m.swing->inertia + swing_inertia;
+    h[n] = swing_momentum_rate;
+  }
+  for (int i = 0; i < J; ++i) {
+    for (int j = 0; j < i; ++j) s.mass_matrix[i * J + j] = s.mass_matrix[j * J + i];
+  }
+  gravity_force.assign(J, ex(0));
+  for (int j = 0; j < n; ++j) gravity_force[j] = -potential.diff(s.x[j]);
+  s.bias.resize(J);
+  for (int j = 0; j < J; ++j) s.bias[j] = h[j] - gravity_force[j];
+  ex kinetic = 0;
+  for (int i = 0; i < J; ++i) {
+    for (int j = 0; j < J; ++j) kinetic += s.mass_matrix[i * J + j] * qd[i] * qd[j];
+  }
+  s.energy = {kinetic / 2, potential};
+  s.velocity_terms = h;
+}
+
+void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
+  const int J = s.num_joints, n = s.num_links;
+  std::vector<ex> q(s.x.begin(), s.x.begin() + J);
+  const std::vector<ex> qd(s.x.begin() + J, s.x.begin() + 2 * J);
+  std::vector<ex> generalized;
+  BuildRigidBodyDynamics(m, s, generalized);
 
   const auto& hyd = m.hydraulics;
   std::vector<ex> xdot(s.num_states);
@@ -269,14 +377,25 @@ void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
     const ex force = pa * area_a - pb * area_b + end_force;
     for (int i = 0; i < J; ++i) generalized[i] += force * lever[i];
   }
+  // M q̈ = force: hydraulic, gravity, external and friction forces less the velocity terms.
+  s.force.resize(J);
   for (int j = 0; j < J; ++j) {
     const double friction = j < n ? m.links[j].viscous_friction : m.swing->viscous_friction;
     xdot[j] = qd[j];
-    xdot[J + j] = (generalized[j] + s.u[J + j] - friction * qd[j]) / inertia[j];
+    xdot[J + j] = 0;  // solved numerically from the mass matrix in the emitted code
+    s.force[j] = generalized[j] + s.u[J + j] - friction * qd[j] - s.velocity_terms[j];
   }
   s.rhs = xdot;
-  for (const ex& row : s.rhs) {
-    for (const auto& xi : s.x) s.jacobian.push_back(row.diff(xi));
+  for (int row = 0; row < s.num_states; ++row) {
+    for (const auto& xi : s.x) {
+      s.jacobian.push_back(row >= J && row < 2 * J ? ex(0) : s.rhs[row].diff(xi));
+    }
+  }
+  for (int j = 0; j < J; ++j) {
+    for (const auto& xi : s.x) s.d_force_d_x.push_back(s.force[j].diff(xi));
+  }
+  for (int k = 0; k < J; ++k) {
+    for (const ex& entry : s.mass_matrix) s.d_mass_d_q.push_back(entry.diff(s.x[k]));
   }
 }
 

@@ -38,8 +38,19 @@ struct SymbolicMachine {
   std::vector<GiNaC::ex> cylinder_length, lever_arm;
 
   std::vector<GiNaC::symbol> x, u;  ///< plant state `x[i]` and input `u[i]`
-  std::vector<GiNaC::ex> rhs;       ///< ẋ = f(x, u)
-  std::vector<GiNaC::ex> jacobian;  ///< ∂f/∂x, row-major
+  /// ẋ = f(x, u), except the accelerations q̈ (rows J … 2J−1, zero here): those solve
+  /// M q̈ = force numerically in the emitted code.
+  std::vector<GiNaC::ex> rhs;
+  std::vector<GiNaC::ex> jacobian;  ///< ∂f/∂x, row-major; rows J … 2J−1 zero (see above)
+
+  // Rigid-body dynamics of the arm (Lagrangian of every moving body through the closed chains).
+  std::vector<GiNaC::ex> mass_matrix;     ///< M(q, payload), J × J row-major, symmetric
+  std::vector<GiNaC::ex> velocity_terms;  ///< h(q, q̇): Coriolis and centrifugal [N·m]
+  std::vector<GiNaC::ex> bias;            ///< h − Q_gravity: M q̈ + bias = actuator + external
+  std::vector<GiNaC::ex> force;           ///< right side of M q̈ = force, everything included
+  std::vector<GiNaC::ex> energy;          ///< [kinetic T, potential V] [J]
+  std::vector<GiNaC::ex> d_force_d_x;     ///< J × num_states
+  std::vector<GiNaC::ex> d_mass_d_q;      ///< ∂M/∂q_k: J blocks of J × J
 };
 
 SymbolicMachine BuildSymbolicMachine(const model::MachineDescription& machine);

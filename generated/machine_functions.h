@@ -28,6 +28,12 @@ struct MachineFunctions {
   void (*plant_jacobian)(double t, const double* x, const double* u, double* jacobian);
   void (*tip_displacement_residual)(const double* angles_i, const double* angles_j,
                                     const double* measured, const double* params, double* residual);
+  // Rigid-body dynamics of the arm: M(q) q'' + bias(q, q') = actuator + external forces.
+  void (*mass_matrix)(const double* q, double payload, double* mass);  // J x J
+  void (*bias_forces)(const double* q, const double* qd, double payload, double pitch,
+                      double* bias);  // Coriolis, centrifugal, minus gravity
+  void (*mechanical_energy)(const double* q, const double* qd, double payload, double pitch,
+                            double* energy);  // [kinetic, potential]
 };
 
 }  // namespace autoshovel::generated

@@ -3,6 +3,8 @@
 #include "generated/registry.h"
 
 #include "generated/excavator_25t/excavator_25t.h"
+#include "generated/hyundai_hl740_9s/hyundai_hl740_9s.h"
+#include "generated/hyundai_hl740tm_7/hyundai_hl740tm_7.h"
 #include "generated/sdlg_l955he/sdlg_l955he.h"
 #include "generated/xcmg_968ev/xcmg_968ev.h"
 
@@ -10,9 +12,8 @@ namespace autoshovel::generated {
 
 const std::vector<const MachineFunctions*>& AllMachines() {
   static const std::vector<const MachineFunctions*> machines{
-      &excavator_25t::Functions(),
-      &sdlg_l955he::Functions(),
-      &xcmg_968ev::Functions(),
+      &excavator_25t::Functions(), &hyundai_hl740_9s::Functions(), &hyundai_hl740tm_7::Functions(),
+      &sdlg_l955he::Functions(),   &xcmg_968ev::Functions(),
   };
   return machines;
 }

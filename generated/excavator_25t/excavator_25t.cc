@@ -117,7 +117,7 @@ int InverseKinematics(const double* target, const double* params, double* q) {
   const double t1 = (sqrt(((target[0] * target[0]) + (target[1] * target[1]))) -
                      params[2] * cos(target[3]) - 0.15);
   const double cos_elbow =
-      0.5 * (((t0 * t0) - (params[0] * params[0]) + (t1 * t1) - (params[1] * params[1]))) /
+      ((-(t0 * t0) - (t1 * t1) + (params[0] * params[0]) + (params[1] * params[1]))) * (-0.5) /
       (params[1] * params[0]);
   if (!(cos_elbow >= -1.0 && cos_elbow <= 1.0)) return 1;
   double branch[2][kNumJoints];
@@ -127,35 +127,35 @@ int InverseKinematics(const double* target, const double* params, double* q) {
     const double t1 = (1.95 - target[2] + params[2] * t0);
     const double t2 = (sqrt(((target[0] * target[0]) + (target[1] * target[1]))) -
                        params[2] * cos(target[3]) - 0.15);
-    const double t3 = ((t1 * t1) - (params[0] * params[0]) + (t2 * t2) - (params[1] * params[1]));
+    const double t3 = (-(t1 * t1) - (t2 * t2) + (params[0] * params[0]) + (params[1] * params[1]));
     const double t4 = (1.0 / (params[0]));
     const double t5 =
         atan2(params[1] *
-                  sqrt((-0.25 * (t3 * t3) / (params[0] * params[0] * params[1] * params[1]) + 1.0)),
-              (params[0] + t4 * 0.5 * t3));
+                  sqrt((1.0 - 0.25 * (t3 * t3) / (params[0] * params[0] * params[1] * params[1]))),
+              (params[0] - t4 * t3 * 0.5));
     const double t6 = atan2((-1.95 - params[2] * t0 + target[2]), t2);
-    const double t7 = acos(t4 * 0.5 * t3 / (params[1]));
+    const double t7 = acos(t4 * t3 * (-0.5) / (params[1]));
     solution[0] = (-t5 + t6);
     solution[1] = t7;
-    solution[2] = (-t7 + t5 - t6 + target[3]);
+    solution[2] = (t5 - t7 - t6 + target[3]);
     solution[3] = atan2(target[1], target[0]);
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
   }
   {
     double* solution = branch[1];
     const double t0 = sin(target[3]);
-    const double t1 = (1.95 - target[2] + params[2] * t0);
-    const double t2 = (sqrt(((target[0] * target[0]) + (target[1] * target[1]))) -
+    const double t1 = (sqrt(((target[0] * target[0]) + (target[1] * target[1]))) -
                        params[2] * cos(target[3]) - 0.15);
-    const double t3 =
-        acos(0.5 * (((t1 * t1) - (params[0] * params[0]) + (t2 * t2) - (params[1] * params[1]))) /
-             (params[1] * params[0]));
+    const double t2 = atan2((-1.95 - params[2] * t0 + target[2]), t1);
+    const double t3 = (1.95 - target[2] + params[2] * t0);
     const double t4 =
-        atan2(params[1] * sin(t3 * (-1.0)), (params[0] + cos(t3 * (-1.0)) * params[1]));
-    const double t5 = atan2((-1.95 - params[2] * t0 + target[2]), t2);
-    solution[0] = (-t4 + t5);
-    solution[1] = t3 * (-1.0);
-    solution[2] = (t3 + t4 - t5 + target[3]);
+        acos(((-(t3 * t3) - (t1 * t1) + (params[0] * params[0]) + (params[1] * params[1]))) *
+             (-0.5) / (params[1] * params[0]));
+    const double t5 =
+        atan2(params[1] * sin(t4 * (-1.0)), (params[0] + cos(t4 * (-1.0)) * params[1]));
+    solution[0] = (t2 - t5);
+    solution[1] = t4 * (-1.0);
+    solution[2] = (t4 - t2 + target[3] + t5);
     solution[3] = atan2(target[1], target[0]);
     for (int j = 0; j < kNumJoints; ++j) solution[j] = Wrap(solution[j]);
   }
@@ -197,14 +197,14 @@ double CylinderLength(int actuator, const double* q) {
       return length;
     }
     case 2: {
-      const double t0 = (q[0] + q[1]);
+      const double t0 = (q[2] + q[0] + q[1]);
       const double t1 = cos(t0);
-      const double t2 = (q[2] + q[0] + q[1]);
-      const double t3 = cos(t2);
+      const double t2 = (q[0] + q[1]);
+      const double t3 = sin(t2);
       const double t4 = sin(t0);
-      const double t5 = sin(t2);
-      const double t6 = (0.552 * t3 + t4 * 0.15700000000000003 - t5 * 0.016 + 0.315 * t1);
-      const double t7 = (0.15700000000000003 * t1 - 0.016 * t3 - t5 * 0.552 - 0.315 * t4);
+      const double t5 = cos(t2);
+      const double t6 = (0.552 * t1 + t3 * 0.15700000000000003 - t4 * 0.016 + 0.315 * t5);
+      const double t7 = (0.15700000000000003 * t5 - 0.016 * t1 - t4 * 0.552 - 0.315 * t3);
       const double t8 = (t7 * t7);
       const double t9 = (t6 * t6);
       const double t10 = (0.21712699999999996 + t8 + t9);
@@ -212,9 +212,9 @@ double CylinderLength(int actuator, const double* q) {
       const double t12 = (1.0 / sqrt(t11));
       const double t13 = sqrt((-0.25 * (t10 * t10) / (t11) + 0.48441599999999996));
       const double t14 = atan2(((t6 * t10 * t12 + 2.0 * t7 * t13)) * 0.5 * t12,
-                               ((-t6 * 2.0 * t13 + t7 * t10 * t12)) * 0.5 * t12);
-      const double t15 = (3.081 * t1 + 0.696 * cos(t14) + t4 * 0.623);
-      const double t16 = (sin(t14) * 0.696 - 0.623 * t1 + t4 * 3.081);
+                               ((-t7 * t10 * t12 + t6 * 2.0 * t13)) * (-0.5) * t12);
+      const double t15 = (0.696 * sin(t14) - 0.623 * t5 + t3 * 3.081);
+      const double t16 = (cos(t14) * 0.696 + 3.081 * t5 + t3 * 0.623);
       const double length = sqrt(((t15 * t15) + (t16 * t16)));
       return length;
     }
@@ -261,16 +261,16 @@ double LeverArm(int actuator, const double* q) {
       return lever;
     }
     case 2: {
-      const double t0 = (q[0] + q[1]);
+      const double t0 = (q[2] + q[0] + q[1]);
       const double t1 = cos(t0);
-      const double t2 = (q[2] + q[0] + q[1]);
-      const double t3 = cos(t2);
+      const double t2 = (q[0] + q[1]);
+      const double t3 = sin(t2);
       const double t4 = sin(t0);
-      const double t5 = sin(t2);
-      const double t6 = (0.552 * t3 + t4 * 0.15700000000000003 - t5 * 0.016 + 0.315 * t1);
-      const double t7 = (-0.016) * t3;
-      const double t8 = t5 * (-0.552);
-      const double t9 = (0.15700000000000003 * t1 + t7 + t8 - 0.315 * t4);
+      const double t5 = cos(t2);
+      const double t6 = (0.552 * t1 + t3 * 0.15700000000000003 - t4 * 0.016 + 0.315 * t5);
+      const double t7 = (-0.016) * t1;
+      const double t8 = t4 * (-0.552);
+      const double t9 = (0.15700000000000003 * t5 + t7 + t8 - 0.315 * t3);
       const double t10 = (t9 * t9);
       const double t11 = (t6 * t6);
       const double t12 = (0.21712699999999996 + t10 + t11);
@@ -281,33 +281,34 @@ double LeverArm(int actuator, const double* q) {
       const double t17 = (-0.25 * t15 * t16 + 0.48441599999999996);
       const double t18 = sqrt(t17);
       const double t19 = (t6 * t12 * t14 + 2.0 * t9 * t18);
-      const double t20 = (-t6 * 2.0 * t18 + t9 * t12 * t14);
-      const double t21 = atan2(t19 * 0.5 * t14, t20 * 0.5 * t14);
-      const double t22 = cos(t21);
-      const double t23 = (3.081 * t1 + 0.696 * t22 + t4 * 0.623);
-      const double t24 = sin(t21);
-      const double t25 = (t24 * 0.696 - 0.623 * t1 + t4 * 3.081);
+      const double t20 = (-t9 * t12 * t14 + t6 * 2.0 * t18);
+      const double t21 = atan2(t19 * 0.5 * t14, t20 * (-0.5) * t14);
+      const double t22 = sin(t21);
+      const double t23 = (0.696 * t22 - 0.623 * t5 + t3 * 3.081);
+      const double t24 = cos(t21);
+      const double t25 = (t24 * 0.696 + 3.081 * t5 + t3 * 0.623);
       const double t26 = (1.0 / ((((t20 * t20) * t16 + (t19 * t19) * t16))));
       const double t27 = (t7 + t8);
-      const double t28 = (-0.552 * t3 + t5 * 0.016);
+      const double t28 = (-0.552 * t1 + t4 * 0.016);
       const double t29 = (t6 * t27 + t9 * t28);
-      const double t30 = (2.0 * t12 * t29 * t16 - t15 * t29 / (t13 * t13));
-      const double t31 = (1.0 / sqrt(t17));
-      const double t32 = pow(t13, (-1.5));
-      const double t33 = (t20 * t26 *
-                              ((((-t27 * 2.0 * t12 * t14 - 4.0 * t28 * t18 + t30 * t9 * t31 +
-                                  t6 * 2.0 * t12 * t29 * t32 - t6 * 4.0 * t29 * t14)) *
-                                    t14 +
-                                t19 * 2.0 * t29 * t32)) *
-                              t14 -
-                          t19 *
-                              ((((-t9 * 4.0 * t29 * t14 + 2.0 * t9 * t12 * t29 * t32 +
-                                  t27 * 4.0 * t18 - t6 * t30 * t31 - 2.0 * t28 * t12 * t14)) *
-                                    t14 +
-                                t20 * 2.0 * t29 * t32)) *
-                              t26 * t14);
+      const double t30 = pow(t13, (-1.5));
+      const double t31 = (t15 * t29 / (t13 * t13) - 2.0 * t12 * t29 * t16);
+      const double t32 = (1.0 / sqrt(t17));
+      const double t33 =
+          (-t19 * t26 *
+               ((-((-t9 * 4.0 * t29 * t14 + 2.0 * t9 * t12 * t29 * t30 + t6 * t31 * t32 +
+                    t27 * 4.0 * t18 - 2.0 * t28 * t12 * t14)) *
+                     t14 +
+                 t20 * 2.0 * t29 * t30)) *
+               t14 +
+           t20 * t26 *
+               ((-((t9 * t31 * t32 - t6 * 2.0 * t12 * t29 * t30 + t6 * 4.0 * t29 * t14 +
+                    4.0 * t28 * t18 + t27 * 2.0 * t12 * t14)) *
+                     t14 +
+                 t19 * 2.0 * t29 * t30)) *
+               t14);
       const double lever = (1.0 / sqrt(((t23 * t23) + (t25 * t25)))) *
-                           ((-t33 * t25 * 0.696 * t22 + t33 * t24 * 0.696 * t23)) * 0.5;
+                           ((-t33 * 0.696 * t25 * t22 + t23 * t33 * t24 * 0.696)) * 0.5;
       return lever;
     }
     case 3: {
@@ -347,6 +348,37 @@ int JointFromCylinderLength(int actuator, double length, const double* q, double
   return 0;
 }
 
+namespace {
+
+// In place: the lower triangle of `mass` becomes L with M = L L^T.
+void Factor(double* mass) {
+  for (int j = 0; j < kNumJoints; ++j) {
+    double d = mass[j * kNumJoints + j];
+    for (int k = 0; k < j; ++k) d -= mass[j * kNumJoints + k] * mass[j * kNumJoints + k];
+    const double l = std::sqrt(d);
+    mass[j * kNumJoints + j] = l;
+    for (int i = j + 1; i < kNumJoints; ++i) {
+      double v = mass[i * kNumJoints + j];
+      for (int k = 0; k < j; ++k) v -= mass[i * kNumJoints + k] * mass[j * kNumJoints + k];
+      mass[i * kNumJoints + j] = v / l;
+    }
+  }
+}
+
+// Solves L L^T y = b in place.
+void Solve(const double* factor, double* b) {
+  for (int i = 0; i < kNumJoints; ++i) {
+    for (int k = 0; k < i; ++k) b[i] -= factor[i * kNumJoints + k] * b[k];
+    b[i] /= factor[i * kNumJoints + i];
+  }
+  for (int i = kNumJoints - 1; i >= 0; --i) {
+    for (int k = i + 1; k < kNumJoints; ++k) b[i] -= factor[k * kNumJoints + i] * b[k];
+    b[i] /= factor[i * kNumJoints + i];
+  }
+}
+
+}  // namespace
+
 void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::acos;
   using std::atan2;
@@ -354,6 +386,1479 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::pow;
   using std::sin;
   using std::sqrt;
+  double mass[kNumJoints * kNumJoints];
+  double acceleration[kNumJoints];
+  const double t0 = cos(x[0]);
+  const double t1 = sin(x[0]);
+  const double t2 = (1.09 - 0.236 * t0 + t1 * 2.979);
+  const double t3 = 0.236 * t1;
+  const double t4 = t0 * 2.979;
+  const double t5 = (-0.356 + t3 + t4);
+  const double t6 = ((t2 * t2) + (t5 * t5));
+  const double t7 = sqrt(t6);
+  const double t8 = (x[12] - 2e+05);
+  const double t9 = (t8 * t8);
+  const double t10 = (1.0 / sqrt(t6));
+  const double t11 = (((t3 + t4)) * t2 + t5 * ((-t1 * 2.979 + 0.236 * t0)));
+  const double t12 = (x[12] - 3.7e+07);
+  const double t13 = (-x[12] + u[10]);
+  const double t14 = sqrt(((x[8] * x[8]) + 1e-06));
+  const double t15 = (t14 + x[8]);
+  const double t16 = (-t14 + x[8]);
+  const double t17 = (x[0] + x[1]);
+  const double t18 = cos(t17);
+  const double t19 = t18 * (-0.8);
+  const double t20 = sin(t17);
+  const double t21 = t20 * (-0.104);
+  const double t22 = (1.11 * t1 + t19 + 3.136 * t0 + t21);
+  const double t23 = (-t20 * 0.8 + 3.136 * t1 + 0.104 * t18 - 1.11 * t0);
+  const double t24 = ((t22 * t22) + (t23 * t23));
+  const double t25 = sqrt(t24);
+  const double t26 = (x[13] - 3.7e+07);
+  const double t27 = (u[11] - x[13]);
+  const double t28 = sqrt((1e-06 + (x[9] * x[9])));
+  const double t29 = (x[9] + t28);
+  const double t30 = (1.0 / sqrt(t24));
+  const double t31 = (-0.104) * t18;
+  const double t32 = t20 * 0.8;
+  const double t33 = (t22 * ((t31 + t32)) + ((t19 + t21)) * t23);
+  const double t34 = (t22 * ((t31 + t32 - 3.136 * t1 + 1.11 * t0)) + t23 * t22);
+  const double t35 = (x[13] - 2e+05);
+  const double t36 = (t35 * t35);
+  const double t37 = (-x[9] + t28);
+  const double t38 = (x[2] + x[0] + x[1]);
+  const double t39 = sin(t38);
+  const double t40 = cos(t38);
+  const double t41 = (0.315 * t18 + t20 * 0.15700000000000003 - 0.016 * t39 + 0.552 * t40);
+  const double t42 = (t41 * t41);
+  const double t43 = (-0.016) * t40;
+  const double t44 = t39 * (-0.552);
+  const double t45 = (t43 + t44 + 0.15700000000000003 * t18 - t20 * 0.315);
+  const double t46 = (t45 * t45);
+  const double t47 = (0.21712699999999996 + t42 + t46);
+  const double t48 = (t42 + t46);
+  const double t49 = (1.0 / sqrt(t48));
+  const double t50 = (1.0 / (t48));
+  const double t51 = (t47 * t47);
+  const double t52 = (-0.25 * t50 * t51 + 0.48441599999999996);
+  const double t53 = sqrt(t52);
+  const double t54 = (t47 * t49 * t41 + 2.0 * t53 * t45);
+  const double t55 = (2.0 * t41 * t53 - t47 * t49 * t45);
+  const double t56 = atan2(t54 * 0.5 * t49, t55 * t49 * (-0.5));
+  const double t57 = sin(t56);
+  const double t58 = (-0.623 * t18 + t20 * 3.081 + 0.696 * t57);
+  const double t59 = t20 * 0.623;
+  const double t60 = cos(t56);
+  const double t61 = 3.081 * t18;
+  const double t62 = (t59 + 0.696 * t60 + t61);
+  const double t63 = ((t58 * t58) + (t62 * t62));
+  const double t64 = sqrt(t63);
+  const double t65 = (1.0 / sqrt(t63));
+  const double t66 = 0.016 * t39;
+  const double t67 = t40 * (-0.552);
+  const double t68 = (-0.315 * t18 + t66 + t67 - t20 * 0.15700000000000003);
+  const double t69 = (t41 * t45 + t68 * t45);
+  const double t70 = pow(t48, (-1.5));
+  const double t71 = (1.0 / (t48 * t48));
+  const double t72 = (t47 * 2.0 * t50 * t69 - t71 * t51 * t69);
+  const double t73 = (1.0 / sqrt(t52));
+  const double t74 = (1.0 / (((t50 * (t55 * t55) + t50 * (t54 * t54)))));
+  const double t75 = (((t49 * ((t47 * 2.0 * t49 * t45 + 4.0 * t49 * t69 * t41 + 4.0 * t68 * t53 -
+                                t47 * 2.0 * t70 * t69 * t41 - t72 * t73 * t45)) -
+                        2.0 * t54 * t70 * t69)) *
+                          t55 * t49 * t74 +
+                      t54 * t49 *
+                          ((2.0 * t55 * t70 * t69 + ((t72 * t73 * t41 + t47 * 2.0 * t68 * t49 -
+                                                      t47 * 2.0 * t70 * t69 * t45 -
+                                                      4.0 * t53 * t45 + 4.0 * t49 * t69 * t45)) *
+                                                        t49)) *
+                          t74);
+  const double t76 = (((-t20 * 3.081 + 0.348 * t57 * t75 + 0.623 * t18)) * t62 +
+                      ((t59 + t61 - 0.348 * t75 * t60)) * t58);
+  const double t77 = (x[14] - 3.7e+07);
+  const double t78 = sqrt((1e-06 + (x[10] * x[10])));
+  const double t79 = (x[10] + t78);
+  const double t80 = (x[14] - u[12]);
+  const double t81 = (x[14] - 2e+05);
+  const double t82 = (t81 * t81);
+  const double t83 = (x[10] - t78);
+  const double t84 = (t66 + t67);
+  const double t85 = (t43 + t44);
+  const double t86 = (t84 * t45 + t85 * t41);
+  const double t87 = (t47 * 2.0 * t50 * t86 - t71 * t51 * t86);
+  const double t88 =
+      (-t54 *
+           ((t49 * ((-t47 * 2.0 * t49 * t84 - 4.0 * t49 * t86 * t45 - t87 * t73 * t41 +
+                     4.0 * t85 * t53 + t47 * 2.0 * t70 * t86 * t45)) -
+             2.0 * t55 * t70 * t86)) *
+           t49 * t74 +
+       ((-2.0 * t54 * t70 * t86 + ((-t47 * 2.0 * t70 * t41 * t86 + 4.0 * t49 * t41 * t86 +
+                                    t47 * 2.0 * t85 * t49 - t87 * t73 * t45 + 4.0 * t84 * t53)) *
+                                      t49)) *
+           t55 * t49 * t74);
+  const double t89 = (-0.696 * t58 * t60 * t88 + t62 * 0.696 * t57 * t88);
+  const double t90 = sqrt((1e-06 + (x[11] * x[11])));
+  const double t91 = (t90 + x[11]);
+  const double t92 = (u[13] - x[15]);
+  const double t93 = (x[15] - 2e+05);
+  const double t94 = (t93 * t93);
+  const double t95 = (-2.9e+07 + x[15]);
+  const double t96 = (x[11] - t90);
+  const double t97 = (x[16] - 3.7e+07);
+  const double t98 = (x[16] - 2e+05);
+  const double t99 = (t98 * t98);
+  const double t100 = (u[10] - x[16]);
+  const double t101 = (x[17] - 2e+05);
+  const double t102 = (t101 * t101);
+  const double t103 = (x[17] - 3.7e+07);
+  const double t104 = (x[17] - u[11]);
+  const double t105 = (x[18] - 3.7e+07);
+  const double t106 = (x[18] - 2e+05);
+  const double t107 = (t106 * t106);
+  const double t108 = (x[18] - u[12]);
+  const double t109 = (u[13] - x[19]);
+  const double t110 = (x[19] - 2e+05);
+  const double t111 = (t110 * t110);
+  const double t112 = (-2.9e+07 + x[19]);
+  const double t113 = (-0.35 * t0 - t1 * 2.6);
+  const double t114 = 5.7 * t0;
+  const double t115 = t20 * (-0.1);
+  const double t116 = 1.1 * t18;
+  const double t117 = (t114 + t115 + t116);
+  const double t118 = t1 * (-0.35);
+  const double t119 = 2.6 * t0;
+  const double t120 = (t118 + t119);
+  const double t121 = t1 * (-5.7);
+  const double t122 = t18 * (-0.1);
+  const double t123 = t20 * (-1.1);
+  const double t124 = (t121 + t122 + t123);
+  const double t125 = t40 * 0.567857142857143;
+  const double t126 = 2.9 * t18;
+  const double t127 = t39 * 0.0578571428571429;
+  const double t128 = (t125 + t114 + t126 + t127);
+  const double t129 = t40 * 0.0578571428571429;
+  const double t130 = t20 * (-2.9);
+  const double t131 = t39 * (-0.567857142857143);
+  const double t132 = (t129 + t130 + t121 + t131);
+  const double t133 = t39 * (-0.7);
+  const double t134 = t40 * (-0.3);
+  const double t135 = (t133 + t130 + t121 + t134);
+  const double t136 = t39 * (-0.3);
+  const double t137 = t40 * 0.7;
+  const double t138 = (t136 + t114 + t126 + t137);
+  const double t139 = (t133 + t130 + t134);
+  const double t140 = (t115 + t116);
+  const double t141 = (t125 + t126 + t127);
+  const double t142 = (t129 + t130 + t131);
+  const double t143 = (t136 + t126 + t137);
+  const double t144 = (t122 + t123);
+  const double t145 =
+      (1150.0 + 950.0 * t135 * t139 + t117 * t140 * 1100.0 + u[8] * ((t128 * t141 + t132 * t142)) +
+       t143 * 950.0 * t138 + 1100.0 * t124 * t144);
+  const double t146 = (t136 + t137);
+  const double t147 = (t133 + t134);
+  const double t148 = (t125 + t127);
+  const double t149 = (t129 + t131);
+  const double t150 =
+      (950.0 * t138 * t146 + 250.0 + t147 * 950.0 * t135 + ((t128 * t148 + t149 * t132)) * u[8]);
+  const double t151 =
+      (t147 * 950.0 * t139 + 250.0 + t143 * 950.0 * t146 + ((t149 * t142 + t141 * t148)) * u[8]);
+  const double t152 = (-t20 * 110.0 + t18 * 1210.0 + 6270.0 * t0 + 165.0);
+  const double t153 = (t125 + t114 + t126 + 0.15 + t127);
+  const double t154 = (-t39 * 285.0 + 665.0 * t40 + t18 * 2755.0 + 142.5 + 5415.0 * t0);
+  const double t155 = (5720.0 * t0 + 330.0 - t1 * 770.0);
+  const double t156 = (x[4] * x[4]);
+  const double t157 = sin(u[9]);
+  const double t158 = t39 * 0.3;
+  const double t159 = (-2.9) * t18;
+  const double t160 = (-5.7) * t0;
+  const double t161 = t40 * (-0.7);
+  const double t162 = (t158 + t159 + t161);
+  const double t163 = t162 * x[5];
+  const double t164 = (t158 + t161);
+  const double t165 = t164 * x[6];
+  const double t166 =
+      (x[4] * ((((t158 + t159 + t160 + t161)) * x[4] + t163 + t165)) +
+       x[6] * ((t164 * x[5] + t165 + t164 * x[4])) + ((t162 * x[4] + t163 + t165)) * x[5]);
+  const double t167 = (t64 - 2.525);
+  const double t168 = ((t167 * t167) + 1e-06);
+  const double t169 = (t64 - 3.71);
+  const double t170 = ((t169 * t169) + 1e-06);
+  const double t171 =
+      (4e+08 * t64 - 2e+08 * sqrt(t168) + 0.013823007675795093 * x[18] - 1.247e+09 +
+       sqrt(t170) * 2e+08 - 0.026546457922833753 * x[14] +
+       ((t65 * t89 * 1e+06 * x[6] + t65 * 2e+06 * x[4] * t76 + t65 * 2e+06 * x[5] * t76)) *
+           (((1.0 / sqrt(t170)) * t169 + 2.0 - (1.0 / sqrt(t168)) * t167)));
+  const double t172 = t65 * t171 * t76 * (-0.5);
+  const double t173 = x[5] * t144;
+  const double t174 = (t124 * x[4] + t173);
+  const double t175 = (x[4] * t174 + x[5] * ((x[4] * t144 + t173)));
+  const double t176 = (x[7] * x[7]);
+  const double t177 = t20 * 0.1;
+  const double t178 = t18 * (-1.1);
+  const double t179 = (t177 + t178);
+  const double t180 = t179 * x[5];
+  const double t181 =
+      (x[5] * ((t180 + t179 * x[4])) + ((t180 + ((t177 + t178 + t160)) * x[4])) * x[4]);
+  const double t182 = cos(u[9]);
+  const double t183 = (-4.005 + t25);
+  const double t184 = (1e-06 + (t183 * t183));
+  const double t185 = (t25 - 2.595);
+  const double t186 = (1e-06 + (t185 * t185));
+  const double t187 = (-0.035342917352885174 * x[13] + 4e+08 * t25 - 1.32e+09 + sqrt(t184) * 2e+08 -
+                       sqrt(t186) * 2e+08 + x[17] * 0.01802488784997144 +
+                       (((1.0 / sqrt(t184)) * t183 - (1.0 / sqrt(t186)) * t185 + 2.0)) *
+                           ((t30 * 2e+06 * x[5] * t33 + t30 * 2e+06 * t34 * x[4])));
+  const double t188 = t147 * x[6];
+  const double t189 = x[5] * t139;
+  const double t190 = (t189 + t135 * x[4] + t188);
+  const double t191 = (((t147 * x[5] + t147 * x[4] + t188)) * x[6] +
+                       ((t189 + x[4] * t139 + t188)) * x[5] + x[4] * t190);
+  const double t192 = t39 * (-0.0578571428571429);
+  const double t193 = (-0.567857142857143) * t40;
+  const double t194 = (t192 + t159 + t193);
+  const double t195 = x[5] * t194;
+  const double t196 = (t192 + t193);
+  const double t197 = t196 * x[6];
+  const double t198 =
+      (x[4] * ((x[4] * ((t192 + t159 + t160 + t193)) + t195 + t197)) +
+       x[5] * ((x[4] * t194 + t195 + t197)) + ((t197 + t196 * x[5] + t196 * x[4])) * x[6]);
+  const double t199 = x[5] * t142;
+  const double t200 = t149 * x[6];
+  const double t201 = (t199 + x[4] * t132 + t200);
+  const double t202 = (x[5] * ((x[4] * t142 + t199 + t200)) + x[4] * t201 +
+                       ((t149 * x[5] + t200 + t149 * x[4])) * x[6]);
+  const double t203 = (-3.775 + t7);
+  const double t204 = (1e-06 + (t203 * t203));
+  const double t205 = (-2.03 + t7);
+  const double t206 = (1e-06 + (t205 * t205));
+  xdot[0] = x[4];
+  xdot[1] = x[5];
+  xdot[2] = x[6];
+  xdot[3] = x[7];
+  xdot[8] = (-x[8] * 16.666666666666668 + u[0] * 16.666666666666668);
+  xdot[9] = (-x[9] * 16.666666666666668 + u[1] * 16.666666666666668);
+  xdot[10] = (-x[10] * 16.666666666666668 + u[2] * 16.666666666666668);
+  xdot[11] = (-12.5 * x[11] + 12.5 * u[3]);
+  xdot[12] = 1.2e+09 *
+             ((sqrt((t9 + 1e+10)) * 3.5e-09 - t10 * x[4] * 0.03078760800517998 * t11 -
+               sqrt(((t12 * t12) + 1e+10)) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
+               t13 * 2.8577380332470414e-06 * pow(((t13 * t13) + 4e+10), (-0.25)) * t15 +
+               pow((4e+10 + t9), (-0.25)) * t8 * 2.8577380332470414e-06 * t16)) /
+             (((t7 * 0.03078760800517998 - 0.059498844250515354)));
+  xdot[13] = ((-sqrt((1e+10 + (t26 * t26))) * 3.5e-09 +
+               2.8577380332470414e-06 * t27 * t29 * pow((4e+10 + (t27 * t27)), (-0.25)) -
+               t30 * 0.017671458676442587 * x[5] * t33 - t30 * t34 * 0.017671458676442587 * x[4] -
+               x[13] * 7e-09 + 0.1302 + sqrt((1e+10 + t36)) * 3.5e-09 -
+               pow((4e+10 + t36), (-0.25)) * t35 * 2.8577380332470414e-06 * t37)) *
+             1.2e+09 / (((0.017671458676442587 * t25 - 0.04285743526536852)));
+  xdot[14] = 1.2e+09 *
+             ((-t65 * x[4] * 0.013273228961416876 * t76 + 0.093 -
+               t65 * x[5] * 0.013273228961416876 * t76 - sqrt(((t77 * t77) + 1e+10)) * 2.5e-09 -
+               t79 * t80 * 2.0412414523193154e-06 * pow((4e+10 + (t80 * t80)), (-0.25)) +
+               pow((4e+10 + t82), (-0.25)) * t81 * t83 * 2.0412414523193154e-06 - x[14] * 5e-09 -
+               t65 * t89 * 0.006636614480708438 * x[6] + 2.5e-09 * sqrt((1e+10 + t82)))) /
+             (((-0.03151490312757761 + t64 * 0.013273228961416876)));
+  xdot[15] = (t91 * t92 * 510310.3630798288 * pow((4e+10 + (t92 * t92)), (-0.25)) + 1.825e+10 +
+              625.0 * sqrt((1e+10 + t94)) - 625.0 * sqrt(((t95 * t95) + 1e+10)) - 7.5e+08 * x[7] +
+              t96 * t93 * pow((4e+10 + t94), (-0.25)) * 510310.3630798288 - x[15] * 1250.0);
+  xdot[16] = ((0.015079644737231009 * t10 * x[4] * t11 - sqrt(((t97 * t97) + 1e+10)) * 3.5e-09 -
+               pow((4e+10 + t99), (-0.25)) * t98 * 2.8577380332470414e-06 * t15 -
+               pow((4e+10 + (t100 * t100)), (-0.25)) * 2.8577380332470414e-06 * t100 * t16 -
+               x[16] * 7e-09 + 0.1302 + sqrt((1e+10 + t99)) * 3.5e-09)) *
+             1.2e+09 / (((0.05992565888304706 - 0.015079644737231009 * t7)));
+  xdot[17] = 1.2e+09 *
+             ((sqrt((t102 + 1e+10)) * 3.5e-09 - sqrt((1e+10 + (t103 * t103))) * 3.5e-09 +
+               t30 * t34 * x[4] * 0.00901244392498572 + 0.1302 -
+               pow((4e+10 + t102), (-0.25)) * t101 * 2.8577380332470414e-06 * t29 - x[17] * 7e-09 +
+               t30 * x[5] * t33 * 0.00901244392498572 -
+               pow((4e+10 + (t104 * t104)), (-0.25)) * 2.8577380332470414e-06 * t104 * t37)) /
+             (((0.03909483791956781 - t25 * 0.00901244392498572)));
+  xdot[18] =
+      ((-2.5e-09 * sqrt((1e+10 + (t105 * t105))) + 0.093 + t65 * 0.006911503837897547 * x[4] * t76 +
+        t65 * 0.006911503837897547 * x[5] * t76 + 2.5e-09 * sqrt((t107 + 1e+10)) +
+        0.0034557519189487734 * t65 * t89 * x[6] - x[18] * 5e-09 +
+        t83 * t108 * 2.0412414523193154e-06 * pow((4e+10 + (t108 * t108)), (-0.25)) -
+        pow((4e+10 + t107), (-0.25)) * t106 * t79 * 2.0412414523193154e-06)) *
+      1.2e+09 / (((0.0276416792385999 - 0.006911503837897547 * t64)));
+  xdot[19] = (1.825e+10 - t96 * 510310.3630798288 * t109 * pow(((t109 * t109) + 4e+10), (-0.25)) +
+              625.0 * sqrt((t111 + 1e+10)) - 625.0 * sqrt(((t112 * t112) + 1e+10)) -
+              pow((4e+10 + t111), (-0.25)) * t110 * t91 * 510310.3630798288 + 7.5e+08 * x[7] -
+              x[19] * 1250.0);
+  mass[0] = (7650.0 + 2200.0 * (t113 * t113) + (t117 * t117) * 1100.0 + (t120 * t120) * 2200.0 +
+             1100.0 * (t124 * t124) + (((t128 * t128) + (t132 * t132))) * u[8] +
+             950.0 * (t135 * t135) + (t138 * t138) * 950.0);
+  mass[1] = t145;
+  mass[2] = t150;
+  mass[3] = 0.0;
+  mass[4] = t145;
+  mass[5] = ((t144 * t144) * 1100.0 + 1150.0 + 950.0 * (t139 * t139) + (t143 * t143) * 950.0 +
+             u[8] * (((t142 * t142) + (t141 * t141))) + 1100.0 * (t140 * t140));
+  mass[6] = t151;
+  mass[7] = 0.0;
+  mass[8] = t150;
+  mass[9] = t151;
+  mass[10] = ((((t149 * t149) + (t148 * t148))) * u[8] + (t147 * t147) * 950.0 + 250.0 +
+              (t146 * t146) * 950.0);
+  mass[11] = 0.0;
+  mass[12] = 0.0;
+  mass[13] = 0.0;
+  mass[14] = 0.0;
+  mass[15] = (((t114 + t115 + t116 + 0.15)) * t152 + 60000.0 + (t153 * t153) * u[8] +
+              ((t136 + t114 + t126 + 0.15 + t137)) * t154 + t155 * ((t118 + 0.15 + t119)));
+  acceleration[0] =
+      (-t156 * t113 * t120 * 2200.0 - t113 * t157 * 21574.629999999997 - 950.0 * t135 * t166 -
+       t156 * t113 * 2200.0 * ((t1 * 0.35 - t119)) + t172 - t117 * 1100.0 * t175 +
+       t176 * t113 * t155 - t181 * 1100.0 * t124 - t138 * t182 * 9316.3175 - x[4] * 6000.0 -
+       t30 * t187 * t34 * 0.5 + t176 * t153 * u[8] * t132 - t157 * t135 * 9316.3175 + u[4] +
+       t176 * t135 * t154 - t117 * t182 * 10787.314999999999 - t157 * t124 * 10787.314999999999 -
+       950.0 * t138 * t191 + ((-t128 * t182 * 9.80665 - t157 * 9.80665 * t132)) * u[8] -
+       ((t198 * t132 + t128 * t202)) * u[8] + t176 * t124 * t152 -
+       t120 * t182 * 21574.629999999997 +
+       t10 * t11 *
+           ((-t10 * 2e+06 * x[4] * ((2.0 + (1.0 / sqrt(t204)) * t203 - t205 * (1.0 / sqrt(t206)))) *
+                 t11 -
+             2e+08 * sqrt(t204) + sqrt(t206) * 2e+08 - 0.015079644737231009 * x[16] + 1.161e+09 -
+             4e+08 * t7 + x[12] * 0.03078760800517998)));
+  acceleration[1] =
+      (-t143 * t182 * 9316.3175 - t157 * t139 * 9316.3175 + t176 * t144 * t152 + t172 +
+       t176 * t139 * t154 - ((t198 * t142 + t141 * t202)) * u[8] - 2500.0 * x[5] -
+       950.0 * t166 * t139 - t181 * 1100.0 * t144 +
+       u[8] * ((-t141 * t182 * 9.80665 - t157 * 9.80665 * t142)) -
+       t157 * 10787.314999999999 * t144 - t143 * 950.0 * t191 + u[5] + t176 * t153 * u[8] * t142 -
+       t140 * t182 * 10787.314999999999 - t140 * 1100.0 * t175 - t30 * t187 * 0.5 * t33);
+  acceleration[2] =
+      (-t147 * 950.0 * t166 + t176 * t153 * t149 * u[8] - 950.0 * t191 * t146 + t176 * t147 * t154 +
+       ((-t157 * t149 * 9.80665 - t182 * t148 * 9.80665)) * u[8] - 800.0 * x[6] -
+       t182 * t146 * 9316.3175 + u[6] - u[8] * ((t198 * t149 + t148 * t202)) -
+       t147 * t157 * 9316.3175 - t65 * 0.25 * t89 * t171);
+  acceleration[3] =
+      (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 -
+       t113 * x[7] * x[4] * ((11440.0 * t0 + 660.0 - t1 * 1540.0)) + u[7] -
+       t153 * 2.0 * x[7] * u[8] * t201 -
+       ((330.0 + 12540.0 * t0 + 2420.0 * t18 - t20 * 220.0)) * x[7] * t174 -
+       x[7] * ((-t39 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t18 + 1330.0 * t40)) * t190);
+  Factor(mass);
+  Solve(mass, acceleration);
+  std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
+}
+
+void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);
+  double mass[kNumJoints * kNumJoints];
+  double acceleration[kNumJoints];
+  double d_force[kNumJoints * kNumStates] = {};
+  double d_mass[kNumJoints * kNumJoints * kNumJoints] = {};
+  const double t0 = cos(x[0]);
+  const double t1 = sin(x[0]);
+  const double t2 = (1.09 - 0.236 * t0 + t1 * 2.979);
+  const double t3 = 0.236 * t1;
+  const double t4 = t0 * 2.979;
+  const double t5 = (-0.356 + t3 + t4);
+  const double t6 = ((t2 * t2) + (t5 * t5));
+  const double t7 = (1.0 / sqrt(t6));
+  const double t8 = (t3 + t4);
+  const double t9 = (-t1 * 2.979 + 0.236 * t0);
+  const double t10 = ((t8 * t8) + t2 * t9 + ((-t4 - t3)) * t5 + (t9 * t9));
+  const double t11 = pow(t6, (-1.5));
+  const double t12 = (t8 * t2 + t5 * t9);
+  const double t13 = (t12 * t12);
+  const double t14 = sqrt(t6);
+  const double t15 = (t14 * 0.03078760800517998 - 0.059498844250515354);
+  const double t16 = (1.0 / (t15));
+  const double t17 = (x[12] - 2e+05);
+  const double t18 = (t17 * t17);
+  const double t19 = (t18 + 1e+10);
+  const double t20 = (x[12] - 3.7e+07);
+  const double t21 = ((t20 * t20) + 1e+10);
+  const double t22 = (-x[12] + u[10]);
+  const double t23 = (t22 * t22);
+  const double t24 = (t23 + 4e+10);
+  const double t25 = pow(t24, (-0.25));
+  const double t26 = ((x[8] * x[8]) + 1e-06);
+  const double t27 = sqrt(t26);
+  const double t28 = (t27 + x[8]);
+  const double t29 = (4e+10 + t18);
+  const double t30 = pow(t29, (-0.25));
+  const double t31 = (-t27 + x[8]);
+  const double t32 = x[8] * (1.0 / sqrt(t26));
+  const double t33 = (t32 - 1.0);
+  const double t34 = (t32 + 1.0);
+  const double t35 = x[12] * 2.0;
+  const double t36 = (t35 - 4e+05);
+  const double t37 = (x[0] + x[1]);
+  const double t38 = cos(t37);
+  const double t39 = t38 * (-0.8);
+  const double t40 = sin(t37);
+  const double t41 = t40 * (-0.104);
+  const double t42 = (1.11 * t1 + t39 + 3.136 * t0 + t41);
+  const double t43 = (t42 * t42);
+  const double t44 = (-t40 * 0.8 + 3.136 * t1 + 0.104 * t38 - 1.11 * t0);
+  const double t45 = (t43 + (t44 * t44));
+  const double t46 = (1.0 / sqrt(t45));
+  const double t47 = (x[13] - 3.7e+07);
+  const double t48 = (1e+10 + (t47 * t47));
+  const double t49 = (u[11] - x[13]);
+  const double t50 = (1e-06 + (x[9] * x[9]));
+  const double t51 = sqrt(t50);
+  const double t52 = (x[9] + t51);
+  const double t53 = (t49 * t49);
+  const double t54 = (4e+10 + t53);
+  const double t55 = pow(t54, (-0.25));
+  const double t56 = (-0.104) * t38;
+  const double t57 = t40 * 0.8;
+  const double t58 = (t56 + t57);
+  const double t59 = (t39 + t41);
+  const double t60 = (t42 * t58 + t59 * t44);
+  const double t61 = (t56 + t57 - 3.136 * t1 + 1.11 * t0);
+  const double t62 = (t42 * t61 + t44 * t42);
+  const double t63 = (x[13] - 2e+05);
+  const double t64 = (t63 * t63);
+  const double t65 = (1e+10 + t64);
+  const double t66 = (4e+10 + t64);
+  const double t67 = pow(t66, (-0.25));
+  const double t68 = (-x[9] + t51);
+  const double t69 =
+      (-sqrt(t48) * 3.5e-09 + 2.8577380332470414e-06 * t49 * t52 * t55 -
+       t46 * 0.017671458676442587 * x[5] * t60 - t46 * t62 * 0.017671458676442587 * x[4] -
+       x[13] * 7e-09 + 0.1302 + sqrt(t65) * 3.5e-09 - t67 * t63 * 2.8577380332470414e-06 * t68);
+  const double t70 = sqrt(t45);
+  const double t71 = (0.017671458676442587 * t70 - 0.04285743526536852);
+  const double t72 = (1.0 / (t71 * t71));
+  const double t73 = (1.0 / (t71));
+  const double t74 = 0.8 * t38;
+  const double t75 = t40 * 0.104;
+  const double t76 = t42 * ((t74 + t75));
+  const double t77 = t44 * t58;
+  const double t78 = (t76 + t77 + t59 * t42 + t58 * t61);
+  const double t79 = pow(t45, (-1.5));
+  const double t80 = (t62 * t62);
+  const double t81 =
+      (t42 * ((-3.136 * t0 + t74 - 1.11 * t1 + t75)) + t44 * t61 + t43 + (t61 * t61));
+  const double t82 = (t60 * t60);
+  const double t83 = (t76 + t77 + (t59 * t59) + (t58 * t58));
+  const double t84 = (1.0 / sqrt(t50)) * x[9];
+  const double t85 = (t84 + 1.0);
+  const double t86 = (t84 - 1.0);
+  const double t87 = x[13] * 2.0;
+  const double t88 = (t87 - 4e+05);
+  const double t89 = (x[2] + x[0] + x[1]);
+  const double t90 = sin(t89);
+  const double t91 = cos(t89);
+  const double t92 = (0.315 * t38 + t40 * 0.15700000000000003 - 0.016 * t90 + 0.552 * t91);
+  const double t93 = (t92 * t92);
+  const double t94 = (-0.016) * t91;
+  const double t95 = t90 * (-0.552);
+  const double t96 = (t94 + t95 + 0.15700000000000003 * t38 - t40 * 0.315);
+  const double t97 = (t96 * t96);
+  const double t98 = (0.21712699999999996 + t93 + t97);
+  const double t99 = (t93 + t97);
+  const double t100 = (1.0 / sqrt(t99));
+  const double t101 = (1.0 / (t99));
+  const double t102 = (t98 * t98);
+  const double t103 = (-0.25 * t101 * t102 + 0.48441599999999996);
+  const double t104 = sqrt(t103);
+  const double t105 = (t98 * t100 * t92 + 2.0 * t104 * t96);
+  const double t106 = (2.0 * t92 * t104 - t98 * t100 * t96);
+  const double t107 = atan2(t105 * 0.5 * t100, t106 * t100 * (-0.5));
+  const double t108 = sin(t107);
+  const double t109 = (-0.623 * t38 + t40 * 3.081 + 0.696 * t108);
+  const double t110 = t40 * 0.623;
+  const double t111 = cos(t107);
+  const double t112 = 3.081 * t38;
+  const double t113 = (t110 + 0.696 * t111 + t112);
+  const double t114 = ((t109 * t109) + (t113 * t113));
+  const double t115 = (1.0 / sqrt(t114));
+  const double t116 = sqrt(t114);
+  const double t117 = (-0.03151490312757761 + t116 * 0.013273228961416876);
+  const double t118 = (1.0 / (t117 * t117));
+  const double t119 = (-3.081) * t40;
+  const double t120 = 0.016 * t90;
+  const double t121 = t91 * (-0.552);
+  const double t122 = (-0.315 * t38 + t120 + t121 - t40 * 0.15700000000000003);
+  const double t123 = (t92 * t96 + t122 * t96);
+  const double t124 = pow(t99, (-1.5));
+  const double t125 = (1.0 / (t99 * t99));
+  const double t126 = (t98 * 2.0 * t101 * t123 - t125 * t102 * t123);
+  const double t127 = (1.0 / sqrt(t103));
+  const double t128 = (t98 * 2.0 * t100 * t96 + 4.0 * t100 * t123 * t92 + 4.0 * t122 * t104 -
+                       t98 * 2.0 * t124 * t123 * t92 - t126 * t127 * t96);
+  const double t129 = (t100 * t128 - 2.0 * t105 * t124 * t123);
+  const double t130 = (t106 * t106);
+  const double t131 = (t105 * t105);
+  const double t132 = (t101 * t130 + t101 * t131);
+  const double t133 = (1.0 / (t132));
+  const double t134 = (t126 * t127 * t92 + t98 * 2.0 * t122 * t100 - t98 * 2.0 * t124 * t123 * t96 -
+                       4.0 * t104 * t96 + 4.0 * t100 * t123 * t96);
+  const double t135 = (2.0 * t106 * t124 * t123 + t134 * t100);
+  const double t136 = (t129 * t106 * t100 * t133 + t105 * t100 * t135 * t133);
+  const double t137 = 0.623 * t38;
+  const double t138 = (t119 + 0.348 * t108 * t136 + t137);
+  const double t139 = (t110 + t112 - 0.348 * t136 * t111);
+  const double t140 = (t138 * t113 + t139 * t109);
+  const double t141 = (x[14] - 3.7e+07);
+  const double t142 = ((t141 * t141) + 1e+10);
+  const double t143 = (1e-06 + (x[10] * x[10]));
+  const double t144 = sqrt(t143);
+  const double t145 = (x[10] + t144);
+  const double t146 = (x[14] - u[12]);
+  const double t147 = (t146 * t146);
+  const double t148 = (4e+10 + t147);
+  const double t149 = pow(t148, (-0.25));
+  const double t150 = (x[14] - 2e+05);
+  const double t151 = (t150 * t150);
+  const double t152 = (4e+10 + t151);
+  const double t153 = pow(t152, (-0.25));
+  const double t154 = (x[10] - t144);
+  const double t155 = (t120 + t121);
+  const double t156 = (t94 + t95);
+  const double t157 = (t155 * t96 + t156 * t92);
+  const double t158 = (t98 * 2.0 * t101 * t157 - t125 * t102 * t157);
+  const double t159 = (-t98 * 2.0 * t100 * t155 - 4.0 * t100 * t157 * t96 - t158 * t127 * t92 +
+                       4.0 * t156 * t104 + t98 * 2.0 * t124 * t157 * t96);
+  const double t160 = (t100 * t159 - 2.0 * t106 * t124 * t157);
+  const double t161 = (-t98 * 2.0 * t124 * t92 * t157 + 4.0 * t100 * t92 * t157 +
+                       t98 * 2.0 * t156 * t100 - t158 * t127 * t96 + 4.0 * t155 * t104);
+  const double t162 = (-2.0 * t105 * t124 * t157 + t161 * t100);
+  const double t163 = (-t105 * t160 * t100 * t133 + t162 * t106 * t100 * t133);
+  const double t164 = (-0.696 * t109 * t111 * t163 + t113 * 0.696 * t108 * t163);
+  const double t165 = (1e+10 + t151);
+  const double t166 =
+      (-t115 * x[4] * 0.013273228961416876 * t140 + 0.093 -
+       t115 * x[5] * 0.013273228961416876 * t140 - sqrt(t142) * 2.5e-09 -
+       t145 * t146 * 2.0412414523193154e-06 * t149 + t153 * t150 * t154 * 2.0412414523193154e-06 -
+       x[14] * 5e-09 - t115 * t164 * 0.006636614480708438 * x[6] + 2.5e-09 * sqrt(t165));
+  const double t167 = (1.0 / (t117));
+  const double t168 = pow(t114, (-1.5));
+  const double t169 = (t140 * t140);
+  const double t170 = (t136 * t136);
+  const double t171 = (1.0 / (t132 * t132));
+  const double t172 = (2.0 * t125 * t123 * t131 + t134 * t106 * t101 + 2.0 * t125 * t123 * t130 -
+                       t105 * t101 * t128);
+  const double t173 = 0.016 * t91;
+  const double t174 = t90 * 0.552;
+  const double t175 = (t173 + t174 - 0.15700000000000003 * t38 + t40 * 0.315);
+  const double t176 = (t122 * t92 + (t122 * t122) + t175 * t96 + t97);
+  const double t177 = pow(t99, (-2.5));
+  const double t178 = (t123 * t123);
+  const double t179 = (t126 * t126);
+  const double t180 = pow(t103, (-1.5));
+  const double t181 = (1.0 / (t99 * t99 * t99));
+  const double t182 = (-t176 * t125 * t102 + 4.0 * t101 * t178 + t98 * t176 * 2.0 * t101 +
+                       t181 * 4.0 * t102 * t178 - t98 * t125 * t178 * 8.0);
+  const double t183 =
+      (-t105 * 4.0 * t171 * t100 * t135 * t172 + t105 * 4.0 * t124 * t123 * t135 * t133 -
+       2.0 * t100 * t128 * t135 * t133 +
+       t105 * t100 * t133 *
+           ((t134 * t124 * t123 * 8.0 - t176 * t106 * t124 * 8.0 + 24.0 * t177 * t106 * t178 -
+             t100 * ((t98 * t175 * t100 * 8.0 + t179 * t180 * t92 + t126 * t127 * 8.0 * t96 -
+                      16.0 * t122 * t104 + 32.0 * t122 * t100 * t123 - 32.0 * t124 * t178 * t96 -
+                      t98 * 16.0 * t122 * t124 * t123 + t98 * 24.0 * t177 * t178 * t96 -
+                      t98 * t176 * t124 * 8.0 * t96 + 4.0 * t127 * t182 * t92 +
+                      t176 * 16.0 * t100 * t96)))) +
+       ((-t105 * 24.0 * t177 * t178 + t124 * t123 * t128 * 8.0 +
+         ((32.0 * t124 * t178 * t92 - t98 * t122 * t100 * 8.0 - t98 * 24.0 * t177 * t178 * t92 +
+           t98 * t176 * t124 * 8.0 * t92 + t179 * t180 * t96 - 32.0 * t100 * t123 * t96 +
+           4.0 * t127 * t182 * t96 - 16.0 * t175 * t104 + t126 * t122 * t127 * 8.0 -
+           t176 * 16.0 * t100 * t92 + t98 * 16.0 * t124 * t123 * t96)) *
+             t100 +
+         t176 * t105 * t124 * 8.0)) *
+           t106 * t100 * t133 -
+       4.0 * t129 * t171 * t106 * t100 * t172 + 4.0 * t129 * t106 * t124 * t123 * t133 +
+       t134 * 2.0 * t129 * t100 * t133);
+  const double t184 =
+      (t113 * ((-t110 - t170 * 0.174 * t111 - 0.087 * t108 * t183 - t112)) + (t139 * t139) +
+       (t138 * t138) + ((t119 - t170 * 0.174 * t108 + 0.087 * t111 * t183 + t137)) * t109);
+  const double t185 = t92 * t155;
+  const double t186 = (t173 + t174);
+  const double t187 = t186 * t96;
+  const double t188 = (t122 * t155 + t185 + t187 + t156 * t96);
+  const double t189 = (-16.0) * t155 * t104;
+  const double t190 = t98 * t186 * t100 * 8.0;
+  const double t191 = (-4.0 * t101 * t123 * t157 + t125 * t102 * t188 - t98 * 2.0 * t101 * t188 -
+                       t181 * 4.0 * t102 * t123 * t157 + t98 * t125 * t123 * 8.0 * t157);
+  const double t192 =
+      t105 *
+      ((4.0 * t124 * t123 * t159 - t134 * 4.0 * t124 * t157 - 24.0 * t177 * t106 * t123 * t157 +
+        t106 * t124 * t188 * 8.0 +
+        ((16.0 * t188 * t100 * t96 - t98 * t124 * t123 * 8.0 * t155 + 16.0 * t100 * t123 * t155 +
+          t189 + t190 - 32.0 * t124 * t123 * t157 * t96 + t98 * 24.0 * t177 * t123 * t157 * t96 -
+          t98 * t124 * t188 * 8.0 * t96 + t158 * 4.0 * t127 * t96 + 16.0 * t122 * t100 * t157 +
+          t126 * t158 * t180 * t92 - t191 * 4.0 * t127 * t92 - t98 * t122 * t124 * 8.0 * t157 +
+          t126 * 4.0 * t156 * t127)) *
+            t100)) *
+      t100 * t133 * (-1.0);
+  const double t193 = (-16.0) * t186 * t104;
+  const double t194 = t98 * (-8.0) * t100 * t155;
+  const double t195 =
+      t106 * t100 * t133 *
+      ((t105 * t124 * t188 * 8.0 + t161 * 4.0 * t124 * t123 + 4.0 * t124 * t128 * t157 -
+        t105 * 24.0 * t177 * t123 * t157 +
+        ((-16.0 * t156 * t100 * t123 - 16.0 * t100 * t157 * t96 + t158 * 4.0 * t122 * t127 +
+          t98 * t124 * t188 * 8.0 * t92 + 32.0 * t124 * t123 * t92 * t157 +
+          t126 * 4.0 * t127 * t155 + t98 * t124 * 8.0 * t157 * t96 + t193 -
+          t191 * 4.0 * t127 * t96 + t126 * t158 * t180 * t96 + t98 * t156 * t124 * t123 * 8.0 -
+          16.0 * t188 * t100 * t92 - t98 * 24.0 * t177 * t123 * t92 * t157 + t194)) *
+            t100));
+  const double t196 =
+      (t105 * 4.0 * t171 * t160 * t100 * t172 + t192 - t162 * 4.0 * t171 * t106 * t100 * t172 +
+       t162 * 4.0 * t106 * t124 * t123 * t133 + 2.0 * t160 * t100 * t128 * t133 +
+       t162 * t134 * 2.0 * t100 * t133 - t105 * 4.0 * t160 * t124 * t123 * t133 + t195);
+  const double t197 = (-t139 * 0.696 * t111 * t163 + 0.174 * t196 * t109 * t111 +
+                       t138 * 0.696 * t108 * t163 - t113 * 0.348 * t136 * t111 * t163 -
+                       t113 * 0.174 * t196 * t108 - 0.348 * t108 * t136 * t109 * t163);
+  const double t198 =
+      (-15927874.753700253 * t115 * t118 * t166 * t140 +
+       t167 * 1.2e+09 *
+           ((t168 * t164 * 0.006636614480708438 * x[6] * t140 +
+             t168 * t169 * x[4] * 0.013273228961416876 + t168 * t169 * x[5] * 0.013273228961416876 -
+             t115 * t184 * x[5] * 0.013273228961416876 - t115 * t184 * x[4] * 0.013273228961416876 -
+             t197 * t115 * 0.006636614480708438 * x[6])));
+  const double t199 = (-2.0 * t125 * t130 * t157 - 2.0 * t125 * t131 * t157 + t106 * t101 * t159 +
+                       t161 * t105 * t101);
+  const double t200 = ((t156 * t156) + t185 + (t155 * t155) + t187);
+  const double t201 = (t157 * t157);
+  const double t202 = (t181 * 4.0 * t201 * t102 - t125 * t102 * t200 + t98 * 2.0 * t101 * t200 +
+                       4.0 * t201 * t101 - t98 * t125 * t201 * 8.0);
+  const double t203 = (t158 * t158);
+  const double t204 =
+      (t105 * 4.0 * t171 * t160 * t100 * t199 - t161 * 2.0 * t160 * t100 * t133 -
+       t162 * 4.0 * t171 * t106 * t100 * t199 + t105 * 4.0 * t160 * t124 * t133 * t157 +
+       ((t106 * t124 * t200 * 8.0 - 24.0 * t177 * t106 * t201 +
+         t100 * ((-t98 * 16.0 * t124 * t155 * t157 + 4.0 * t127 * t202 * t92 + t189 + t190 +
+                  t203 * t180 * t92 + t158 * t156 * t127 * 8.0 - t98 * t124 * t200 * 8.0 * t96 +
+                  t98 * 24.0 * t177 * t201 * t96 + 32.0 * t100 * t155 * t157 +
+                  16.0 * t100 * t200 * t96 - 32.0 * t201 * t124 * t96)) +
+         t124 * 8.0 * t159 * t157)) *
+           t105 * t100 * t133 +
+       t162 * 2.0 * t100 * t133 * t159 - t162 * 4.0 * t106 * t124 * t133 * t157 +
+       t106 *
+           ((-t105 * t124 * t200 * 8.0 -
+             t100 *
+                 ((32.0 * t201 * t124 * t92 - 16.0 * t100 * t200 * t92 + t158 * t127 * 8.0 * t155 +
+                   t98 * 16.0 * t156 * t124 * t157 + t203 * t180 * t96 + t193 +
+                   t98 * t124 * t200 * 8.0 * t92 + 4.0 * t127 * t202 * t96 + t194 -
+                   32.0 * t156 * t100 * t157 - t98 * 24.0 * t177 * t201 * t92)) +
+             t105 * 24.0 * t177 * t201 - t161 * t124 * 8.0 * t157)) *
+           t100 * t133);
+  const double t205 = (t163 * t163);
+  const double t206 = (-t204 * 0.174 * t109 * t111 - 0.348 * t108 * t205 * t109 +
+                       0.24220799999999998 * (t111 * t111) * t205 - t113 * 0.348 * t205 * t111 +
+                       t204 * t113 * 0.174 * t108 + (t108 * t108) * 0.24220799999999998 * t205);
+  const double t207 = (t164 * t164);
+  const double t208 =
+      (t105 * 4.0 * t171 * t100 * t135 * t199 + t192 - t161 * 2.0 * t100 * t135 * t133 +
+       4.0 * t129 * t171 * t106 * t100 * t199 + 4.0 * t129 * t106 * t124 * t133 * t157 -
+       2.0 * t129 * t100 * t133 * t159 + t105 * 4.0 * t124 * t135 * t133 * t157 + t195);
+  const double t209 = (t138 * 0.348 * t108 * t163 - 0.348 * t139 * t111 * t163 +
+                       ((-0.174 * t108 * t136 * t163 + 0.087 * t208 * t111)) * t109 +
+                       t113 * ((-0.087 * t108 * t208 - 0.174 * t136 * t111 * t163)));
+  const double t210 = t167 * t115 * (-15927874.753700253) * t140;
+  const double t211 = x[10] * (1.0 / sqrt(t143));
+  const double t212 = (t211 - 1.0);
+  const double t213 = (t211 + 1.0);
+  const double t214 = x[14] * 2.0;
+  const double t215 = (t214 - 4e+05);
+  const double t216 = (1e-06 + (x[11] * x[11]));
+  const double t217 = x[11] * (1.0 / sqrt(t216));
+  const double t218 = (t217 + 1.0);
+  const double t219 = (u[13] - x[15]);
+  const double t220 = (t219 * t219);
+  const double t221 = (4e+10 + t220);
+  const double t222 = pow(t221, (-0.25));
+  const double t223 = (t217 - 1.0);
+  const double t224 = (x[15] - 2e+05);
+  const double t225 = (t224 * t224);
+  const double t226 = (4e+10 + t225);
+  const double t227 = pow(t226, (-0.25));
+  const double t228 = sqrt(t216);
+  const double t229 = (t228 + x[11]);
+  const double t230 = x[15] * 2.0;
+  const double t231 = (t230 - 4e+05);
+  const double t232 = (x[11] - t228);
+  const double t233 = (-2.9e+07 + x[15]);
+  const double t234 = (x[16] - 3.7e+07);
+  const double t235 = ((t234 * t234) + 1e+10);
+  const double t236 = (x[16] - 2e+05);
+  const double t237 = (t236 * t236);
+  const double t238 = (4e+10 + t237);
+  const double t239 = pow(t238, (-0.25));
+  const double t240 = (u[10] - x[16]);
+  const double t241 = (t240 * t240);
+  const double t242 = (4e+10 + t241);
+  const double t243 = pow(t242, (-0.25));
+  const double t244 = (1e+10 + t237);
+  const double t245 = (0.05992565888304706 - 0.015079644737231009 * t14);
+  const double t246 = (1.0 / (t245));
+  const double t247 = x[16] * 2.0;
+  const double t248 = (t247 - 4e+05);
+  const double t249 = (0.03909483791956781 - t70 * 0.00901244392498572);
+  const double t250 = (1.0 / (t249));
+  const double t251 = (1.0 / (t249 * t249));
+  const double t252 = (x[17] - 2e+05);
+  const double t253 = (t252 * t252);
+  const double t254 = (t253 + 1e+10);
+  const double t255 = (x[17] - 3.7e+07);
+  const double t256 = (1e+10 + (t255 * t255));
+  const double t257 = (4e+10 + t253);
+  const double t258 = pow(t257, (-0.25));
+  const double t259 = (x[17] - u[11]);
+  const double t260 = (t259 * t259);
+  const double t261 = (4e+10 + t260);
+  const double t262 = pow(t261, (-0.25));
+  const double t263 =
+      (sqrt(t254) * 3.5e-09 - sqrt(t256) * 3.5e-09 + t46 * t62 * x[4] * 0.00901244392498572 +
+       0.1302 - t258 * t252 * 2.8577380332470414e-06 * t52 - x[17] * 7e-09 +
+       t46 * x[5] * t60 * 0.00901244392498572 - t262 * 2.8577380332470414e-06 * t259 * t68);
+  const double t264 = x[17] * 2.0;
+  const double t265 = (t264 - 4e+05);
+  const double t266 = (x[18] - 3.7e+07);
+  const double t267 = (1e+10 + (t266 * t266));
+  const double t268 = (x[18] - 2e+05);
+  const double t269 = (t268 * t268);
+  const double t270 = (t269 + 1e+10);
+  const double t271 = (x[18] - u[12]);
+  const double t272 = (t271 * t271);
+  const double t273 = (4e+10 + t272);
+  const double t274 = pow(t273, (-0.25));
+  const double t275 = (4e+10 + t269);
+  const double t276 = pow(t275, (-0.25));
+  const double t277 =
+      (-2.5e-09 * sqrt(t267) + 0.093 + t115 * 0.006911503837897547 * x[4] * t140 +
+       t115 * 0.006911503837897547 * x[5] * t140 + 2.5e-09 * sqrt(t270) +
+       0.0034557519189487734 * t115 * t164 * x[6] - x[18] * 5e-09 +
+       t154 * t271 * 2.0412414523193154e-06 * t274 - t276 * t268 * t145 * 2.0412414523193154e-06);
+  const double t278 = (0.0276416792385999 - 0.006911503837897547 * t116);
+  const double t279 = (1.0 / (t278 * t278));
+  const double t280 = (1.0 / (t278));
+  const double t281 =
+      (8293804.6054770565 * t277 * t279 * t115 * t140 +
+       ((t115 * 0.006911503837897547 * t184 * x[5] + t115 * 0.006911503837897547 * t184 * x[4] -
+         t168 * 0.006911503837897547 * t169 * x[4] - t168 * 0.006911503837897547 * t169 * x[5] +
+         t197 * 0.0034557519189487734 * t115 * x[6] -
+         0.0034557519189487734 * t168 * t164 * x[6] * t140)) *
+           1.2e+09 * t280);
+  const double t282 = 8293804.6054770565 * t115 * t140 * t280;
+  const double t283 = x[18] * 2.0;
+  const double t284 = (t283 - 4e+05);
+  const double t285 = (x[19] - 2e+05);
+  const double t286 = (t285 * t285);
+  const double t287 = (4e+10 + t286);
+  const double t288 = pow(t287, (-0.25));
+  const double t289 = (u[13] - x[19]);
+  const double t290 = (t289 * t289);
+  const double t291 = (t290 + 4e+10);
+  const double t292 = pow(t291, (-0.25));
+  const double t293 = x[19] * 2.0;
+  const double t294 = (-2.9e+07 + x[19]);
+  const double t295 = (t293 - 4e+05);
+  const double t296 = (-0.35 * t0 - t1 * 2.6);
+  const double t297 = (t296 * t296);
+  const double t298 = 5.7 * t0;
+  const double t299 = t40 * (-0.1);
+  const double t300 = 1.1 * t38;
+  const double t301 = (t298 + t299 + t300);
+  const double t302 = t1 * (-0.35);
+  const double t303 = 2.6 * t0;
+  const double t304 = (t302 + t303);
+  const double t305 = t1 * (-5.7);
+  const double t306 = t38 * (-0.1);
+  const double t307 = t40 * (-1.1);
+  const double t308 = (t305 + t306 + t307);
+  const double t309 = t91 * 0.567857142857143;
+  const double t310 = 2.9 * t38;
+  const double t311 = t90 * 0.0578571428571429;
+  const double t312 = (t309 + t298 + t310 + t311);
+  const double t313 = t91 * 0.0578571428571429;
+  const double t314 = t40 * (-2.9);
+  const double t315 = t90 * (-0.567857142857143);
+  const double t316 = (t313 + t314 + t305 + t315);
+  const double t317 = (t316 * t316);
+  const double t318 = t90 * (-0.7);
+  const double t319 = t91 * (-0.3);
+  const double t320 = (t318 + t314 + t305 + t319);
+  const double t321 = t90 * (-0.3);
+  const double t322 = t91 * 0.7;
+  const double t323 = (t321 + t298 + t310 + t322);
+  const double t324 = (t318 + t314 + t319);
+  const double t325 = (t299 + t300);
+  const double t326 = (t309 + t310 + t311);
+  const double t327 = (t313 + t314 + t315);
+  const double t328 = (t321 + t310 + t322);
+  const double t329 = (t306 + t307);
+  const double t330 =
+      (1150.0 + 950.0 * t320 * t324 + t301 * t325 * 1100.0 + u[8] * ((t312 * t326 + t316 * t327)) +
+       t328 * 950.0 * t323 + 1100.0 * t308 * t329);
+  const double t331 = (t321 + t322);
+  const double t332 = (t318 + t319);
+  const double t333 = (t309 + t311);
+  const double t334 = (t313 + t315);
+  const double t335 =
+      (950.0 * t323 * t331 + 250.0 + t332 * 950.0 * t320 + ((t312 * t333 + t334 * t316)) * u[8]);
+  const double t336 = (t327 * t327);
+  const double t337 =
+      (t332 * 950.0 * t324 + 250.0 + t328 * 950.0 * t331 + ((t334 * t327 + t326 * t333)) * u[8]);
+  const double t338 = (t334 * t334);
+  const double t339 = (t298 + t299 + t300 + 0.15);
+  const double t340 = (-t40 * 110.0 + t38 * 1210.0 + 6270.0 * t0 + 165.0);
+  const double t341 = (t309 + t298 + t310 + 0.15 + t311);
+  const double t342 = (t321 + t298 + t310 + 0.15 + t322);
+  const double t343 = (-t90 * 285.0 + 665.0 * t91 + t38 * 2755.0 + 142.5 + 5415.0 * t0);
+  const double t344 = (5720.0 * t0 + 330.0 - t1 * 770.0);
+  const double t345 = (t302 + 0.15 + t303);
+  const double t346 = (x[4] * x[4]);
+  const double t347 = sin(u[9]);
+  const double t348 = t90 * 0.3;
+  const double t349 = (-2.9) * t38;
+  const double t350 = (-5.7) * t0;
+  const double t351 = t91 * (-0.7);
+  const double t352 = (t348 + t349 + t350 + t351);
+  const double t353 = (t348 + t349 + t351);
+  const double t354 = t353 * x[5];
+  const double t355 = (t348 + t351);
+  const double t356 = t355 * x[6];
+  const double t357 = (t352 * x[4] + t354 + t356);
+  const double t358 = (t355 * x[5] + t356 + t355 * x[4]);
+  const double t359 = x[6] * t358;
+  const double t360 = (t353 * x[4] + t354 + t356);
+  const double t361 = t360 * x[5];
+  const double t362 = (x[4] * t357 + t359 + t361);
+  const double t363 = (t1 * 0.35 - t303);
+  const double t364 = (t116 - 2.525);
+  const double t365 = (t364 * t364);
+  const double t366 = (t365 + 1e-06);
+  const double t367 = (t116 - 3.71);
+  const double t368 = (t367 * t367);
+  const double t369 = (t368 + 1e-06);
+  const double t370 =
+      (t115 * t164 * 1e+06 * x[6] + t115 * 2e+06 * x[4] * t140 + t115 * 2e+06 * x[5] * t140);
+  const double t371 = (1.0 / sqrt(t369));
+  const double t372 = (1.0 / sqrt(t366));
+  const double t373 = (t371 * t367 + 2.0 - t372 * t364);
+  const double t374 = (4e+08 * t116 - 2e+08 * sqrt(t366) + 0.013823007675795093 * x[18] -
+                       1.247e+09 + sqrt(t369) * 2e+08 - 0.026546457922833753 * x[14] + t370 * t373);
+  const double t375 = t115 * t374 * t140 * (-0.5);
+  const double t376 = x[5] * t329;
+  const double t377 = (t308 * x[4] + t376);
+  const double t378 = (x[4] * t329 + t376);
+  const double t379 = (x[4] * t377 + x[5] * t378);
+  const double t380 = (x[7] * x[7]);
+  const double t381 = t40 * 0.1;
+  const double t382 = t38 * (-1.1);
+  const double t383 = (t381 + t382);
+  const double t384 = t383 * x[5];
+  const double t385 = (t384 + t383 * x[4]);
+  const double t386 = x[5] * t385;
+  const double t387 = (t381 + t382 + t350);
+  const double t388 = (t384 + t387 * x[4]);
+  const double t389 = (t386 + t388 * x[4]);
+  const double t390 = cos(u[9]);
+  const double t391 = (-4.005 + t70);
+  const double t392 = (t391 * t391);
+  const double t393 = (1e-06 + t392);
+  const double t394 = (t70 - 2.595);
+  const double t395 = (t394 * t394);
+  const double t396 = (1e-06 + t395);
+  const double t397 = (1.0 / sqrt(t393));
+  const double t398 = (1.0 / sqrt(t396));
+  const double t399 = (t397 * t391 - t398 * t394 + 2.0);
+  const double t400 = (t46 * 2e+06 * x[5] * t60 + t46 * 2e+06 * t62 * x[4]);
+  const double t401 = (-0.035342917352885174 * x[13] + 4e+08 * t70 - 1.32e+09 + sqrt(t393) * 2e+08 -
+                       sqrt(t396) * 2e+08 + x[17] * 0.01802488784997144 + t399 * t400);
+  const double t402 = t332 * x[6];
+  const double t403 = (t332 * x[5] + t332 * x[4] + t402);
+  const double t404 = x[5] * t324;
+  const double t405 = (t404 + x[4] * t324 + t402);
+  const double t406 = (t404 + t320 * x[4] + t402);
+  const double t407 = (t403 * x[6] + t405 * x[5] + x[4] * t406);
+  const double t408 = t90 * (-0.0578571428571429);
+  const double t409 = (-0.567857142857143) * t91;
+  const double t410 = (t408 + t349 + t350 + t409);
+  const double t411 = (t408 + t349 + t409);
+  const double t412 = x[5] * t411;
+  const double t413 = (t408 + t409);
+  const double t414 = t413 * x[6];
+  const double t415 = (x[4] * t410 + t412 + t414);
+  const double t416 = (x[4] * t411 + t412 + t414);
+  const double t417 = x[5] * t416;
+  const double t418 = (t414 + t413 * x[5] + t413 * x[4]);
+  const double t419 = t418 * x[6];
+  const double t420 = (x[4] * t415 + t417 + t419);
+  const double t421 = x[5] * t327;
+  const double t422 = t334 * x[6];
+  const double t423 = (x[4] * t327 + t421 + t422);
+  const double t424 = (t421 + x[4] * t316 + t422);
+  const double t425 = (t334 * x[5] + t422 + t334 * x[4]);
+  const double t426 = (x[5] * t423 + x[4] * t424 + t425 * x[6]);
+  const double t427 = (-3.775 + t14);
+  const double t428 = (t427 * t427);
+  const double t429 = (1e-06 + t428);
+  const double t430 = (1.0 / sqrt(t429));
+  const double t431 = (-2.03 + t14);
+  const double t432 = (t431 * t431);
+  const double t433 = (1e-06 + t432);
+  const double t434 = (1.0 / sqrt(t433));
+  const double t435 = (2.0 + t430 * t427 - t431 * t434);
+  const double t436 =
+      (-t7 * 2e+06 * x[4] * t435 * t12 - 2e+08 * sqrt(t429) + sqrt(t433) * 2e+08 -
+       0.015079644737231009 * x[16] + 1.161e+09 - 4e+08 * t14 + x[12] * 0.03078760800517998);
+  const double t437 = (11440.0 * t0 + 660.0 - t1 * 1540.0);
+  const double t438 = (330.0 + 12540.0 * t0 + 2420.0 * t38 - t40 * 220.0);
+  const double t439 = (-t90 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t38 + 1330.0 * t91);
+  const double t440 = t90 * (-665.0);
+  const double t441 = t91 * (-285.0);
+  const double t442 = t40 * (-2755.0);
+  const double t443 = (t440 + t441 + t442 - t1 * 5415.0);
+  const double t444 = (-t1 * 5720.0 - 770.0 * t0);
+  const double t445 = 0.1 * t38;
+  const double t446 = t40 * 1.1;
+  const double t447 = (t445 + t446);
+  const double t448 = t447 * x[5];
+  const double t449 = (t448 + t447 * x[4]);
+  const double t450 = x[5] * t449;
+  const double t451 = t1 * 5.7;
+  const double t452 = (t450 + x[4] * ((((t445 + t446 + t451)) * x[4] + t448)));
+  const double t453 = t115 * t184 * t374 * (-0.5);
+  const double t454 = pow(t366, (-1.5));
+  const double t455 = pow(t369, (-1.5));
+  const double t456 = (t115 * 2e+08 * t371 * t140 * t367 - t115 * 2e+08 * t372 * t140 * t364 +
+                       ((t365 * t115 * t454 * t140 - t368 * t115 * t455 * t140 +
+                         t115 * t371 * t140 - t115 * t372 * t140)) *
+                           t370 +
+                       4e+08 * t115 * t140 +
+                       ((-t168 * t169 * 2e+06 * x[4] - t168 * t169 * 2e+06 * x[5] +
+                         t197 * t115 * 1e+06 * x[6] + t115 * 2e+06 * t184 * x[5] +
+                         t115 * 2e+06 * t184 * x[4] - t168 * t164 * 1e+06 * x[6] * t140)) *
+                           t373);
+  const double t457 = t456 * t115 * t140 * (-0.5);
+  const double t458 = pow(t396, (-1.5));
+  const double t459 = pow(t393, (-1.5));
+  const double t460 =
+      (-t398 * t46 * t394 * 2e+08 * t62 + 4e+08 * t46 * t62 + t46 * 2e+08 * t62 * t397 * t391 -
+       t400 * ((-t458 * t46 * t62 * t395 - t46 * t62 * t397 + t398 * t46 * t62 +
+                t46 * t392 * t62 * t459)) +
+       ((t46 * 2e+06 * x[5] * t78 + t46 * 2e+06 * x[4] * t81 - t79 * 2e+06 * t62 * x[5] * t60 -
+         t79 * t80 * 2e+06 * x[4])) *
+           t399);
+  const double t461 = t40 * 2.9;
+  const double t462 = t90 * 0.567857142857143;
+  const double t463 = t91 * (-0.0578571428571429);
+  const double t464 = (t461 + t462 + t463);
+  const double t465 = t464 * x[5];
+  const double t466 = (t462 + t463);
+  const double t467 = t466 * x[6];
+  const double t468 = (t464 * x[4] + t465 + t467);
+  const double t469 = t468 * x[5];
+  const double t470 = (t466 * x[4] + t467 + t466 * x[5]);
+  const double t471 = x[6] * t470;
+  const double t472 = (((t465 + t467 + ((t461 + t462 + t463 + t451)) * x[4])) * x[4] + t469 + t471);
+  const double t473 = t168 * t169 * t374 * 0.5;
+  const double t474 = (-110.0) * t38;
+  const double t475 = t40 * (-1210.0);
+  const double t476 = (t474 + t475 - t1 * 6270.0);
+  const double t477 = t90 * 0.7;
+  const double t478 = t91 * 0.3;
+  const double t479 = (t477 + t478);
+  const double t480 = t479 * x[6];
+  const double t481 = (t461 + t477 + t478);
+  const double t482 = t481 * x[5];
+  const double t483 = (t479 * x[5] + t479 * x[4] + t480);
+  const double t484 = x[6] * t483;
+  const double t485 = (t480 + t481 * x[4] + t482);
+  const double t486 = t485 * x[5];
+  const double t487 = (x[4] * ((t480 + ((t461 + t477 + t451 + t478)) * x[4] + t482)) + t484 + t486);
+  const double t488 = t347 * t353 * (-9316.3175);
+  const double t489 = t383 * t380 * t340;
+  const double t490 = (-1100.0) * t379 * t329;
+  const double t491 = (-950.0) * t362 * t353;
+  const double t492 = t420 * t411;
+  const double t493 = (t469 + t468 * x[4] + t471);
+  const double t494 = (x[4] * t416 + t417 + t419);
+  const double t495 = t426 * t327;
+  const double t496 = t79 * t401 * t62 * 0.5 * t60;
+  const double t497 = (t359 + t361 + t360 * x[4]);
+  const double t498 = t389 * t383 * (-1100.0);
+  const double t499 = (x[4] * t449 + t450);
+  const double t500 =
+      (t46 * 2e+08 * t397 * t60 * t391 + 4e+08 * t46 * t60 - t398 * t46 * t394 * 2e+08 * t60 +
+       t399 * ((t46 * 2e+06 * x[4] * t78 + t46 * t83 * 2e+06 * x[5] -
+                t79 * 2e+06 * t62 * x[4] * t60 - t79 * 2e+06 * x[5] * t82)) -
+       ((-t458 * t46 * t395 * t60 + t398 * t46 * t60 + t46 * t392 * t459 * t60 -
+         t46 * t397 * t60)) *
+           t400);
+  const double t501 = (-950.0) * t407 * t324;
+  const double t502 = u[8] * ((-t347 * 9.80665 * t411 - t390 * 9.80665 * t327));
+  const double t503 = t380 * t341 * u[8] * t411;
+  const double t504 = t380 * t353 * t343;
+  const double t505 = (t440 + t441 + t442);
+  const double t506 = t383 * t347 * (-10787.314999999999);
+  const double t507 = (-10787.314999999999) * t390 * t329;
+  const double t508 = t390 * t324 * (-9316.3175);
+  const double t509 = t380 * u[8] * t316 * t327;
+  const double t510 = t46 * t401 * (-0.5) * t78;
+  const double t511 = (t484 + t485 * x[4] + t486);
+  const double t512 = (x[4] * t385 + t386);
+  const double t513 = (t474 + t475);
+  const double t514 = t332 * t390 * (-9316.3175);
+  const double t515 = (t440 + t441);
+  const double t516 = t355 * (-950.0) * t362;
+  const double t517 = t380 * t355 * t343;
+  const double t518 = t168 * 0.25 * t164 * t374 * t140;
+  const double t519 = (x[5] * t470 + x[4] * t470 + t471);
+  const double t520 = t334 * t426;
+  const double t521 = (t419 + t418 * x[4] + t418 * x[5]);
+  const double t522 = t413 * t420;
+  const double t523 = t380 * t334 * u[8] * t316;
+  const double t524 = t332 * (-950.0) * t407;
+  const double t525 = (-4e+08 * t115 * t164 -
+                       2.0 *
+                           ((t115 * 1e+06 * x[6] * t206 - t168 * x[6] * t207 * 5e+05 -
+                             t168 * t164 * 1e+06 * x[4] * t140 - t168 * t164 * 1e+06 * x[5] * t140 +
+                             t115 * 2e+06 * t209 * x[4] + t115 * 2e+06 * t209 * x[5])) *
+                           t373 +
+                       t370 * ((t115 * t164 * t372 - t365 * t115 * t454 * t164 -
+                                t115 * t371 * t164 + t368 * t115 * t455 * t164)) -
+                       t115 * 2e+08 * t371 * t164 * t367 + t115 * 2e+08 * t164 * t372 * t364);
+  const double t526 = t115 * 0.25 * t525 * t140;
+  const double t527 = (x[4] * t483 + x[5] * t483 + t484);
+  const double t528 = t115 * t209 * t374 * (-0.5);
+  const double t529 = t355 * t347 * (-9316.3175);
+  const double t530 = ((-t413 * t347 * 9.80665 - t390 * t334 * 9.80665)) * u[8];
+  const double t531 = (x[4] * t358 + x[5] * t358 + t359);
+  const double t532 = t413 * t380 * t341 * u[8];
+  const double t533 = (1.0 / (t114));
+  const double t534 = t533 * (-1e+06) * t169 * t373;
+  const double t535 = (1.0 / (t45));
+  const double t536 = t535 * (-1e+06) * t62 * t399 * t60;
+  const double t537 = (-5e+05) * t533 * t164 * t140 * t373;
+  const double t538 = t115 * 0.013273228961416876 * t140;
+  const double t539 = (-0.006911503837897547) * t115 * t140;
+  const double t540 = t380 * t334 * u[8] * t327;
+  const double t541 = t197 * t115 * t374 * (-0.25);
+  const double t542 = t456 * t115 * t164 * (-0.25);
+  const double t543 = (-220.0) * t38;
+  const double t544 = t40 * (-2420.0);
+  const double t545 = t90 * (-1330.0);
+  const double t546 = t40 * (-5510.0);
+  const double t547 = t91 * (-570.0);
+  const double t548 = 950.0 * t323 * t324;
+  const double t549 = t383 * 1100.0 * t308;
+  const double t550 = t301 * 1100.0 * t329;
+  const double t551 = 950.0 * t320 * t353;
+  const double t552 = t316 * t411;
+  const double t553 = t312 * t327;
+  const double t554 = (t548 + t549 + t325 * 1100.0 * t308 + t550 + 950.0 * t352 * t324 + t551 +
+                       1100.0 * t387 * t329 + u[8] * ((t326 * t316 + t552 + t553 + t410 * t327)) +
+                       t328 * 950.0 * t320);
+  const double t555 = t312 * t334;
+  const double t556 = t413 * t316;
+  const double t557 = t332 * 950.0 * t323;
+  const double t558 = t355 * 950.0 * t320;
+  const double t559 = (((t555 + t333 * t316 + t556 + t334 * t410)) * u[8] + t332 * 950.0 * t352 +
+                       t557 + 950.0 * t320 * t331 + t558);
+  const double t560 = t411 * t327;
+  const double t561 = t326 * t327;
+  const double t562 = (t328 * 1900.0 * t324 + ((t560 + t561)) * 2.0 * u[8] + t383 * 2200.0 * t329 +
+                       1900.0 * t353 * t324 + t325 * 2200.0 * t329);
+  const double t563 = t328 * t332 * 950.0;
+  const double t564 = t326 * t334;
+  const double t565 = t334 * t411;
+  const double t566 = t413 * t327;
+  const double t567 = t333 * t327;
+  const double t568 = t332 * 950.0 * t353;
+  const double t569 = t355 * 950.0 * t324;
+  const double t570 = 950.0 * t331 * t324;
+  const double t571 = (t563 + ((t564 + t565 + t566 + t567)) * u[8] + t568 + t569 + t570);
+  const double t572 = t333 * t334;
+  const double t573 = t413 * t334;
+  const double t574 = (2.0 * u[8] * ((t572 + t573)) + t332 * t355 * 1900.0 + t332 * 1900.0 * t331);
+  const double t575 =
+      (t548 + t549 + 950.0 * t353 * t324 + t328 * 950.0 * t324 + t550 + t551 +
+       ((t560 + t552 + t553 + t561)) * u[8] + t383 * 1100.0 * t329 + t325 * 1100.0 * t329);
+  const double t576 = (((t555 + t556 + t565 + t567)) * u[8] + t568 + t557 + t570 + t558);
+  const double t577 = (((t564 + t555 + t556 + t566)) * u[8] + t563 + t569 + t557 + t558);
+  const double t578 = t332 * 950.0 * t331;
+  const double t579 = t332 * t355 * 950.0;
+  const double t580 = (t578 + t557 + u[8] * ((t572 + t573 + t555 + t556)) + t579 + t558);
+  const double t581 = (t578 + t563 + ((t572 + t564 + t573 + t566)) * u[8] + t569 + t579);
+  jacobian[4] = 1.0;
+  jacobian[25] = 1.0;
+  jacobian[46] = 1.0;
+  jacobian[67] = 1.0;
+  jacobian[168] = (-16.666666666666668);
+  jacobian[189] = (-16.666666666666668);
+  jacobian[210] = (-16.666666666666668);
+  jacobian[231] = (-12.5);
+  jacobian[240] =
+      (((-t7 * t10 * x[4] * 0.03078760800517998 + t11 * t13 * x[4] * 0.03078760800517998)) *
+           1.2e+09 * t16 -
+       t7 * 36945129.606215976 *
+           ((sqrt(t19) * 3.5e-09 - t7 * x[4] * 0.03078760800517998 * t12 - sqrt(t21) * 3.5e-09 -
+             x[12] * 7e-09 + 0.1302 + t22 * 2.8577380332470414e-06 * t25 * t28 +
+             t30 * t17 * 2.8577380332470414e-06 * t31)) *
+           t12 / (t15 * t15));
+  jacobian[244] = (-36945129.606215976) * t7 * t16 * t12;
+  jacobian[248] =
+      1.2e+09 *
+      ((-t33 * t30 * t17 * 2.8577380332470414e-06 + t22 * 2.8577380332470414e-06 * t25 * t34)) *
+      t16;
+  jacobian[252] = 1.2e+09 *
+                  ((-2.8577380332470414e-06 * t25 * t28 -
+                    7.144345083117603e-07 * t17 * t36 * pow(t29, (-1.25)) * t31 -
+                    ((-7.4e+07 + t35)) * (1.0 / sqrt(t21)) * 1.75e-09 +
+                    t30 * 2.8577380332470414e-06 * t31 + (1.0 / sqrt(t19)) * t36 * 1.75e-09 +
+                    t23 * 1.4288690166235207e-06 * t28 * pow(t24, (-1.25)) - 7e-09)) *
+                  t16;
+  jacobian[260] =
+      (-t46 * t69 * t62 * t72 * 21205750.411731105 +
+       t73 * 1.2e+09 *
+           ((-t46 * 0.017671458676442587 * x[5] * t78 + t79 * t80 * 0.017671458676442587 * x[4] +
+             t79 * t62 * 0.017671458676442587 * x[5] * t60 -
+             t46 * 0.017671458676442587 * x[4] * t81)));
+  jacobian[261] =
+      (-t46 * t69 * t72 * 21205750.411731105 * t60 +
+       t73 * 1.2e+09 *
+           ((t79 * 0.017671458676442587 * x[5] * t82 - t46 * t83 * 0.017671458676442587 * x[5] +
+             t79 * t62 * 0.017671458676442587 * x[4] * t60 -
+             t46 * 0.017671458676442587 * x[4] * t78)));
+  jacobian[264] = t73 * t46 * t62 * (-21205750.411731105);
+  jacobian[265] = t73 * t46 * t60 * (-21205750.411731105);
+  jacobian[269] =
+      ((2.8577380332470414e-06 * t49 * t55 * t85 - t67 * t63 * 2.8577380332470414e-06 * t86)) *
+      t73 * 1.2e+09;
+  jacobian[273] = t73 * 1.2e+09 *
+                  ((-(1.0 / sqrt(t48)) * ((t87 - 7.4e+07)) * 1.75e-09 +
+                    pow(t54, (-1.25)) * t53 * t52 * 1.4288690166235207e-06 -
+                    2.8577380332470414e-06 * t52 * t55 - t67 * 2.8577380332470414e-06 * t68 +
+                    7.144345083117603e-07 * t63 * t88 * pow(t66, (-1.25)) * t68 +
+                    t88 * (1.0 / sqrt(t65)) * 1.75e-09 - 7e-09));
+  jacobian[280] = t198;
+  jacobian[281] = t198;
+  jacobian[282] =
+      (t167 * 1.2e+09 *
+           ((t168 * t164 * 0.006636614480708438 * x[5] * t140 +
+             t168 * t164 * 0.006636614480708438 * x[4] * t140 -
+             t115 * 0.006636614480708438 * x[6] * t206 + t168 * 0.003318307240354219 * x[6] * t207 -
+             t115 * t209 * x[4] * 0.013273228961416876 -
+             t115 * t209 * x[5] * 0.013273228961416876)) -
+       t115 * 7963937.376850126 * t118 * t164 * t166);
+  jacobian[284] = t210;
+  jacobian[285] = t210;
+  jacobian[286] = t167 * (-7963937.376850126) * t115 * t164;
+  jacobian[290] = ((-t153 * t150 * t212 * 2.0412414523193154e-06 -
+                    t213 * t146 * 2.0412414523193154e-06 * t149)) *
+                  t167 * 1.2e+09;
+  jacobian[294] = t167 * 1.2e+09 *
+                  ((-t215 * t150 * 5.103103630798288e-07 * t154 * pow(t152, (-1.25)) +
+                    t153 * t154 * 2.0412414523193154e-06 + (1.0 / sqrt(t165)) * t215 * 1.25e-09 +
+                    pow(t148, (-1.25)) * t145 * 1.0206207261596577e-06 * t147 -
+                    t145 * 2.0412414523193154e-06 * t149 -
+                    (1.0 / sqrt(t142)) * 1.25e-09 * ((t214 - 7.4e+07)) - 5e-09));
+  jacobian[307] = (-7.5e+08);
+  jacobian[311] = (t218 * t219 * 510310.3630798288 * t222 - t223 * t224 * t227 * 510310.3630798288);
+  jacobian[315] = (t220 * pow(t221, (-1.25)) * t229 * 255155.1815399144 +
+                   t231 * (1.0 / sqrt((1e+10 + t225))) * 312.5 - 1250.0 -
+                   t232 * t231 * t224 * 127577.5907699572 * pow(t226, (-1.25)) -
+                   t229 * 510310.3630798288 * t222 + t232 * t227 * 510310.3630798288 -
+                   ((t230 - 5.8e+07)) * (1.0 / sqrt(((t233 * t233) + 1e+10))) * 312.5);
+  jacobian[320] =
+      (((0.015079644737231009 * t7 * x[4] * t12 - sqrt(t235) * 3.5e-09 -
+         t239 * t236 * 2.8577380332470414e-06 * t28 - t243 * 2.8577380332470414e-06 * t240 * t31 -
+         x[16] * 7e-09 + 0.1302 + sqrt(t244) * 3.5e-09)) *
+           t7 * 18095573.68467721 * t12 / (t245 * t245) +
+       1.2e+09 * t246 *
+           ((0.015079644737231009 * t7 * t10 * x[4] - 0.015079644737231009 * t11 * t13 * x[4])));
+  jacobian[324] = t7 * t246 * 18095573.68467721 * t12;
+  jacobian[328] =
+      1.2e+09 *
+      ((t33 * t243 * 2.8577380332470414e-06 * t240 - t239 * t236 * 2.8577380332470414e-06 * t34)) *
+      t246;
+  jacobian[336] = 1.2e+09 * t246 *
+                  ((-1.4288690166235207e-06 * pow(t242, (-1.25)) * t241 * t31 +
+                    t243 * 2.8577380332470414e-06 * t31 + (1.0 / sqrt(t244)) * t248 * 1.75e-09 +
+                    7.144345083117603e-07 * t236 * t248 * t28 * pow(t238, (-1.25)) -
+                    t239 * 2.8577380332470414e-06 * t28 -
+                    ((t247 - 7.4e+07)) * (1.0 / sqrt(t235)) * 1.75e-09 - 7e-09));
+  jacobian[340] =
+      (((t46 * x[5] * t78 * 0.00901244392498572 + t46 * x[4] * t81 * 0.00901244392498572 -
+         t79 * t62 * x[5] * t60 * 0.00901244392498572 - t79 * t80 * x[4] * 0.00901244392498572)) *
+           1.2e+09 * t250 +
+       t251 * t46 * 10814932.709982865 * t62 * t263);
+  jacobian[341] =
+      (t251 * t46 * 10814932.709982865 * t263 * t60 +
+       1.2e+09 *
+           ((-t79 * t62 * x[4] * t60 * 0.00901244392498572 +
+             t46 * t83 * x[5] * 0.00901244392498572 + t46 * x[4] * t78 * 0.00901244392498572 -
+             t79 * x[5] * t82 * 0.00901244392498572)) *
+           t250);
+  jacobian[344] = t46 * 10814932.709982865 * t62 * t250;
+  jacobian[345] = t46 * 10814932.709982865 * t250 * t60;
+  jacobian[349] =
+      1.2e+09 * t250 *
+      ((-t258 * t252 * 2.8577380332470414e-06 * t85 - t262 * 2.8577380332470414e-06 * t259 * t86));
+  jacobian[357] =
+      ((7.144345083117603e-07 * t252 * t265 * t52 * pow(t257, (-1.25)) -
+        t262 * 2.8577380332470414e-06 * t68 - ((-7.4e+07 + t264)) * (1.0 / sqrt(t256)) * 1.75e-09 +
+        t265 * (1.0 / sqrt(t254)) * 1.75e-09 +
+        t260 * 1.4288690166235207e-06 * pow(t261, (-1.25)) * t68 -
+        t258 * 2.8577380332470414e-06 * t52 - 7e-09)) *
+      1.2e+09 * t250;
+  jacobian[360] = t281;
+  jacobian[361] = t281;
+  jacobian[362] = (t277 * t279 * t115 * t164 * 4146902.3027385282 +
+                   1.2e+09 *
+                       ((0.0034557519189487734 * t115 * x[6] * t206 -
+                         t168 * 0.0017278759594743867 * x[6] * t207 -
+                         0.0034557519189487734 * t168 * t164 * x[5] * t140 -
+                         0.0034557519189487734 * t168 * t164 * x[4] * t140 +
+                         t115 * 0.006911503837897547 * t209 * x[4] +
+                         t115 * 0.006911503837897547 * t209 * x[5])) *
+                       t280);
+  jacobian[364] = t282;
+  jacobian[365] = t282;
+  jacobian[366] = t115 * t164 * t280 * 4146902.3027385282;
+  jacobian[370] = 1.2e+09 *
+                  ((-t271 * t212 * 2.0412414523193154e-06 * t274 -
+                    t276 * t213 * t268 * 2.0412414523193154e-06)) *
+                  t280;
+  jacobian[378] = 1.2e+09 *
+                  ((-((-7.4e+07 + t283)) * 1.25e-09 * (1.0 / sqrt(t267)) -
+                    t154 * pow(t273, (-1.25)) * t272 * 1.0206207261596577e-06 +
+                    t154 * 2.0412414523193154e-06 * t274 - t276 * t145 * 2.0412414523193154e-06 +
+                    t268 * 5.103103630798288e-07 * t284 * t145 * pow(t275, (-1.25)) +
+                    t284 * 1.25e-09 * (1.0 / sqrt(t270)) - 5e-09)) *
+                  t280;
+  jacobian[387] = 7.5e+08;
+  jacobian[391] =
+      (-t288 * t285 * t218 * 510310.3630798288 + t223 * 510310.3630798288 * t289 * t292);
+  jacobian[399] =
+      (-((t293 - 5.8e+07)) * (1.0 / sqrt(((t294 * t294) + 1e+10))) * 312.5 - 1250.0 -
+       t288 * t229 * 510310.3630798288 +
+       t295 * t285 * 127577.5907699572 * t229 * pow(t287, (-1.25)) +
+       (1.0 / sqrt((t286 + 1e+10))) * t295 * 312.5 -
+       t290 * t232 * pow(t291, (-1.25)) * 255155.1815399144 + t232 * 510310.3630798288 * t292);
+  mass[0] = (7650.0 + 2200.0 * t297 + (t301 * t301) * 1100.0 + (t304 * t304) * 2200.0 +
+             1100.0 * (t308 * t308) + (((t312 * t312) + t317)) * u[8] + 950.0 * (t320 * t320) +
+             (t323 * t323) * 950.0);
+  mass[1] = t330;
+  mass[2] = t335;
+  mass[3] = 0.0;
+  mass[4] = t330;
+  mass[5] = ((t329 * t329) * 1100.0 + 1150.0 + 950.0 * (t324 * t324) + (t328 * t328) * 950.0 +
+             u[8] * ((t336 + (t326 * t326))) + 1100.0 * (t325 * t325));
+  mass[6] = t337;
+  mass[7] = 0.0;
+  mass[8] = t335;
+  mass[9] = t337;
+  mass[10] =
+      (((t338 + (t333 * t333))) * u[8] + (t332 * t332) * 950.0 + 250.0 + (t331 * t331) * 950.0);
+  mass[11] = 0.0;
+  mass[12] = 0.0;
+  mass[13] = 0.0;
+  mass[14] = 0.0;
+  mass[15] = (t339 * t340 + 60000.0 + (t341 * t341) * u[8] + t342 * t343 + t344 * t345);
+  acceleration[0] =
+      (-t346 * t296 * t304 * 2200.0 - t296 * t347 * 21574.629999999997 - 950.0 * t320 * t362 -
+       t346 * t296 * 2200.0 * t363 + t375 - t301 * 1100.0 * t379 + t380 * t296 * t344 -
+       t389 * 1100.0 * t308 - t323 * t390 * 9316.3175 - x[4] * 6000.0 - t46 * t401 * t62 * 0.5 +
+       t380 * t341 * u[8] * t316 - t347 * t320 * 9316.3175 + u[4] + t380 * t320 * t343 -
+       t301 * t390 * 10787.314999999999 - t347 * t308 * 10787.314999999999 - 950.0 * t323 * t407 +
+       ((-t312 * t390 * 9.80665 - t347 * 9.80665 * t316)) * u[8] -
+       ((t420 * t316 + t312 * t426)) * u[8] + t380 * t308 * t340 -
+       t304 * t390 * 21574.629999999997 + t7 * t12 * t436);
+  acceleration[1] =
+      (-t328 * t390 * 9316.3175 - t347 * t324 * 9316.3175 + t380 * t329 * t340 + t375 +
+       t380 * t324 * t343 - ((t420 * t327 + t326 * t426)) * u[8] - 2500.0 * x[5] -
+       950.0 * t362 * t324 - t389 * 1100.0 * t329 +
+       u[8] * ((-t326 * t390 * 9.80665 - t347 * 9.80665 * t327)) -
+       t347 * 10787.314999999999 * t329 - t328 * 950.0 * t407 + u[5] + t380 * t341 * u[8] * t327 -
+       t325 * t390 * 10787.314999999999 - t325 * 1100.0 * t379 - t46 * t401 * 0.5 * t60);
+  acceleration[2] =
+      (-t332 * 950.0 * t362 + t380 * t341 * t334 * u[8] - 950.0 * t407 * t331 + t380 * t332 * t343 +
+       ((-t347 * t334 * 9.80665 - t390 * t333 * 9.80665)) * u[8] - 800.0 * x[6] -
+       t390 * t331 * 9316.3175 + u[6] - u[8] * ((t420 * t334 + t333 * t426)) -
+       t332 * t347 * 9316.3175 - t115 * 0.25 * t164 * t374);
+  acceleration[3] =
+      (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 - t296 * x[7] * x[4] * t437 + u[7] -
+       t341 * 2.0 * x[7] * u[8] * t424 - t438 * x[7] * t377 - x[7] * t439 * t406);
+  d_force[0] =
+      (((-t390 * 9.80665 * t316 - t347 * t410 * 9.80665)) * u[8] - t346 * 2200.0 * t297 -
+       t347 * 21574.629999999997 * t363 + t7 * t10 * t436 + t443 * t380 * t320 +
+       t79 * t401 * t80 * 0.5 + t380 * t296 * t444 - t452 * 1100.0 * t308 -
+       t346 * (t363 * t363) * 2200.0 + t453 - t320 * t390 * 9316.3175 + t457 -
+       t389 * 1100.0 * t387 - t390 * t308 * 10787.314999999999 + t380 * t317 * u[8] -
+       950.0 * t323 * t362 + t380 * t341 * u[8] * t410 - t11 * t13 * t436 -
+       t296 * t390 * 21574.629999999997 - 950.0 * t320 * t407 - t347 * t352 * 9316.3175 -
+       t346 * t296 * ((t1 * 2.6 + 0.35 * t0)) * 2200.0 + t380 * t352 * t343 -
+       t46 * t62 * t460 * 0.5 +
+       t7 *
+           ((-t7 * 2e+06 * t10 * x[4] * t435 + t7 * t431 * t434 * 2e+08 * t12 - 4e+08 * t7 * t12 +
+             t11 * t13 * 2e+06 * x[4] * t435 -
+             t7 * 2e+06 * x[4] * t12 *
+                 ((t7 * t430 * t12 - t7 * t428 * pow(t429, (-1.5)) * t12 +
+                   pow(t433, (-1.5)) * t7 * t432 * t12 - t7 * t434 * t12)) -
+             t7 * 2e+08 * t430 * t427 * t12)) *
+           t12 -
+       ((t420 * t410 + t472 * t316 + t316 * t426 + t420 * t312)) * u[8] -
+       t346 * t304 * 2200.0 * t363 + t380 * t363 * t344 - 950.0 * t352 * t362 + t380 * t387 * t340 +
+       t473 - 1100.0 * t308 * t379 - t347 * t387 * 10787.314999999999 + t380 * t308 * t476 -
+       t46 * t401 * 0.5 * t81 - t389 * t301 * 1100.0 - 950.0 * t320 * t487);
+  d_force[1] =
+      (t488 + t489 + t490 + t491 - ((t492 + t316 * t493 + t312 * t494 + t495)) * u[8] + t453 +
+       t496 - t497 * 950.0 * t323 + t457 + t498 - 1100.0 * t499 * t308 - t46 * t500 * t62 * 0.5 +
+       t501 + t502 + t503 + t504 + t380 * t320 * t505 + t506 + t507 + t508 + t473 + t509 + t510 -
+       950.0 * t320 * t511 - t301 * 1100.0 * t512 + t380 * t308 * t513);
+  d_force[2] = (t514 + t380 * t320 * t515 + t516 + t517 + t518 -
+                ((t519 * t316 + t520 + t521 * t312 + t522)) * u[8] + t523 + t524 + t526 -
+                950.0 * t320 * t527 + t528 + t529 + t530 - 950.0 * t323 * t531 + t532);
+  d_force[4] =
+      (t534 - t13 * 2e+06 * t435 / (t6)-t296 * t363 * x[4] * 4400.0 - t320 * 1900.0 * t357 -
+       t323 * 1900.0 * t406 - t296 * t304 * x[4] * 4400.0 - 6000.0 - t535 * t80 * t399 * 1e+06 -
+       2200.0 * t388 * t308 - t301 * 2200.0 * t377 - 2.0 * ((t312 * t424 + t415 * t316)) * u[8]);
+  d_force[5] = (t536 - t320 * 1900.0 * t360 + t534 - t405 * t323 * 1900.0 - 2200.0 * t308 * t385 -
+                t301 * 2200.0 * t378 - ((t416 * t316 + t312 * t423)) * 2.0 * u[8]);
+  d_force[6] = (-t320 * 1900.0 * t358 - 2.0 * u[8] * ((t418 * t316 + t425 * t312)) + t537 -
+                t323 * 1900.0 * t403);
+  d_force[7] = (t296 * 2.0 * t344 * x[7] + 2.0 * t308 * x[7] * t340 + t320 * 2.0 * x[7] * t343 +
+                t341 * 2.0 * x[7] * u[8] * t316);
+  d_force[12] = t7 * 0.03078760800517998 * t12;
+  d_force[13] = t46 * t62 * 0.017671458676442587;
+  d_force[14] = t538;
+  d_force[16] = t7 * (-0.015079644737231009) * t12;
+  d_force[17] = (-0.00901244392498572) * t46 * t62;
+  d_force[18] = t539;
+  d_force[20] =
+      (-950.0 * t487 * t324 + t488 + t380 * t329 * t476 + t489 + t490 - t46 * t460 * 0.5 * t60 +
+       t491 - t328 * 950.0 * t362 + t453 + t496 + t457 + t498 - t389 * t325 * 1100.0 + t501 + t502 +
+       t503 + t504 + t506 - u[8] * ((t472 * t327 + t492 + t495 + t420 * t326)) + t507 -
+       t452 * 1100.0 * t329 + t443 * t380 * t324 + t508 + t473 + t509 + t510);
+  d_force[21] =
+      (t380 * t329 * t513 + t488 + t489 - 950.0 * t511 * t324 + t490 + t380 * t336 * u[8] + t491 -
+       t325 * 1100.0 * t512 - t497 * t328 * 950.0 + t453 + t380 * t324 * t505 + t457 + t498 -
+       1100.0 * t499 * t329 + t501 + t502 + t503 - t46 * t500 * 0.5 * t60 + t504 -
+       ((t493 * t327 + t492 + t495 + t494 * t326)) * u[8] + t506 + t79 * t401 * 0.5 * t82 + t507 +
+       t508 - t46 * t401 * t83 * 0.5 + t473);
+  d_force[22] = (t514 + t516 + t517 + t518 + t380 * t515 * t324 -
+                 ((t521 * t326 + t520 + t519 * t327 + t522)) * u[8] + t540 + t524 + t526 -
+                 950.0 * t324 * t527 + t528 + t529 - t328 * 950.0 * t531 + t530 + t532);
+  d_force[24] = (-1900.0 * t357 * t324 + t536 - ((t415 * t327 + t326 * t424)) * 2.0 * u[8] + t534 -
+                 2200.0 * t388 * t329 - t325 * 2200.0 * t377 - t328 * 1900.0 * t406);
+  d_force[25] = (-2200.0 * t329 * t385 - 2500.0 - ((t326 * t423 + t416 * t327)) * 2.0 * u[8] +
+                 t534 - t535 * t399 * 1e+06 * t82 - 1900.0 * t360 * t324 - t325 * 2200.0 * t378 -
+                 t405 * t328 * 1900.0);
+  d_force[26] = (-((t418 * t327 + t425 * t326)) * 2.0 * u[8] + t537 - 1900.0 * t358 * t324 -
+                 t328 * 1900.0 * t403);
+  d_force[27] =
+      (2.0 * x[7] * t324 * t343 + 2.0 * x[7] * t329 * t340 + t341 * 2.0 * x[7] * u[8] * t327);
+  d_force[33] = t46 * 0.017671458676442587 * t60;
+  d_force[34] = t538;
+  d_force[37] = (-0.00901244392498572) * t46 * t60;
+  d_force[38] = t539;
+  d_force[40] = (t514 + t541 + t516 + t542 + t517 + t443 * t380 * t332 + t518 + t523 -
+                 950.0 * t362 * t331 + t524 - ((t420 * t333 + t520 + t334 * t472 + t522)) * u[8] +
+                 t529 - t332 * 950.0 * t487 + t530 + t532);
+  d_force[41] = (t514 + t541 + t516 + t542 + t517 - t497 * 950.0 * t331 + t518 + t540 -
+                 t332 * 950.0 * t511 + t524 + t380 * t332 * t505 -
+                 ((t520 + t334 * t493 + t494 * t333 + t522)) * u[8] + t529 + t530 + t532);
+  d_force[42] =
+      (t514 + t516 + t517 + t380 * t338 * u[8] - t115 * 0.25 * t374 * t206 + t380 * t332 * t515 +
+       t524 + 0.125 * t168 * t374 * t207 - u[8] * ((t520 + t521 * t333 + t519 * t334 + t522)) -
+       t332 * 950.0 * t527 - 950.0 * t331 * t531 + 0.125 * t115 * t164 * t525 + t529 + t530 + t532);
+  d_force[44] = (-2.0 * ((t333 * t424 + t334 * t415)) * u[8] - 1900.0 * t331 * t406 + t537 -
+                 t332 * 1900.0 * t357);
+  d_force[45] = (-t405 * 1900.0 * t331 - t332 * 1900.0 * t360 -
+                 ((t333 * t423 + t334 * t416)) * 2.0 * u[8] + t537);
+  d_force[46] = (-250000.0 * t533 * t207 * t373 - 2.0 * u[8] * ((t425 * t333 + t418 * t334)) -
+                 t332 * 1900.0 * t358 - 800.0 - 1900.0 * t403 * t331);
+  d_force[47] = (t341 * 2.0 * t334 * x[7] * u[8] + t332 * 2.0 * x[7] * t343);
+  d_force[54] = t115 * t164 * 0.006636614480708438;
+  d_force[58] = t115 * (-0.0034557519189487734) * t164;
+  d_force[60] =
+      (-((t543 - t1 * 12540.0 + t544)) * x[7] * t377 -
+       ((-1540.0 * t0 - t1 * 11440.0)) * t296 * x[7] * x[4] - t438 * t388 * x[7] -
+       ((t545 + t546 - 10830.0 * t1 + t547)) * x[7] * t406 - 2.0 * x[7] * u[8] * t316 * t424 -
+       t363 * x[7] * x[4] * t437 - x[7] * t439 * t357 - t341 * 2.0 * x[7] * t415 * u[8]);
+  d_force[61] = (-2.0 * x[7] * u[8] * t424 * t327 - t360 * x[7] * t439 -
+                 x[7] * ((t545 + t546 + t547)) * t406 - t438 * x[7] * t385 -
+                 t341 * 2.0 * x[7] * u[8] * t416 - ((t543 + t544)) * x[7] * t377);
+  d_force[62] = (-x[7] * t358 * t439 - ((t545 + t547)) * x[7] * t406 -
+                 2.0 * t334 * x[7] * u[8] * t424 - t418 * t341 * 2.0 * x[7] * u[8]);
+  d_force[64] = (-t320 * x[7] * t439 - t438 * t308 * x[7] - t341 * 2.0 * x[7] * u[8] * t316 -
+                 t296 * x[7] * t437);
+  d_force[65] = (-x[7] * t439 * t324 - t341 * 2.0 * x[7] * u[8] * t327 - t438 * x[7] * t329);
+  d_force[66] = (-t341 * 2.0 * t334 * x[7] * u[8] - t332 * x[7] * t439);
+  d_force[67] =
+      (-t439 * t406 - t341 * 2.0 * u[8] * t424 - t438 * t377 - t296 * x[4] * t437 - 20000.0);
+  d_force[75] = 0.0025;
+  d_force[79] = (-0.0025);
+  d_mass[0] =
+      (t296 * t304 * 4400.0 + ((t312 * t316 + t410 * t316)) * 2.0 * u[8] + t296 * t363 * 4400.0 +
+       t301 * 2200.0 * t308 + t320 * t323 * 1900.0 + 2200.0 * t387 * t308 + t320 * t352 * 1900.0);
+  d_mass[1] = t554;
+  d_mass[2] = t559;
+  d_mass[4] = t554;
+  d_mass[5] = t562;
+  d_mass[6] = t571;
+  d_mass[8] = t559;
+  d_mass[9] = t571;
+  d_mass[10] = t574;
+  d_mass[15] = (t296 * t344 + t444 * t345 + t320 * t343 + t341 * 2.0 * u[8] * t316 + t308 * t340 +
+                t443 * t342 + t339 * t476);
+  d_mass[16] = (t320 * 1900.0 * t353 + t323 * 1900.0 * t324 + ((t552 + t553)) * 2.0 * u[8] +
+                t383 * 2200.0 * t308 + t301 * 2200.0 * t329);
+  d_mass[17] = t575;
+  d_mass[18] = t576;
+  d_mass[20] = t575;
+  d_mass[21] = t562;
+  d_mass[22] = t571;
+  d_mass[24] = t576;
+  d_mass[25] = t571;
+  d_mass[26] = t574;
+  d_mass[31] = (t339 * t513 + t341 * 2.0 * u[8] * t327 + t324 * t343 + t329 * t340 + t342 * t505);
+  d_mass[32] = (t355 * t320 * 1900.0 + ((t555 + t556)) * 2.0 * u[8] + t332 * t323 * 1900.0);
+  d_mass[33] = t577;
+  d_mass[34] = t580;
+  d_mass[36] = t577;
+  d_mass[37] = (t328 * t332 * 1900.0 + 2.0 * ((t564 + t566)) * u[8] + t355 * 1900.0 * t324);
+  d_mass[38] = t581;
+  d_mass[40] = t580;
+  d_mass[41] = t581;
+  d_mass[42] = t574;
+  d_mass[47] = (t341 * 2.0 * t334 * u[8] + t342 * t515 + t332 * t343);
+  Factor(mass);
+  Solve(mass, acceleration);
+  for (int c = 0; c < kNumStates; ++c) {
+    double column[kNumJoints];
+    for (int j = 0; j < kNumJoints; ++j) {
+      column[j] = d_force[j * kNumStates + c];
+      if (c < kNumJoints) {
+        for (int k = 0; k < kNumJoints; ++k) {
+          column[j] -= d_mass[(c * kNumJoints + j) * kNumJoints + k] * acceleration[k];
+        }
+      }
+    }
+    Solve(mass, column);
+    for (int j = 0; j < kNumJoints; ++j) jacobian[(kNumJoints + j) * kNumStates + c] = column[j];
+  }
+}
+
+void MassMatrix(const double* q, double payload, double* mass) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  double x[kNumStates] = {};
+  double u[kNumInputs] = {};
+  std::copy(q, q + kNumJoints, x);
+  u[2 * kNumJoints] = payload;
   const double t0 = cos(x[0]);
   const double t1 = sin(x[0]);
   const double t2 = (-0.35 * t0 - t1 * 2.6);
@@ -388,1111 +1893,265 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t31 = t21 * (-0.3);
   const double t32 = t18 * 0.7;
   const double t33 = (t31 + t3 + t20 + t32);
-  const double t34 = sin(u[9]);
-  const double t35 = cos(u[9]);
-  const double t36 = (1.09 - 0.236 * t0 + t1 * 2.979);
-  const double t37 = 0.236 * t1;
-  const double t38 = t0 * 2.979;
-  const double t39 = (-0.356 + t37 + t38);
-  const double t40 = ((t36 * t36) + (t39 * t39));
-  const double t41 = (1.0 / sqrt(t40));
-  const double t42 = (((t37 + t38)) * t36 + t39 * ((-t1 * 2.979 + 0.236 * t0)));
-  const double t43 = sqrt(t40);
-  const double t44 = (-3.775 + t43);
-  const double t45 = (1e-06 + (t44 * t44));
-  const double t46 = (-2.03 + t43);
-  const double t47 = (1e-06 + (t46 * t46));
-  const double t48 = t7 * (-0.8);
-  const double t49 = t5 * (-0.104);
-  const double t50 = (1.11 * t1 + t48 + 3.136 * t0 + t49);
-  const double t51 = (-t5 * 0.8 + 3.136 * t1 + 0.104 * t7 - 1.11 * t0);
-  const double t52 = ((t50 * t50) + (t51 * t51));
-  const double t53 = (1.0 / sqrt(t52));
-  const double t54 = sqrt(t52);
-  const double t55 = (-4.005 + t54);
-  const double t56 = (1e-06 + (t55 * t55));
-  const double t57 = (t54 - 2.595);
-  const double t58 = (1e-06 + (t57 * t57));
-  const double t59 = (-0.104) * t7;
-  const double t60 = t5 * 0.8;
-  const double t61 = (t50 * ((t59 + t60)) + ((t48 + t49)) * t51);
-  const double t62 = (t50 * ((t59 + t60 - 3.136 * t1 + 1.11 * t0)) + t51 * t50);
-  const double t63 = (-0.035342917352885174 * x[13] + 4e+08 * t54 - 1.32e+09 + sqrt(t56) * 2e+08 -
-                      sqrt(t58) * 2e+08 + x[17] * 0.01802488784997144 +
-                      (((1.0 / sqrt(t56)) * t55 - (1.0 / sqrt(t58)) * t57 + 2.0)) *
-                          ((t53 * 2e+06 * x[5] * t61 + t53 * 2e+06 * t62 * x[4])));
-  const double t64 = (0.315 * t7 + t5 * 0.15700000000000003 - 0.016 * t21 + 0.552 * t18);
-  const double t65 = (t64 * t64);
-  const double t66 = (-0.016) * t18;
-  const double t67 = t21 * (-0.552);
-  const double t68 = (t66 + t67 + 0.15700000000000003 * t7 - t5 * 0.315);
-  const double t69 = (t68 * t68);
-  const double t70 = (0.21712699999999996 + t65 + t69);
-  const double t71 = (t65 + t69);
-  const double t72 = (1.0 / sqrt(t71));
-  const double t73 = (1.0 / (t71));
-  const double t74 = (t70 * t70);
-  const double t75 = (-0.25 * t73 * t74 + 0.48441599999999996);
-  const double t76 = sqrt(t75);
-  const double t77 = (t70 * t72 * t64 + 2.0 * t76 * t68);
-  const double t78 = (-2.0 * t64 * t76 + t70 * t72 * t68);
-  const double t79 = atan2(t77 * 0.5 * t72, t78 * 0.5 * t72);
-  const double t80 = sin(t79);
-  const double t81 = (0.696 * t80 - 0.623 * t7 + t5 * 3.081);
-  const double t82 = t5 * 0.623;
-  const double t83 = 3.081 * t7;
-  const double t84 = cos(t79);
-  const double t85 = (t82 + t83 + 0.696 * t84);
-  const double t86 = ((t81 * t81) + (t85 * t85));
-  const double t87 = (1.0 / sqrt(t86));
-  const double t88 = sqrt(t86);
-  const double t89 = (t88 - 2.525);
-  const double t90 = ((t89 * t89) + 1e-06);
-  const double t91 = (t88 - 3.71);
-  const double t92 = (1e-06 + (t91 * t91));
-  const double t93 = pow(t71, (-1.5));
-  const double t94 = 0.016 * t21;
-  const double t95 = t18 * (-0.552);
-  const double t96 = (-0.315 * t7 + t94 + t95 - t5 * 0.15700000000000003);
-  const double t97 = (t64 * t68 + t96 * t68);
-  const double t98 = (1.0 / (t71 * t71));
-  const double t99 = (t70 * 2.0 * t73 * t97 - t98 * t74 * t97);
-  const double t100 = (1.0 / sqrt(t75));
-  const double t101 = (1.0 / (((t73 * (t78 * t78) + t73 * (t77 * t77)))));
-  const double t102 =
-      (t77 *
-           ((t78 * 2.0 * t93 * t97 -
-             ((t99 * t100 * t64 + t70 * 2.0 * t96 * t72 - t70 * 2.0 * t93 * t97 * t68 -
-               4.0 * t76 * t68 + 4.0 * t72 * t97 * t68)) *
-                 t72)) *
-           t72 * t101 +
-       t78 *
-           ((t72 * ((t70 * 2.0 * t72 * t68 + 4.0 * t72 * t97 * t64 + 4.0 * t96 * t76 -
-                     t70 * 2.0 * t93 * t97 * t64 - t99 * t100 * t68)) -
-             2.0 * t77 * t93 * t97)) *
-           t72 * t101);
-  const double t103 = (((0.348 * t84 * t102 + t82 + t83)) * t81 +
-                       t85 * ((-t5 * 3.081 - 0.348 * t102 * t80 + 0.623 * t7)));
-  const double t104 = (t94 + t95);
-  const double t105 = (t66 + t67);
-  const double t106 = (t104 * t68 + t105 * t64);
-  const double t107 = (t70 * 2.0 * t73 * t106 - t98 * t74 * t106);
-  const double t108 =
-      (t78 *
-           ((((-4.0 * t104 * t76 - 4.0 * t72 * t64 * t106 + t107 * t100 * t68 +
-               t70 * 2.0 * t93 * t64 * t106 - t70 * 2.0 * t105 * t72)) *
-                 t72 +
-             2.0 * t77 * t93 * t106)) *
-           t72 * t101 -
-       ((-t72 * ((t70 * 2.0 * t72 * t104 + t107 * t100 * t64 - t70 * 2.0 * t93 * t106 * t68 +
-                  4.0 * t72 * t106 * t68 - 4.0 * t105 * t76)) +
-         t78 * 2.0 * t93 * t106)) *
-           t77 * t72 * t101);
-  const double t109 = (-t108 * 0.696 * t84 * t81 + t108 * t85 * 0.696 * t80);
-  const double t110 =
-      (4e+08 * t88 + 0.013823007675795093 * x[18] - 1.247e+09 - 2e+08 * sqrt(t90) -
-       0.026546457922833753 * x[14] + 2e+08 * sqrt(t92) +
-       ((t87 * 2e+06 * x[4] * t103 + t87 * 2e+06 * x[5] * t103 + t87 * t109 * 1e+06 * x[6])) *
-           ((2.0 + (1.0 / sqrt(t92)) * t91 - t89 * (1.0 / sqrt(t90)))));
-  const double t111 = (t14 + t15);
-  const double t112 = (t6 + t8);
-  const double t113 = (t31 + t20 + t32);
-  const double t114 = (t19 + t20 + t22);
-  const double t115 = (t24 + t25 + t26);
-  const double t116 = (t28 + t25 + t29);
-  const double t117 = (t24 + t26);
-  const double t118 = (t19 + t22);
-  const double t119 = (t28 + t29);
-  const double t120 = (t31 + t32);
-  const double t121 = (t19 + t3 + t20 + 0.15 + t22);
-  const double t122 = (x[12] - 2e+05);
-  const double t123 = (t122 * t122);
-  const double t124 = (x[12] - 3.7e+07);
-  const double t125 = (-x[12] + u[10]);
-  const double t126 = sqrt(((x[8] * x[8]) + 1e-06));
-  const double t127 = (t126 + x[8]);
-  const double t128 = (-t126 + x[8]);
-  const double t129 = (x[13] - 3.7e+07);
-  const double t130 = (u[11] - x[13]);
-  const double t131 = sqrt((1e-06 + (x[9] * x[9])));
-  const double t132 = (x[9] + t131);
-  const double t133 = (x[13] - 2e+05);
-  const double t134 = (t133 * t133);
-  const double t135 = (-x[9] + t131);
-  const double t136 = (x[14] - 3.7e+07);
-  const double t137 = (x[14] - 2e+05);
-  const double t138 = (t137 * t137);
-  const double t139 = sqrt((1e-06 + (x[10] * x[10])));
-  const double t140 = (x[10] - t139);
-  const double t141 = (x[10] + t139);
-  const double t142 = (u[12] - x[14]);
-  const double t143 = sqrt((1e-06 + (x[11] * x[11])));
-  const double t144 = (t143 - x[11]);
-  const double t145 = (x[15] - 2e+05);
-  const double t146 = (t145 * t145);
-  const double t147 = (t143 + x[11]);
-  const double t148 = (u[13] - x[15]);
-  const double t149 = (-2.9e+07 + x[15]);
-  const double t150 = (x[16] - 3.7e+07);
-  const double t151 = (x[16] - 2e+05);
-  const double t152 = (t151 * t151);
-  const double t153 = (x[16] - u[10]);
-  const double t154 = (x[17] - 2e+05);
-  const double t155 = (t154 * t154);
-  const double t156 = (x[17] - 3.7e+07);
-  const double t157 = (u[11] - x[17]);
-  const double t158 = (x[18] - 3.7e+07);
-  const double t159 = (x[18] - 2e+05);
-  const double t160 = (t159 * t159);
-  const double t161 = (u[12] - x[18]);
-  const double t162 = (x[19] - u[13]);
-  const double t163 = (x[19] - 2e+05);
-  const double t164 = (t163 * t163);
-  const double t165 = (-2.9e+07 + x[19]);
-  xdot[0] = x[4];
-  xdot[1] = x[5];
-  xdot[2] = x[6];
-  xdot[3] = x[7];
-  xdot[4] = (-0.5) *
-            ((t34 * 21574.629999999997 * t16 + 18632.635 * t33 * t35 -
-              t41 * 2.0 * t42 *
-                  ((-t41 * 2e+06 * x[4] *
-                        ((2.0 + (1.0 / sqrt(t45)) * t44 - t46 * (1.0 / sqrt(t47)))) * t42 -
-                    2e+08 * sqrt(t45) + sqrt(t47) * 2e+08 - 0.015079644737231009 * x[16] +
-                    1.161e+09 - 4e+08 * t43 + x[12] * 0.03078760800517998)) +
-              t34 * 18632.635 * t30 + x[4] * 12000.0 - 2.0 * u[4] + t53 * t63 * t62 +
-              t12 * t35 * 43149.259999999995 + t9 * t35 * 21574.629999999997 -
-              ((-t23 * t35 * 9.80665 - t34 * 9.80665 * t27)) * 2.0 * u[8] +
-              t2 * t34 * 43149.259999999995 + t87 * t110 * t103)) /
-            (((7650.0 + 2200.0 * (t2 * t2) + (t9 * t9) * 1100.0 + (t12 * t12) * 2200.0 +
-               1100.0 * (t16 * t16) + (((t23 * t23) + (t27 * t27))) * u[8] + 950.0 * (t30 * t30) +
-               (t33 * t33) * 950.0)));
-  xdot[5] = 0.5 *
-            ((-t34 * 21574.629999999997 * t111 - t112 * t35 * 21574.629999999997 -
-              t113 * 18632.635 * t35 +
-              2.0 * u[8] * ((-t114 * t35 * 9.80665 - t34 * 9.80665 * t115)) - t87 * t110 * t103 -
-              5000.0 * x[5] - t53 * t63 * t61 + 2.0 * u[5] - t34 * 18632.635 * t116)) /
-            ((((t111 * t111) * 1100.0 + 1150.0 + 950.0 * (t116 * t116) + (t113 * t113) * 950.0 +
-               u[8] * (((t115 * t115) + (t114 * t114))) + 1100.0 * (t112 * t112))));
-  xdot[6] = ((-4.0 * ((-t34 * t117 * 9.80665 - t35 * t118 * 9.80665)) * u[8] + 3200.0 * x[6] +
-              t87 * t109 * t110 - 4.0 * u[6] + 37265.27 * t119 * t34 + 37265.27 * t35 * t120)) *
-            (-0.25) /
-            ((((((t117 * t117) + (t118 * t118))) * u[8] + (t119 * t119) * 950.0 + 250.0 +
-               (t120 * t120) * 950.0)));
-  xdot[7] = ((-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 + u[7])) /
-            (((((t3 + t6 + t8 + 0.15)) * ((-t5 * 110.0 + t7 * 1210.0 + 6270.0 * t0 + 165.0)) +
-               60000.0 + (t121 * t121) * u[8] +
-               ((t31 + t3 + t20 + 0.15 + t32)) *
-                   ((-t21 * 285.0 + 665.0 * t18 + t7 * 2755.0 + 142.5 + 5415.0 * t0)) +
-               ((5720.0 * t0 + 330.0 - t1 * 770.0)) * ((t10 + 0.15 + t11)))));
-  xdot[8] = (-x[8] * 16.666666666666668 + u[0] * 16.666666666666668);
-  xdot[9] = (-x[9] * 16.666666666666668 + u[1] * 16.666666666666668);
-  xdot[10] = (-x[10] * 16.666666666666668 + u[2] * 16.666666666666668);
-  xdot[11] = (-12.5 * x[11] + 12.5 * u[3]);
-  xdot[12] = 1.2e+09 *
-             ((sqrt((t123 + 1e+10)) * 3.5e-09 - t41 * x[4] * 0.03078760800517998 * t42 -
-               sqrt(((t124 * t124) + 1e+10)) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
-               t125 * 2.8577380332470414e-06 * pow(((t125 * t125) + 4e+10), (-0.25)) * t127 +
-               pow((4e+10 + t123), (-0.25)) * t122 * 2.8577380332470414e-06 * t128)) /
-             (((t43 * 0.03078760800517998 - 0.059498844250515354)));
-  xdot[13] = ((-sqrt((1e+10 + (t129 * t129))) * 3.5e-09 +
-               2.8577380332470414e-06 * t130 * t132 * pow((4e+10 + (t130 * t130)), (-0.25)) -
-               t53 * 0.017671458676442587 * x[5] * t61 - t53 * t62 * 0.017671458676442587 * x[4] -
-               x[13] * 7e-09 + 0.1302 + sqrt((1e+10 + t134)) * 3.5e-09 -
-               pow((4e+10 + t134), (-0.25)) * t133 * 2.8577380332470414e-06 * t135)) *
-             1.2e+09 / (((0.017671458676442587 * t54 - 0.04285743526536852)));
-  xdot[14] = 1.2e+09 *
-             ((-t87 * t109 * 0.006636614480708438 * x[6] + 0.093 -
-               t87 * x[5] * 0.013273228961416876 * t103 - t87 * x[4] * 0.013273228961416876 * t103 -
-               sqrt(((t136 * t136) + 1e+10)) * 2.5e-09 +
-               pow((4e+10 + t138), (-0.25)) * t137 * t140 * 2.0412414523193154e-06 - x[14] * 5e-09 +
-               2.5e-09 * sqrt((1e+10 + t138)) +
-               t141 * t142 * pow((4e+10 + (t142 * t142)), (-0.25)) * 2.0412414523193154e-06)) /
-             (((t88 * 0.013273228961416876 - 0.03151490312757761)));
-  xdot[15] = (-t144 * t145 * pow((4e+10 + t146), (-0.25)) * 510310.3630798288 +
-              t147 * t148 * 510310.3630798288 * pow((4e+10 + (t148 * t148)), (-0.25)) + 1.825e+10 +
-              625.0 * sqrt((1e+10 + t146)) - 625.0 * sqrt(((t149 * t149) + 1e+10)) -
-              7.5e+08 * x[7] - x[15] * 1250.0);
-  xdot[16] =
-      1.2e+09 *
-      ((0.015079644737231009 * t41 * x[4] * t42 - sqrt(((t150 * t150) + 1e+10)) * 3.5e-09 -
-        pow((4e+10 + t152), (-0.25)) * t151 * 2.8577380332470414e-06 * t127 - x[16] * 7e-09 +
-        0.1302 + pow((4e+10 + (t153 * t153)), (-0.25)) * 2.8577380332470414e-06 * t153 * t128 +
-        sqrt((1e+10 + t152)) * 3.5e-09)) /
-      (((0.05992565888304706 - 0.015079644737231009 * t43)));
-  xdot[17] = 1.2e+09 *
-             ((sqrt((t155 + 1e+10)) * 3.5e-09 - sqrt((1e+10 + (t156 * t156))) * 3.5e-09 +
-               t53 * t62 * x[4] * 0.00901244392498572 + 0.1302 +
-               t157 * 2.8577380332470414e-06 * t135 * pow((4e+10 + (t157 * t157)), (-0.25)) -
-               pow((4e+10 + t155), (-0.25)) * t154 * 2.8577380332470414e-06 * t132 - x[17] * 7e-09 +
-               t53 * x[5] * t61 * 0.00901244392498572)) /
-             (((0.03909483791956781 - t54 * 0.00901244392498572)));
-  xdot[18] =
-      ((-2.5e-09 * sqrt((1e+10 + (t158 * t158))) + 0.093 +
-        t87 * 0.006911503837897547 * x[5] * t103 + 2.5e-09 * sqrt((t160 + 1e+10)) +
-        t87 * 0.006911503837897547 * x[4] * t103 + t87 * t109 * 0.0034557519189487734 * x[6] -
-        t140 * t161 * 2.0412414523193154e-06 * pow((4e+10 + (t161 * t161)), (-0.25)) -
-        x[18] * 5e-09 - pow((4e+10 + t160), (-0.25)) * t159 * t141 * 2.0412414523193154e-06)) *
-      1.2e+09 / (((0.0276416792385999 - t88 * 0.006911503837897547)));
-  xdot[19] = (-t144 * t162 * 510310.3630798288 * pow((4e+10 + (t162 * t162)), (-0.25)) + 1.825e+10 +
-              625.0 * sqrt((t164 + 1e+10)) - 625.0 * sqrt(((t165 * t165) + 1e+10)) -
-              pow((4e+10 + t164), (-0.25)) * t163 * t147 * 510310.3630798288 + 7.5e+08 * x[7] -
-              x[19] * 1250.0);
+  const double t34 = (t28 + t25 + t29);
+  const double t35 = (t6 + t8);
+  const double t36 = (t19 + t20 + t22);
+  const double t37 = (t24 + t25 + t26);
+  const double t38 = (t31 + t20 + t32);
+  const double t39 = (t14 + t15);
+  const double t40 = (1150.0 + 950.0 * t30 * t34 + t9 * t35 * 1100.0 +
+                      u[8] * ((t23 * t36 + t27 * t37)) + t38 * 950.0 * t33 + 1100.0 * t16 * t39);
+  const double t41 = (t31 + t32);
+  const double t42 = (t28 + t29);
+  const double t43 = (t19 + t22);
+  const double t44 = (t24 + t26);
+  const double t45 =
+      (950.0 * t33 * t41 + 250.0 + t42 * 950.0 * t30 + ((t23 * t43 + t44 * t27)) * u[8]);
+  const double t46 =
+      (t42 * 950.0 * t34 + 250.0 + t38 * 950.0 * t41 + ((t44 * t37 + t36 * t43)) * u[8]);
+  const double t47 = (t19 + t3 + t20 + 0.15 + t22);
+  mass[0] = (7650.0 + 2200.0 * (t2 * t2) + (t9 * t9) * 1100.0 + (t12 * t12) * 2200.0 +
+             1100.0 * (t16 * t16) + (((t23 * t23) + (t27 * t27))) * u[8] + 950.0 * (t30 * t30) +
+             (t33 * t33) * 950.0);
+  mass[1] = t40;
+  mass[2] = t45;
+  mass[3] = 0.0;
+  mass[4] = t40;
+  mass[5] = ((t39 * t39) * 1100.0 + 1150.0 + 950.0 * (t34 * t34) + (t38 * t38) * 950.0 +
+             u[8] * (((t37 * t37) + (t36 * t36))) + 1100.0 * (t35 * t35));
+  mass[6] = t46;
+  mass[7] = 0.0;
+  mass[8] = t45;
+  mass[9] = t46;
+  mass[10] =
+      ((((t44 * t44) + (t43 * t43))) * u[8] + (t42 * t42) * 950.0 + 250.0 + (t41 * t41) * 950.0);
+  mass[11] = 0.0;
+  mass[12] = 0.0;
+  mass[13] = 0.0;
+  mass[14] = 0.0;
+  mass[15] = (((t3 + t6 + t8 + 0.15)) * ((-t5 * 110.0 + t7 * 1210.0 + 6270.0 * t0 + 165.0)) +
+              60000.0 + (t47 * t47) * u[8] +
+              ((t31 + t3 + t20 + 0.15 + t32)) *
+                  ((-t21 * 285.0 + 665.0 * t18 + t7 * 2755.0 + 142.5 + 5415.0 * t0)) +
+              ((5720.0 * t0 + 330.0 - t1 * 770.0)) * ((t10 + 0.15 + t11)));
 }
 
-void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
+void BiasForces(const double* q, const double* qd, double payload, double pitch, double* bias) {
   using std::acos;
   using std::atan2;
   using std::cos;
   using std::pow;
   using std::sin;
   using std::sqrt;
-  std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);
-  const double t0 = (x[0] + x[1]);
-  const double t1 = cos(t0);
-  const double t2 = sin(t0);
-  const double t3 = (x[2] + x[0] + x[1]);
-  const double t4 = sin(t3);
-  const double t5 = cos(t3);
-  const double t6 = (0.315 * t1 + t2 * 0.15700000000000003 - 0.016 * t4 + 0.552 * t5);
-  const double t7 = (t6 * t6);
-  const double t8 = (-0.016) * t5;
-  const double t9 = t4 * (-0.552);
-  const double t10 = (t8 + t9 + 0.15700000000000003 * t1 - t2 * 0.315);
-  const double t11 = (t10 * t10);
-  const double t12 = (0.21712699999999996 + t7 + t11);
-  const double t13 = (t7 + t11);
-  const double t14 = (1.0 / sqrt(t13));
-  const double t15 = (1.0 / (t13));
-  const double t16 = (t12 * t12);
-  const double t17 = (-0.25 * t15 * t16 + 0.48441599999999996);
-  const double t18 = sqrt(t17);
-  const double t19 = (t12 * t14 * t6 + 2.0 * t18 * t10);
-  const double t20 = (-2.0 * t6 * t18 + t12 * t14 * t10);
-  const double t21 = atan2(t19 * 0.5 * t14, t20 * 0.5 * t14);
-  const double t22 = sin(t21);
-  const double t23 = (0.696 * t22 - 0.623 * t1 + t2 * 3.081);
-  const double t24 = t2 * 0.623;
-  const double t25 = 3.081 * t1;
-  const double t26 = cos(t21);
-  const double t27 = (t24 + t25 + 0.696 * t26);
-  const double t28 = ((t23 * t23) + (t27 * t27));
-  const double t29 = (1.0 / sqrt(t28));
-  const double t30 = pow(t13, (-1.5));
-  const double t31 = 0.016 * t4;
-  const double t32 = t5 * (-0.552);
-  const double t33 = (-0.315 * t1 + t31 + t32 - t2 * 0.15700000000000003);
-  const double t34 = (t6 * t10 + t33 * t10);
-  const double t35 = (1.0 / (t13 * t13));
-  const double t36 = (t12 * 2.0 * t15 * t34 - t35 * t16 * t34);
-  const double t37 = (1.0 / sqrt(t17));
-  const double t38 = (t36 * t37 * t6 + t12 * 2.0 * t33 * t14 - t12 * 2.0 * t30 * t34 * t10 -
-                      4.0 * t18 * t10 + 4.0 * t14 * t34 * t10);
-  const double t39 = (t20 * 2.0 * t30 * t34 - t38 * t14);
-  const double t40 = (t20 * t20);
-  const double t41 = (t19 * t19);
-  const double t42 = (t15 * t40 + t15 * t41);
-  const double t43 = (1.0 / (t42));
-  const double t44 = (t12 * 2.0 * t14 * t10 + 4.0 * t14 * t34 * t6 + 4.0 * t33 * t18 -
-                      t12 * 2.0 * t30 * t34 * t6 - t36 * t37 * t10);
-  const double t45 = (t14 * t44 - 2.0 * t19 * t30 * t34);
-  const double t46 = (t19 * t39 * t14 * t43 + t20 * t45 * t14 * t43);
-  const double t47 = (0.348 * t26 * t46 + t24 + t25);
-  const double t48 = (-3.081) * t2;
-  const double t49 = 0.623 * t1;
-  const double t50 = (t48 - 0.348 * t46 * t22 + t49);
-  const double t51 = (t47 * t23 + t27 * t50);
-  const double t52 = sqrt(t28);
-  const double t53 = (t52 - 2.525);
-  const double t54 = (t53 * t53);
-  const double t55 = (t54 + 1e-06);
-  const double t56 = (1.0 / sqrt(t55));
-  const double t57 = (t31 + t32);
-  const double t58 = (t8 + t9);
-  const double t59 = (t57 * t10 + t58 * t6);
-  const double t60 = (t12 * 2.0 * t15 * t59 - t35 * t16 * t59);
-  const double t61 = (-4.0 * t57 * t18 - 4.0 * t14 * t6 * t59 + t60 * t37 * t10 +
-                      t12 * 2.0 * t30 * t6 * t59 - t12 * 2.0 * t58 * t14);
-  const double t62 = (t61 * t14 + 2.0 * t19 * t30 * t59);
-  const double t63 = (t12 * 2.0 * t14 * t57 + t60 * t37 * t6 - t12 * 2.0 * t30 * t59 * t10 +
-                      4.0 * t14 * t59 * t10 - 4.0 * t58 * t18);
-  const double t64 = (-t14 * t63 + t20 * 2.0 * t30 * t59);
-  const double t65 = (t20 * t62 * t14 * t43 - t64 * t19 * t14 * t43);
-  const double t66 = (-t65 * 0.696 * t26 * t23 + t65 * t27 * 0.696 * t22);
-  const double t67 =
-      (t29 * 2e+06 * x[4] * t51 + t29 * 2e+06 * x[5] * t51 + t29 * t66 * 1e+06 * x[6]);
-  const double t68 = (t52 - 3.71);
-  const double t69 = (t68 * t68);
-  const double t70 = (1e-06 + t69);
-  const double t71 = (1.0 / sqrt(t70));
-  const double t72 = pow(t55, (-1.5));
-  const double t73 = pow(t70, (-1.5));
-  const double t74 = (1.0 / (t42 * t42));
-  const double t75 =
-      (2.0 * t35 * t34 * t41 + 2.0 * t35 * t34 * t40 - t19 * t15 * t44 - t20 * t38 * t15);
-  const double t76 = pow(t13, (-2.5));
-  const double t77 = (t34 * t34);
-  const double t78 = 0.016 * t5;
-  const double t79 = t4 * 0.552;
-  const double t80 = (t78 + t79 - 0.15700000000000003 * t1 + t2 * 0.315);
-  const double t81 = (t33 * t6 + (t33 * t33) + t80 * t10 + t11);
-  const double t82 = (1.0 / (t13 * t13 * t13));
-  const double t83 = (-t81 * t35 * t16 + 4.0 * t15 * t77 + t12 * t81 * 2.0 * t15 +
-                      t82 * 4.0 * t16 * t77 - t12 * t35 * t77 * 8.0);
-  const double t84 = (t36 * t36);
-  const double t85 = pow(t17, (-1.5));
-  const double t86 =
-      (t20 * t74 * 4.0 * t45 * t14 * t75 - t19 * t39 * 4.0 * t30 * t43 * t34 +
-       t74 * t19 * t39 * 4.0 * t14 * t75 - t20 * 4.0 * t45 * t30 * t43 * t34 -
-       ((-t19 * 24.0 * t76 * t77 + t30 * t34 * t44 * 8.0 -
-         ((-4.0 * t37 * t83 * t10 - t84 * t85 * t10 + 32.0 * t14 * t34 * t10 -
-           32.0 * t30 * t77 * t6 + t81 * 16.0 * t14 * t6 - t12 * 16.0 * t30 * t34 * t10 +
-           t12 * t33 * t14 * 8.0 + t12 * 24.0 * t76 * t77 * t6 - t36 * t33 * t37 * 8.0 +
-           16.0 * t80 * t18 - t12 * t81 * t30 * 8.0 * t6)) *
-             t14 +
-         t81 * t19 * t30 * 8.0)) *
-           t20 * t14 * t43 +
-       2.0 * t39 * t14 * t43 * t44 +
-       t19 * t14 * t43 *
-           ((t20 * t81 * t30 * 8.0 - t20 * 24.0 * t76 * t77 + t38 * t30 * t34 * 8.0 -
-             t14 *
-                 ((t12 * t80 * t14 * 8.0 + t84 * t85 * t6 + t36 * t37 * 8.0 * t10 -
-                   16.0 * t33 * t18 + 32.0 * t33 * t14 * t34 - 32.0 * t30 * t77 * t10 -
-                   t12 * 16.0 * t33 * t30 * t34 + t12 * 24.0 * t76 * t77 * t10 -
-                   t12 * t81 * t30 * 8.0 * t10 + 4.0 * t37 * t83 * t6 + t81 * 16.0 * t14 * t10)))) +
-       t38 * 2.0 * t45 * t14 * t43);
-  const double t87 = (t46 * t46);
-  const double t88 =
-      (((-t24 - 0.087 * t86 * t22 - t25 - 0.174 * t26 * t87)) * t27 +
-       t23 * ((t48 - 0.174 * t87 * t22 + t49 + 0.087 * t86 * t26)) + (t47 * t47) + (t50 * t50));
-  const double t89 = pow(t28, (-1.5));
-  const double t90 = (t51 * t51);
-  const double t91 = t6 * t57;
-  const double t92 = (t78 + t79);
-  const double t93 = t92 * t10;
-  const double t94 = (t33 * t57 + t91 + t93 + t58 * t10);
-  const double t95 = (4.0 * t15 * t34 * t59 + t12 * 2.0 * t15 * t94 - t12 * t35 * t34 * 8.0 * t59 -
-                      t35 * t16 * t94 + t82 * 4.0 * t16 * t34 * t59);
-  const double t96 = (-16.0) * t92 * t18;
-  const double t97 = t12 * (-8.0) * t14 * t57;
-  const double t98 =
-      (-t19 * t30 * t94 * 8.0 + 4.0 * t61 * t30 * t34 - 4.0 * t30 * t44 * t59 +
-       t19 * 24.0 * t76 * t34 * t59 -
-       ((4.0 * t37 * t95 * t10 - 16.0 * t58 * t14 * t34 - 16.0 * t14 * t59 * t10 +
-         t60 * 4.0 * t33 * t37 + t12 * t30 * t94 * 8.0 * t6 + 32.0 * t30 * t34 * t6 * t59 +
-         t36 * 4.0 * t37 * t57 + t12 * t30 * 8.0 * t59 * t10 + t96 + t36 * t60 * t85 * t10 +
-         t12 * t58 * t30 * t34 * 8.0 - 16.0 * t94 * t14 * t6 - t12 * 24.0 * t76 * t34 * t6 * t59 +
-         t97)) *
-           t14);
-  const double t99 = (-16.0) * t57 * t18;
-  const double t100 = t12 * t92 * t14 * 8.0;
-  const double t101 =
-      (4.0 * t30 * t34 * t63 -
-       t14 * ((16.0 * t94 * t14 * t10 - t12 * t30 * t34 * 8.0 * t57 + 16.0 * t14 * t34 * t57 + t99 +
-               t100 - 32.0 * t30 * t34 * t59 * t10 + 4.0 * t37 * t6 * t95 +
-               t12 * 24.0 * t76 * t34 * t59 * t10 - t12 * t30 * t94 * 8.0 * t10 +
-               t60 * 4.0 * t37 * t10 + 16.0 * t33 * t14 * t59 + t36 * t60 * t85 * t6 -
-               t12 * t33 * t30 * 8.0 * t59 + t36 * 4.0 * t58 * t37)) -
-       t20 * 24.0 * t76 * t34 * t59 + t20 * t30 * t94 * 8.0 + t38 * 4.0 * t30 * t59);
-  const double t102 =
-      (t20 * t14 * t43 * t98 - t62 * t38 * 2.0 * t14 * t43 - t64 * t19 * 4.0 * t30 * t43 * t34 +
-       t74 * t64 * t19 * 4.0 * t14 * t75 + t20 * t62 * 4.0 * t30 * t43 * t34 -
-       t20 * t62 * t74 * 4.0 * t14 * t75 + t19 * t101 * t14 * t43 + t64 * 2.0 * t14 * t43 * t44);
-  const double t103 =
-      (t65 * 0.348 * t46 * t23 * t22 + t65 * 0.696 * t22 * t50 - t65 * 0.696 * t26 * t47 +
-       0.174 * t102 * t26 * t23 - 0.174 * t27 * t102 * t22 + t65 * 0.348 * t27 * t26 * t46);
-  const double t104 = (2.0 + t71 * t68 - t53 * t56);
-  const double t105 =
-      (t29 * 4e+08 * t51 - t29 * 2e+08 * t53 * t56 * t51 +
-       t67 *
-           ((-t29 * t56 * t51 + t29 * t71 * t51 + t29 * t54 * t72 * t51 - t29 * t73 * t51 * t69)) +
-       t29 * 2e+08 * t71 * t68 * t51 +
-       ((t29 * t88 * 2e+06 * x[4] + t29 * t88 * 2e+06 * x[5] - t89 * t66 * 1e+06 * x[6] * t51 -
-         t89 * t90 * 2e+06 * x[4] - t89 * t90 * 2e+06 * x[5] + t29 * t103 * 1e+06 * x[6])) *
-           t104);
-  const double t106 = t29 * (-1.0) * t51 * t105;
-  const double t107 = sin(x[0]);
-  const double t108 = t1 * (-0.8);
-  const double t109 = cos(x[0]);
-  const double t110 = t2 * (-0.104);
-  const double t111 = (1.11 * t107 + t108 + 3.136 * t109 + t110);
-  const double t112 = (t111 * t111);
-  const double t113 = (-t2 * 0.8 + 3.136 * t107 + 0.104 * t1 - 1.11 * t109);
-  const double t114 = (t112 + (t113 * t113));
-  const double t115 = pow(t114, (-1.5));
-  const double t116 = sqrt(t114);
-  const double t117 = (-4.005 + t116);
-  const double t118 = (t117 * t117);
-  const double t119 = (1e-06 + t118);
-  const double t120 = (t116 - 2.595);
-  const double t121 = (t120 * t120);
-  const double t122 = (1e-06 + t121);
-  const double t123 = (1.0 / sqrt(t119));
-  const double t124 = (1.0 / sqrt(t122));
-  const double t125 = (t123 * t117 - t124 * t120 + 2.0);
-  const double t126 = (1.0 / sqrt(t114));
-  const double t127 = (-0.104) * t1;
-  const double t128 = t2 * 0.8;
-  const double t129 = (t127 + t128);
-  const double t130 = (t108 + t110);
-  const double t131 = (t111 * t129 + t130 * t113);
-  const double t132 = (t127 + t128 - 3.136 * t107 + 1.11 * t109);
-  const double t133 = (t111 * t132 + t113 * t111);
-  const double t134 = (t126 * 2e+06 * x[5] * t131 + t126 * 2e+06 * t133 * x[4]);
-  const double t135 =
-      (-0.035342917352885174 * x[13] + 4e+08 * t116 - 1.32e+09 + sqrt(t119) * 2e+08 -
-       sqrt(t122) * 2e+08 + x[17] * 0.01802488784997144 + t125 * t134);
-  const double t136 = (t133 * t133);
-  const double t137 = sin(u[9]);
-  const double t138 = t4 * 0.3;
-  const double t139 = (-2.9) * t1;
-  const double t140 = (-5.7) * t109;
-  const double t141 = t5 * (-0.7);
-  const double t142 = (t138 + t139 + t140 + t141);
-  const double t143 = cos(u[9]);
-  const double t144 = t5 * 0.0578571428571429;
-  const double t145 = t2 * (-2.9);
-  const double t146 = t107 * (-5.7);
-  const double t147 = t4 * (-0.567857142857143);
-  const double t148 = (t144 + t145 + t146 + t147);
-  const double t149 = t4 * (-0.0578571428571429);
-  const double t150 = (-0.567857142857143) * t5;
-  const double t151 = (t149 + t139 + t140 + t150);
-  const double t152 = 0.8 * t1;
-  const double t153 = t2 * 0.104;
-  const double t154 =
-      (t111 * ((-3.136 * t109 + t152 - 1.11 * t107 + t153)) + t113 * t132 + t112 + (t132 * t132));
-  const double t155 = t1 * (-0.1);
-  const double t156 = t2 * (-1.1);
-  const double t157 = (t146 + t155 + t156);
-  const double t158 = (1.09 - 0.236 * t109 + t107 * 2.979);
-  const double t159 = 0.236 * t107;
-  const double t160 = t109 * 2.979;
-  const double t161 = (-0.356 + t159 + t160);
-  const double t162 = ((t158 * t158) + (t161 * t161));
-  const double t163 = (1.0 / sqrt(t162));
-  const double t164 = (t159 + t160);
-  const double t165 = (-t107 * 2.979 + 0.236 * t109);
-  const double t166 = ((t164 * t164) + t158 * t165 + ((-t160 - t159)) * t161 + (t165 * t165));
-  const double t167 = sqrt(t162);
-  const double t168 = (-3.775 + t167);
-  const double t169 = (t168 * t168);
-  const double t170 = (1e-06 + t169);
-  const double t171 = (1.0 / sqrt(t170));
-  const double t172 = (-2.03 + t167);
-  const double t173 = (t172 * t172);
-  const double t174 = (1e-06 + t173);
-  const double t175 = (1.0 / sqrt(t174));
-  const double t176 = (2.0 + t171 * t168 - t172 * t175);
-  const double t177 = (t164 * t158 + t161 * t165);
-  const double t178 =
-      (-t163 * 2e+06 * x[4] * t176 * t177 - 2e+08 * sqrt(t170) + sqrt(t174) * 2e+08 -
-       0.015079644737231009 * x[16] + 1.161e+09 - 4e+08 * t167 + x[12] * 0.03078760800517998);
-  const double t179 = (4e+08 * t52 + 0.013823007675795093 * x[18] - 1.247e+09 - 2e+08 * sqrt(t55) -
-                       0.026546457922833753 * x[14] + 2e+08 * sqrt(t70) + t67 * t104);
-  const double t180 = t29 * t88 * t179 * (-1.0);
-  const double t181 = pow(t122, (-1.5));
-  const double t182 = pow(t119, (-1.5));
-  const double t183 = t111 * ((t152 + t153));
-  const double t184 = t113 * t129;
-  const double t185 = (t183 + t184 + t130 * t111 + t129 * t132);
-  const double t186 = (-t124 * t126 * t120 * 2e+08 * t133 + 4e+08 * t126 * t133 +
-                       t126 * 2e+08 * t133 * t123 * t117 -
-                       t134 * ((-t181 * t126 * t133 * t121 - t126 * t133 * t123 +
-                                t124 * t126 * t133 + t126 * t118 * t133 * t182)) +
-                       ((t126 * 2e+06 * x[5] * t185 + t126 * 2e+06 * x[4] * t154 -
-                         t115 * 2e+06 * t133 * x[5] * t131 - t115 * t136 * 2e+06 * x[4])) *
-                           t125);
-  const double t187 = pow(t162, (-1.5));
-  const double t188 = (t177 * t177);
-  const double t189 = t2 * 0.1;
-  const double t190 = t1 * (-1.1);
-  const double t191 = (t189 + t190 + t140);
-  const double t192 = t4 * (-0.7);
-  const double t193 = t5 * (-0.3);
-  const double t194 = (t192 + t145 + t146 + t193);
-  const double t195 = t89 * t90 * t179;
-  const double t196 = (-0.35 * t109 - t107 * 2.6);
-  const double t197 = (t107 * 0.35 - 2.6 * t109);
-  const double t198 = 5.7 * t109;
-  const double t199 = t2 * (-0.1);
-  const double t200 = 1.1 * t1;
-  const double t201 = (t198 + t199 + t200);
-  const double t202 = t107 * (-0.35);
-  const double t203 = 2.6 * t109;
-  const double t204 = (t202 + t203);
-  const double t205 = t5 * 0.567857142857143;
-  const double t206 = 2.9 * t1;
-  const double t207 = t4 * 0.0578571428571429;
-  const double t208 = (t205 + t198 + t206 + t207);
-  const double t209 = t4 * (-0.3);
-  const double t210 = t5 * 0.7;
-  const double t211 = (t209 + t198 + t206 + t210);
-  const double t212 =
-      (7650.0 + 2200.0 * (t196 * t196) + (t201 * t201) * 1100.0 + (t204 * t204) * 2200.0 +
-       1100.0 * (t157 * t157) + (((t208 * t208) + (t148 * t148))) * u[8] + 950.0 * (t194 * t194) +
-       (t211 * t211) * 950.0);
-  const double t213 = (1.0 / (t212));
-  const double t214 = (1.0 / (t212 * t212));
-  const double t215 =
-      (t137 * 21574.629999999997 * t157 + 18632.635 * t211 * t143 - t163 * 2.0 * t177 * t178 +
-       t137 * 18632.635 * t194 + x[4] * 12000.0 - 2.0 * u[4] + t126 * t135 * t133 +
-       t204 * t143 * 43149.259999999995 + t201 * t143 * 21574.629999999997 -
-       ((-t208 * t143 * 9.80665 - t137 * 9.80665 * t148)) * 2.0 * u[8] +
-       t196 * t137 * 43149.259999999995 + t29 * t179 * t51);
-  const double t216 = (t138 + t139 + t141);
-  const double t217 = (t192 + t145 + t193);
-  const double t218 = (t149 + t139 + t150);
-  const double t219 = (t144 + t145 + t147);
-  const double t220 = (t189 + t190);
-  const double t221 = (t155 + t156);
-  const double t222 = t115 * t135 * t133 * t131 * (-1.0);
-  const double t223 = (-t137 * 9.80665 * t218 - t143 * 9.80665 * t219);
-  const double t224 = (-2.0) * u[8] * t223;
-  const double t225 = t220 * t137 * 21574.629999999997;
-  const double t226 = t29 * t51 * t105;
-  const double t227 = 18632.635 * t143 * t217;
-  const double t228 = t143 * 21574.629999999997 * t221;
-  const double t229 = (t183 + t184 + (t130 * t130) + (t129 * t129));
-  const double t230 = (t131 * t131);
-  const double t231 = (t126 * 2e+08 * t123 * t131 * t117 +
-                       ((-t124 * t126 * t131 - t126 * t118 * t182 * t131 +
-                         t181 * t126 * t121 * t131 + t126 * t123 * t131)) *
-                           t134 +
-                       4e+08 * t126 * t131 - t124 * t126 * t120 * 2e+08 * t131 +
-                       t125 * ((t126 * 2e+06 * x[4] * t185 + t126 * t229 * 2e+06 * x[5] -
-                                t115 * 2e+06 * t133 * x[4] * t131 - t115 * 2e+06 * x[5] * t230)));
-  const double t232 = t137 * 18632.635 * t216;
-  const double t233 = t89 * t90 * t179 * (-1.0);
-  const double t234 = t126 * t135 * t185;
-  const double t235 = t29 * t88 * t179;
-  const double t236 = (t138 + t141);
-  const double t237 = (t144 + t147);
-  const double t238 = (t149 + t150);
-  const double t239 = (t192 + t193);
-  const double t240 = 37265.27 * t236 * t137;
-  const double t241 = 37265.27 * t239 * t143;
-  const double t242 = (t65 * t65);
-  const double t243 = (t59 * t59);
-  const double t244 = ((t58 * t58) + t91 + (t57 * t57) + t93);
-  const double t245 = (t60 * t60);
-  const double t246 = (t82 * 4.0 * t243 * t16 - t35 * t16 * t244 + t12 * 2.0 * t15 * t244 +
-                       4.0 * t243 * t15 - t12 * t35 * t243 * 8.0);
-  const double t247 =
-      (2.0 * t35 * t40 * t59 + 2.0 * t35 * t41 * t59 - t20 * t15 * t63 + t19 * t61 * t15);
-  const double t248 =
-      (-t64 * t19 * 4.0 * t30 * t43 * t59 -
-       t20 *
-           ((-t19 * 24.0 * t76 * t243 - t61 * t30 * 8.0 * t59 + t19 * t30 * t244 * 8.0 +
-             t14 * ((32.0 * t243 * t30 * t6 - 16.0 * t14 * t244 * t6 + t60 * t37 * 8.0 * t57 +
-                     t12 * 16.0 * t58 * t30 * t59 + t245 * t85 * t10 + t96 +
-                     t12 * t30 * t244 * 8.0 * t6 + 4.0 * t37 * t246 * t10 + t97 -
-                     32.0 * t58 * t14 * t59 - t12 * 24.0 * t76 * t243 * t6)))) *
-           t14 * t43 +
-       t19 * t14 * t43 *
-           ((t30 * 8.0 * t59 * t63 - t20 * 24.0 * t76 * t243 -
-             t14 * ((-t12 * 16.0 * t30 * t57 * t59 + 4.0 * t37 * t246 * t6 + t99 + t100 +
-                     t245 * t85 * t6 + t60 * t58 * t37 * 8.0 - t12 * t30 * t244 * 8.0 * t10 +
-                     t12 * 24.0 * t76 * t243 * t10 + 32.0 * t14 * t57 * t59 +
-                     16.0 * t14 * t244 * t10 - 32.0 * t243 * t30 * t10)) +
-             t20 * t30 * t244 * 8.0)) -
-       t64 * 2.0 * t61 * t14 * t43 - t20 * t62 * t74 * 4.0 * t247 * t14 +
-       t20 * t62 * 4.0 * t30 * t43 * t59 + t74 * t64 * t19 * 4.0 * t247 * t14 -
-       t62 * 2.0 * t14 * t43 * t63);
-  const double t249 =
-      ((t22 * t22) * 0.24220799999999998 * t242 + 0.24220799999999998 * (t26 * t26) * t242 -
-       0.348 * t27 * t26 * t242 - 0.174 * t248 * t27 * t22 - 0.348 * t23 * t22 * t242 +
-       0.174 * t248 * t26 * t23);
-  const double t250 = (t66 * t66);
-  const double t251 = (-t20 * t74 * 4.0 * t45 * t247 * t14 - t20 * t14 * t43 * t98 +
-                       2.0 * t39 * t61 * t14 * t43 - 2.0 * t45 * t14 * t43 * t63 +
-                       t19 * t39 * 4.0 * t30 * t43 * t59 - t74 * t19 * t39 * 4.0 * t247 * t14 +
-                       t20 * 4.0 * t45 * t30 * t43 * t59 - t19 * t101 * t14 * t43);
-  const double t252 = (((t65 * 0.174 * t26 * t46 + 0.087 * t251 * t22)) * t27 +
-                       ((-0.087 * t251 * t26 + t65 * 0.174 * t46 * t22)) * t23 +
-                       t65 * 0.348 * t22 * t50 - t65 * 0.348 * t26 * t47);
-  const double t253 =
-      (-t29 * t66 * 2e+08 * t53 * t56 +
-       ((-t89 * t66 * 1e+06 * x[4] * t51 - t89 * t66 * 1e+06 * x[5] * t51 +
-         t29 * 1e+06 * x[6] * t249 - t89 * t250 * x[6] * 5e+05 + t29 * 2e+06 * t252 * x[4] +
-         t29 * 2e+06 * t252 * x[5])) *
-           2.0 * t104 +
-       t29 * t66 * 2e+08 * t71 * t68 + t29 * 4e+08 * t66 -
-       ((-t29 * t54 * t66 * t72 + t29 * t66 * t73 * t69 - t29 * t66 * t71 + t29 * t66 * t56)) *
-           t67);
-  const double t254 = (-t238 * t137 * 9.80665 - t143 * t237 * 9.80665);
-  const double t255 = t254 * (-4.0) * u[8];
-  const double t256 = t89 * t66 * t179 * (-1.0) * t51;
-  const double t257 = (t240 + t241 + t29 * t253 * t51 + t255 + t29 * 2.0 * t252 * t179 + t256);
-  const double t258 = (1.0 / (t114));
-  const double t259 = (1.0 / (t28));
-  const double t260 = t259 * t90 * 2e+06 * t104;
-  const double t261 = (t209 + t206 + t210);
-  const double t262 = (t205 + t206 + t207);
-  const double t263 = (t199 + t200);
-  const double t264 =
-      ((t221 * t221) * 1100.0 + 1150.0 + 950.0 * (t217 * t217) + (t261 * t261) * 950.0 +
-       u[8] * (((t219 * t219) + (t262 * t262))) + 1100.0 * (t263 * t263));
-  const double t265 = (1.0 / (t264 * t264));
-  const double t266 =
-      (-t137 * 21574.629999999997 * t221 - t263 * t143 * 21574.629999999997 -
-       t261 * 18632.635 * t143 + 2.0 * u[8] * ((-t262 * t143 * 9.80665 - t137 * 9.80665 * t219)) -
-       t29 * t179 * t51 - 5000.0 * x[5] - t126 * t135 * t131 + 2.0 * u[5] -
-       t137 * 18632.635 * t217);
-  const double t267 = ((t261 * 1900.0 * t217 + ((t218 * t219 + t262 * t219)) * 2.0 * u[8] +
-                        t220 * 2200.0 * t221 + 1900.0 * t216 * t217 + t263 * 2200.0 * t221)) *
-                      t265 * t266 * (-0.5);
-  const double t268 = (1.0 / (t264));
-  const double t269 = t259 * t90 * (-2e+06) * t104;
-  const double t270 = (t205 + t207);
-  const double t271 = (t209 + t210);
-  const double t272 = ((((t237 * t237) + (t270 * t270))) * u[8] + (t239 * t239) * 950.0 + 250.0 +
-                       (t271 * t271) * 950.0);
-  const double t273 =
-      ((-4.0 * ((-t137 * t237 * 9.80665 - t143 * t270 * 9.80665)) * u[8] + 3200.0 * x[6] +
-        t29 * t66 * t179 - 4.0 * u[6] + 37265.27 * t239 * t137 + 37265.27 * t143 * t271)) *
-      0.25 *
-      ((2.0 * u[8] * ((t270 * t237 + t238 * t237)) + t239 * t236 * 1900.0 + t239 * 1900.0 * t271)) /
-      (t272 * t272);
-  const double t274 = (1.0 / (t272));
-  const double t275 =
-      (t273 - 0.25 * t274 * ((t240 + t29 * t103 * t179 + t241 + t255 + t29 * t66 * t105 + t256)));
-  const double t276 = t259 * (-5e+05) * t66 * t274 * t104 * t51;
-  const double t277 = (5720.0 * t109 + 330.0 - t107 * 770.0);
-  const double t278 = (t202 + 0.15 + t203);
-  const double t279 = (-t4 * 285.0 + 665.0 * t5 + t1 * 2755.0 + 142.5 + 5415.0 * t109);
-  const double t280 = (t205 + t198 + t206 + 0.15 + t207);
-  const double t281 = (-t2 * 110.0 + t1 * 1210.0 + 6270.0 * t109 + 165.0);
-  const double t282 = t4 * (-665.0);
-  const double t283 = t5 * (-285.0);
-  const double t284 = t2 * (-2755.0);
-  const double t285 = (t209 + t198 + t206 + 0.15 + t210);
-  const double t286 = (t198 + t199 + t200 + 0.15);
-  const double t287 = (-110.0) * t1;
-  const double t288 = t2 * (-1210.0);
-  const double t289 = (t286 * t281 + 60000.0 + (t280 * t280) * u[8] + t285 * t279 + t277 * t278);
-  const double t290 = (1.0 / (t289 * t289));
-  const double t291 = (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 + u[7]);
-  const double t292 = (1.0 / (t289));
-  const double t293 = (t167 * 0.03078760800517998 - 0.059498844250515354);
-  const double t294 = (1.0 / (t293));
-  const double t295 = (x[12] - 2e+05);
-  const double t296 = (t295 * t295);
-  const double t297 = (t296 + 1e+10);
-  const double t298 = (x[12] - 3.7e+07);
-  const double t299 = ((t298 * t298) + 1e+10);
-  const double t300 = (-x[12] + u[10]);
-  const double t301 = (t300 * t300);
-  const double t302 = (t301 + 4e+10);
-  const double t303 = pow(t302, (-0.25));
-  const double t304 = ((x[8] * x[8]) + 1e-06);
-  const double t305 = sqrt(t304);
-  const double t306 = (t305 + x[8]);
-  const double t307 = (4e+10 + t296);
-  const double t308 = pow(t307, (-0.25));
-  const double t309 = (-t305 + x[8]);
-  const double t310 = x[8] * (1.0 / sqrt(t304));
-  const double t311 = (t310 - 1.0);
-  const double t312 = (t310 + 1.0);
-  const double t313 = x[12] * 2.0;
-  const double t314 = (t313 - 4e+05);
-  const double t315 = (x[13] - 3.7e+07);
-  const double t316 = (1e+10 + (t315 * t315));
-  const double t317 = (u[11] - x[13]);
-  const double t318 = (1e-06 + (x[9] * x[9]));
-  const double t319 = sqrt(t318);
-  const double t320 = (x[9] + t319);
-  const double t321 = (t317 * t317);
-  const double t322 = (4e+10 + t321);
-  const double t323 = pow(t322, (-0.25));
-  const double t324 = (x[13] - 2e+05);
-  const double t325 = (t324 * t324);
-  const double t326 = (1e+10 + t325);
-  const double t327 = (4e+10 + t325);
-  const double t328 = pow(t327, (-0.25));
-  const double t329 = (-x[9] + t319);
-  const double t330 =
-      (-sqrt(t316) * 3.5e-09 + 2.8577380332470414e-06 * t317 * t320 * t323 -
-       t126 * 0.017671458676442587 * x[5] * t131 - t126 * t133 * 0.017671458676442587 * x[4] -
-       x[13] * 7e-09 + 0.1302 + sqrt(t326) * 3.5e-09 - t328 * t324 * 2.8577380332470414e-06 * t329);
-  const double t331 = (0.017671458676442587 * t116 - 0.04285743526536852);
-  const double t332 = (1.0 / (t331 * t331));
-  const double t333 = (1.0 / (t331));
-  const double t334 = (1.0 / sqrt(t318)) * x[9];
-  const double t335 = (t334 + 1.0);
-  const double t336 = (t334 - 1.0);
-  const double t337 = x[13] * 2.0;
-  const double t338 = (t337 - 4e+05);
-  const double t339 = (t52 * 0.013273228961416876 - 0.03151490312757761);
-  const double t340 = (1.0 / (t339 * t339));
-  const double t341 = (x[14] - 3.7e+07);
-  const double t342 = ((t341 * t341) + 1e+10);
-  const double t343 = (x[14] - 2e+05);
-  const double t344 = (t343 * t343);
-  const double t345 = (4e+10 + t344);
-  const double t346 = pow(t345, (-0.25));
-  const double t347 = (1e-06 + (x[10] * x[10]));
-  const double t348 = sqrt(t347);
-  const double t349 = (x[10] - t348);
-  const double t350 = (1e+10 + t344);
-  const double t351 = (x[10] + t348);
-  const double t352 = (u[12] - x[14]);
-  const double t353 = (t352 * t352);
-  const double t354 = (4e+10 + t353);
-  const double t355 = pow(t354, (-0.25));
-  const double t356 =
-      (-t29 * t66 * 0.006636614480708438 * x[6] + 0.093 - t29 * x[5] * 0.013273228961416876 * t51 -
-       t29 * x[4] * 0.013273228961416876 * t51 - sqrt(t342) * 2.5e-09 +
-       t346 * t343 * t349 * 2.0412414523193154e-06 - x[14] * 5e-09 + 2.5e-09 * sqrt(t350) +
-       t351 * t352 * t355 * 2.0412414523193154e-06);
-  const double t357 = (1.0 / (t339));
-  const double t358 =
-      (-t29 * 15927874.753700253 * t51 * t340 * t356 +
-       ((-t29 * t103 * 0.006636614480708438 * x[6] + t89 * t66 * 0.006636614480708438 * x[6] * t51 +
-         t89 * t90 * x[4] * 0.013273228961416876 - t29 * t88 * x[5] * 0.013273228961416876 -
-         t29 * t88 * x[4] * 0.013273228961416876 + t89 * t90 * x[5] * 0.013273228961416876)) *
-           1.2e+09 * t357);
-  const double t359 = t29 * (-15927874.753700253) * t357 * t51;
-  const double t360 = x[10] * (1.0 / sqrt(t347));
-  const double t361 = (t360 - 1.0);
-  const double t362 = (t360 + 1.0);
-  const double t363 = x[14] * 2.0;
-  const double t364 = (t363 - 4e+05);
-  const double t365 = (1e-06 + (x[11] * x[11]));
-  const double t366 = x[11] * (1.0 / sqrt(t365));
-  const double t367 = (t366 + 1.0);
-  const double t368 = (u[13] - x[15]);
-  const double t369 = (t368 * t368);
-  const double t370 = (4e+10 + t369);
-  const double t371 = pow(t370, (-0.25));
-  const double t372 = (t366 - 1.0);
-  const double t373 = (x[15] - 2e+05);
-  const double t374 = (t373 * t373);
-  const double t375 = (4e+10 + t374);
-  const double t376 = pow(t375, (-0.25));
-  const double t377 = sqrt(t365);
-  const double t378 = (t377 - x[11]);
-  const double t379 = x[15] * 2.0;
-  const double t380 = (t379 - 4e+05);
-  const double t381 = (t377 + x[11]);
-  const double t382 = (-2.9e+07 + x[15]);
-  const double t383 = (0.05992565888304706 - 0.015079644737231009 * t167);
-  const double t384 = (1.0 / (t383));
-  const double t385 = (x[16] - 3.7e+07);
-  const double t386 = ((t385 * t385) + 1e+10);
-  const double t387 = (x[16] - 2e+05);
-  const double t388 = (t387 * t387);
-  const double t389 = (4e+10 + t388);
-  const double t390 = pow(t389, (-0.25));
-  const double t391 = (x[16] - u[10]);
-  const double t392 = (t391 * t391);
-  const double t393 = (4e+10 + t392);
-  const double t394 = pow(t393, (-0.25));
-  const double t395 = (1e+10 + t388);
-  const double t396 = x[16] * 2.0;
-  const double t397 = (t396 - 4e+05);
-  const double t398 = (0.03909483791956781 - t116 * 0.00901244392498572);
-  const double t399 = (1.0 / (t398));
-  const double t400 = (1.0 / (t398 * t398));
-  const double t401 = (x[17] - 2e+05);
-  const double t402 = (t401 * t401);
-  const double t403 = (t402 + 1e+10);
-  const double t404 = (x[17] - 3.7e+07);
-  const double t405 = (1e+10 + (t404 * t404));
-  const double t406 = (u[11] - x[17]);
-  const double t407 = (t406 * t406);
-  const double t408 = (4e+10 + t407);
-  const double t409 = pow(t408, (-0.25));
-  const double t410 = (4e+10 + t402);
-  const double t411 = pow(t410, (-0.25));
-  const double t412 =
-      (sqrt(t403) * 3.5e-09 - sqrt(t405) * 3.5e-09 + t126 * t133 * x[4] * 0.00901244392498572 +
-       0.1302 + t406 * 2.8577380332470414e-06 * t329 * t409 -
-       t411 * t401 * 2.8577380332470414e-06 * t320 - x[17] * 7e-09 +
-       t126 * x[5] * t131 * 0.00901244392498572);
-  const double t413 = x[17] * 2.0;
-  const double t414 = (t413 - 4e+05);
-  const double t415 = (x[18] - 3.7e+07);
-  const double t416 = (1e+10 + (t415 * t415));
-  const double t417 = (x[18] - 2e+05);
-  const double t418 = (t417 * t417);
-  const double t419 = (t418 + 1e+10);
-  const double t420 = (u[12] - x[18]);
-  const double t421 = (t420 * t420);
-  const double t422 = (4e+10 + t421);
-  const double t423 = pow(t422, (-0.25));
-  const double t424 = (4e+10 + t418);
-  const double t425 = pow(t424, (-0.25));
-  const double t426 =
-      (-2.5e-09 * sqrt(t416) + 0.093 + t29 * 0.006911503837897547 * x[5] * t51 +
-       2.5e-09 * sqrt(t419) + t29 * 0.006911503837897547 * x[4] * t51 +
-       t29 * t66 * 0.0034557519189487734 * x[6] - t349 * t420 * 2.0412414523193154e-06 * t423 -
-       x[18] * 5e-09 - t425 * t417 * t351 * 2.0412414523193154e-06);
-  const double t427 = (0.0276416792385999 - t52 * 0.006911503837897547);
-  const double t428 = (1.0 / (t427 * t427));
-  const double t429 = (1.0 / (t427));
-  const double t430 =
-      (t29 * 8293804.6054770565 * t426 * t428 * t51 +
-       ((t29 * t88 * 0.006911503837897547 * x[4] + t29 * t88 * 0.006911503837897547 * x[5] -
-         t89 * 0.006911503837897547 * t90 * x[5] - t89 * 0.006911503837897547 * t90 * x[4] -
-         t89 * t66 * 0.0034557519189487734 * x[6] * t51 +
-         t29 * t103 * 0.0034557519189487734 * x[6])) *
-           1.2e+09 * t429);
-  const double t431 = t29 * 8293804.6054770565 * t429 * t51;
-  const double t432 = x[18] * 2.0;
-  const double t433 = (t432 - 4e+05);
-  const double t434 = (x[19] - u[13]);
-  const double t435 = (t434 * t434);
-  const double t436 = (4e+10 + t435);
-  const double t437 = pow(t436, (-0.25));
-  const double t438 = (x[19] - 2e+05);
-  const double t439 = (t438 * t438);
-  const double t440 = (4e+10 + t439);
-  const double t441 = pow(t440, (-0.25));
-  const double t442 = x[19] * 2.0;
-  const double t443 = (-2.9e+07 + x[19]);
-  const double t444 = (t442 - 4e+05);
-  jacobian[4] = 1.0;
-  jacobian[25] = 1.0;
-  jacobian[46] = 1.0;
-  jacobian[67] = 1.0;
-  jacobian[80] =
-      (((t106 + t115 * t135 * t136 - t137 * 18632.635 * t142 +
-         ((-t143 * 9.80665 * t148 - t137 * t151 * 9.80665)) * 2.0 * u[8] - t126 * t135 * t154 -
-         t143 * 21574.629999999997 * t157 + t163 * 2.0 * t166 * t178 + t180 - t126 * t133 * t186 +
-         t163 *
-             ((-t163 * 2e+06 * t166 * x[4] * t176 + t163 * t172 * t175 * 2e+08 * t177 -
-               4e+08 * t163 * t177 + t187 * t188 * 2e+06 * x[4] * t176 -
-               t163 * 2e+06 * x[4] * t177 *
-                   ((t163 * t171 * t177 - t163 * t169 * pow(t170, (-1.5)) * t177 +
-                     pow(t174, (-1.5)) * t163 * t173 * t177 - t163 * t175 * t177)) -
-               t163 * 2e+08 * t171 * t168 * t177)) *
-             2.0 * t177 -
-         t137 * t191 * 21574.629999999997 - 18632.635 * t194 * t143 - t187 * t188 * 2.0 * t178 +
-         t195 - t196 * t143 * 43149.259999999995 - t137 * t197 * 43149.259999999995)) *
-           0.5 * t213 +
-       t214 * 0.5 *
-           ((t196 * t204 * 4400.0 + ((t208 * t148 + t151 * t148)) * 2.0 * u[8] +
-             t196 * t197 * 4400.0 + t201 * 2200.0 * t157 + t194 * t211 * 1900.0 +
-             2200.0 * t191 * t157 + t194 * t142 * 1900.0)) *
-           t215);
-  jacobian[81] = (t214 * 0.5 *
-                      ((t194 * 1900.0 * t216 + t211 * 1900.0 * t217 +
-                        ((t148 * t218 + t208 * t219)) * 2.0 * u[8] + t220 * 2200.0 * t157 +
-                        t201 * 2200.0 * t221)) *
-                      t215 -
-                  0.5 *
-                      ((t222 + t224 + t225 + t226 + t227 + t228 + t231 * t126 * t133 + t232 + t233 +
-                        t234 + t235)) *
-                      t213);
-  jacobian[82] = (t214 *
-                      ((t236 * t194 * 1900.0 + ((t208 * t237 + t238 * t148)) * 2.0 * u[8] +
-                        t239 * t211 * 1900.0)) *
-                      0.5 * t215 -
-                  0.25 * t257 * t213);
-  jacobian[84] = ((t258 * t136 * 2e+06 * t125 + 4e+06 * t188 * t176 / (t162) + t260 + 12000.0)) *
-                 t213 * (-0.5);
-  jacobian[85] = ((t258 * 2e+06 * t133 * t125 * t131 + t260)) * t213 * (-0.5);
-  jacobian[86] = t259 * (-5e+05) * t66 * t213 * t104 * t51;
-  jacobian[92] = t163 * 0.03078760800517998 * t213 * t177;
-  jacobian[93] = t126 * t133 * 0.017671458676442587 * t213;
-  jacobian[94] = t29 * 0.013273228961416876 * t213 * t51;
-  jacobian[96] = t163 * (-0.015079644737231009) * t213 * t177;
-  jacobian[97] = (-0.00901244392498572) * t126 * t133 * t213;
-  jacobian[98] = t29 * (-0.006911503837897547) * t213 * t51;
-  jacobian[100] = (t267 - ((t126 * t186 * t131 + t222 + t224 + t225 + t226 + t227 + t228 + t232 +
-                            t233 + t234 + t235)) *
-                              0.5 * t268);
-  jacobian[101] = (((t106 - t225 + 2.0 * u[8] * t223 + t180 - t231 * t126 * t131 +
-                     t115 * t135 * t230 - t227 - t228 + t195 - t232 - t126 * t135 * t229)) *
-                       0.5 * t268 +
-                   t267);
-  jacobian[102] =
-      (-0.25 * t257 * t268 - ((t261 * t239 * 1900.0 + 2.0 * ((t262 * t237 + t238 * t219)) * u[8] +
-                               t236 * 1900.0 * t217)) *
-                                 t265 * 0.5 * t266);
-  jacobian[104] = ((-t258 * 2e+06 * t133 * t125 * t131 + t269)) * 0.5 * t268;
-  jacobian[105] = ((t269 - 5000.0 - t258 * 2e+06 * t125 * t230)) * 0.5 * t268;
-  jacobian[106] = t259 * (-5e+05) * t66 * t268 * t104 * t51;
-  jacobian[113] = t126 * 0.017671458676442587 * t268 * t131;
-  jacobian[114] = t29 * t268 * 0.013273228961416876 * t51;
-  jacobian[117] = (-0.00901244392498572) * t126 * t268 * t131;
-  jacobian[118] = t29 * (-0.006911503837897547) * t268 * t51;
-  jacobian[120] = t275;
-  jacobian[121] = t275;
-  jacobian[122] =
-      (t273 - 0.125 * t274 *
-                  ((-t89 * t250 * t179 + t29 * 2.0 * t249 * t179 + 74530.54 * t236 * t137 +
-                    t29 * t253 * t66 + 74530.54 * t239 * t143 - t254 * u[8] * 8.0)));
-  jacobian[124] = t276;
-  jacobian[125] = t276;
-  jacobian[126] = ((t259 * t250 * 1e+06 * t104 + 3200.0)) * t274 * (-0.25);
-  jacobian[134] = t29 * t66 * 0.006636614480708438 * t274;
-  jacobian[138] = t29 * t66 * (-0.0034557519189487734) * t274;
-  jacobian[140] =
-      ((t196 * t277 + ((-t107 * 5720.0 - 770.0 * t109)) * t278 + t194 * t279 +
-        t280 * 2.0 * u[8] * t148 + t157 * t281 + ((t282 + t283 + t284 - t107 * 5415.0)) * t285 +
-        t286 * ((t287 + t288 - t107 * 6270.0)))) *
-      t290 * t291 * (-1.0);
-  jacobian[141] = ((t286 * ((t287 + t288)) + t280 * 2.0 * u[8] * t219 + t217 * t279 + t221 * t281 +
-                    t285 * ((t282 + t283 + t284)))) *
-                  t290 * t291 * (-1.0);
-  jacobian[142] =
-      t290 * t291 * ((t280 * 2.0 * t237 * u[8] + t285 * ((t282 + t283)) + t239 * t279)) * (-1.0);
-  jacobian[147] = t292 * (-20000.0);
-  jacobian[155] = t292 * 0.0025;
-  jacobian[159] = t292 * (-0.0025);
-  jacobian[168] = (-16.666666666666668);
-  jacobian[189] = (-16.666666666666668);
-  jacobian[210] = (-16.666666666666668);
-  jacobian[231] = (-12.5);
-  jacobian[240] =
-      (((-t163 * t166 * x[4] * 0.03078760800517998 + t187 * t188 * x[4] * 0.03078760800517998)) *
-           1.2e+09 * t294 -
-       t163 * 36945129.606215976 *
-           ((sqrt(t297) * 3.5e-09 - t163 * x[4] * 0.03078760800517998 * t177 -
-             sqrt(t299) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
-             t300 * 2.8577380332470414e-06 * t303 * t306 +
-             t308 * t295 * 2.8577380332470414e-06 * t309)) *
-           t177 / (t293 * t293));
-  jacobian[244] = (-36945129.606215976) * t163 * t294 * t177;
-  jacobian[248] = 1.2e+09 *
-                  ((-t311 * t308 * t295 * 2.8577380332470414e-06 +
-                    t300 * 2.8577380332470414e-06 * t303 * t312)) *
-                  t294;
-  jacobian[252] = 1.2e+09 *
-                  ((-2.8577380332470414e-06 * t303 * t306 -
-                    7.144345083117603e-07 * t295 * t314 * pow(t307, (-1.25)) * t309 -
-                    ((-7.4e+07 + t313)) * (1.0 / sqrt(t299)) * 1.75e-09 +
-                    t308 * 2.8577380332470414e-06 * t309 + (1.0 / sqrt(t297)) * t314 * 1.75e-09 +
-                    t301 * 1.4288690166235207e-06 * t306 * pow(t302, (-1.25)) - 7e-09)) *
-                  t294;
-  jacobian[260] = (-t126 * t330 * t133 * t332 * 21205750.411731105 +
-                   t333 * 1.2e+09 *
-                       ((-t126 * 0.017671458676442587 * x[5] * t185 +
-                         t115 * t136 * 0.017671458676442587 * x[4] +
-                         t115 * t133 * 0.017671458676442587 * x[5] * t131 -
-                         t126 * 0.017671458676442587 * x[4] * t154)));
-  jacobian[261] =
-      (-t126 * t330 * t332 * 21205750.411731105 * t131 +
-       t333 * 1.2e+09 *
-           ((t115 * 0.017671458676442587 * x[5] * t230 - t126 * t229 * 0.017671458676442587 * x[5] +
-             t115 * t133 * 0.017671458676442587 * x[4] * t131 -
-             t126 * 0.017671458676442587 * x[4] * t185)));
-  jacobian[264] = t333 * t126 * t133 * (-21205750.411731105);
-  jacobian[265] = t333 * t126 * t131 * (-21205750.411731105);
-  jacobian[269] = ((2.8577380332470414e-06 * t317 * t323 * t335 -
-                    t328 * t324 * 2.8577380332470414e-06 * t336)) *
-                  t333 * 1.2e+09;
-  jacobian[273] = t333 * 1.2e+09 *
-                  ((-(1.0 / sqrt(t316)) * ((t337 - 7.4e+07)) * 1.75e-09 +
-                    pow(t322, (-1.25)) * t321 * t320 * 1.4288690166235207e-06 -
-                    2.8577380332470414e-06 * t320 * t323 - t328 * 2.8577380332470414e-06 * t329 +
-                    7.144345083117603e-07 * t324 * t338 * pow(t327, (-1.25)) * t329 +
-                    t338 * (1.0 / sqrt(t326)) * 1.75e-09 - 7e-09));
-  jacobian[280] = t358;
-  jacobian[281] = t358;
-  jacobian[282] =
-      (-t29 * t66 * 7963937.376850126 * t340 * t356 +
-       1.2e+09 * t357 *
-           ((t89 * t250 * 0.003318307240354219 * x[6] +
-             t89 * t66 * 0.006636614480708438 * x[4] * t51 -
-             t29 * t252 * x[4] * 0.013273228961416876 - t29 * t252 * x[5] * 0.013273228961416876 +
-             t89 * t66 * 0.006636614480708438 * x[5] * t51 -
-             t29 * 0.006636614480708438 * x[6] * t249)));
-  jacobian[284] = t359;
-  jacobian[285] = t359;
-  jacobian[286] = t29 * t66 * (-7963937.376850126) * t357;
-  jacobian[290] = 1.2e+09 *
-                  ((-t346 * t343 * t361 * 2.0412414523193154e-06 +
-                    t362 * t352 * t355 * 2.0412414523193154e-06)) *
-                  t357;
-  jacobian[294] = 1.2e+09 * t357 *
-                  ((-t364 * t343 * 5.103103630798288e-07 * t349 * pow(t345, (-1.25)) +
-                    pow(t354, (-1.25)) * t351 * 1.0206207261596577e-06 * t353 +
-                    t346 * t349 * 2.0412414523193154e-06 + (1.0 / sqrt(t350)) * t364 * 1.25e-09 -
-                    (1.0 / sqrt(t342)) * 1.25e-09 * ((t363 - 7.4e+07)) -
-                    t351 * t355 * 2.0412414523193154e-06 - 5e-09));
-  jacobian[307] = (-7.5e+08);
-  jacobian[311] = (t367 * t368 * 510310.3630798288 * t371 - t372 * t373 * t376 * 510310.3630798288);
-  jacobian[315] = (t378 * t380 * t373 * 127577.5907699572 * pow(t375, (-1.25)) +
-                   t369 * pow(t370, (-1.25)) * t381 * 255155.1815399144 +
-                   t380 * (1.0 / sqrt((1e+10 + t374))) * 312.5 - 1250.0 -
-                   t381 * 510310.3630798288 * t371 - t378 * t376 * 510310.3630798288 -
-                   ((t379 - 5.8e+07)) * (1.0 / sqrt(((t382 * t382) + 1e+10))) * 312.5);
-  jacobian[320] = (1.2e+09 * t384 *
-                       ((0.015079644737231009 * t163 * t166 * x[4] -
-                         0.015079644737231009 * t187 * t188 * x[4])) +
-                   t163 * 18095573.68467721 *
-                       ((0.015079644737231009 * t163 * x[4] * t177 - sqrt(t386) * 3.5e-09 -
-                         t390 * t387 * 2.8577380332470414e-06 * t306 - x[16] * 7e-09 + 0.1302 +
-                         t394 * 2.8577380332470414e-06 * t391 * t309 + sqrt(t395) * 3.5e-09)) *
-                       t177 / (t383 * t383));
-  jacobian[324] = t163 * t384 * 18095573.68467721 * t177;
-  jacobian[328] = ((-t311 * t394 * 2.8577380332470414e-06 * t391 -
-                    t390 * t387 * 2.8577380332470414e-06 * t312)) *
-                  1.2e+09 * t384;
-  jacobian[336] = ((-t392 * 1.4288690166235207e-06 * pow(t393, (-1.25)) * t309 +
-                    (1.0 / sqrt(t395)) * t397 * 1.75e-09 + t394 * 2.8577380332470414e-06 * t309 +
-                    7.144345083117603e-07 * t387 * t397 * t306 * pow(t389, (-1.25)) -
-                    t390 * 2.8577380332470414e-06 * t306 -
-                    ((t396 - 7.4e+07)) * (1.0 / sqrt(t386)) * 1.75e-09 - 7e-09)) *
-                  1.2e+09 * t384;
-  jacobian[340] =
-      (((t126 * x[5] * t185 * 0.00901244392498572 + t126 * x[4] * t154 * 0.00901244392498572 -
-         t115 * t133 * x[5] * t131 * 0.00901244392498572 -
-         t115 * t136 * x[4] * 0.00901244392498572)) *
-           1.2e+09 * t399 +
-       t400 * t126 * 10814932.709982865 * t412 * t133);
-  jacobian[341] =
-      (t400 * t126 * 10814932.709982865 * t412 * t131 +
-       1.2e+09 *
-           ((-t115 * t133 * x[4] * t131 * 0.00901244392498572 +
-             t126 * t229 * x[5] * 0.00901244392498572 + t126 * x[4] * t185 * 0.00901244392498572 -
-             t115 * x[5] * t230 * 0.00901244392498572)) *
-           t399);
-  jacobian[344] = t126 * 10814932.709982865 * t133 * t399;
-  jacobian[345] = t126 * 10814932.709982865 * t399 * t131;
-  jacobian[349] =
-      1.2e+09 * t399 *
-      ((t406 * 2.8577380332470414e-06 * t336 * t409 - t411 * t401 * 2.8577380332470414e-06 * t335));
-  jacobian[357] =
-      ((pow(t408, (-1.25)) * 1.4288690166235207e-06 * t407 * t329 +
-        7.144345083117603e-07 * t401 * t414 * t320 * pow(t410, (-1.25)) -
-        ((-7.4e+07 + t413)) * (1.0 / sqrt(t405)) * 1.75e-09 + t414 * (1.0 / sqrt(t403)) * 1.75e-09 -
-        2.8577380332470414e-06 * t329 * t409 - t411 * 2.8577380332470414e-06 * t320 - 7e-09)) *
-      1.2e+09 * t399;
-  jacobian[360] = t430;
-  jacobian[361] = t430;
-  jacobian[362] =
-      (1.2e+09 * t429 *
-           ((t29 * 0.006911503837897547 * t252 * x[5] + t29 * 0.006911503837897547 * t252 * x[4] -
-             t89 * t250 * 0.0017278759594743867 * x[6] + t29 * 0.0034557519189487734 * x[6] * t249 -
-             t89 * t66 * 0.0034557519189487734 * x[5] * t51 -
-             t89 * t66 * 0.0034557519189487734 * x[4] * t51)) +
-       t29 * t66 * t426 * t428 * 4146902.3027385282);
-  jacobian[364] = t431;
-  jacobian[365] = t431;
-  jacobian[366] = t29 * t66 * t429 * 4146902.3027385282;
-  jacobian[370] = 1.2e+09 *
-                  ((t420 * t361 * 2.0412414523193154e-06 * t423 -
-                    t425 * t362 * t417 * 2.0412414523193154e-06)) *
-                  t429;
-  jacobian[378] = 1.2e+09 * t429 *
-                  ((-((-7.4e+07 + t432)) * 1.25e-09 * (1.0 / sqrt(t416)) -
-                    t421 * t349 * pow(t422, (-1.25)) * 1.0206207261596577e-06 +
-                    t349 * 2.0412414523193154e-06 * t423 - t425 * t351 * 2.0412414523193154e-06 +
-                    t417 * 5.103103630798288e-07 * t433 * t351 * pow(t424, (-1.25)) +
-                    t433 * 1.25e-09 * (1.0 / sqrt(t419)) - 5e-09));
-  jacobian[387] = 7.5e+08;
-  jacobian[391] =
-      (-t372 * t434 * 510310.3630798288 * t437 - t441 * t438 * t367 * 510310.3630798288);
-  jacobian[399] =
-      (-((t442 - 5.8e+07)) * (1.0 / sqrt(((t443 * t443) + 1e+10))) * 312.5 - 1250.0 -
-       t441 * t381 * 510310.3630798288 +
-       t444 * t438 * 127577.5907699572 * t381 * pow(t440, (-1.25)) +
-       (1.0 / sqrt((t439 + 1e+10))) * t444 * 312.5 +
-       t378 * pow(t436, (-1.25)) * t435 * 255155.1815399144 - t378 * 510310.3630798288 * t437);
+  double x[kNumStates] = {};
+  double u[kNumInputs] = {};
+  std::copy(q, q + kNumJoints, x);
+  std::copy(qd, qd + kNumJoints, x + kNumJoints);
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const double t0 = (x[2] + x[0] + x[1]);
+  const double t1 = sin(t0);
+  const double t2 = t1 * (-0.3);
+  const double t3 = cos(x[0]);
+  const double t4 = 5.7 * t3;
+  const double t5 = (x[0] + x[1]);
+  const double t6 = cos(t5);
+  const double t7 = 2.9 * t6;
+  const double t8 = cos(t0);
+  const double t9 = t8 * 0.7;
+  const double t10 = (t2 + t4 + t7 + t9);
+  const double t11 = t1 * (-0.7);
+  const double t12 = t8 * (-0.3);
+  const double t13 = (t11 + t12);
+  const double t14 = t13 * x[6];
+  const double t15 = sin(t5);
+  const double t16 = t15 * (-2.9);
+  const double t17 = (t11 + t16 + t12);
+  const double t18 = x[5] * t17;
+  const double t19 = sin(x[0]);
+  const double t20 = t19 * (-5.7);
+  const double t21 = (t11 + t16 + t20 + t12);
+  const double t22 = (t18 + t21 * x[4] + t14);
+  const double t23 =
+      (((t13 * x[5] + t13 * x[4] + t14)) * x[6] + ((t18 + x[4] * t17 + t14)) * x[5] + x[4] * t22);
+  const double t24 = (x[4] * x[4]);
+  const double t25 = (-0.35 * t3 - t19 * 2.6);
+  const double t26 = (-t19 * 0.35 + 2.6 * t3);
+  const double t27 = t1 * (-0.0578571428571429);
+  const double t28 = (-2.9) * t6;
+  const double t29 = (-5.7) * t3;
+  const double t30 = (-0.567857142857143) * t8;
+  const double t31 = (t27 + t28 + t30);
+  const double t32 = x[5] * t31;
+  const double t33 = (t27 + t30);
+  const double t34 = t33 * x[6];
+  const double t35 = (x[4] * ((x[4] * ((t27 + t28 + t29 + t30)) + t32 + t34)) +
+                      x[5] * ((x[4] * t31 + t32 + t34)) + ((t34 + t33 * x[5] + t33 * x[4])) * x[6]);
+  const double t36 = t8 * 0.0578571428571429;
+  const double t37 = t1 * (-0.567857142857143);
+  const double t38 = (t36 + t16 + t20 + t37);
+  const double t39 = t8 * 0.567857142857143;
+  const double t40 = t1 * 0.0578571428571429;
+  const double t41 = (t39 + t4 + t7 + t40);
+  const double t42 = (t36 + t16 + t37);
+  const double t43 = x[5] * t42;
+  const double t44 = (t36 + t37);
+  const double t45 = t44 * x[6];
+  const double t46 = (t43 + x[4] * t38 + t45);
+  const double t47 =
+      (x[5] * ((x[4] * t42 + t43 + t45)) + x[4] * t46 + ((t44 * x[5] + t45 + t44 * x[4])) * x[6]);
+  const double t48 = cos(u[9]);
+  const double t49 = sin(u[9]);
+  const double t50 = (x[7] * x[7]);
+  const double t51 = t6 * (-0.1);
+  const double t52 = t15 * (-1.1);
+  const double t53 = (t20 + t51 + t52);
+  const double t54 = (-t15 * 110.0 + t6 * 1210.0 + 6270.0 * t3 + 165.0);
+  const double t55 = t15 * (-0.1);
+  const double t56 = 1.1 * t6;
+  const double t57 = (t4 + t55 + t56);
+  const double t58 = (t51 + t52);
+  const double t59 = x[5] * t58;
+  const double t60 = (t53 * x[4] + t59);
+  const double t61 = (x[4] * t60 + x[5] * ((x[4] * t58 + t59)));
+  const double t62 = t15 * 0.1;
+  const double t63 = t6 * (-1.1);
+  const double t64 = (t62 + t63);
+  const double t65 = t64 * x[5];
+  const double t66 = (x[5] * ((t65 + t64 * x[4])) + ((t65 + ((t62 + t63 + t29)) * x[4])) * x[4]);
+  const double t67 = (-t1 * 285.0 + 665.0 * t8 + t6 * 2755.0 + 142.5 + 5415.0 * t3);
+  const double t68 = (t39 + t4 + t7 + 0.15 + t40);
+  const double t69 = t1 * 0.3;
+  const double t70 = t8 * (-0.7);
+  const double t71 = (t69 + t28 + t70);
+  const double t72 = t71 * x[5];
+  const double t73 = (t69 + t70);
+  const double t74 = t73 * x[6];
+  const double t75 = (x[4] * ((((t69 + t28 + t29 + t70)) * x[4] + t72 + t74)) +
+                      x[6] * ((t73 * x[5] + t74 + t73 * x[4])) + ((t71 * x[4] + t72 + t74)) * x[5]);
+  const double t76 = (t2 + t7 + t9);
+  const double t77 = (t39 + t7 + t40);
+  const double t78 = (t55 + t56);
+  const double t79 = (t2 + t9);
+  const double t80 = (t39 + t40);
+  bias[0] =
+      (950.0 * t10 * t23 + t24 * t25 * t26 * 2200.0 + ((t35 * t38 + t41 * t47)) * u[8] -
+       ((-t41 * t48 * 9.80665 - t49 * 9.80665 * t38)) * u[8] -
+       t50 * t25 * ((5720.0 * t3 + 330.0 - t19 * 770.0)) - t50 * t53 * t54 + t57 * 1100.0 * t61 +
+       t66 * 1100.0 * t53 + t26 * t48 * 21574.629999999997 +
+       t24 * t25 * 2200.0 * ((t19 * 0.35 - 2.6 * t3)) - t50 * t21 * t67 - t50 * t68 * u[8] * t38 +
+       t57 * t48 * 10787.314999999999 + t10 * t48 * 9316.3175 + t49 * t21 * 9316.3175 +
+       t49 * t53 * 10787.314999999999 + 950.0 * t21 * t75 + t25 * t49 * 21574.629999999997);
+  bias[1] =
+      (t76 * t48 * 9316.3175 - t50 * t17 * t67 + t49 * t17 * 9316.3175 +
+       t49 * 10787.314999999999 * t58 + t76 * 950.0 * t23 + 950.0 * t75 * t17 + t66 * 1100.0 * t58 -
+       t50 * t68 * u[8] * t42 - t50 * t58 * t54 -
+       u[8] * ((-t77 * t48 * 9.80665 - t49 * 9.80665 * t42)) + ((t35 * t42 + t77 * t47)) * u[8] +
+       t78 * 1100.0 * t61 + t78 * t48 * 10787.314999999999);
+  bias[2] = (-t50 * t68 * t44 * u[8] + t13 * 950.0 * t75 + 950.0 * t23 * t79 +
+             u[8] * ((t35 * t44 + t80 * t47)) + t48 * t79 * 9316.3175 - t50 * t13 * t67 +
+             t13 * t49 * 9316.3175 - ((-t49 * t44 * 9.80665 - t48 * t80 * 9.80665)) * u[8]);
+  bias[3] = (((330.0 + 12540.0 * t3 + 2420.0 * t6 - t15 * 220.0)) * x[7] * t60 +
+             t25 * x[7] * x[4] * ((11440.0 * t3 + 660.0 - t19 * 1540.0)) +
+             x[7] * ((-t1 * 570.0 + 285.0 + 10830.0 * t3 + 5510.0 * t6 + 1330.0 * t8)) * t22 +
+             t68 * 2.0 * x[7] * u[8] * t46);
+}
+
+void MechanicalEnergy(const double* q, const double* qd, double payload, double pitch,
+                      double* energy) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  double x[kNumStates] = {};
+  double u[kNumInputs] = {};
+  std::copy(q, q + kNumJoints, x);
+  std::copy(qd, qd + kNumJoints, x + kNumJoints);
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const double t0 = cos(x[0]);
+  const double t1 = 5.7 * t0;
+  const double t2 = (x[0] + x[1]);
+  const double t3 = sin(t2);
+  const double t4 = t3 * (-0.1);
+  const double t5 = cos(t2);
+  const double t6 = 1.1 * t5;
+  const double t7 = (x[2] + x[0] + x[1]);
+  const double t8 = cos(t7);
+  const double t9 = t8 * 0.567857142857143;
+  const double t10 = 2.9 * t5;
+  const double t11 = sin(t7);
+  const double t12 = t11 * 0.0578571428571429;
+  const double t13 = (t9 + t1 + t10 + 0.15 + t12);
+  const double t14 = t11 * (-0.3);
+  const double t15 = t8 * 0.7;
+  const double t16 = sin(x[0]);
+  const double t17 = t16 * (-0.35);
+  const double t18 = 2.6 * t0;
+  const double t19 = t11 * (-0.7);
+  const double t20 = t8 * (-0.3);
+  const double t21 = (t19 + t20);
+  const double t22 = t3 * (-2.9);
+  const double t23 = (t19 + t22 + t20);
+  const double t24 = (t14 + t10 + t15);
+  const double t25 = (t14 + t15);
+  const double t26 = t8 * 0.0578571428571429;
+  const double t27 = t11 * (-0.567857142857143);
+  const double t28 = (t26 + t27);
+  const double t29 = (t26 + t22 + t27);
+  const double t30 = (t9 + t10 + t12);
+  const double t31 = (t9 + t12);
+  const double t32 = t5 * (-0.1);
+  const double t33 = t3 * (-1.1);
+  const double t34 = (t32 + t33);
+  const double t35 = (t4 + t6);
+  const double t36 = (t14 + t1 + t10 + t15);
+  const double t37 = t16 * (-5.7);
+  const double t38 = (t19 + t22 + t37 + t20);
+  const double t39 = (t9 + t1 + t10 + t12);
+  const double t40 = (t26 + t22 + t37 + t27);
+  const double t41 = (-0.35 * t0 - t16 * 2.6);
+  const double t42 = (t1 + t4 + t6);
+  const double t43 = (t17 + t18);
+  const double t44 = (t37 + t32 + t33);
+  const double t45 = sin(u[9]);
+  const double t46 = cos(u[9]);
+  const double t47 = t3 * 2.9;
+  const double t48 = t16 * 5.7;
+  energy[0] =
+      ((x[7] * x[7]) * 0.5 *
+           ((((t1 + t4 + t6 + 0.15)) * ((-t3 * 110.0 + t5 * 1210.0 + 6270.0 * t0 + 165.0)) +
+             60000.0 + (t13 * t13) * u[8] +
+             ((t14 + t1 + t10 + 0.15 + t15)) *
+                 ((-t11 * 285.0 + 665.0 * t8 + t5 * 2755.0 + 142.5 + 5415.0 * t0)) +
+             ((5720.0 * t0 + 330.0 - t16 * 770.0)) * ((t17 + 0.15 + t18)))) +
+       ((t21 * 950.0 * t23 + 250.0 + t24 * 950.0 * t25 + ((t28 * t29 + t30 * t31)) * u[8])) * x[5] *
+           x[6] +
+       (x[5] * x[5]) *
+           (((t34 * t34) * 1100.0 + 1150.0 + 950.0 * (t23 * t23) + (t24 * t24) * 950.0 +
+             u[8] * (((t29 * t29) + (t30 * t30))) + 1100.0 * (t35 * t35))) *
+           0.5 +
+       ((950.0 * t36 * t25 + 250.0 + t21 * 950.0 * t38 + ((t39 * t31 + t28 * t40)) * u[8])) * x[4] *
+           x[6] +
+       (x[6] * x[6]) * 0.5 *
+           (((((t28 * t28) + (t31 * t31))) * u[8] + (t21 * t21) * 950.0 + 250.0 +
+             (t25 * t25) * 950.0)) +
+       (x[4] * x[4]) *
+           ((7650.0 + 2200.0 * (t41 * t41) + (t42 * t42) * 1100.0 + (t43 * t43) * 2200.0 +
+             1100.0 * (t44 * t44) + (((t39 * t39) + (t40 * t40))) * u[8] + 950.0 * (t38 * t38) +
+             (t36 * t36) * 950.0)) *
+           0.5 +
+       ((1150.0 + 950.0 * t38 * t23 + t42 * t35 * 1100.0 + u[8] * ((t39 * t30 + t40 * t29)) +
+         t24 * 950.0 * t36 + 1100.0 * t44 * t34)) *
+           x[5] * x[4]);
+  energy[1] = (t42 * t45 * 10787.314999999999 + t45 * t43 * 21574.629999999997 -
+               u[8] * ((-t46 * ((t47 + t11 * 0.567857142857143 - t26 + t48)) * 9.80665 -
+                        t39 * t45 * 9.80665)) +
+               ((t47 + t11 * 0.7 + t48 + t8 * 0.3)) * t46 * 9316.3175 + t45 * t36 * 9316.3175 +
+               ((t16 * 2.6 + 0.35 * t0)) * t46 * 21574.629999999997 +
+               ((0.1 * t5 + t3 * 1.1 + t48)) * t46 * 10787.314999999999);
 }
 
 namespace {
@@ -1533,7 +2192,10 @@ const MachineFunctions& Functions() {
       &JointFromCylinderLength,
       &PlantRhs,
       &PlantJacobian,
-      &Residual};
+      &Residual,
+      &MassMatrix,
+      &BiasForces,
+      &MechanicalEnergy};
   return functions;
 }
 

@@ -115,6 +115,13 @@ int JointFromCylinderLength(int actuator, double length, const double* q, double
 /// Plant right-hand side xdot = f(t, x, u) and its Jacobian df/dx (row-major).
 void PlantRhs(double t, const double* x, const double* u, double* xdot);
 void PlantJacobian(double t, const double* x, const double* u, double* jacobian);
+/// Mass matrix M(q) (J x J, row-major) with a payload [kg] in the bucket.
+void MassMatrix(const double* q, double payload, double* mass);
+/// Coriolis and centrifugal terms minus gravity: M q'' + bias = actuator + external.
+void BiasForces(const double* q, const double* qd, double payload, double pitch, double* bias);
+/// [kinetic, potential] energy of the arm [J].
+void MechanicalEnergy(const double* q, const double* qd, double payload, double pitch,
+                      double* energy);
 /// Everything above behind the common interface of the registry.
 const MachineFunctions& Functions();
 

@@ -154,25 +154,25 @@ double CylinderLength(int actuator, const double* q) {
       return length;
     }
     case 1: {
-      const double t0 = (q[0] + q[1]);
-      const double t1 = sin(t0);
-      const double t2 = cos(q[0]);
-      const double t3 = cos(t0);
+      const double t0 = cos(q[0]);
+      const double t1 = (q[0] + q[1]);
+      const double t2 = sin(t1);
+      const double t3 = cos(t1);
       const double t4 = sin(q[0]);
-      const double t5 = (-0.389 * t1 + t2 * 0.5249999999999999 + 0.159 * t3 + 0.365 * t4);
+      const double t5 = (-0.389 * t2 + t0 * 0.5249999999999999 + 0.159 * t3 + 0.365 * t4);
       const double t6 = (t5 * t5);
-      const double t7 = (0.159 * t1 - 0.365 * t2 + t4 * 0.5249999999999999 + 0.389 * t3);
+      const double t7 = (0.159 * t2 - 0.365 * t0 + t4 * 0.5249999999999999 + 0.389 * t3);
       const double t8 = (t7 * t7);
       const double t9 = (t6 + t8);
       const double t10 = (1.0 / sqrt(t9));
       const double t11 = (t6 + t8 - 0.38752);
       const double t12 = sqrt((-(t11 * t11) * 0.25 / (t9) + 0.567009));
       const double t13 = atan2(t10 * 0.5 * ((t12 * t5 * 2.0 + t10 * t11 * t7)),
-                               t10 * ((t10 * t5 * t11 - t12 * 2.0 * t7)) * 0.5);
+                               t10 * ((-t10 * t5 * t11 + t12 * 2.0 * t7)) * (-0.5));
       const double t14 = cos(t13);
       const double t15 = sin(t13);
-      const double t16 = (-0.853 * t14 + t2 * 2.093 + 0.15500000000000003 * t4 + 0.141 * t15);
-      const double t17 = (-t2 * 0.15500000000000003 - 0.141 * t14 - 0.853 * t15 + 2.093 * t4);
+      const double t16 = (-t0 * 0.15500000000000003 - 0.141 * t14 - 0.853 * t15 + 2.093 * t4);
+      const double t17 = (-0.853 * t14 + t0 * 2.093 + 0.15500000000000003 * t4 + 0.141 * t15);
       const double length = sqrt(((t16 * t16) + (t17 * t17)));
       return length;
     }
@@ -201,16 +201,16 @@ double LeverArm(int actuator, const double* q) {
       return lever;
     }
     case 1: {
-      const double t0 = (q[0] + q[1]);
-      const double t1 = sin(t0);
-      const double t2 = (-0.389) * t1;
-      const double t3 = cos(q[0]);
-      const double t4 = cos(t0);
+      const double t0 = cos(q[0]);
+      const double t1 = (q[0] + q[1]);
+      const double t2 = sin(t1);
+      const double t3 = (-0.389) * t2;
+      const double t4 = cos(t1);
       const double t5 = 0.159 * t4;
       const double t6 = sin(q[0]);
-      const double t7 = (t2 + t3 * 0.5249999999999999 + t5 + 0.365 * t6);
+      const double t7 = (t3 + t0 * 0.5249999999999999 + t5 + 0.365 * t6);
       const double t8 = (t7 * t7);
-      const double t9 = (0.159 * t1 - 0.365 * t3 + t6 * 0.5249999999999999 + 0.389 * t4);
+      const double t9 = (0.159 * t2 - 0.365 * t0 + t6 * 0.5249999999999999 + 0.389 * t4);
       const double t10 = (t9 * t9);
       const double t11 = (t8 + t10);
       const double t12 = (1.0 / sqrt(t11));
@@ -220,33 +220,31 @@ double LeverArm(int actuator, const double* q) {
       const double t16 = (-t14 * t15 * 0.25 + 0.567009);
       const double t17 = sqrt(t16);
       const double t18 = (t17 * t7 * 2.0 + t12 * t13 * t9);
-      const double t19 = (t12 * t7 * t13 - t17 * 2.0 * t9);
-      const double t20 = atan2(t12 * 0.5 * t18, t12 * t19 * 0.5);
+      const double t19 = (-t12 * t7 * t13 + t17 * 2.0 * t9);
+      const double t20 = atan2(t12 * 0.5 * t18, t12 * t19 * (-0.5));
       const double t21 = cos(t20);
       const double t22 = sin(t20);
-      const double t23 = (-0.853 * t21 + t3 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
-      const double t24 = (-t3 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
-      const double t25 = (-0.389 * t4 - 0.159 * t1);
-      const double t26 = (t2 + t5);
-      const double t27 = (t25 * t7 + t9 * t26);
-      const double t28 = (t27 * t14 / (t11 * t11) - t27 * t13 * 2.0 * t15);
-      const double t29 = (1.0 / sqrt(t16));
-      const double t30 = pow(t11, (-1.5));
-      const double t31 = (1.0 / ((((t19 * t19) * t15 + (t18 * t18) * t15))));
+      const double t23 = (-t0 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
+      const double t24 = (-0.853 * t21 + t0 * 2.093 + 0.15500000000000003 * t6 + 0.141 * t22);
+      const double t25 = (1.0 / (((t15 * (t19 * t19) + (t18 * t18) * t15))));
+      const double t26 = (-0.389 * t4 - 0.159 * t2);
+      const double t27 = (t3 + t5);
+      const double t28 = (t26 * t7 + t9 * t27);
+      const double t29 = (t28 * t14 / (t11 * t11) - t28 * t13 * 2.0 * t15);
+      const double t30 = (1.0 / sqrt(t16));
+      const double t31 = pow(t11, (-1.5));
       const double t32 =
-          (-t12 * t19 *
-               ((t12 * ((-t17 * t25 * 4.0 - t27 * t12 * 4.0 * t9 - t12 * t13 * 2.0 * t26 -
-                         t7 * t28 * t29 + t27 * t13 * 2.0 * t30 * t9)) +
-                 t27 * 2.0 * t30 * t18)) *
-               t31 +
-           t12 *
-               ((t27 * t19 * 2.0 * t30 +
-                 t12 * ((-t25 * t12 * t13 * 2.0 + t17 * 4.0 * t26 + t27 * t7 * t13 * 2.0 * t30 -
-                         t27 * t12 * t7 * 4.0 + t28 * t9 * t29)))) *
-               t31 * t18);
+          (t12 * t25 * t18 *
+               ((t12 * ((t28 * t12 * t7 * 4.0 + t26 * t12 * t13 * 2.0 - t17 * 4.0 * t27 -
+                         t29 * t9 * t30 - t28 * t7 * t13 * 2.0 * t31)) +
+                 t28 * t19 * 2.0 * t31)) +
+           t12 * t19 * t25 *
+               ((t12 * ((t12 * t13 * 2.0 * t27 + t28 * t12 * 4.0 * t9 + t7 * t29 * t30 -
+                         t28 * t13 * 2.0 * t31 * t9 + t17 * t26 * 4.0)) -
+                 t28 * 2.0 * t31 * t18)));
       const double lever = (1.0 / sqrt(((t23 * t23) + (t24 * t24)))) *
-                           ((t24 * ((0.0705 * t32 * t22 - t32 * 0.4265 * t21)) +
-                             ((0.0705 * t32 * t21 + t32 * 0.4265 * t22)) * t23));
+                           ((((-0.0705 * t32 * t21 - 0.4265 * t22 * t32)) * t24 +
+                             t23 * ((-0.0705 * t22 * t32 + 0.4265 * t32 * t21))));
       return lever;
     }
     default:
@@ -282,6 +280,37 @@ int JointFromCylinderLength(int actuator, double length, const double* q, double
   return 0;
 }
 
+namespace {
+
+// In place: the lower triangle of `mass` becomes L with M = L L^T.
+void Factor(double* mass) {
+  for (int j = 0; j < kNumJoints; ++j) {
+    double d = mass[j * kNumJoints + j];
+    for (int k = 0; k < j; ++k) d -= mass[j * kNumJoints + k] * mass[j * kNumJoints + k];
+    const double l = std::sqrt(d);
+    mass[j * kNumJoints + j] = l;
+    for (int i = j + 1; i < kNumJoints; ++i) {
+      double v = mass[i * kNumJoints + j];
+      for (int k = 0; k < j; ++k) v -= mass[i * kNumJoints + k] * mass[j * kNumJoints + k];
+      mass[i * kNumJoints + j] = v / l;
+    }
+  }
+}
+
+// Solves L L^T y = b in place.
+void Solve(const double* factor, double* b) {
+  for (int i = 0; i < kNumJoints; ++i) {
+    for (int k = 0; k < i; ++k) b[i] -= factor[i * kNumJoints + k] * b[k];
+    b[i] /= factor[i * kNumJoints + i];
+  }
+  for (int i = kNumJoints - 1; i >= 0; --i) {
+    for (int k = i + 1; k < kNumJoints; ++k) b[i] -= factor[k * kNumJoints + i] * b[k];
+    b[i] /= factor[i * kNumJoints + i];
+  }
+}
+
+}  // namespace
+
 void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::acos;
   using std::atan2;
@@ -289,190 +318,219 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::pow;
   using std::sin;
   using std::sqrt;
-  const double t0 = sin(x[0]);
-  const double t1 = cos(x[0]);
-  const double t2 = (-t0 * 0.1 + 1.55 * t1);
-  const double t3 = cos(u[5]);
-  const double t4 = (x[0] + x[1]);
-  const double t5 = cos(t4);
-  const double t6 = sin(t4);
-  const double t7 = (0.389 * t5 + t0 * 0.5249999999999999 - 0.365 * t1 + t6 * 0.159);
-  const double t8 = 0.159 * t5;
-  const double t9 = t6 * (-0.389);
-  const double t10 = (0.365 * t0 + t8 + t9 + t1 * 0.5249999999999999);
-  const double t11 = (t10 * t10);
-  const double t12 = (t7 * t7);
-  const double t13 = (t11 + t12 - 0.38752);
-  const double t14 = (t11 + t12);
-  const double t15 = (1.0 / sqrt(t14));
-  const double t16 = (t13 * t13);
-  const double t17 = (1.0 / (t14));
-  const double t18 = (0.567009 - 0.25 * t16 * t17);
-  const double t19 = sqrt(t18);
-  const double t20 = (t7 * t13 * t15 + 2.0 * t10 * t19);
-  const double t21 = (t7 * 2.0 * t19 - t13 * t10 * t15);
-  const double t22 = atan2(0.5 * t20 * t15, t21 * (-0.5) * t15);
-  const double t23 = cos(t22);
-  const double t24 = sin(t22);
-  const double t25 = (-0.141 * t23 - t24 * 0.853 - 0.15500000000000003 * t1 + t0 * 2.093);
-  const double t26 = t0 * 0.15500000000000003;
-  const double t27 = 2.093 * t1;
-  const double t28 = (t26 + t24 * 0.141 - 0.853 * t23 + t27);
-  const double t29 = ((t25 * t25) + (t28 * t28));
-  const double t30 = sqrt(t29);
-  const double t31 = (-2.9000000000000004 + t30);
-  const double t32 = ((t31 * t31) + 1e-06);
-  const double t33 = (-1.59 + t30);
-  const double t34 = (1e-06 + (t33 * t33));
-  const double t35 = (1.0 / ((((t21 * t21) * t17 + (t20 * t20) * t17))));
-  const double t36 = (-0.389) * t5;
-  const double t37 = t6 * (-0.159);
-  const double t38 = (t36 - t0 * 0.5249999999999999 + 0.365 * t1 + t37);
-  const double t39 = (t38 * t10 + t7 * t10);
-  const double t40 = (1.0 / sqrt(t18));
-  const double t41 = (1.0 / (t14 * t14));
-  const double t42 = (-2.0 * t13 * t39 * t17 + t41 * t39 * t16);
-  const double t43 = pow(t14, (-1.5));
-  const double t44 =
-      (t35 *
-           ((((t38 * 2.0 * t13 * t15 - 4.0 * t10 * t19 + 4.0 * t10 * t39 * t15 - t7 * t40 * t42 -
-               2.0 * t13 * t10 * t39 * t43)) *
-                 t15 +
-             2.0 * t21 * t39 * t43)) *
-           t20 * t15 -
-       ((2.0 * t39 * t20 * t43 - ((t38 * 4.0 * t19 + t40 * t42 * t10 - t7 * 2.0 * t13 * t39 * t43 +
-                                   t7 * 4.0 * t39 * t15 + 2.0 * t13 * t10 * t15)) *
-                                     t15)) *
-           t35 * t21 * t15);
-  const double t45 =
-      (t25 * ((t26 - t24 * 0.0705 * t44 + 0.4265 * t23 * t44 + t27)) +
-       ((-0.0705 * t23 * t44 - t24 * 0.4265 * t44 - t0 * 2.093 + 0.15500000000000003 * t1)) * t28);
-  const double t46 = (1.0 / sqrt(t29));
-  const double t47 = (t8 + t9);
-  const double t48 = (t36 + t37);
-  const double t49 = (t47 * t7 + t48 * t10);
-  const double t50 = (-2.0 * t13 * t17 * t49 + t41 * t16 * t49);
-  const double t51 = (t35 *
-                          ((((-t7 * t50 * t40 - 2.0 * t13 * t10 * t43 * t49 +
-                              2.0 * t13 * t48 * t15 + 4.0 * t10 * t49 * t15 - t47 * 4.0 * t19)) *
-                                t15 +
-                            2.0 * t21 * t43 * t49)) *
-                          t20 * t15 +
-                      ((((-t7 * 2.0 * t13 * t43 * t49 + t50 * t40 * t10 + t47 * 2.0 * t13 * t15 +
-                          t7 * 4.0 * t49 * t15 + 4.0 * t48 * t19)) *
-                            t15 -
-                        2.0 * t20 * t43 * t49)) *
-                          t35 * t21 * t15);
-  const double t52 = (((-0.0705 * t23 * t51 - t24 * 0.4265 * t51)) * t28 +
-                      t25 * ((-t24 * 0.0705 * t51 + 0.4265 * t23 * t51)));
-  const double t53 = (sqrt(t32) * 2e+08 - sqrt(t34) * 2e+08 - 8.98e+08 -
-                      0.06283185307179587 * x[7] + 4e+08 * t30 + 0.04712388980384691 * x[9] +
-                      ((-t33 * (1.0 / sqrt(t34)) + (1.0 / sqrt(t32)) * t31 + 2.0)) *
-                          ((t45 * 2e+06 * x[2] * t46 + 2e+06 * x[3] * t52 * t46)));
-  const double t54 = 3.11 * t1;
-  const double t55 = t6 * (-0.25);
-  const double t56 = 0.55 * t5;
-  const double t57 = (t54 + t55 + t56);
-  const double t58 = (0.194 * t1 + 1.595 + t0 * 0.857);
-  const double t59 = (-0.194) * t0;
-  const double t60 = 0.857 * t1;
-  const double t61 = (t59 + t60 - 1.339);
-  const double t62 = (t58 * ((t59 + t60)) + ((-t0 * 0.857 - 0.194 * t1)) * t61);
-  const double t63 = ((t58 * t58) + (t61 * t61));
-  const double t64 = (1.0 / sqrt(t63));
-  const double t65 = sqrt(t63);
-  const double t66 = (-2.51 + t65);
-  const double t67 = (1e-06 + (t66 * t66));
-  const double t68 = (t65 - 1.4);
-  const double t69 = (1e-06 + (t68 * t68));
-  const double t70 = sin(u[5]);
-  const double t71 = t6 * (-0.55);
-  const double t72 = (-0.25) * t5;
-  const double t73 = t0 * (-3.11);
-  const double t74 = (t71 + t72 + t73);
-  const double t75 = (-1.55 * t0 - 0.1 * t1);
-  const double t76 = t6 * (-0.4011545671438309);
-  const double t77 = (-0.16343387866394005) * t5;
-  const double t78 = (t76 + t77 + t73);
-  const double t79 = t6 * (-0.16343387866394005);
-  const double t80 = 0.4011545671438309 * t5;
-  const double t81 = (t79 + t54 + t80);
-  const double t82 = (t71 + t72);
-  const double t83 = (t76 + t77);
-  const double t84 = (t79 + t80);
-  const double t85 = (t55 + t56);
-  const double t86 = (-2.8e+07 + x[6]);
-  const double t87 = sqrt(((x[4] * x[4]) + 1e-06));
-  const double t88 = (x[4] + t87);
-  const double t89 = (x[6] - u[6]);
-  const double t90 = (x[6] - 2e+05);
-  const double t91 = (t90 * t90);
-  const double t92 = (-x[4] + t87);
-  const double t93 = sqrt(((x[5] * x[5]) + 1e-06));
-  const double t94 = (t93 + x[5]);
-  const double t95 = (x[7] - u[7]);
-  const double t96 = (x[7] - 2e+05);
-  const double t97 = (t96 * t96);
-  const double t98 = (t93 - x[5]);
-  const double t99 = (-2.8e+07 + x[7]);
-  const double t100 = (x[8] - 2e+05);
-  const double t101 = (t100 * t100);
-  const double t102 = (-x[8] + u[6]);
-  const double t103 = (-2.8e+07 + x[8]);
-  const double t104 = (x[9] - 2e+05);
-  const double t105 = (t104 * t104);
-  const double t106 = (-u[7] + x[9]);
-  const double t107 = (-2.8e+07 + x[9]);
+  double mass[kNumJoints * kNumJoints];
+  double acceleration[kNumJoints];
+  const double t0 = cos(x[0]);
+  const double t1 = sin(x[0]);
+  const double t2 = (0.194 * t0 + 1.595 + t1 * 0.857);
+  const double t3 = (-0.194) * t1;
+  const double t4 = 0.857 * t0;
+  const double t5 = (t3 + t4 - 1.339);
+  const double t6 = ((t2 * t2) + (t5 * t5));
+  const double t7 = sqrt(t6);
+  const double t8 = (-2.8e+07 + x[6]);
+  const double t9 = (t2 * ((t3 + t4)) + ((-t1 * 0.857 - 0.194 * t0)) * t5);
+  const double t10 = (1.0 / sqrt(t6));
+  const double t11 = sqrt(((x[4] * x[4]) + 1e-06));
+  const double t12 = (x[4] + t11);
+  const double t13 = (x[6] - u[6]);
+  const double t14 = (x[6] - 2e+05);
+  const double t15 = (t14 * t14);
+  const double t16 = (-t11 + x[4]);
+  const double t17 = (x[0] + x[1]);
+  const double t18 = cos(t17);
+  const double t19 = sin(t17);
+  const double t20 = (0.389 * t18 + t1 * 0.5249999999999999 - 0.365 * t0 + t19 * 0.159);
+  const double t21 = 0.159 * t18;
+  const double t22 = t19 * (-0.389);
+  const double t23 = (0.365 * t1 + t21 + t22 + t0 * 0.5249999999999999);
+  const double t24 = (t23 * t23);
+  const double t25 = (t20 * t20);
+  const double t26 = (t24 + t25 - 0.38752);
+  const double t27 = (t24 + t25);
+  const double t28 = (1.0 / sqrt(t27));
+  const double t29 = (t26 * t26);
+  const double t30 = (1.0 / (t27));
+  const double t31 = (0.567009 - 0.25 * t29 * t30);
+  const double t32 = sqrt(t31);
+  const double t33 = (t20 * t26 * t28 + 2.0 * t23 * t32);
+  const double t34 = (-t20 * 2.0 * t32 + t26 * t23 * t28);
+  const double t35 = atan2(0.5 * t33 * t28, t34 * 0.5 * t28);
+  const double t36 = cos(t35);
+  const double t37 = sin(t35);
+  const double t38 = (-0.15500000000000003 * t0 - 0.141 * t36 + t1 * 2.093 - t37 * 0.853);
+  const double t39 = t1 * 0.15500000000000003;
+  const double t40 = 2.093 * t0;
+  const double t41 = (0.141 * t37 + t39 - 0.853 * t36 + t40);
+  const double t42 = ((t38 * t38) + (t41 * t41));
+  const double t43 = sqrt(t42);
+  const double t44 = sqrt(((x[5] * x[5]) + 1e-06));
+  const double t45 = (t44 + x[5]);
+  const double t46 = (x[7] - u[7]);
+  const double t47 = (1.0 / sqrt(t42));
+  const double t48 = (1.0 / sqrt(t31));
+  const double t49 = (1.0 / (t27 * t27));
+  const double t50 = (t21 + t22);
+  const double t51 = (-0.389) * t18;
+  const double t52 = t19 * (-0.159);
+  const double t53 = (t51 + t52);
+  const double t54 = (t50 * t20 + t53 * t23);
+  const double t55 = (-t49 * t29 * t54 + 2.0 * t26 * t30 * t54);
+  const double t56 = pow(t27, (-1.5));
+  const double t57 = (1.0 / ((((t33 * t33) * t30 + (t34 * t34) * t30))));
+  const double t58 =
+      (-((((-t20 * t48 * t55 - 2.0 * t26 * t53 * t28 - 4.0 * t23 * t54 * t28 +
+            2.0 * t26 * t23 * t56 * t54 + t50 * 4.0 * t32)) *
+              t28 +
+          t34 * 2.0 * t56 * t54)) *
+           t33 * t57 * t28 +
+       t34 *
+           ((2.0 * t33 * t56 * t54 - ((-t20 * 2.0 * t26 * t56 * t54 + t50 * 2.0 * t26 * t28 +
+                                       t20 * 4.0 * t54 * t28 - t48 * t23 * t55 + 4.0 * t53 * t32)) *
+                                         t28)) *
+           t57 * t28);
+  const double t59 = (t38 * ((-0.0705 * t37 * t58 + 0.4265 * t36 * t58)) +
+                      ((-0.0705 * t36 * t58 - t37 * 0.4265 * t58)) * t41);
+  const double t60 = (x[7] - 2e+05);
+  const double t61 = (t60 * t60);
+  const double t62 = (t51 - t1 * 0.5249999999999999 + 0.365 * t0 + t52);
+  const double t63 = (t62 * t23 + t20 * t23);
+  const double t64 = (-2.0 * t26 * t63 * t30 + t49 * t63 * t29);
+  const double t65 =
+      (((t34 * 2.0 * t63 * t56 - ((t62 * 2.0 * t26 * t28 - 4.0 * t23 * t32 + 4.0 * t23 * t63 * t28 -
+                                   t20 * t48 * t64 - 2.0 * t26 * t23 * t63 * t56)) *
+                                     t28)) *
+           t33 * t57 * t28 +
+       t34 *
+           ((((t62 * 4.0 * t32 + t48 * t64 * t23 - t20 * 2.0 * t26 * t63 * t56 +
+               t20 * 4.0 * t63 * t28 + 2.0 * t26 * t23 * t28)) *
+                 t28 -
+             2.0 * t63 * t33 * t56)) *
+           t57 * t28);
+  const double t66 =
+      (((t37 * 0.4265 * t65 + 0.0705 * t36 * t65 - t1 * 2.093 + 0.15500000000000003 * t0)) * t41 +
+       t38 * ((0.0705 * t37 * t65 + t39 - 0.4265 * t36 * t65 + t40)));
+  const double t67 = (-t44 + x[5]);
+  const double t68 = (-2.8e+07 + x[7]);
+  const double t69 = (x[8] - u[6]);
+  const double t70 = (x[8] - 2e+05);
+  const double t71 = (t70 * t70);
+  const double t72 = (-2.8e+07 + x[8]);
+  const double t73 = (x[9] - 2e+05);
+  const double t74 = (t73 * t73);
+  const double t75 = (-2.8e+07 + x[9]);
+  const double t76 = (-x[9] + u[7]);
+  const double t77 = (-t1 * 0.1 + 1.55 * t0);
+  const double t78 = t19 * (-0.55);
+  const double t79 = (-0.25) * t18;
+  const double t80 = t1 * (-3.11);
+  const double t81 = (t78 + t79 + t80);
+  const double t82 = t19 * (-0.16343387866394005);
+  const double t83 = 3.11 * t0;
+  const double t84 = 0.4011545671438309 * t18;
+  const double t85 = (t82 + t83 + t84);
+  const double t86 = t19 * (-0.4011545671438309);
+  const double t87 = (-0.16343387866394005) * t18;
+  const double t88 = (t86 + t87 + t80);
+  const double t89 = t19 * (-0.25);
+  const double t90 = 0.55 * t18;
+  const double t91 = (t83 + t89 + t90);
+  const double t92 = (-1.55 * t1 - 0.1 * t0);
+  const double t93 = (t86 + t87);
+  const double t94 = (t82 + t84);
+  const double t95 = (t78 + t79);
+  const double t96 = (t89 + t90);
+  const double t97 =
+      (((t88 * t93 + t85 * t94)) * u[4] + 600.0 + 1550.0 * t81 * t95 + t96 * 1550.0 * t91);
+  const double t98 = cos(u[5]);
+  const double t99 = (-2.51 + t7);
+  const double t100 = (1e-06 + (t99 * t99));
+  const double t101 = (t7 - 1.4);
+  const double t102 = (1e-06 + (t101 * t101));
+  const double t103 = x[3] * t95;
+  const double t104 = (((t103 + t81 * x[2])) * x[2] + x[3] * ((t103 + x[2] * t95)));
+  const double t105 = (x[2] * x[2]);
+  const double t106 = sin(u[5]);
+  const double t107 = t19 * 0.25;
+  const double t108 = (-0.55) * t18;
+  const double t109 = (t107 + t108);
+  const double t110 = x[3] * t109;
+  const double t111 = (-3.11) * t0;
+  const double t112 =
+      (((t110 + x[2] * t109)) * x[3] + ((((t107 + t111 + t108)) * x[2] + t110)) * x[2]);
+  const double t113 = t19 * 0.16343387866394005;
+  const double t114 = (-0.4011545671438309) * t18;
+  const double t115 = (t113 + t114);
+  const double t116 = t115 * x[3];
+  const double t117 =
+      (x[2] * ((t116 + ((t111 + t113 + t114)) * x[2])) + ((t116 + t115 * x[2])) * x[3]);
+  const double t118 = t93 * x[3];
+  const double t119 = (((t93 * x[2] + t118)) * x[3] + ((t118 + t88 * x[2])) * x[2]);
+  const double t120 = (-1.59 + t43);
+  const double t121 = ((t120 * t120) + 1e-06);
+  const double t122 = (t43 - 2.9000000000000004);
+  const double t123 = ((t122 * t122) + 1e-06);
+  const double t124 =
+      (-sqrt(t121) * 2e+08 - 8.98e+08 -
+       ((t47 * t59 * 2e+06 * x[3] + t47 * t66 * 2e+06 * x[2])) *
+           ((t120 * (1.0 / sqrt(t121)) - t122 * (1.0 / sqrt(t123)) - 2.0)) -
+       0.06283185307179587 * x[7] + sqrt(t123) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t43);
   xdot[0] = x[2];
   xdot[1] = x[3];
-  xdot[2] = ((-t2 * 50994.579999999994 * t3 - t53 * t45 * t46 - t57 * t3 * 30400.614999999998 -
-              x[2] * 4000.0 + 2.0 * u[2] +
-              t62 * t64 * 2.0 *
-                  ((-2e+08 * sqrt(t67) + x[6] * 0.04021238596594936 -
-                    ((-(1.0 / sqrt(t69)) * t68 + 2.0 + (1.0 / sqrt(t67)) * t66)) * t62 * t64 *
-                        2e+06 * x[2] +
-                    7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t69) - 4e+08 * t65)) -
-              t70 * t74 * 30400.614999999998 - t75 * 50994.579999999994 * t70 +
-              2.0 * ((-t70 * t78 * 9.80665 - t81 * t3 * 9.80665)) * u[4])) *
-            0.5 /
-            (((2600.0 * (t2 * t2) + 1550.0 * (t74 * t74) + (((t81 * t81) + (t78 * t78))) * u[4] +
-               1550.0 * (t57 * t57) + 2600.0 * (t75 * t75) + 2900.0)));
-  xdot[3] = (-0.5) *
-            ((-2.0 * ((-t84 * t3 * 9.80665 - t70 * t83 * 9.80665)) * u[4] +
-              t85 * t3 * 30400.614999999998 - 2.0 * u[3] + t53 * t52 * t46 + 1600.0 * x[3] +
-              t70 * 30400.614999999998 * t82)) /
-            ((((t82 * t82) * 1550.0 + 600.0 + (((t83 * t83) + (t84 * t84))) * u[4] +
-               1550.0 * (t85 * t85))));
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
   xdot[6] = 1.2e+09 *
-            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t86 * t86))) + 0.094 -
-              6.666666666666667e-09 * x[6] - t62 * t64 * x[2] * 0.04021238596594936 -
-              t88 * 2.721655269759087e-06 * pow((4e+10 + (t89 * t89)), (-0.25)) * t89 +
-              3.3333333333333334e-09 * sqrt((t91 + 1e+10)) -
-              t92 * pow((4e+10 + t91), (-0.25)) * 2.721655269759087e-06 * t90)) /
-            (((t65 * 0.04021238596594936 - 0.0522973403523291)));
-  xdot[7] = ((-t94 * pow((4e+10 + (t95 * t95)), (-0.25)) * 2.0412414523193154e-06 * t95 -
-              0.031415926535897934 * t45 * x[2] * t46 - x[7] * 5e-09 -
-              0.031415926535897934 * x[3] * t52 * t46 + 0.07050000000000001 +
-              sqrt((1e+10 + t97)) * 2.5e-09 -
-              t98 * 2.0412414523193154e-06 * t96 * pow((4e+10 + t97), (-0.25)) -
-              2.5e-09 * sqrt((1e+10 + (t99 * t99))))) *
-            1.2e+09 / (((0.031415926535897934 * t30 - 0.04695132319207772)));
-  xdot[8] = 1.2e+09 *
-            ((0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t101 + 1e+10)) +
-              t62 * t64 * x[2] * 0.027488935718910694 +
-              t102 * t92 * 2.721655269759087e-06 * pow((4e+10 + (t102 * t102)), (-0.25)) -
-              pow((4e+10 + t101), (-0.25)) * t88 * 2.721655269759087e-06 * t100 -
-              3.3333333333333334e-09 * sqrt(((t103 * t103) + 1e+10)))) /
-            (((-t65 * 0.027488935718910694 + 0.07299722865446584)));
-  xdot[9] = 1.2e+09 *
-            ((sqrt((1e+10 + t105)) * 2.5e-09 - x[9] * 5e-09 -
-              t94 * 2.0412414523193154e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
-              t45 * 0.023561944901923454 * x[2] * t46 + 0.07050000000000001 -
-              pow(((t106 * t106) + 4e+10), (-0.25)) * t98 * 2.0412414523193154e-06 * t106 -
-              2.5e-09 * sqrt(((t107 * t107) + 1e+10)) + 0.023561944901923454 * x[3] * t52 * t46)) /
-            (((0.07132964021557801 - 0.023561944901923454 * t30)));
+            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t8 * t8))) + 0.094 -
+              6.666666666666667e-09 * x[6] - t9 * t10 * x[2] * 0.04021238596594936 -
+              t12 * 2.721655269759087e-06 * pow((4e+10 + (t13 * t13)), (-0.25)) * t13 +
+              3.3333333333333334e-09 * sqrt((t15 + 1e+10)) +
+              t16 * pow((4e+10 + t15), (-0.25)) * 2.721655269759087e-06 * t14)) /
+            (((t7 * 0.04021238596594936 - 0.0522973403523291)));
+  xdot[7] = 1.2e+09 *
+            ((-t45 * pow((4e+10 + (t46 * t46)), (-0.25)) * 2.0412414523193154e-06 * t46 -
+              x[7] * 5e-09 - t47 * 0.031415926535897934 * t59 * x[3] + 0.07050000000000001 +
+              sqrt((1e+10 + t61)) * 2.5e-09 - t47 * 0.031415926535897934 * t66 * x[2] +
+              t67 * 2.0412414523193154e-06 * t60 * pow((4e+10 + t61), (-0.25)) -
+              2.5e-09 * sqrt((1e+10 + (t68 * t68))))) /
+            (((0.031415926535897934 * t43 - 0.04695132319207772)));
+  xdot[8] = ((t16 * pow((4e+10 + (t69 * t69)), (-0.25)) * 2.721655269759087e-06 * t69 + 0.094 -
+              6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t71 + 1e+10)) +
+              t9 * t10 * x[2] * 0.027488935718910694 -
+              pow((4e+10 + t71), (-0.25)) * t12 * 2.721655269759087e-06 * t70 -
+              3.3333333333333334e-09 * sqrt(((t72 * t72) + 1e+10)))) *
+            1.2e+09 / (((-t7 * 0.027488935718910694 + 0.07299722865446584)));
+  xdot[9] =
+      1.2e+09 *
+      ((sqrt((1e+10 + t74)) * 2.5e-09 + t47 * 0.023561944901923454 * t66 * x[2] - x[9] * 5e-09 -
+        t45 * 2.0412414523193154e-06 * pow((4e+10 + t74), (-0.25)) * t73 + 0.07050000000000001 -
+        2.5e-09 * sqrt(((t75 * t75) + 1e+10)) + t47 * t59 * 0.023561944901923454 * x[3] -
+        t76 * t67 * pow(((t76 * t76) + 4e+10), (-0.25)) * 2.0412414523193154e-06)) /
+      (((0.07132964021557801 - 0.023561944901923454 * t43)));
+  mass[0] = (2600.0 * (t77 * t77) + 1550.0 * (t81 * t81) + (((t85 * t85) + (t88 * t88))) * u[4] +
+             1550.0 * (t91 * t91) + 2600.0 * (t92 * t92) + 2900.0);
+  mass[1] = t97;
+  mass[2] = t97;
+  mass[3] =
+      ((t95 * t95) * 1550.0 + 600.0 + (((t93 * t93) + (t94 * t94))) * u[4] + 1550.0 * (t96 * t96));
+  acceleration[0] =
+      (-2000.0 * x[2] - t91 * t98 * 15200.307499999999 +
+       t9 * t10 *
+           ((-2e+08 * sqrt(t100) + x[6] * 0.04021238596594936 -
+             ((-(1.0 / sqrt(t102)) * t101 + 2.0 + (1.0 / sqrt(t100)) * t99)) * t9 * t10 * 2e+06 *
+                 x[2] +
+             7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t102) - 4e+08 * t7)) -
+       1550.0 * t91 * t104 - 2600.0 * t105 * t92 * ((t1 * 0.1 - 1.55 * t0)) -
+       t92 * t106 * 25497.289999999997 - 2600.0 * t77 * t105 * t92 +
+       ((-t106 * t88 * 9.80665 - t85 * t98 * 9.80665)) * u[4] - 1550.0 * t81 * t112 + u[2] -
+       ((t117 * t88 + t85 * t119)) * u[4] - t47 * t66 * t124 * 0.5 -
+       t77 * t98 * 25497.289999999997 - t106 * t81 * 15200.307499999999);
+  acceleration[1] =
+      (-t96 * t98 * 15200.307499999999 - ((t119 * t94 + t117 * t93)) * u[4] - t96 * 1550.0 * t104 -
+       t47 * t59 * t124 * 0.5 + ((-t94 * t98 * 9.80665 - t106 * t93 * 9.80665)) * u[4] -
+       1550.0 * t112 * t95 - 800.0 * x[3] + u[3] - t106 * t95 * 15200.307499999999);
+  Factor(mass);
+  Solve(mass, acceleration);
+  std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
 }
 
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
@@ -483,522 +541,779 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   using std::sin;
   using std::sqrt;
   std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);
-  const double t0 = sin(x[0]);
-  const double t1 = cos(x[0]);
-  const double t2 = (-1.55 * t0 - 0.1 * t1);
-  const double t3 = (t0 * 0.1 - 1.55 * t1);
-  const double t4 = (x[0] + x[1]);
-  const double t5 = sin(t4);
-  const double t6 = t5 * 0.25;
-  const double t7 = (-3.11) * t1;
-  const double t8 = cos(t4);
-  const double t9 = (-0.55) * t8;
-  const double t10 = (t6 + t7 + t9);
-  const double t11 = t5 * (-0.55);
-  const double t12 = (-0.25) * t8;
-  const double t13 = t0 * (-3.11);
-  const double t14 = (t11 + t12 + t13);
-  const double t15 = t5 * (-0.4011545671438309);
-  const double t16 = (-0.16343387866394005) * t8;
-  const double t17 = (t15 + t16 + t13);
-  const double t18 = t5 * 0.16343387866394005;
-  const double t19 = (-0.4011545671438309) * t8;
-  const double t20 = (t7 + t18 + t19);
-  const double t21 = t5 * (-0.16343387866394005);
-  const double t22 = 3.11 * t1;
-  const double t23 = 0.4011545671438309 * t8;
-  const double t24 = (t21 + t22 + t23);
-  const double t25 = t5 * (-0.25);
-  const double t26 = 0.55 * t8;
-  const double t27 = (t22 + t25 + t26);
-  const double t28 = (-t0 * 0.1 + 1.55 * t1);
-  const double t29 =
-      (2600.0 * (t28 * t28) + 1550.0 * (t14 * t14) + (((t24 * t24) + (t17 * t17))) * u[4] +
-       1550.0 * (t27 * t27) + 2600.0 * (t2 * t2) + 2900.0);
-  const double t30 = (1.0 / (t29 * t29));
-  const double t31 = cos(u[5]);
-  const double t32 = (0.389 * t8 + t0 * 0.5249999999999999 - 0.365 * t1 + t5 * 0.159);
-  const double t33 = 0.159 * t8;
-  const double t34 = t5 * (-0.389);
-  const double t35 = (0.365 * t0 + t33 + t34 + t1 * 0.5249999999999999);
-  const double t36 = (t35 * t35);
-  const double t37 = (t32 * t32);
-  const double t38 = (t36 + t37 - 0.38752);
-  const double t39 = (t36 + t37);
-  const double t40 = (1.0 / sqrt(t39));
-  const double t41 = (t38 * t38);
-  const double t42 = (1.0 / (t39));
-  const double t43 = (0.567009 - 0.25 * t41 * t42);
-  const double t44 = sqrt(t43);
-  const double t45 = (t32 * t38 * t40 + 2.0 * t35 * t44);
-  const double t46 = (t32 * 2.0 * t44 - t38 * t35 * t40);
-  const double t47 = atan2(0.5 * t45 * t40, t46 * (-0.5) * t40);
-  const double t48 = cos(t47);
-  const double t49 = sin(t47);
-  const double t50 = (-0.141 * t48 - t49 * 0.853 - 0.15500000000000003 * t1 + t0 * 2.093);
-  const double t51 = t0 * 0.15500000000000003;
-  const double t52 = 2.093 * t1;
-  const double t53 = (t51 + t49 * 0.141 - 0.853 * t48 + t52);
-  const double t54 = ((t50 * t50) + (t53 * t53));
-  const double t55 = sqrt(t54);
-  const double t56 = (-2.9000000000000004 + t55);
-  const double t57 = (t56 * t56);
-  const double t58 = (t57 + 1e-06);
-  const double t59 = (-1.59 + t55);
-  const double t60 = (t59 * t59);
-  const double t61 = (1e-06 + t60);
-  const double t62 = (1.0 / sqrt(t61));
-  const double t63 = (1.0 / sqrt(t58));
-  const double t64 = (-t59 * t62 + t63 * t56 + 2.0);
-  const double t65 = (t46 * t46);
-  const double t66 = (t45 * t45);
-  const double t67 = (t65 * t42 + t66 * t42);
-  const double t68 = (1.0 / (t67));
-  const double t69 = (-0.389) * t8;
-  const double t70 = t5 * (-0.159);
-  const double t71 = (t69 - t0 * 0.5249999999999999 + 0.365 * t1 + t70);
-  const double t72 = (t71 * t35 + t32 * t35);
-  const double t73 = (1.0 / sqrt(t43));
-  const double t74 = (1.0 / (t39 * t39));
-  const double t75 = (-2.0 * t38 * t72 * t42 + t74 * t72 * t41);
-  const double t76 = pow(t39, (-1.5));
-  const double t77 = (t71 * 2.0 * t38 * t40 - 4.0 * t35 * t44 + 4.0 * t35 * t72 * t40 -
-                      t32 * t73 * t75 - 2.0 * t38 * t35 * t72 * t76);
-  const double t78 = (t77 * t40 + 2.0 * t46 * t72 * t76);
-  const double t79 = (t71 * 4.0 * t44 + t73 * t75 * t35 - t32 * 2.0 * t38 * t72 * t76 +
-                      t32 * 4.0 * t72 * t40 + 2.0 * t38 * t35 * t40);
-  const double t80 = (2.0 * t72 * t45 * t76 - t79 * t40);
-  const double t81 = (t68 * t78 * t45 * t40 - t80 * t68 * t46 * t40);
-  const double t82 = (t51 - t49 * 0.0705 * t81 + 0.4265 * t48 * t81 + t52);
-  const double t83 = t0 * (-2.093);
-  const double t84 = 0.15500000000000003 * t1;
-  const double t85 = (-0.0705 * t48 * t81 - t49 * 0.4265 * t81 + t83 + t84);
-  const double t86 = (t50 * t82 + t85 * t53);
-  const double t87 = (1.0 / sqrt(t54));
-  const double t88 = (t33 + t34);
-  const double t89 = (t69 + t70);
-  const double t90 = (t88 * t32 + t89 * t35);
-  const double t91 = (-2.0 * t38 * t42 * t90 + t74 * t41 * t90);
-  const double t92 = (-t32 * t91 * t73 - 2.0 * t38 * t35 * t76 * t90 + 2.0 * t38 * t89 * t40 +
-                      4.0 * t35 * t90 * t40 - t88 * 4.0 * t44);
-  const double t93 = (t92 * t40 + 2.0 * t46 * t76 * t90);
-  const double t94 = (-t32 * 2.0 * t38 * t76 * t90 + t91 * t73 * t35 + t88 * 2.0 * t38 * t40 +
-                      t32 * 4.0 * t90 * t40 + 4.0 * t89 * t44);
-  const double t95 = (t94 * t40 - 2.0 * t45 * t76 * t90);
-  const double t96 = (t68 * t93 * t45 * t40 + t95 * t68 * t46 * t40);
-  const double t97 = (-0.0705 * t48 * t96 - t49 * 0.4265 * t96);
-  const double t98 = (-t49 * 0.0705 * t96 + 0.4265 * t48 * t96);
-  const double t99 = (t97 * t53 + t50 * t98);
-  const double t100 = (t86 * 2e+06 * x[2] * t87 + 2e+06 * x[3] * t99 * t87);
-  const double t101 =
-      (sqrt(t58) * 2e+08 - sqrt(t61) * 2e+08 - 8.98e+08 - 0.06283185307179587 * x[7] + 4e+08 * t55 +
-       0.04712388980384691 * x[9] + t64 * t100);
-  const double t102 = (0.194 * t1 + 1.595 + t0 * 0.857);
-  const double t103 = (-0.194) * t0;
-  const double t104 = 0.857 * t1;
-  const double t105 = (t103 + t104);
-  const double t106 = (-t0 * 0.857 - 0.194 * t1);
-  const double t107 = (t103 + t104 - 1.339);
-  const double t108 = (t102 * t105 + t106 * t107);
-  const double t109 = ((t102 * t102) + (t107 * t107));
-  const double t110 = (1.0 / sqrt(t109));
-  const double t111 = sqrt(t109);
-  const double t112 = (-2.51 + t111);
-  const double t113 = (t112 * t112);
-  const double t114 = (1e-06 + t113);
-  const double t115 = (t111 - 1.4);
-  const double t116 = (t115 * t115);
-  const double t117 = (1e-06 + t116);
-  const double t118 = (1.0 / sqrt(t117));
-  const double t119 = (1.0 / sqrt(t114));
-  const double t120 = (-t118 * t115 + 2.0 + t119 * t112);
-  const double t121 =
-      (-2e+08 * sqrt(t114) + x[6] * 0.04021238596594936 - t120 * t108 * t110 * 2e+06 * x[2] +
-       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t117) - 4e+08 * t111);
-  const double t122 = sin(u[5]);
-  const double t123 =
-      (-t28 * 50994.579999999994 * t31 - t101 * t86 * t87 - t27 * t31 * 30400.614999999998 -
-       x[2] * 4000.0 + 2.0 * u[2] + t108 * t110 * 2.0 * t121 - t122 * t14 * 30400.614999999998 -
-       t2 * 50994.579999999994 * t122 +
-       2.0 * ((-t122 * t17 * 9.80665 - t24 * t31 * 9.80665)) * u[4]);
-  const double t124 = pow(t109, (-1.5));
-  const double t125 = (t108 * t108);
-  const double t126 = (t81 * t81);
-  const double t127 = (t72 * t72);
-  const double t128 = pow(t39, (-2.5));
-  const double t129 = (-0.159) * t8;
-  const double t130 = t5 * 0.389;
-  const double t131 = (t129 - t1 * 0.5249999999999999 - 0.365 * t0 + t130);
-  const double t132 = (t131 * t35 + t36 + (t71 * t71) + t71 * t32);
-  const double t133 = (1.0 / (t39 * t39 * t39));
-  const double t134 = (-4.0 * t133 * t127 * t41 + t38 * t127 * t74 * 8.0 - 2.0 * t38 * t132 * t42 +
-                       t74 * t132 * t41 - 4.0 * t127 * t42);
-  const double t135 = pow(t43, (-1.5));
-  const double t136 = (t75 * t75);
-  const double t137 = (1.0 / (t67 * t67));
-  const double t138 =
-      (2.0 * t74 * t65 * t72 + t77 * t46 * t42 + 2.0 * t66 * t74 * t72 - t45 * t42 * t79);
-  const double t139 =
-      (2.0 * t68 * t78 * t79 * t40 - t68 * 4.0 * t78 * t72 * t45 * t76 +
-       t80 * t68 * 4.0 * t46 * t72 * t76 -
-       t68 *
-           ((24.0 * t127 * t128 * t46 - t46 * 8.0 * t132 * t76 + t77 * 8.0 * t72 * t76 -
-             ((-t71 * 16.0 * t44 - t71 * 16.0 * t38 * t72 * t76 + t71 * 32.0 * t72 * t40 -
-               t38 * 8.0 * t132 * t35 * t76 - t73 * 8.0 * t75 * t35 + 16.0 * t132 * t35 * t40 -
-               t32 * 4.0 * t73 * t134 - 32.0 * t127 * t35 * t76 + 24.0 * t38 * t127 * t128 * t35 +
-               t131 * t38 * 8.0 * t40 + t32 * t135 * t136)) *
-                 t40)) *
-           t45 * t40 -
-       t137 * t80 * 4.0 * t46 * t138 * t40 + t137 * 4.0 * t78 * t138 * t45 * t40 +
-       ((-8.0 * t132 * t45 * t76 +
-         ((-t32 * t38 * 8.0 * t132 * t76 - 16.0 * t38 * t35 * t72 * t76 - t32 * 32.0 * t127 * t76 +
-           t32 * 16.0 * t132 * t40 + t71 * t38 * 8.0 * t40 + t32 * 24.0 * t38 * t127 * t128 +
-           4.0 * t73 * t134 * t35 + 32.0 * t35 * t72 * t40 - t135 * t35 * t136 + t131 * 16.0 * t44 +
-           t71 * t73 * 8.0 * t75)) *
-             t40 +
-         24.0 * t127 * t128 * t45 - 8.0 * t72 * t76 * t79)) *
-           t68 * t46 * t40 +
-       2.0 * t80 * t68 * t77 * t40);
-  const double t140 = ((t85 * t85) +
-                       t50 * ((t49 * 0.21325 * t126 + t139 * 0.106625 * t48 + t83 + t84 +
-                               t126 * t48 * 0.03525 - t49 * t139 * 0.017625)) +
-                       (t82 * t82) +
-                       t53 * ((0.21325 * t126 * t48 - t139 * 0.017625 * t48 -
-                               t49 * t139 * 0.106625 - t52 - t51 - t49 * t126 * 0.03525)));
-  const double t141 = ((t106 * t106) + (t105 * t105) + t107 * ((0.194 * t0 - t104)) + t106 * t102);
-  const double t142 = pow(t54, (-1.5));
-  const double t143 = (t86 * t86);
-  const double t144 = pow(t61, (-1.5));
-  const double t145 = pow(t58, (-1.5));
-  const double t146 = t85 * t97;
-  const double t147 = t98 * t82;
-  const double t148 = t32 * t89;
-  const double t149 = (t129 + t130);
-  const double t150 = t149 * t35;
-  const double t151 = (t71 * t89 + t88 * t35 + t148 + t150);
-  const double t152 = (2.0 * t151 * t38 * t42 + 4.0 * t133 * t72 * t41 * t90 +
-                       4.0 * t72 * t42 * t90 - t151 * t74 * t41 - t38 * t74 * 8.0 * t72 * t90);
-  const double t153 =
-      (24.0 * t128 * t72 * t45 * t90 +
-       ((t38 * t89 * 8.0 * t40 + t32 * 16.0 * t151 * t40 - t38 * 8.0 * t35 * t76 * t90 -
-         t32 * 32.0 * t72 * t76 * t90 + t71 * t91 * 4.0 * t73 +
-         t32 * 24.0 * t38 * t128 * t72 * t90 + 16.0 * t35 * t90 * t40 + 16.0 * t149 * t44 +
-         4.0 * t89 * t73 * t75 - t152 * 4.0 * t73 * t35 - t91 * t135 * t75 * t35 +
-         t88 * 16.0 * t72 * t40 - t88 * t38 * 8.0 * t72 * t76 - t32 * t151 * t38 * 8.0 * t76)) *
-           t40 -
-       4.0 * t94 * t72 * t76 - t151 * 8.0 * t45 * t76 - 4.0 * t76 * t90 * t79);
-  const double t154 = t149 * t38 * 8.0 * t40;
-  const double t155 = (-16.0) * t89 * t44;
-  const double t156 =
-      (4.0 * t72 * t92 * t76 - t151 * t46 * 8.0 * t76 + 24.0 * t128 * t46 * t72 * t90 +
-       4.0 * t77 * t76 * t90 -
-       ((t154 + t155 - t38 * t89 * 8.0 * t72 * t76 - t88 * 4.0 * t73 * t75 +
-         t71 * 16.0 * t90 * t40 - t91 * 4.0 * t73 * t35 + t32 * t152 * 4.0 * t73 -
-         32.0 * t35 * t72 * t76 * t90 + 16.0 * t89 * t72 * t40 - t71 * t38 * 8.0 * t76 * t90 +
-         16.0 * t151 * t35 * t40 + 24.0 * t38 * t128 * t35 * t72 * t90 + t32 * t91 * t135 * t75 -
-         t151 * t38 * 8.0 * t35 * t76)) *
-           t40);
-  const double t157 =
-      (-t95 * 2.0 * t68 * t77 * t40 + t137 * 4.0 * t93 * t138 * t45 * t40 + t153 * t68 * t46 * t40 -
-       t68 * 4.0 * t93 * t72 * t45 * t76 - t95 * t68 * 4.0 * t46 * t72 * t76 -
-       t68 * t45 * t156 * t40 + t95 * t137 * 4.0 * t46 * t138 * t40 + 2.0 * t68 * t93 * t79 * t40);
-  const double t158 = t48 * 0.03525 * t81 * t96;
-  const double t159 = t49 * 0.21325 * t81 * t96;
-  const double t160 = 0.21325 * t48 * t81 * t96;
-  const double t161 = t49 * (-0.03525) * t81 * t96;
+  double mass[kNumJoints * kNumJoints];
+  double acceleration[kNumJoints];
+  double d_force[kNumJoints * kNumStates] = {};
+  double d_mass[kNumJoints * kNumJoints * kNumJoints] = {};
+  const double t0 = cos(x[0]);
+  const double t1 = sin(x[0]);
+  const double t2 = (0.194 * t0 + 1.595 + t1 * 0.857);
+  const double t3 = (-0.194) * t1;
+  const double t4 = 0.857 * t0;
+  const double t5 = (t3 + t4 - 1.339);
+  const double t6 = ((t2 * t2) + (t5 * t5));
+  const double t7 = sqrt(t6);
+  const double t8 = (t7 * 0.04021238596594936 - 0.0522973403523291);
+  const double t9 = (1.0 / (t8));
+  const double t10 = pow(t6, (-1.5));
+  const double t11 = (t3 + t4);
+  const double t12 = (-t1 * 0.857 - 0.194 * t0);
+  const double t13 = (t2 * t11 + t12 * t5);
+  const double t14 = (t13 * t13);
+  const double t15 = (1.0 / sqrt(t6));
+  const double t16 = ((t12 * t12) + (t11 * t11) + t5 * ((0.194 * t1 - t4)) + t12 * t2);
+  const double t17 = (-2.8e+07 + x[6]);
+  const double t18 = (1e+10 + (t17 * t17));
+  const double t19 = ((x[4] * x[4]) + 1e-06);
+  const double t20 = sqrt(t19);
+  const double t21 = (x[4] + t20);
+  const double t22 = (x[6] - u[6]);
+  const double t23 = (t22 * t22);
+  const double t24 = (4e+10 + t23);
+  const double t25 = pow(t24, (-0.25));
+  const double t26 = (x[6] - 2e+05);
+  const double t27 = (t26 * t26);
+  const double t28 = (t27 + 1e+10);
+  const double t29 = (-t20 + x[4]);
+  const double t30 = (4e+10 + t27);
+  const double t31 = pow(t30, (-0.25));
+  const double t32 = (1.0 / sqrt(t19)) * x[4];
+  const double t33 = (1.0 + t32);
+  const double t34 = (t32 - 1.0);
+  const double t35 = 2.0 * x[6];
+  const double t36 = (-4e+05 + t35);
+  const double t37 = (x[0] + x[1]);
+  const double t38 = cos(t37);
+  const double t39 = sin(t37);
+  const double t40 = (0.389 * t38 + t1 * 0.5249999999999999 - 0.365 * t0 + t39 * 0.159);
+  const double t41 = 0.159 * t38;
+  const double t42 = t39 * (-0.389);
+  const double t43 = (0.365 * t1 + t41 + t42 + t0 * 0.5249999999999999);
+  const double t44 = (t43 * t43);
+  const double t45 = (t40 * t40);
+  const double t46 = (t44 + t45 - 0.38752);
+  const double t47 = (t44 + t45);
+  const double t48 = (1.0 / sqrt(t47));
+  const double t49 = (t46 * t46);
+  const double t50 = (1.0 / (t47));
+  const double t51 = (0.567009 - 0.25 * t49 * t50);
+  const double t52 = sqrt(t51);
+  const double t53 = (t40 * t46 * t48 + 2.0 * t43 * t52);
+  const double t54 = (-t40 * 2.0 * t52 + t46 * t43 * t48);
+  const double t55 = atan2(0.5 * t53 * t48, t54 * 0.5 * t48);
+  const double t56 = cos(t55);
+  const double t57 = sin(t55);
+  const double t58 = (-0.15500000000000003 * t0 - 0.141 * t56 + t1 * 2.093 - t57 * 0.853);
+  const double t59 = t1 * 0.15500000000000003;
+  const double t60 = 2.093 * t0;
+  const double t61 = (0.141 * t57 + t59 - 0.853 * t56 + t60);
+  const double t62 = ((t58 * t58) + (t61 * t61));
+  const double t63 = (1.0 / sqrt(t62));
+  const double t64 = (-0.389) * t38;
+  const double t65 = t39 * (-0.159);
+  const double t66 = (t64 - t1 * 0.5249999999999999 + 0.365 * t0 + t65);
+  const double t67 = (t66 * t43 + t40 * t43);
+  const double t68 = pow(t47, (-1.5));
+  const double t69 = (1.0 / sqrt(t51));
+  const double t70 = (1.0 / (t47 * t47));
+  const double t71 = (-2.0 * t46 * t67 * t50 + t70 * t67 * t49);
+  const double t72 = (t66 * 2.0 * t46 * t48 - 4.0 * t43 * t52 + 4.0 * t43 * t67 * t48 -
+                      t40 * t69 * t71 - 2.0 * t46 * t43 * t67 * t68);
+  const double t73 = (t54 * 2.0 * t67 * t68 - t72 * t48);
+  const double t74 = (t53 * t53);
+  const double t75 = (t54 * t54);
+  const double t76 = (t74 * t50 + t75 * t50);
+  const double t77 = (1.0 / (t76));
+  const double t78 = (t66 * 4.0 * t52 + t69 * t71 * t43 - t40 * 2.0 * t46 * t67 * t68 +
+                      t40 * 4.0 * t67 * t48 + 2.0 * t46 * t43 * t48);
+  const double t79 = (t78 * t48 - 2.0 * t67 * t53 * t68);
+  const double t80 = (t73 * t53 * t77 * t48 + t54 * t79 * t77 * t48);
+  const double t81 = t1 * (-2.093);
+  const double t82 = 0.15500000000000003 * t0;
+  const double t83 = (t57 * 0.4265 * t80 + 0.0705 * t56 * t80 + t81 + t82);
+  const double t84 = (0.0705 * t57 * t80 + t59 - 0.4265 * t56 * t80 + t60);
+  const double t85 = (t83 * t61 + t58 * t84);
+  const double t86 = ((x[5] * x[5]) + 1e-06);
+  const double t87 = sqrt(t86);
+  const double t88 = (t87 + x[5]);
+  const double t89 = (x[7] - u[7]);
+  const double t90 = (t89 * t89);
+  const double t91 = (4e+10 + t90);
+  const double t92 = pow(t91, (-0.25));
+  const double t93 = (t41 + t42);
+  const double t94 = (t64 + t65);
+  const double t95 = (t93 * t40 + t94 * t43);
+  const double t96 = (-t70 * t49 * t95 + 2.0 * t46 * t50 * t95);
+  const double t97 = (-t40 * t69 * t96 - 2.0 * t46 * t94 * t48 - 4.0 * t43 * t95 * t48 +
+                      2.0 * t46 * t43 * t68 * t95 + t93 * 4.0 * t52);
+  const double t98 = (t97 * t48 + t54 * 2.0 * t68 * t95);
+  const double t99 = (-t40 * 2.0 * t46 * t68 * t95 + t93 * 2.0 * t46 * t48 + t40 * 4.0 * t95 * t48 -
+                      t69 * t43 * t96 + 4.0 * t94 * t52);
+  const double t100 = (2.0 * t53 * t68 * t95 - t99 * t48);
+  const double t101 = (-t98 * t53 * t77 * t48 + t54 * t100 * t77 * t48);
+  const double t102 = (-0.0705 * t57 * t101 + 0.4265 * t56 * t101);
+  const double t103 = (-0.0705 * t56 * t101 - t57 * 0.4265 * t101);
+  const double t104 = (t58 * t102 + t103 * t61);
+  const double t105 = (x[7] - 2e+05);
+  const double t106 = (t105 * t105);
+  const double t107 = (1e+10 + t106);
+  const double t108 = (-t87 + x[5]);
+  const double t109 = (4e+10 + t106);
+  const double t110 = pow(t109, (-0.25));
+  const double t111 = (-2.8e+07 + x[7]);
+  const double t112 = (1e+10 + (t111 * t111));
+  const double t113 = (-t88 * t92 * 2.0412414523193154e-06 * t89 - x[7] * 5e-09 -
+                       t63 * 0.031415926535897934 * t104 * x[3] + 0.07050000000000001 +
+                       sqrt(t107) * 2.5e-09 - t63 * 0.031415926535897934 * t85 * x[2] +
+                       t108 * 2.0412414523193154e-06 * t105 * t110 - 2.5e-09 * sqrt(t112));
+  const double t114 = sqrt(t62);
+  const double t115 = (0.031415926535897934 * t114 - 0.04695132319207772);
+  const double t116 = (1.0 / (t115 * t115));
+  const double t117 = (1.0 / (t115));
+  const double t118 = (-0.159) * t38;
+  const double t119 = t39 * 0.389;
+  const double t120 = (t118 - t0 * 0.5249999999999999 - 0.365 * t1 + t119);
+  const double t121 = (t120 * t43 + t44 + (t66 * t66) + t66 * t40);
+  const double t122 = (t67 * t67);
+  const double t123 = (1.0 / (t47 * t47 * t47));
+  const double t124 = (-t46 * t122 * t70 * 8.0 - t70 * t121 * t49 + 2.0 * t46 * t121 * t50 +
+                       4.0 * t122 * t50 + 4.0 * t123 * t122 * t49);
+  const double t125 = pow(t47, (-2.5));
+  const double t126 = pow(t51, (-1.5));
+  const double t127 = (t71 * t71);
+  const double t128 =
+      (-2.0 * t75 * t70 * t67 - 2.0 * t74 * t70 * t67 + t54 * t72 * t50 + t53 * t50 * t78);
+  const double t129 = (1.0 / (t76 * t76));
+  const double t130 =
+      (((t54 * 8.0 * t121 * t68 -
+         ((-t66 * 16.0 * t52 + t40 * 4.0 * t69 * t124 - t66 * 16.0 * t46 * t67 * t68 +
+           t66 * 32.0 * t67 * t48 - t46 * 8.0 * t121 * t43 * t68 - t69 * 8.0 * t71 * t43 +
+           16.0 * t121 * t43 * t48 - 32.0 * t122 * t43 * t68 + 24.0 * t46 * t122 * t125 * t43 +
+           t120 * t46 * 8.0 * t48 + t40 * t126 * t127)) *
+             t48 -
+         t54 * 24.0 * t122 * t125 + t72 * 8.0 * t67 * t68)) *
+           t53 * t77 * t48 -
+       t54 * t79 * 4.0 * t67 * t68 * t77 - t73 * 4.0 * t67 * t53 * t68 * t77 +
+       t73 * 2.0 * t77 * t78 * t48 + t79 * 2.0 * t72 * t77 * t48 +
+       t54 *
+           ((((-t40 * t46 * 8.0 * t121 * t68 - 16.0 * t46 * t43 * t67 * t68 -
+               t40 * 32.0 * t122 * t68 + t40 * 16.0 * t121 * t48 + t66 * t46 * 8.0 * t48 +
+               t40 * 24.0 * t46 * t122 * t125 + 32.0 * t43 * t67 * t48 - 4.0 * t69 * t124 * t43 -
+               t126 * t43 * t127 + t120 * 16.0 * t52 + t66 * t69 * 8.0 * t71)) *
+                 t48 -
+             8.0 * t121 * t53 * t68 + 24.0 * t122 * t125 * t53 - 8.0 * t67 * t68 * t78)) *
+           t77 * t48 -
+       t54 * t79 * t128 * 4.0 * t129 * t48 - t73 * t128 * 4.0 * t129 * t53 * t48);
+  const double t131 = (t80 * t80);
+  const double t132 = (((-0.106625 * t130 * t56 + t81 + t82 + 0.21325 * t57 * t131 +
+                         t57 * 0.017625 * t130 + t56 * t131 * 0.03525)) *
+                           t58 +
+                       ((t57 * 0.106625 * t130 + 0.017625 * t130 * t56 - t60 +
+                         0.21325 * t56 * t131 - t59 - t57 * t131 * 0.03525)) *
+                           t61 +
+                       (t83 * t83) + (t84 * t84));
+  const double t133 = pow(t62, (-1.5));
+  const double t134 = (t85 * t85);
+  const double t135 = t83 * t103;
+  const double t136 = t56 * t101 * (-0.03525) * t80;
+  const double t137 = (-0.21325) * t57 * t101 * t80;
+  const double t138 = t40 * t94;
+  const double t139 = (t118 + t119);
+  const double t140 = t139 * t43;
+  const double t141 = (t66 * t94 + t93 * t43 + t138 + t140);
+  const double t142 = (-2.0 * t141 * t46 * t50 - 4.0 * t123 * t67 * t49 * t95 + t141 * t70 * t49 -
+                       4.0 * t67 * t50 * t95 + t46 * t70 * 8.0 * t67 * t95);
+  const double t143 = t46 * (-8.0) * t94 * t48;
+  const double t144 = (-16.0) * t139 * t52;
+  const double t145 =
+      ((((t40 * t141 * t46 * 8.0 * t68 - t40 * 16.0 * t141 * t48 - t126 * t71 * t43 * t96 +
+          t40 * 32.0 * t67 * t68 * t95 - 16.0 * t43 * t95 * t48 + t46 * 8.0 * t43 * t68 * t95 -
+          4.0 * t69 * t43 * t142 - t40 * 24.0 * t46 * t125 * t67 * t95 + t66 * 4.0 * t69 * t96 +
+          t93 * t46 * 8.0 * t67 * t68 + t143 + t144 - t93 * 16.0 * t67 * t48 -
+          4.0 * t94 * t69 * t71)) *
+            t48 +
+        t141 * 8.0 * t53 * t68 + 4.0 * t99 * t67 * t68 + 4.0 * t68 * t95 * t78 -
+        24.0 * t125 * t67 * t53 * t95)) *
+      t54 * t77 * t48;
+  const double t146 = ((-((t139 * t46 * 8.0 * t48 - 16.0 * t94 * t52 - t46 * t94 * 8.0 * t67 * t68 -
+                           t93 * 4.0 * t69 * t71 + t66 * 16.0 * t95 * t48 + 4.0 * t69 * t43 * t96 -
+                           32.0 * t43 * t67 * t68 * t95 - t40 * 4.0 * t69 * t142 +
+                           16.0 * t94 * t67 * t48 - t66 * t46 * 8.0 * t68 * t95 +
+                           16.0 * t141 * t43 * t48 + 24.0 * t46 * t125 * t43 * t67 * t95 -
+                           t40 * t126 * t71 * t96 - t141 * t46 * 8.0 * t43 * t68)) *
+                            t48 +
+                        t54 * t141 * 8.0 * t68 + 4.0 * t72 * t68 * t95 -
+                        t54 * 24.0 * t125 * t67 * t95 - 4.0 * t97 * t67 * t68)) *
+                      (-1.0) * t53 * t77 * t48;
+  const double t147 =
+      (t128 * 4.0 * t129 * t98 * t53 * t48 + t145 - t54 * t100 * t128 * 4.0 * t129 * t48 +
+       4.0 * t98 * t67 * t53 * t68 * t77 - t54 * t100 * 4.0 * t67 * t68 * t77 +
+       t100 * 2.0 * t72 * t77 * t48 + t146 - 2.0 * t98 * t77 * t78 * t48);
+  const double t148 = (-0.21325) * t56 * t101 * t80;
+  const double t149 = t57 * t101 * 0.03525 * t80;
+  const double t150 = t84 * t102;
+  const double t151 =
+      (t135 + ((t136 + t137 - t57 * 0.017625 * t147 + 0.106625 * t56 * t147)) * t58 +
+       ((t148 + t149 - 0.017625 * t56 * t147 - t57 * 0.106625 * t147)) * t61 + t150);
+  const double t152 = (t104 * t104);
+  const double t153 = (t101 * t101);
+  const double t154 =
+      (-t54 * t97 * t50 - 2.0 * t74 * t70 * t95 - 2.0 * t75 * t70 * t95 + t99 * t53 * t50);
+  const double t155 = (t95 * t95);
+  const double t156 = ((t94 * t94) + (t93 * t93) + t138 + t140);
+  const double t157 = (t46 * t70 * t155 * 8.0 - 4.0 * t123 * t155 * t49 - 4.0 * t155 * t50 -
+                       2.0 * t156 * t46 * t50 + t156 * t70 * t49);
+  const double t158 = (t96 * t96);
+  const double t159 =
+      (-t54 * t100 * t154 * 4.0 * t129 * t48 - 2.0 * t99 * t98 * t77 * t48 +
+       t54 *
+           ((-24.0 * t125 * t155 * t53 + t99 * 8.0 * t68 * t95 + t156 * 8.0 * t53 * t68 +
+             ((-t93 * 32.0 * t95 * t48 - t157 * 4.0 * t69 * t43 + t143 + t144 -
+               t40 * 16.0 * t156 * t48 + t126 * t158 * t43 + t93 * 16.0 * t46 * t68 * t95 +
+               t94 * t69 * 8.0 * t96 + t40 * t156 * t46 * 8.0 * t68 + t40 * 32.0 * t155 * t68 -
+               t40 * 24.0 * t46 * t125 * t155)) *
+                 t48)) *
+           t77 * t48 -
+       t54 * t100 * 4.0 * t68 * t77 * t95 +
+       ((-((-16.0 * t156 * t43 * t48 - 32.0 * t94 * t95 * t48 - t139 * t46 * 8.0 * t48 -
+            24.0 * t46 * t125 * t155 * t43 - t40 * t126 * t158 - t93 * t69 * 8.0 * t96 +
+            32.0 * t155 * t43 * t68 + 16.0 * t46 * t94 * t68 * t95 + 16.0 * t94 * t52 +
+            t156 * t46 * 8.0 * t43 * t68 + t40 * t157 * 4.0 * t69)) *
+             t48 +
+         t54 * 24.0 * t125 * t155 - t54 * t156 * 8.0 * t68 + t97 * 8.0 * t68 * t95)) *
+           t53 * t77 * t48 -
+       t100 * 2.0 * t97 * t77 * t48 + t154 * 4.0 * t129 * t98 * t53 * t48 +
+       4.0 * t98 * t53 * t68 * t77 * t95);
+  const double t160 = (((0.21325 * t153 * t56 - 0.017625 * t56 * t159 - t57 * t153 * 0.03525 -
+                         t57 * 0.106625 * t159)) *
+                           t61 +
+                       (t102 * t102) +
+                       ((0.106625 * t56 * t159 + 0.21325 * t57 * t153 - t57 * 0.017625 * t159 +
+                         t153 * t56 * 0.03525)) *
+                           t58 +
+                       (t103 * t103));
+  const double t161 = (t54 * t79 * t154 * 4.0 * t129 * t48 - t73 * 2.0 * t99 * t77 * t48 + t145 +
+                       t73 * t154 * 4.0 * t129 * t53 * t48 + t79 * 2.0 * t97 * t77 * t48 + t146 +
+                       t73 * 4.0 * t53 * t68 * t77 * t95 + t54 * t79 * 4.0 * t68 * t77 * t95);
   const double t162 =
-      (t146 + t147 + t50 * ((-t49 * 0.017625 * t157 + 0.106625 * t48 * t157 + t158 + t159)) +
-       t53 * ((t160 + t161 - t49 * 0.106625 * t157 - 0.017625 * t48 * t157)));
-  const double t163 =
-      (-t86 * 2e+08 * t59 * t62 * t87 +
-       ((-t86 * t62 * t87 + t86 * t63 * t87 + t86 * t144 * t87 * t60 - t57 * t86 * t145 * t87)) *
-           t100 +
-       t86 * 2e+08 * t63 * t87 * t56 +
-       t64 * ((2e+06 * x[2] * t87 * t140 + 2e+06 * x[3] * t162 * t87 -
-               t86 * 2e+06 * x[3] * t99 * t142 - 2e+06 * x[2] * t142 * t143)) +
-       4e+08 * t86 * t87);
-  const double t164 = (1.0 / (t29));
-  const double t165 = (t15 + t16);
-  const double t166 = (t18 + t19);
-  const double t167 = (t6 + t9);
-  const double t168 = (t11 + t12);
-  const double t169 =
-      (-t94 * t45 * t42 + 2.0 * t66 * t74 * t90 + 2.0 * t74 * t65 * t90 + t46 * t92 * t42);
-  const double t170 = ((t89 * t89) + (t88 * t88) + t148 + t150);
-  const double t171 = (t90 * t90);
-  const double t172 = (2.0 * t170 * t38 * t42 + 4.0 * t171 * t42 - t170 * t74 * t41 -
-                       t38 * t74 * t171 * 8.0 + 4.0 * t133 * t171 * t41);
-  const double t173 = (t91 * t91);
-  const double t174 =
-      (t137 * 4.0 * t169 * t93 * t45 * t40 - t68 * 4.0 * t93 * t45 * t76 * t90 +
-       t95 * t137 * 4.0 * t169 * t46 * t40 + 2.0 * t68 * t94 * t93 * t40 -
-       t68 * t46 *
-           ((((-t88 * 32.0 * t90 * t40 - t38 * t89 * 8.0 * t40 - 16.0 * t149 * t44 -
-               t91 * t89 * t73 * 8.0 - t32 * 16.0 * t170 * t40 + t88 * 16.0 * t38 * t76 * t90 +
-               4.0 * t73 * t35 * t172 + t32 * t170 * t38 * 8.0 * t76 + t32 * 32.0 * t171 * t76 +
-               t173 * t135 * t35 - t32 * 24.0 * t38 * t128 * t171)) *
-                 t40 -
-             24.0 * t128 * t171 * t45 + t94 * 8.0 * t76 * t90 + t170 * 8.0 * t45 * t76)) *
-           t40 -
-       t95 * 2.0 * t68 * t92 * t40 - t95 * t68 * 4.0 * t46 * t76 * t90 -
-       ((-t170 * t46 * 8.0 * t76 -
-         ((t154 + t155 + t32 * 4.0 * t73 * t172 + 32.0 * t89 * t90 * t40 -
-           16.0 * t38 * t89 * t76 * t90 - t88 * t91 * t73 * 8.0 - 32.0 * t171 * t35 * t76 +
-           24.0 * t38 * t128 * t171 * t35 - t170 * t38 * 8.0 * t35 * t76 + 16.0 * t170 * t35 * t40 +
-           t32 * t173 * t135)) *
-             t40 +
-         8.0 * t92 * t76 * t90 + 24.0 * t128 * t46 * t171)) *
-           t68 * t45 * t40);
-  const double t175 = (t96 * t96);
-  const double t176 = (t50 * ((-t49 * 0.017625 * t174 + 0.106625 * t48 * t174 +
-                               t49 * 0.21325 * t175 + t175 * t48 * 0.03525)) +
-                       (t97 * t97) + (t98 * t98) +
-                       t53 * ((-t49 * 0.106625 * t174 - 0.017625 * t48 * t174 -
-                               t49 * t175 * 0.03525 + 0.21325 * t175 * t48)));
-  const double t177 = (t99 * t99);
-  const double t178 = (-2.0 * t68 * t78 * t94 * t40 + t137 * t80 * 4.0 * t169 * t46 * t40 +
-                       t68 * 4.0 * t78 * t45 * t76 * t90 - t80 * t68 * 4.0 * t46 * t76 * t90 -
-                       t153 * t68 * t46 * t40 + t68 * t45 * t156 * t40 -
-                       t137 * 4.0 * t78 * t169 * t45 * t40 - 2.0 * t80 * t68 * t92 * t40);
-  const double t179 =
-      (t50 * ((t49 * t178 * 0.017625 - t178 * 0.106625 * t48 + t158 + t159)) + t146 + t147 +
-       ((t178 * 0.017625 * t48 + t49 * t178 * 0.106625 + t160 + t161)) * t53);
-  const double t180 =
-      (-2e+08 * t59 * t99 * t62 * t87 +
-       t64 * ((t176 * 2e+06 * x[3] * t87 - t86 * 2e+06 * x[2] * t99 * t142 -
-               2e+06 * t177 * x[3] * t142 + t179 * 2e+06 * x[2] * t87)) +
-       2e+08 * t63 * t99 * t87 * t56 -
-       ((t57 * t145 * t99 * t87 - t99 * t144 * t87 * t60 - t63 * t99 * t87 + t99 * t62 * t87)) *
-           t100 +
-       4e+08 * t99 * t87);
-  const double t181 = (-2.0) * u[4] * ((-t165 * t31 * 9.80665 - t122 * t166 * 9.80665));
-  const double t182 = t31 * 30400.614999999998 * t168;
-  const double t183 = t101 * t86 * t99 * t142 * (-1.0);
-  const double t184 = t122 * 30400.614999999998 * t167;
-  const double t185 = (1.0 / (t54));
-  const double t186 = (t21 + t23);
-  const double t187 = (t25 + t26);
-  const double t188 = ((t168 * t168) * 1550.0 + 600.0 + (((t165 * t165) + (t186 * t186))) * u[4] +
-                       1550.0 * (t187 * t187));
-  const double t189 =
-      ((2.0 * ((t165 * t166 + t165 * t186)) * u[4] + t187 * 3100.0 * t168 + 3100.0 * t167 * t168)) *
-      0.5 *
-      ((-2.0 * ((-t186 * t31 * 9.80665 - t122 * t165 * 9.80665)) * u[4] +
-        t187 * t31 * 30400.614999999998 - 2.0 * u[3] + t101 * t99 * t87 + 1600.0 * x[3] +
-        t122 * 30400.614999999998 * t168)) /
-      (t188 * t188);
-  const double t190 = (1.0 / (t188));
-  const double t191 = (t111 * 0.04021238596594936 - 0.0522973403523291);
-  const double t192 = (1.0 / (t191));
-  const double t193 = (-2.8e+07 + x[6]);
-  const double t194 = (1e+10 + (t193 * t193));
-  const double t195 = ((x[4] * x[4]) + 1e-06);
-  const double t196 = sqrt(t195);
-  const double t197 = (x[4] + t196);
-  const double t198 = (x[6] - u[6]);
-  const double t199 = (t198 * t198);
-  const double t200 = (4e+10 + t199);
-  const double t201 = pow(t200, (-0.25));
-  const double t202 = (x[6] - 2e+05);
-  const double t203 = (t202 * t202);
-  const double t204 = (t203 + 1e+10);
-  const double t205 = (-x[4] + t196);
-  const double t206 = (4e+10 + t203);
-  const double t207 = pow(t206, (-0.25));
-  const double t208 = (1.0 / sqrt(t195)) * x[4];
-  const double t209 = (1.0 + t208);
-  const double t210 = (t208 - 1.0);
-  const double t211 = 2.0 * x[6];
-  const double t212 = (-4e+05 + t211);
-  const double t213 = (0.031415926535897934 * t55 - 0.04695132319207772);
-  const double t214 = (1.0 / (t213));
-  const double t215 = (1.0 / (t213 * t213));
-  const double t216 = ((x[5] * x[5]) + 1e-06);
-  const double t217 = sqrt(t216);
-  const double t218 = (t217 + x[5]);
-  const double t219 = (x[7] - u[7]);
-  const double t220 = (t219 * t219);
-  const double t221 = (4e+10 + t220);
-  const double t222 = pow(t221, (-0.25));
-  const double t223 = (x[7] - 2e+05);
+      (t58 * ((-t57 * 0.017625 * t161 + 0.106625 * t56 * t161 + t136 + t137)) + t135 +
+       ((-0.017625 * t56 * t161 - t57 * 0.106625 * t161 + t148 + t149)) * t61 + t150);
+  const double t163 = (1.0 / sqrt(t86)) * x[5];
+  const double t164 = (t163 - 1.0);
+  const double t165 = (t163 + 1.0);
+  const double t166 = 2.0 * x[7];
+  const double t167 = (-4e+05 + t166);
+  const double t168 = (-t7 * 0.027488935718910694 + 0.07299722865446584);
+  const double t169 = (1.0 / (t168));
+  const double t170 = (x[8] - u[6]);
+  const double t171 = (t170 * t170);
+  const double t172 = (4e+10 + t171);
+  const double t173 = pow(t172, (-0.25));
+  const double t174 = (x[8] - 2e+05);
+  const double t175 = (t174 * t174);
+  const double t176 = (t175 + 1e+10);
+  const double t177 = (4e+10 + t175);
+  const double t178 = pow(t177, (-0.25));
+  const double t179 = (-2.8e+07 + x[8]);
+  const double t180 = ((t179 * t179) + 1e+10);
+  const double t181 = 2.0 * x[8];
+  const double t182 = (-4e+05 + t181);
+  const double t183 = (0.07132964021557801 - 0.023561944901923454 * t114);
+  const double t184 = (1.0 / (t183));
+  const double t185 = (1.0 / (t183 * t183));
+  const double t186 = (x[9] - 2e+05);
+  const double t187 = (t186 * t186);
+  const double t188 = (1e+10 + t187);
+  const double t189 = (4e+10 + t187);
+  const double t190 = pow(t189, (-0.25));
+  const double t191 = (-2.8e+07 + x[9]);
+  const double t192 = ((t191 * t191) + 1e+10);
+  const double t193 = (-x[9] + u[7]);
+  const double t194 = (t193 * t193);
+  const double t195 = (t194 + 4e+10);
+  const double t196 = pow(t195, (-0.25));
+  const double t197 =
+      (sqrt(t188) * 2.5e-09 + t63 * 0.023561944901923454 * t85 * x[2] - x[9] * 5e-09 -
+       t88 * 2.0412414523193154e-06 * t190 * t186 + 0.07050000000000001 - 2.5e-09 * sqrt(t192) +
+       t63 * t104 * 0.023561944901923454 * x[3] - t193 * t108 * t196 * 2.0412414523193154e-06);
+  const double t198 = 2.0 * x[9];
+  const double t199 = (-4e+05 + t198);
+  const double t200 = (-t1 * 0.1 + 1.55 * t0);
+  const double t201 = t39 * (-0.55);
+  const double t202 = (-0.25) * t38;
+  const double t203 = t1 * (-3.11);
+  const double t204 = (t201 + t202 + t203);
+  const double t205 = t39 * (-0.16343387866394005);
+  const double t206 = 3.11 * t0;
+  const double t207 = 0.4011545671438309 * t38;
+  const double t208 = (t205 + t206 + t207);
+  const double t209 = t39 * (-0.4011545671438309);
+  const double t210 = (-0.16343387866394005) * t38;
+  const double t211 = (t209 + t210 + t203);
+  const double t212 = t39 * (-0.25);
+  const double t213 = 0.55 * t38;
+  const double t214 = (t206 + t212 + t213);
+  const double t215 = (-1.55 * t1 - 0.1 * t0);
+  const double t216 = (t215 * t215);
+  const double t217 = (t209 + t210);
+  const double t218 = (t205 + t207);
+  const double t219 = (t201 + t202);
+  const double t220 = (t212 + t213);
+  const double t221 =
+      (((t211 * t217 + t208 * t218)) * u[4] + 600.0 + 1550.0 * t204 * t219 + t220 * 1550.0 * t214);
+  const double t222 = cos(u[5]);
+  const double t223 = (-2.51 + t7);
   const double t224 = (t223 * t223);
-  const double t225 = (1e+10 + t224);
-  const double t226 = (t217 - x[5]);
-  const double t227 = (4e+10 + t224);
-  const double t228 = pow(t227, (-0.25));
-  const double t229 = (-2.8e+07 + x[7]);
-  const double t230 = (1e+10 + (t229 * t229));
-  const double t231 =
-      (-t218 * t222 * 2.0412414523193154e-06 * t219 - 0.031415926535897934 * t86 * x[2] * t87 -
-       x[7] * 5e-09 - 0.031415926535897934 * x[3] * t99 * t87 + 0.07050000000000001 +
-       sqrt(t225) * 2.5e-09 - t226 * 2.0412414523193154e-06 * t223 * t228 - 2.5e-09 * sqrt(t230));
-  const double t232 = (1.0 / sqrt(t216)) * x[5];
-  const double t233 = (t232 - 1.0);
-  const double t234 = (t232 + 1.0);
-  const double t235 = 2.0 * x[7];
-  const double t236 = (-4e+05 + t235);
-  const double t237 = (-t111 * 0.027488935718910694 + 0.07299722865446584);
-  const double t238 = (1.0 / (t237));
-  const double t239 = (x[8] - 2e+05);
-  const double t240 = (t239 * t239);
-  const double t241 = (t240 + 1e+10);
-  const double t242 = (-x[8] + u[6]);
-  const double t243 = (t242 * t242);
-  const double t244 = (4e+10 + t243);
-  const double t245 = pow(t244, (-0.25));
-  const double t246 = (4e+10 + t240);
-  const double t247 = pow(t246, (-0.25));
-  const double t248 = (-2.8e+07 + x[8]);
-  const double t249 = ((t248 * t248) + 1e+10);
-  const double t250 = 2.0 * x[8];
-  const double t251 = (-4e+05 + t250);
-  const double t252 = (0.07132964021557801 - 0.023561944901923454 * t55);
-  const double t253 = (1.0 / (t252 * t252));
-  const double t254 = (x[9] - 2e+05);
-  const double t255 = (t254 * t254);
-  const double t256 = (1e+10 + t255);
-  const double t257 = (4e+10 + t255);
-  const double t258 = pow(t257, (-0.25));
-  const double t259 = (-u[7] + x[9]);
-  const double t260 = (t259 * t259);
-  const double t261 = (t260 + 4e+10);
-  const double t262 = pow(t261, (-0.25));
-  const double t263 = (-2.8e+07 + x[9]);
-  const double t264 = ((t263 * t263) + 1e+10);
-  const double t265 =
-      (sqrt(t256) * 2.5e-09 - x[9] * 5e-09 - t218 * 2.0412414523193154e-06 * t258 * t254 +
-       t86 * 0.023561944901923454 * x[2] * t87 + 0.07050000000000001 -
-       t262 * t226 * 2.0412414523193154e-06 * t259 - 2.5e-09 * sqrt(t264) +
-       0.023561944901923454 * x[3] * t99 * t87);
-  const double t266 = (1.0 / (t252));
-  const double t267 = 2.0 * x[9];
-  const double t268 = (-4e+05 + t267);
+  const double t225 = (1e-06 + t224);
+  const double t226 = (t7 - 1.4);
+  const double t227 = (t226 * t226);
+  const double t228 = (1e-06 + t227);
+  const double t229 = (1.0 / sqrt(t228));
+  const double t230 = (1.0 / sqrt(t225));
+  const double t231 = (-t229 * t226 + 2.0 + t230 * t223);
+  const double t232 =
+      (-2e+08 * sqrt(t225) + x[6] * 0.04021238596594936 - t231 * t13 * t15 * 2e+06 * x[2] +
+       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t228) - 4e+08 * t7);
+  const double t233 = x[3] * t219;
+  const double t234 = (t233 + t204 * x[2]);
+  const double t235 = (t233 + x[2] * t219);
+  const double t236 = (t234 * x[2] + x[3] * t235);
+  const double t237 = (x[2] * x[2]);
+  const double t238 = (t1 * 0.1 - 1.55 * t0);
+  const double t239 = sin(u[5]);
+  const double t240 = t39 * 0.25;
+  const double t241 = (-0.55) * t38;
+  const double t242 = (t240 + t241);
+  const double t243 = x[3] * t242;
+  const double t244 = (t243 + x[2] * t242);
+  const double t245 = t244 * x[3];
+  const double t246 = (-3.11) * t0;
+  const double t247 = (t240 + t246 + t241);
+  const double t248 = (t247 * x[2] + t243);
+  const double t249 = (t245 + t248 * x[2]);
+  const double t250 = t39 * 0.16343387866394005;
+  const double t251 = (-0.4011545671438309) * t38;
+  const double t252 = (t250 + t251);
+  const double t253 = t252 * x[3];
+  const double t254 = (t246 + t250 + t251);
+  const double t255 = (t253 + t254 * x[2]);
+  const double t256 = (t253 + t252 * x[2]);
+  const double t257 = t256 * x[3];
+  const double t258 = (x[2] * t255 + t257);
+  const double t259 = t217 * x[3];
+  const double t260 = (t217 * x[2] + t259);
+  const double t261 = (t259 + t211 * x[2]);
+  const double t262 = (t260 * x[3] + t261 * x[2]);
+  const double t263 = (-1.59 + t114);
+  const double t264 = (t263 * t263);
+  const double t265 = (t264 + 1e-06);
+  const double t266 = (t63 * t104 * 2e+06 * x[3] + t63 * t85 * 2e+06 * x[2]);
+  const double t267 = (1.0 / sqrt(t265));
+  const double t268 = (t114 - 2.9000000000000004);
+  const double t269 = (t268 * t268);
+  const double t270 = (t269 + 1e-06);
+  const double t271 = (1.0 / sqrt(t270));
+  const double t272 = (t263 * t267 - t268 * t271 - 2.0);
+  const double t273 = (-sqrt(t265) * 2e+08 - 8.98e+08 - t266 * t272 - 0.06283185307179587 * x[7] +
+                       sqrt(t270) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t114);
+  const double t274 = t39 * 0.55;
+  const double t275 = 0.25 * t38;
+  const double t276 = (t274 + t275);
+  const double t277 = t276 * x[3];
+  const double t278 = (t277 + t276 * x[2]);
+  const double t279 = t278 * x[3];
+  const double t280 = 3.11 * t1;
+  const double t281 = (t279 + ((t277 + x[2] * ((t274 + t280 + t275)))) * x[2]);
+  const double t282 = 0.16343387866394005 * t38;
+  const double t283 = t39 * 0.4011545671438309;
+  const double t284 = (t282 + t283);
+  const double t285 = t284 * x[3];
+  const double t286 = (t284 * x[2] + t285);
+  const double t287 = t286 * x[3];
+  const double t288 = (((t285 + ((t282 + t283 + t280)) * x[2])) * x[2] + t287);
+  const double t289 = pow(t265, (-1.5));
+  const double t290 = pow(t270, (-1.5));
+  const double t291 =
+      (t63 * 4e+08 * t85 -
+       t272 * ((-t133 * t134 * 2e+06 * x[2] + t63 * t132 * 2e+06 * x[2] +
+                t63 * 2e+06 * x[3] * t151 - t133 * t104 * t85 * 2e+06 * x[3])) -
+       t263 * t63 * t85 * t267 * 2e+08 + t63 * t268 * t85 * 2e+08 * t271 -
+       ((t63 * t85 * t267 - t63 * t264 * t85 * t289 - t63 * t85 * t271 + t63 * t269 * t85 * t290)) *
+           t266);
+  const double t292 = t222 * (-15200.307499999999) * t219;
+  const double t293 = t239 * t242 * (-15200.307499999999);
+  const double t294 = (t287 + t286 * x[2]);
+  const double t295 = t258 * t252;
+  const double t296 = (t256 * x[2] + t257);
+  const double t297 = t217 * t262;
+  const double t298 = (-1550.0) * t249 * t242;
+  const double t299 = (t244 * x[2] + t245);
+  const double t300 = u[4] * ((-t217 * t222 * 9.80665 - t239 * t252 * 9.80665));
+  const double t301 = (t278 * x[2] + t279);
+  const double t302 = (-1550.0) * t219 * t236;
+  const double t303 = (-t263 * t63 * t104 * t267 * 2e+08 + t63 * 4e+08 * t104 -
+                       t266 * ((t63 * t104 * t267 - t63 * t104 * t271 + t63 * t104 * t269 * t290 -
+                                t63 * t104 * t264 * t289)) +
+                       t63 * t268 * t104 * 2e+08 * t271 -
+                       t272 * ((t63 * 2e+06 * x[2] * t162 - t133 * 2e+06 * x[3] * t152 +
+                                t63 * t160 * 2e+06 * x[3] - t133 * t104 * t85 * 2e+06 * x[2])));
+  const double t304 = t133 * t104 * t85 * t273 * 0.5;
+  const double t305 = (1.0 / (t62));
+  const double t306 = t305 * t104 * t85 * t272 * 1e+06;
+  const double t307 = 1550.0 * t214 * t219;
+  const double t308 = 1550.0 * t204 * t242;
+  const double t309 = t208 * t217;
+  const double t310 = t211 * t252;
+  const double t311 = (t307 + t308 + 1550.0 * t247 * t219 + t220 * 1550.0 * t204 +
+                       ((t211 * t218 + t309 + t217 * t254 + t310)) * u[4]);
+  const double t312 = t217 * t252;
+  const double t313 = t217 * t218;
+  const double t314 = (2.0 * ((t312 + t313)) * u[4] + t220 * 3100.0 * t219 + 3100.0 * t242 * t219);
+  const double t315 = (1550.0 * t242 * t219 + t307 + t308 + t220 * 1550.0 * t219 +
+                       ((t312 + t309 + t313 + t310)) * u[4]);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
-  jacobian[20] =
-      (-((t2 * 5200.0 * t3 + t10 * 3100.0 * t14 + 2.0 * ((t17 * t20 + t24 * t17)) * u[4] +
-          3100.0 * t14 * t27 + t28 * t2 * 5200.0)) *
-           t30 * t123 * 0.5 -
-       ((t2 * 50994.579999999994 * t31 + 2.0 * t124 * t121 * t125 -
-         2.0 * u[4] * ((-t17 * t31 * 9.80665 - t122 * t20 * 9.80665)) + t101 * t87 * t140 -
-         t108 * t110 * 2.0 *
-             ((-t108 * 4e+08 * t110 - t108 * t110 * 2e+08 * t119 * t112 +
-               t108 * t110 * 2e+08 * t118 * t115 +
-               t108 *
-                   ((t108 * t110 * t118 - t108 * t110 * t116 * pow(t117, (-1.5)) +
-                     t108 * pow(t114, (-1.5)) * t110 * t113 - t108 * t110 * t119)) *
-                   t110 * 2e+06 * x[2] -
-               t120 * t110 * 2e+06 * t141 * x[2] + t120 * 2e+06 * t124 * x[2] * t125)) +
-         50994.579999999994 * t122 * t3 - t101 * t142 * t143 - t110 * 2.0 * t141 * t121 +
-         t122 * t10 * 30400.614999999998 + t86 * t87 * t163 + t14 * t31 * 30400.614999999998)) *
-           0.5 * t164);
-  jacobian[21] =
-      (-((((t24 * t165 + t17 * t166)) * 2.0 * u[4] + 3100.0 * t14 * t167 + 3100.0 * t27 * t168)) *
-           t30 * t123 * 0.5 -
-       0.5 * t164 * ((t86 * t180 * t87 + t181 + t182 + t101 * t179 * t87 + t183 + t184)));
-  jacobian[22] = ((-4000.0 - t120 * 4e+06 * t125 / (t109)-t64 * 2e+06 * t185 * t143)) * 0.5 * t164;
-  jacobian[23] = t64 * t86 * (-1e+06) * t99 * t185 * t164;
-  jacobian[26] = t108 * t110 * 0.04021238596594936 * t164;
-  jacobian[27] = 0.031415926535897934 * t86 * t164 * t87;
-  jacobian[28] = t108 * (-0.027488935718910694) * t110 * t164;
-  jacobian[29] = t86 * (-0.023561944901923454) * t164 * t87;
-  jacobian[30] =
-      (t189 - t190 * 0.5 * ((t99 * t87 * t163 + t181 + t182 + t183 + t101 * t162 * t87 + t184)));
-  jacobian[31] =
-      (-t190 * 0.5 *
-           ((t181 + t182 + t180 * t99 * t87 - t101 * t177 * t142 + t101 * t176 * t87 + t184)) +
-       t189);
-  jacobian[32] = t64 * t86 * (-1e+06) * t190 * t99 * t185;
-  jacobian[33] = ((1600.0 + t64 * 2e+06 * t177 * t185)) * t190 * (-0.5);
-  jacobian[37] = 0.031415926535897934 * t190 * t99 * t87;
-  jacobian[39] = (-0.023561944901923454) * t190 * t99 * t87;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
-      (1.2e+09 * t192 *
-           ((t124 * x[2] * 0.04021238596594936 * t125 - t110 * t141 * x[2] * 0.04021238596594936)) -
-       t108 * t110 *
-           ((-3.3333333333333334e-09 * sqrt(t194) + 0.094 - 6.666666666666667e-09 * x[6] -
-             t108 * t110 * x[2] * 0.04021238596594936 - t197 * 2.721655269759087e-06 * t201 * t198 +
-             3.3333333333333334e-09 * sqrt(t204) - t205 * t207 * 2.721655269759087e-06 * t202)) *
-           48254863.15913923 / (t191 * t191));
-  jacobian[62] = t108 * (-48254863.15913923) * t192 * t110;
+      (1.2e+09 * t9 *
+           ((t10 * x[2] * 0.04021238596594936 * t14 - t15 * t16 * x[2] * 0.04021238596594936)) -
+       t13 * t15 *
+           ((-3.3333333333333334e-09 * sqrt(t18) + 0.094 - 6.666666666666667e-09 * x[6] -
+             t13 * t15 * x[2] * 0.04021238596594936 - t21 * 2.721655269759087e-06 * t25 * t22 +
+             3.3333333333333334e-09 * sqrt(t28) + t29 * t31 * 2.721655269759087e-06 * t26)) *
+           48254863.15913923 / (t8 * t8));
+  jacobian[62] = t13 * (-48254863.15913923) * t9 * t15;
   jacobian[64] =
-      ((-2.721655269759087e-06 * t201 * t198 * t209 - t210 * t207 * 2.721655269759087e-06 * t202)) *
-      1.2e+09 * t192;
-  jacobian[66] = 1.2e+09 * t192 *
-                 ((-t205 * t207 * 2.721655269759087e-06 - t197 * 2.721655269759087e-06 * t201 +
-                   t212 * pow(t206, (-1.25)) * t205 * t202 * 6.804138174397718e-07 +
-                   t212 * 1.6666666666666667e-09 * (1.0 / sqrt(t204)) - 6.666666666666667e-09 -
-                   1.6666666666666667e-09 * ((-5.6e+07 + t211)) * (1.0 / sqrt(t194)) +
-                   pow(t200, (-1.25)) * 1.3608276348795436e-06 * t199 * t197));
+      ((-2.721655269759087e-06 * t25 * t22 * t33 - t34 * t31 * 2.721655269759087e-06 * t26)) *
+      1.2e+09 * t9;
+  jacobian[66] = 1.2e+09 * t9 *
+                 ((-t21 * 2.721655269759087e-06 * t25 -
+                   t36 * pow(t30, (-1.25)) * t29 * t26 * 6.804138174397718e-07 +
+                   t36 * 1.6666666666666667e-09 * (1.0 / sqrt(t28)) - 6.666666666666667e-09 -
+                   1.6666666666666667e-09 * ((-5.6e+07 + t35)) * (1.0 / sqrt(t18)) +
+                   t29 * t31 * 2.721655269759087e-06 +
+                   pow(t24, (-1.25)) * 1.3608276348795436e-06 * t23 * t21));
   jacobian[70] =
-      (t214 * 1.2e+09 *
-           ((-0.031415926535897934 * x[3] * t162 * t87 - 0.031415926535897934 * x[2] * t87 * t140 +
-             0.031415926535897934 * x[2] * t142 * t143 +
-             0.031415926535897934 * t86 * x[3] * t99 * t142)) -
-       t215 * t231 * t86 * 37699111.84307752 * t87);
+      (-t63 * t85 * 37699111.84307752 * t113 * t116 +
+       t117 * 1.2e+09 *
+           ((-t63 * 0.031415926535897934 * t132 * x[2] + t133 * 0.031415926535897934 * t134 * x[2] -
+             t63 * 0.031415926535897934 * x[3] * t151 +
+             t133 * 0.031415926535897934 * t104 * t85 * x[3])));
   jacobian[71] =
-      (t214 * 1.2e+09 *
-           ((-0.031415926535897934 * t176 * x[3] * t87 + 0.031415926535897934 * t177 * x[3] * t142 +
-             0.031415926535897934 * t86 * x[2] * t99 * t142 -
-             0.031415926535897934 * t179 * x[2] * t87)) -
-       t215 * t231 * 37699111.84307752 * t99 * t87);
-  jacobian[72] = (-37699111.84307752) * t214 * t86 * t87;
-  jacobian[73] = (-37699111.84307752) * t214 * t99 * t87;
-  jacobian[75] = t214 * 1.2e+09 *
-                 ((-2.0412414523193154e-06 * t233 * t223 * t228 -
-                   t234 * t222 * 2.0412414523193154e-06 * t219));
-  jacobian[77] = ((-t218 * t222 * 2.0412414523193154e-06 +
-                   t236 * 5.103103630798288e-07 * pow(t227, (-1.25)) * t226 * t223 -
-                   t226 * 2.0412414523193154e-06 * t228 + (1.0 / sqrt(t225)) * t236 * 1.25e-09 +
-                   pow(t221, (-1.25)) * t218 * t220 * 1.0206207261596577e-06 -
-                   (1.0 / sqrt(t230)) * 1.25e-09 * ((-5.6e+07 + t235)) - 5e-09)) *
-                 t214 * 1.2e+09;
+      (-t63 * t104 * 37699111.84307752 * t113 * t116 +
+       t117 * 1.2e+09 *
+           ((t133 * 0.031415926535897934 * x[3] * t152 - t63 * 0.031415926535897934 * t160 * x[3] +
+             t133 * 0.031415926535897934 * t104 * t85 * x[2] -
+             t63 * 0.031415926535897934 * x[2] * t162)));
+  jacobian[72] = t63 * (-37699111.84307752) * t117 * t85;
+  jacobian[73] = t63 * (-37699111.84307752) * t104 * t117;
+  jacobian[75] =
+      t117 * 1.2e+09 *
+      ((-2.0412414523193154e-06 * t164 * t105 * t110 - t165 * t92 * 2.0412414523193154e-06 * t89));
+  jacobian[77] = t117 * 1.2e+09 *
+                 ((-t88 * t92 * 2.0412414523193154e-06 -
+                   t167 * 5.103103630798288e-07 * pow(t109, (-1.25)) * t108 * t105 +
+                   (1.0 / sqrt(t107)) * t167 * 1.25e-09 + t108 * 2.0412414523193154e-06 * t110 +
+                   pow(t91, (-1.25)) * t88 * t90 * 1.0206207261596577e-06 -
+                   (1.0 / sqrt(t112)) * 1.25e-09 * ((-5.6e+07 + t166)) - 5e-09));
   jacobian[80] =
-      (1.2e+09 * t238 *
-           ((-t124 * x[2] * t125 * 0.027488935718910694 +
-             t110 * t141 * x[2] * 0.027488935718910694)) +
-       t108 * t110 * 32986722.862692833 *
-           ((0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt(t241) +
-             t108 * t110 * x[2] * 0.027488935718910694 +
-             t242 * t205 * 2.721655269759087e-06 * t245 -
-             t247 * t197 * 2.721655269759087e-06 * t239 - 3.3333333333333334e-09 * sqrt(t249))) /
-           (t237 * t237));
-  jacobian[82] = t108 * t110 * 32986722.862692833 * t238;
+      (1.2e+09 * t169 *
+           ((-t10 * x[2] * t14 * 0.027488935718910694 + t15 * t16 * x[2] * 0.027488935718910694)) +
+       t13 *
+           ((t29 * t173 * 2.721655269759087e-06 * t170 + 0.094 - 6.666666666666667e-09 * x[8] +
+             3.3333333333333334e-09 * sqrt(t176) + t13 * t15 * x[2] * 0.027488935718910694 -
+             t178 * t21 * 2.721655269759087e-06 * t174 - 3.3333333333333334e-09 * sqrt(t180))) *
+           t15 * 32986722.862692833 / (t168 * t168));
+  jacobian[82] = t13 * t15 * 32986722.862692833 * t169;
   jacobian[84] =
       1.2e+09 *
-      ((-t247 * 2.721655269759087e-06 * t209 * t239 + t242 * t210 * 2.721655269759087e-06 * t245)) *
-      t238;
-  jacobian[88] = ((-1.6666666666666667e-09 * (1.0 / sqrt(t249)) * ((-5.6e+07 + t250)) -
-                   t247 * t197 * 2.721655269759087e-06 - t205 * 2.721655269759087e-06 * t245 +
-                   1.3608276348795436e-06 * pow(t244, (-1.25)) * t205 * t243 +
-                   t251 * 1.6666666666666667e-09 * (1.0 / sqrt(t241)) - 6.666666666666667e-09 +
-                   t251 * t197 * t239 * pow(t246, (-1.25)) * 6.804138174397718e-07)) *
-                 1.2e+09 * t238;
-  jacobian[90] = (t86 * 28274333.882308144 * t253 * t265 * t87 +
-                  t266 * 1.2e+09 *
-                      ((0.023561944901923454 * x[2] * t87 * t140 -
-                        t86 * 0.023561944901923454 * x[3] * t99 * t142 +
-                        0.023561944901923454 * x[3] * t162 * t87 -
-                        0.023561944901923454 * x[2] * t142 * t143)));
+      ((-t178 * 2.721655269759087e-06 * t33 * t174 - t173 * t34 * 2.721655269759087e-06 * t170)) *
+      t169;
+  jacobian[88] =
+      1.2e+09 * t169 *
+      ((-1.3608276348795436e-06 * t29 * t171 * pow(t172, (-1.25)) -
+        1.6666666666666667e-09 * (1.0 / sqrt(t180)) * ((-5.6e+07 + t181)) -
+        t178 * t21 * 2.721655269759087e-06 + t182 * 1.6666666666666667e-09 * (1.0 / sqrt(t176)) +
+        t29 * t173 * 2.721655269759087e-06 - 6.666666666666667e-09 +
+        t182 * t21 * t174 * pow(t177, (-1.25)) * 6.804138174397718e-07));
+  jacobian[90] =
+      (((t63 * 0.023561944901923454 * x[3] * t151 -
+         t133 * t104 * 0.023561944901923454 * t85 * x[3] +
+         t63 * 0.023561944901923454 * t132 * x[2] - t133 * t134 * 0.023561944901923454 * x[2])) *
+           t184 * 1.2e+09 +
+       t63 * t85 * 28274333.882308144 * t185 * t197);
   jacobian[91] =
-      (t266 * 1.2e+09 *
-           ((0.023561944901923454 * t179 * x[2] * t87 + t176 * 0.023561944901923454 * x[3] * t87 -
-             0.023561944901923454 * t177 * x[3] * t142 -
-             t86 * 0.023561944901923454 * x[2] * t99 * t142)) +
-       28274333.882308144 * t253 * t99 * t265 * t87);
-  jacobian[92] = t86 * t266 * 28274333.882308144 * t87;
-  jacobian[93] = t266 * 28274333.882308144 * t99 * t87;
-  jacobian[95] = t266 * 1.2e+09 *
-                 ((-t262 * 2.0412414523193154e-06 * t233 * t259 -
-                   t234 * 2.0412414523193154e-06 * t258 * t254));
-  jacobian[99] = t266 * 1.2e+09 *
-                 ((-t262 * t226 * 2.0412414523193154e-06 +
-                   t268 * t218 * 5.103103630798288e-07 * pow(t257, (-1.25)) * t254 -
-                   (1.0 / sqrt(t264)) * 1.25e-09 * ((-5.6e+07 + t267)) +
-                   t268 * (1.0 / sqrt(t256)) * 1.25e-09 - t218 * 2.0412414523193154e-06 * t258 +
-                   t260 * t226 * pow(t261, (-1.25)) * 1.0206207261596577e-06 - 5e-09));
+      (t63 * t104 * 28274333.882308144 * t185 * t197 +
+       t184 * 1.2e+09 *
+           ((t63 * 0.023561944901923454 * x[2] * t162 + t63 * t160 * 0.023561944901923454 * x[3] -
+             t133 * 0.023561944901923454 * x[3] * t152 -
+             t133 * t104 * 0.023561944901923454 * t85 * x[2])));
+  jacobian[92] = t63 * t184 * t85 * 28274333.882308144;
+  jacobian[93] = t63 * t104 * t184 * 28274333.882308144;
+  jacobian[95] = ((-t165 * 2.0412414523193154e-06 * t190 * t186 +
+                   t193 * t196 * 2.0412414523193154e-06 * t164)) *
+                 t184 * 1.2e+09;
+  jacobian[99] =
+      ((t199 * t88 * 5.103103630798288e-07 * pow(t189, (-1.25)) * t186 -
+        t194 * pow(t195, (-1.25)) * t108 * 1.0206207261596577e-06 -
+        (1.0 / sqrt(t192)) * 1.25e-09 * ((-5.6e+07 + t198)) + t199 * (1.0 / sqrt(t188)) * 1.25e-09 +
+        t108 * t196 * 2.0412414523193154e-06 - t88 * 2.0412414523193154e-06 * t190 - 5e-09)) *
+      t184 * 1.2e+09;
+  mass[0] =
+      (2600.0 * (t200 * t200) + 1550.0 * (t204 * t204) + (((t208 * t208) + (t211 * t211))) * u[4] +
+       1550.0 * (t214 * t214) + 2600.0 * t216 + 2900.0);
+  mass[1] = t221;
+  mass[2] = t221;
+  mass[3] = ((t219 * t219) * 1550.0 + 600.0 + (((t217 * t217) + (t218 * t218))) * u[4] +
+             1550.0 * (t220 * t220));
+  acceleration[0] =
+      (-2000.0 * x[2] - t214 * t222 * 15200.307499999999 + t13 * t15 * t232 - 1550.0 * t214 * t236 -
+       2600.0 * t237 * t215 * t238 - t215 * t239 * 25497.289999999997 -
+       2600.0 * t200 * t237 * t215 + ((-t239 * t211 * 9.80665 - t208 * t222 * 9.80665)) * u[4] -
+       1550.0 * t204 * t249 + u[2] - ((t258 * t211 + t208 * t262)) * u[4] - t63 * t85 * t273 * 0.5 -
+       t200 * t222 * 25497.289999999997 - t239 * t204 * 15200.307499999999);
+  acceleration[1] = (-t220 * t222 * 15200.307499999999 - ((t262 * t218 + t258 * t217)) * u[4] -
+                     t220 * 1550.0 * t236 - t63 * t104 * t273 * 0.5 +
+                     ((-t218 * t222 * 9.80665 - t239 * t217 * 9.80665)) * u[4] -
+                     1550.0 * t249 * t219 - 800.0 * x[3] + u[3] - t239 * t219 * 15200.307499999999);
+  d_force[0] =
+      (-2600.0 * t216 * t237 - t281 * 1550.0 * t204 - t204 * t222 * 15200.307499999999 -
+       t239 * t238 * 25497.289999999997 - 2600.0 * t200 * t237 * t238 +
+       t13 * t15 *
+           ((-t13 * t15 * 2e+06 *
+                 ((t13 * t15 * t230 + t13 * t15 * t227 * pow(t228, (-1.5)) - t13 * t15 * t229 -
+                   t13 * pow(t225, (-1.5)) * t15 * t224)) *
+                 x[2] -
+             t13 * 4e+08 * t15 - t13 * t15 * 2e+08 * t230 * t223 + t13 * t15 * 2e+08 * t229 * t226 -
+             t231 * t15 * 2e+06 * t16 * x[2] + t231 * 2e+06 * t10 * x[2] * t14)) -
+       t239 * t247 * 15200.307499999999 - 1550.0 * t204 * t236 - 2600.0 * t237 * (t238 * t238) +
+       t133 * t134 * t273 * 0.5 + u[4] * ((-t211 * t222 * 9.80665 - t239 * t254 * 9.80665)) -
+       1550.0 * t214 * t249 - ((t258 * t254 + t211 * t262 + t208 * t258 + t211 * t288)) * u[4] -
+       t63 * t132 * t273 * 0.5 - t291 * t63 * t85 * 0.5 - 1550.0 * t247 * t249 - t10 * t232 * t14 -
+       2600.0 * t237 * t215 * ((1.55 * t1 + 0.1 * t0)) - t215 * t222 * 25497.289999999997 +
+       t15 * t16 * t232);
+  d_force[1] = (t292 + t293 - ((t211 * t294 + t295 + t208 * t296 + t297)) * u[4] + t298 -
+                1550.0 * t214 * t299 + t300 - 1550.0 * t204 * t301 + t302 -
+                t63 * t273 * 0.5 * t162 - t63 * t85 * 0.5 * t303 + t304);
+  d_force[2] = (-2.0 * u[4] * ((t208 * t261 + t211 * t255)) + t305 * t134 * t272 * 1e+06 -
+                t248 * 3100.0 * t204 - t231 * 2e+06 * t14 / (t6)-2000.0 -
+                t200 * t215 * 5200.0 * x[2] - t234 * 3100.0 * t214 - t215 * 5200.0 * t238 * x[2]);
+  d_force[3] = (-2.0 * u[4] * ((t256 * t211 + t208 * t260)) + t306 - 3100.0 * t214 * t235 -
+                3100.0 * t204 * t244);
+  d_force[6] = t13 * t15 * 0.04021238596594936;
+  d_force[7] = t63 * 0.031415926535897934 * t85;
+  d_force[8] = t13 * (-0.027488935718910694) * t15;
+  d_force[9] = t63 * t85 * (-0.023561944901923454);
+  d_force[10] = (t292 + t293 - t291 * t63 * t104 * 0.5 + t298 + t300 + t302 -
+                 t63 * t273 * 0.5 * t151 - t281 * 1550.0 * t219 - t220 * 1550.0 * t249 -
+                 ((t258 * t218 + t295 + t217 * t288 + t297)) * u[4] + t304);
+  d_force[11] =
+      (t133 * t273 * 0.5 * t152 + t292 + t293 - u[4] * ((t295 + t296 * t218 + t294 * t217 + t297)) +
+       t298 + t300 + t302 - 1550.0 * t301 * t219 - t63 * t104 * 0.5 * t303 - t220 * 1550.0 * t299 -
+       t63 * t160 * t273 * 0.5);
+  d_force[12] = (t306 - 2.0 * u[4] * ((t261 * t218 + t217 * t255)) - t220 * t234 * 3100.0 -
+                 t248 * 3100.0 * t219);
+  d_force[13] = (-t220 * 3100.0 * t235 - 2.0 * u[4] * ((t256 * t217 + t260 * t218)) +
+                 t305 * t272 * 1e+06 * t152 - 3100.0 * t244 * t219 - 800.0);
+  d_force[17] = t63 * 0.031415926535897934 * t104;
+  d_force[19] = t63 * t104 * (-0.023561944901923454);
+  d_mass[0] =
+      (t215 * 5200.0 * t238 + t247 * 3100.0 * t204 + 2.0 * ((t211 * t254 + t208 * t211)) * u[4] +
+       3100.0 * t204 * t214 + t200 * t215 * 5200.0);
+  d_mass[1] = t311;
+  d_mass[2] = t311;
+  d_mass[3] = t314;
+  d_mass[4] = (((t309 + t310)) * 2.0 * u[4] + 3100.0 * t204 * t242 + 3100.0 * t214 * t219);
+  d_mass[5] = t315;
+  d_mass[6] = t315;
+  d_mass[7] = t314;
+  Factor(mass);
+  Solve(mass, acceleration);
+  for (int c = 0; c < kNumStates; ++c) {
+    double column[kNumJoints];
+    for (int j = 0; j < kNumJoints; ++j) {
+      column[j] = d_force[j * kNumStates + c];
+      if (c < kNumJoints) {
+        for (int k = 0; k < kNumJoints; ++k) {
+          column[j] -= d_mass[(c * kNumJoints + j) * kNumJoints + k] * acceleration[k];
+        }
+      }
+    }
+    Solve(mass, column);
+    for (int j = 0; j < kNumJoints; ++j) jacobian[(kNumJoints + j) * kNumStates + c] = column[j];
+  }
+}
+
+void MassMatrix(const double* q, double payload, double* mass) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  double x[kNumStates] = {};
+  double u[kNumInputs] = {};
+  std::copy(q, q + kNumJoints, x);
+  u[2 * kNumJoints] = payload;
+  const double t0 = sin(x[0]);
+  const double t1 = cos(x[0]);
+  const double t2 = (-t0 * 0.1 + 1.55 * t1);
+  const double t3 = (x[0] + x[1]);
+  const double t4 = sin(t3);
+  const double t5 = t4 * (-0.55);
+  const double t6 = cos(t3);
+  const double t7 = (-0.25) * t6;
+  const double t8 = t0 * (-3.11);
+  const double t9 = (t5 + t7 + t8);
+  const double t10 = t4 * (-0.16343387866394005);
+  const double t11 = 3.11 * t1;
+  const double t12 = 0.4011545671438309 * t6;
+  const double t13 = (t10 + t11 + t12);
+  const double t14 = t4 * (-0.4011545671438309);
+  const double t15 = (-0.16343387866394005) * t6;
+  const double t16 = (t14 + t15 + t8);
+  const double t17 = t4 * (-0.25);
+  const double t18 = 0.55 * t6;
+  const double t19 = (t11 + t17 + t18);
+  const double t20 = (-1.55 * t0 - 0.1 * t1);
+  const double t21 = (t14 + t15);
+  const double t22 = (t10 + t12);
+  const double t23 = (t5 + t7);
+  const double t24 = (t17 + t18);
+  const double t25 =
+      (((t16 * t21 + t13 * t22)) * u[4] + 600.0 + 1550.0 * t9 * t23 + t24 * 1550.0 * t19);
+  mass[0] = (2600.0 * (t2 * t2) + 1550.0 * (t9 * t9) + (((t13 * t13) + (t16 * t16))) * u[4] +
+             1550.0 * (t19 * t19) + 2600.0 * (t20 * t20) + 2900.0);
+  mass[1] = t25;
+  mass[2] = t25;
+  mass[3] =
+      ((t23 * t23) * 1550.0 + 600.0 + (((t21 * t21) + (t22 * t22))) * u[4] + 1550.0 * (t24 * t24));
+}
+
+void BiasForces(const double* q, const double* qd, double payload, double pitch, double* bias) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  double x[kNumStates] = {};
+  double u[kNumInputs] = {};
+  std::copy(q, q + kNumJoints, x);
+  std::copy(qd, qd + kNumJoints, x + kNumJoints);
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const double t0 = sin(u[5]);
+  const double t1 = (x[0] + x[1]);
+  const double t2 = sin(t1);
+  const double t3 = t2 * (-0.4011545671438309);
+  const double t4 = cos(t1);
+  const double t5 = (-0.16343387866394005) * t4;
+  const double t6 = sin(x[0]);
+  const double t7 = t6 * (-3.11);
+  const double t8 = (t3 + t5 + t7);
+  const double t9 = t2 * (-0.16343387866394005);
+  const double t10 = cos(x[0]);
+  const double t11 = 3.11 * t10;
+  const double t12 = 0.4011545671438309 * t4;
+  const double t13 = (t9 + t11 + t12);
+  const double t14 = cos(u[5]);
+  const double t15 = t2 * (-0.55);
+  const double t16 = (-0.25) * t4;
+  const double t17 = (t15 + t16 + t7);
+  const double t18 = t2 * 0.25;
+  const double t19 = (-0.55) * t4;
+  const double t20 = (t18 + t19);
+  const double t21 = x[3] * t20;
+  const double t22 = (-3.11) * t10;
+  const double t23 = (((t21 + x[2] * t20)) * x[3] + ((((t18 + t22 + t19)) * x[2] + t21)) * x[2]);
+  const double t24 = t2 * (-0.25);
+  const double t25 = 0.55 * t4;
+  const double t26 = (t11 + t24 + t25);
+  const double t27 = t2 * 0.16343387866394005;
+  const double t28 = (-0.4011545671438309) * t4;
+  const double t29 = (t27 + t28);
+  const double t30 = t29 * x[3];
+  const double t31 = (x[2] * ((t30 + ((t22 + t27 + t28)) * x[2])) + ((t30 + t29 * x[2])) * x[3]);
+  const double t32 = (t3 + t5);
+  const double t33 = t32 * x[3];
+  const double t34 = (((t32 * x[2] + t33)) * x[3] + ((t33 + t8 * x[2])) * x[2]);
+  const double t35 = (-t6 * 0.1 + 1.55 * t10);
+  const double t36 = (t15 + t16);
+  const double t37 = x[3] * t36;
+  const double t38 = (((t37 + t17 * x[2])) * x[2] + x[3] * ((t37 + x[2] * t36)));
+  const double t39 = (x[2] * x[2]);
+  const double t40 = (-1.55 * t6 - 0.1 * t10);
+  const double t41 = (t24 + t25);
+  const double t42 = (t9 + t12);
+  bias[0] = (-((-t0 * t8 * 9.80665 - t13 * t14 * 9.80665)) * u[4] + 1550.0 * t17 * t23 +
+             t26 * t14 * 15200.307499999999 + ((t31 * t8 + t13 * t34)) * u[4] +
+             t35 * t14 * 25497.289999999997 + 1550.0 * t26 * t38 + 2600.0 * t35 * t39 * t40 +
+             t40 * t0 * 25497.289999999997 + t0 * t17 * 15200.307499999999 +
+             2600.0 * t39 * t40 * ((t6 * 0.1 - 1.55 * t10)));
+  bias[1] = (t41 * t14 * 15200.307499999999 + t41 * 1550.0 * t38 + 1550.0 * t23 * t36 -
+             ((-t42 * t14 * 9.80665 - t0 * t32 * 9.80665)) * u[4] + t0 * t36 * 15200.307499999999 +
+             ((t34 * t42 + t31 * t32)) * u[4]);
+}
+
+void MechanicalEnergy(const double* q, const double* qd, double payload, double pitch,
+                      double* energy) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  double x[kNumStates] = {};
+  double u[kNumInputs] = {};
+  std::copy(q, q + kNumJoints, x);
+  std::copy(qd, qd + kNumJoints, x + kNumJoints);
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const double t0 = sin(x[0]);
+  const double t1 = cos(x[0]);
+  const double t2 = (-t0 * 0.1 + 1.55 * t1);
+  const double t3 = (x[0] + x[1]);
+  const double t4 = sin(t3);
+  const double t5 = t4 * (-0.55);
+  const double t6 = cos(t3);
+  const double t7 = (-0.25) * t6;
+  const double t8 = t0 * (-3.11);
+  const double t9 = (t5 + t7 + t8);
+  const double t10 = t4 * (-0.16343387866394005);
+  const double t11 = 3.11 * t1;
+  const double t12 = 0.4011545671438309 * t6;
+  const double t13 = (t10 + t11 + t12);
+  const double t14 = t4 * (-0.4011545671438309);
+  const double t15 = (-0.16343387866394005) * t6;
+  const double t16 = (t14 + t15 + t8);
+  const double t17 = t4 * (-0.25);
+  const double t18 = 0.55 * t6;
+  const double t19 = (t11 + t17 + t18);
+  const double t20 = (-1.55 * t0 - 0.1 * t1);
+  const double t21 = (t14 + t15);
+  const double t22 = (t10 + t12);
+  const double t23 = (t5 + t7);
+  const double t24 = (t17 + t18);
+  const double t25 = sin(u[5]);
+  const double t26 = cos(u[5]);
+  const double t27 = 3.11 * t0;
+  energy[0] =
+      ((x[2] * x[2]) *
+           ((2600.0 * (t2 * t2) + 1550.0 * (t9 * t9) + (((t13 * t13) + (t16 * t16))) * u[4] +
+             1550.0 * (t19 * t19) + 2600.0 * (t20 * t20) + 2900.0)) *
+           0.5 +
+       ((((t16 * t21 + t13 * t22)) * u[4] + 600.0 + 1550.0 * t9 * t23 + t24 * 1550.0 * t19)) *
+           x[3] * x[2] +
+       (((t23 * t23) * 1550.0 + 600.0 + (((t21 * t21) + (t22 * t22))) * u[4] +
+         1550.0 * (t24 * t24))) *
+           (x[3] * x[3]) * 0.5);
+  energy[1] =
+      (t25 * t19 * 15200.307499999999 + t26 * ((t4 * 0.55 + t27 + 0.25 * t6)) * 15200.307499999999 -
+       u[4] * ((-t13 * t25 * 9.80665 -
+                t26 * ((0.16343387866394005 * t6 + t4 * 0.4011545671438309 + t27)) * 9.80665)) +
+       t26 * 25497.289999999997 * ((1.55 * t0 + 0.1 * t1)) + t2 * t25 * 25497.289999999997);
 }
 
 namespace {
@@ -1039,7 +1354,10 @@ const MachineFunctions& Functions() {
       &JointFromCylinderLength,
       &PlantRhs,
       &PlantJacobian,
-      &Residual};
+      &Residual,
+      &MassMatrix,
+      &BiasForces,
+      &MechanicalEnergy};
   return functions;
 }
 

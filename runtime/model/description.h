@@ -40,7 +40,10 @@ struct Material {
 
 /// Where a cylinder end is pinned: a point in a body frame.
 struct Mount {
-  std::string body;       ///< "chassis" (frame M), a link name, or "rocker"
+  /// "chassis" (frame M), a link name, or "rocker" (the bell crank of the driven link's
+  /// four-bar). A cylinder may connect any two of them (issue 39): a Z-bar's tilt cylinder runs
+  /// from the chassis to the rocker, so its length depends on the boom and the bucket joint.
+  std::string body;
   Eigen::Vector2d point;  ///< [x, z] in that body's frame [m]
 };
 
@@ -58,6 +61,14 @@ struct FourBarLinkage {
   /// Which of the two closures: +1 puts F to the left of the line from the rocker pivot to G
   /// (counter-clockwise in the x–z plane), -1 to the right.
   int assembly_branch = 1;
+  // Inertial properties of the passive bodies (optional, zero when not given). The rocker and
+  // the coupler move with the closure of the chain; their kinetic and potential energy enter
+  // the plant's Lagrangian through it (codegen/symbolic_model.cc).
+  double rocker_mass = 0;                                           ///< [kg]
+  Eigen::Vector2d rocker_center_of_mass = Eigen::Vector2d::Zero();  ///< rocker frame [m]
+  double rocker_inertia = 0;   ///< about its centre of mass [kg·m²]
+  double coupler_mass = 0;     ///< [kg], centre of mass midway between F and G
+  double coupler_inertia = 0;  ///< about its centre of mass [kg·m²]
 };
 
 struct Link {
@@ -103,6 +114,12 @@ struct Actuator {
   Mount base_mount;             ///< the barrel end
   Mount rod_mount;              ///< the rod end
   double dead_volume = 0;       ///< per chamber, hoses included [m³]
+  // Inertial properties of each cylinder's two bodies (optional, zero when not given): the
+  // barrel turns about the base pin, the rod about the rod pin, both along the pin-to-pin line.
+  double barrel_mass = 0;    ///< [kg], one cylinder
+  double barrel_center = 0;  ///< distance of its centre of mass from the base pin [m]
+  double rod_mass = 0;       ///< [kg], piston and rod of one cylinder
+  double rod_center = 0;     ///< distance of its centre of mass from the rod pin [m]
   // Motor (kind == kMotor):
   double displacement = 0;  ///< at the joint, gearing included [m³/rad]
   double line_volume = 0;   ///< per side [m³]
@@ -219,7 +236,12 @@ struct MachineDescription {
   Hydraulics hydraulics;
   Bucket bucket;
   Sensors sensors;
-  std::vector<Material> materials;  ///< every material in the materials directory
+  std::vector<Material> materials;  ///< every material of the folders searched
+  /// The material folders searched, in order (LoadOptions; the unknown-material error names them).
+  std::vector<std::string> materials_searched;
+  /// Plausibility warnings (runtime/model/plausibility.h): values outside physical ranges that
+  /// still load, each naming the likely unit mistake. Also written once to standard error.
+  std::vector<core::Diagnostic> warnings;
 
   /// Where each value came from, by key path, for errors found after loading.
   std::map<std::string, core::SourceLocation> locations;
@@ -237,8 +259,13 @@ struct MachineDescription {
 };
 
 struct LoadOptions {
-  /// Where material files are found. Empty: `<description dir>/../materials`.
+  /// Where material files are found: this folder alone. Empty: `<description dir>/../materials`,
+  /// then `<models_dir>/materials`, a name found in the first folder that has it (see
+  /// MaterialFolders). `autoshovel --materials DIR` and `--models DIR` set the process-wide
+  /// defaults (SetDefaultMaterialFolders) that apply when these fields are empty.
   std::string materials_dir;
+  /// The models/ folder whose `materials/` is searched after the description's own.
+  std::string models_dir;
   /// Overlays applied in order on top of the description before it is validated: files
   /// written by identification (`autoshovel calibrate arm` …) holding identified values. An
   /// overlay names its machine and the SHA-256 of the description it was identified against;
@@ -253,6 +280,13 @@ struct LoadOptions {
 /// (`file:line:column: key.path: message`); never returns a partly read description.
 MachineDescription LoadMachineDescription(const std::string& path, const LoadOptions& options = {});
 
+/// Process-wide defaults for LoadOptions::materials_dir and models_dir, set once by the command
+/// line (`--materials`, `--models`) so that every command that loads a description honours them.
+void SetDefaultMaterialFolders(const std::string& materials_dir, const std::string& models_dir);
+
+/// The material folders searched for a description at `path`, in order, without duplicates.
+std::vector<std::string> MaterialFolders(const std::string& path, const LoadOptions& options);
+
 /// Loads one material file. Throws core::InputError.
 Material LoadMaterial(const std::string& path);
 
@@ -260,7 +294,7 @@ Material LoadMaterial(const std::string& path);
 std::vector<Material> LoadMaterials(const std::string& directory);
 
 /// Machine descriptions under a models/ folder: every `*.yaml` except in materials/ and
-/// scenarios/, sorted.
+/// scenarios/ and the trained models' provenance files `*.meta.yaml`, sorted.
 std::vector<std::string> FindMachineDescriptions(const std::string& models_dir);
 
 /// A machine given by name (searched under `models_dir`) or by path to its description.

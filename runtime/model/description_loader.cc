@@ -11,6 +11,7 @@
 #include "runtime/core/yaml_reader.h"
 #include "runtime/model/description.h"
 #include "runtime/model/interpreted_model.h"
+#include "runtime/model/plausibility.h"
 
 namespace autoshovel::model {
 namespace {
@@ -77,6 +78,15 @@ FourBarLinkage ReadLinkage(MapReader map) {
   bar.coupler_length = map.Number("coupler_length", NumberRule::Positive("m"));
   bar.assembly_branch = map.Integer("assembly_branch", -1, 1, 1);
   if (bar.assembly_branch == 0) map.Error("assembly_branch", "must be +1 or -1, got 0");
+  bar.rocker_mass = map.Number("rocker_mass", NumberRule::NonNegative("kg"), 0.0);
+  if (map.Has("rocker_center_of_mass")) {
+    bar.rocker_center_of_mass = Point(map, "rocker_center_of_mass");
+  } else {
+    bar.rocker_center_of_mass = {bar.rocker_length / 2, 0.0};  // a straight bar
+  }
+  bar.rocker_inertia = map.Number("rocker_inertia", NumberRule::NonNegative("kg m^2"), 0.0);
+  bar.coupler_mass = map.Number("coupler_mass", NumberRule::NonNegative("kg"), 0.0);
+  bar.coupler_inertia = map.Number("coupler_inertia", NumberRule::NonNegative("kg m^2"), 0.0);
   map.Finish();
   return bar;
 }
@@ -128,6 +138,11 @@ Actuator ReadActuator(MapReader map) {
     a.base_mount = ReadMount(map.Map("base_mount"));
     a.rod_mount = ReadMount(map.Map("rod_mount"));
     a.dead_volume = map.Number("dead_volume", NumberRule::Positive("m^3"));
+    a.barrel_mass = map.Number("barrel_mass", NumberRule::NonNegative("kg"), 0.0);
+    a.barrel_center =
+        map.Number("barrel_center", NumberRule::NonNegative("m"), a.retracted_length / 2);
+    a.rod_mass = map.Number("rod_mass", NumberRule::NonNegative("kg"), 0.0);
+    a.rod_center = map.Number("rod_center", NumberRule::NonNegative("m"), a.retracted_length / 2);
   }
   a.relief_pressure = map.Number("relief_pressure_bar", NumberRule::Positive("bar")) * kBar;
   a.valve = ReadValve(map.Map("valve"));
@@ -354,15 +369,14 @@ class Validator {
     }
   }
 
-  // A cylinder spans exactly its own joint: one end on the driven link (or on its rocker), the
-  // other on the link's parent (chassis for the first link). Then its length depends on that
-  // joint alone, the inverse length → angle is one-dimensional, and the reach check below is
-  // exact. A frame-anchored Z-bar tilt cylinder is described by its boom-anchored equivalent.
+  // A cylinder may connect any two bodies (issue 39): the chassis, a link, or the rocker of
+  // the driven link's four-bar. Its length must move with the joint it drives (one end on the
+  // driven link or its rocker) and may also move with joints before it (a Z-bar's tilt cylinder
+  // pinned to the front frame moves with the boom too); it may not ride on a link after the
+  // joint it drives, which would make the drive depend on the joints it positions.
   void CheckMounts(const Actuator& a, const std::string& path, int joint) {
     const std::vector<std::string> bodies = BodyNames();
     const Link& link = m_.links[joint];
-    const std::string parent = joint == 0 ? "chassis" : m_.links[joint - 1].name;
-    const std::string child = link.linkage ? "rocker" : link.name;
     const Mount* mounts[2] = {&a.base_mount, &a.rod_mount};
     const char* keys[2] = {".base_mount.body", ".rod_mount.body"};
     bool known = true;
@@ -377,15 +391,23 @@ class Validator {
         Error(path + keys[e], "body 'rocker' needs arm.links[" + std::to_string(joint) +
                                   "].linkage ('" + link.name + "' has no four-bar)");
         known = false;
+      } else if (const int k = m_.LinkIndex(body); k > joint) {
+        Error(path + keys[e], "a cylinder driving '" + link.name + "' cannot be pinned to '" +
+                                  body + "', which comes after it in the chain");
+        known = false;
       }
     }
     if (!known) return;
-    const bool ok = (a.base_mount.body == parent && a.rod_mount.body == child) ||
-                    (a.base_mount.body == child && a.rod_mount.body == parent);
-    if (!ok) {
-      Error(path + ".base_mount.body",
-            "a cylinder driving '" + link.name + "' is pinned between '" + parent + "' and '" +
-                child + "', got '" + a.base_mount.body + "' and '" + a.rod_mount.body + "'");
+    if (a.base_mount.body == a.rod_mount.body) {
+      Error(path + ".rod_mount.body",
+            "both ends are pinned to '" + a.base_mount.body + "': the cylinder cannot move");
+      return;
+    }
+    const std::string child = link.linkage ? "rocker" : link.name;
+    if (a.base_mount.body != child && a.rod_mount.body != child) {
+      Error(path + ".rod_mount.body", "a cylinder driving '" + link.name + "' needs one end on '" +
+                                          child + "', got '" + a.base_mount.body + "' and '" +
+                                          a.rod_mount.body + "'");
     }
   }
 
@@ -407,9 +429,16 @@ class Validator {
       for (const auto& material : m_.materials) names.push_back(material.name);
       std::string list;
       for (const auto& name : names) list += (list.empty() ? "" : ", ") + name;
-      Error("bucket.design_material", "unknown material '" + m_.bucket.design_material +
-                                          "' (known: " + list + ")" +
-                                          Suggest(m_.bucket.design_material, names));
+      std::string searched;
+      for (const auto& folder : m_.materials_searched) {
+        std::error_code error;
+        searched += (searched.empty() ? "" : ", ") + folder +
+                    (std::filesystem::is_directory(folder, error) ? "" : " (no such folder)");
+      }
+      Error("bucket.design_material",
+            "unknown material '" + m_.bucket.design_material + "' (known: " +
+                (list.empty() ? "none" : list) + ")" + Suggest(m_.bucket.design_material, names) +
+                "; searched " + searched + " (--materials DIR names another folder)");
     }
   }
 
@@ -462,6 +491,10 @@ class Validator {
       const int joint = m_.LinkIndex(a.joint);
       const Link& link = m_.links[joint];
       const std::string path = "hydraulics.actuators[" + std::to_string(i) + "]";
+      if (const int first = FirstJointMoving(a); first < joint) {
+        CheckCoupledReach(static_cast<int>(i), first, joint, model);
+        continue;
+      }
       std::vector<double> q(J, 0.0);
       constexpr int kSamples = 721;
       double min_length = 1e300, max_length = -1e300, min_lever = 1e300, max_lever = -1e300;
@@ -503,8 +536,111 @@ class Validator {
               "cylinder passes (near) dead centre over the joint range of '" + link.name +
                   "': lever arm dL/dq goes from " + core::FormatNumber(min_lever) + " to " +
                   core::FormatNumber(max_lever) + " m/rad");
+      } else {
+        CheckLoaderValveSense(path, link, max_lever);
       }
     }
+  }
+
+  // Joints are numbered along the chain; a body rides on every joint up to its depth (the
+  // chassis on none, link k on joints 0..k, the rocker of link k on 0..k through the closure).
+  // A cylinder's length moves with the joints between the depths of its two ends.
+  int BodyDepth(const Mount& mount, int driven_joint) const {
+    if (mount.body == "chassis") return 0;
+    if (mount.body == "rocker") return driven_joint + 1;
+    return m_.LinkIndex(mount.body) + 1;
+  }
+  int FirstJointMoving(const Actuator& a) const {
+    const int joint = m_.LinkIndex(a.joint);
+    return std::min(BodyDepth(a.base_mount, joint), BodyDepth(a.rod_mount, joint));
+  }
+
+  // A cylinder whose length also moves with joints before the one it drives (a frame-mounted
+  // Z-bar tilt cylinder): its stroke limits the driven joint to a window that slides with the
+  // others, as on the real machine (self-levelling). Over a grid of the other joints' ranges,
+  // the window must never be empty, together the windows must reach both joint limits, and the
+  // lever arm on the driven joint must keep one sign wherever the cylinder reaches.
+  void CheckCoupledReach(int actuator, int first, int joint, const InterpretedModel& model) {
+    const Actuator& a = m_.hydraulics.actuators[actuator];
+    const Link& link = m_.links[joint];
+    const std::string path = "hydraulics.actuators[" + std::to_string(actuator) + "]";
+    const int J = model.sizes().num_joints;
+    const int others = joint - first;
+    constexpr int kOtherSamples = 25, kOwnSamples = 361;
+    constexpr double kTolerance = 1e-6, kMinLever = 0.02;
+    const double shortest = a.retracted_length, longest = a.retracted_length + a.stroke;
+    double reach_min = 1e300, reach_max = -1e300, min_lever = 1e300, max_lever = -1e300;
+    int grid = 1;
+    for (int k = 0; k < others; ++k) grid *= kOtherSamples;
+    std::vector<double> q(J, 0.0);
+    for (int cell = 0; cell < grid; ++cell) {
+      int rest = cell;
+      for (int k = first; k < joint; ++k) {
+        const int s = rest % kOtherSamples;
+        rest /= kOtherSamples;
+        q[k] = m_.links[k].joint_min +
+               (m_.links[k].joint_max - m_.links[k].joint_min) * s / (kOtherSamples - 1);
+      }
+      bool any = false;
+      for (int s = 0; s < kOwnSamples; ++s) {
+        q[joint] = link.joint_min + (link.joint_max - link.joint_min) * s / (kOwnSamples - 1);
+        const double length = model.CylinderLength(actuator, q.data());
+        if (!std::isfinite(length)) {
+          Error("arm.links[" + std::to_string(joint) + "].linkage",
+                "the four-bar of '" + link.name + "' cannot close at joint angle " +
+                    DegText(q[joint]) + " (coupler or rocker too short)");
+          return;
+        }
+        if (length < shortest - kTolerance || length > longest + kTolerance) continue;
+        any = true;
+        reach_min = std::min(reach_min, q[joint]);
+        reach_max = std::max(reach_max, q[joint]);
+        const double lever = model.LeverArms(actuator, q.data())[joint];
+        min_lever = std::min(min_lever, lever);
+        max_lever = std::max(max_lever, lever);
+      }
+      if (!any) {
+        std::string where;
+        for (int k = first; k < joint; ++k) {
+          where += (where.empty() ? "" : ", ") + m_.links[k].name + " at " + DegText(q[k]);
+        }
+        Error(path + ".stroke", "with " + where + " the cylinder (" + core::FormatNumber(shortest) +
+                                    " to " + core::FormatNumber(longest) +
+                                    " m pin to pin) reaches no angle of '" + link.name + "' in [" +
+                                    DegText(link.joint_min) + ", " + DegText(link.joint_max) + "]");
+        return;
+      }
+    }
+    const double step = (link.joint_max - link.joint_min) / (kOwnSamples - 1);
+    if (reach_min > link.joint_min + step || reach_max < link.joint_max - step) {
+      Error(path + ".stroke", "over the range of the joints before it the cylinder reaches '" +
+                                  link.name + "' from " + DegText(reach_min) + " to " +
+                                  DegText(reach_max) + ", not its limits [" +
+                                  DegText(link.joint_min) + ", " + DegText(link.joint_max) + "]");
+      return;
+    }
+    if (!(min_lever > kMinLever || max_lever < -kMinLever)) {
+      Error(path + ".rod_mount.point", "cylinder passes (near) dead centre where it reaches '" +
+                                           link.name + "': lever arm dL/dq goes from " +
+                                           core::FormatNumber(min_lever) + " to " +
+                                           core::FormatNumber(max_lever) + " m/rad");
+    } else {
+      CheckLoaderValveSense(path, link, max_lever);
+    }
+  }
+
+  // The loader's controllers (runtime/control) command each valve in its joint's direction and
+  // the plant feeds the cap side for a positive command: a loader cylinder must extend to raise
+  // the boom and to rack the bucket back. A linkage that racks back by retracting drives the
+  // wrong way under them (found with a parallel-lift design in issue 39), so it is refused here
+  // rather than run into a stuck-valve stop. The excavator's servo reads the lever's sign.
+  void CheckLoaderValveSense(const std::string& path, const Link& link, double max_lever) {
+    if (m_.kind != MachineKind::kWheelLoader || max_lever > 0) return;
+    Error(path + ".rod_mount.point",
+          "this cylinder retracts to raise '" + link.name +
+              "' (dL/dq < 0); the loader runtime commands valves in the joint's direction with "
+              "extension raising the boom and racking the bucket back: mount it so that it "
+              "extends (e.g. the bell crank's cylinder pin on the other side of its pivot)");
   }
 
   MachineDescription& m_;
@@ -566,7 +702,9 @@ std::vector<std::string> FindMachineDescriptions(const std::string& models_dir) 
       it.disable_recursion_pending();
       continue;
     }
-    if (it->is_regular_file() && it->path().extension() == ".yaml") {
+    // `<stem>.meta.yaml` is a trained model's provenance (prediction/model_provenance.h).
+    if (it->is_regular_file() && it->path().extension() == ".yaml" &&
+        !name.ends_with(".meta.yaml")) {
       files.push_back(it->path().string());
     }
   }
@@ -816,19 +954,27 @@ MachineDescription LoadMachineDescription(const std::string& path, const LoadOpt
     for (const std::string& overlay : options.overlays) ApplyOverlay(m, overlay, sink);
   }
 
-  const std::string materials_dir =
-      options.materials_dir.empty()
-          ? (std::filesystem::path(path).parent_path() / ".." / "materials")
-                .lexically_normal()
-                .string()
-          : options.materials_dir;
-  try {
-    m.materials = LoadMaterials(materials_dir);
-  } catch (const core::InputError& e) {
-    for (const auto& d : e.diagnostics()) sink.Add(d.where, d.key_path, d.message);
+  // Materials: a name is taken from the first folder searched that has it.
+  m.materials_searched = MaterialFolders(path, options);
+  for (const std::string& folder : m.materials_searched) {
+    try {
+      for (Material& material : LoadMaterials(folder)) {
+        if (!m.FindMaterial(material.name)) m.materials.push_back(std::move(material));
+      }
+    } catch (const core::InputError& e) {
+      for (const auto& d : e.diagnostics()) sink.Add(d.where, d.key_path, d.message);
+    }
+  }
+  // Values outside physical ranges (a bore in mm, a mass in tonnes): impossible ones refuse the
+  // file before the geometry is checked on them, implausible ones are warnings.
+  if (sink.empty()) {
+    PlausibilityFindings plausibility = CheckPlausibility(m);
+    for (auto& d : plausibility.errors) sink.Add(d.where, d.key_path, d.message);
+    m.warnings = std::move(plausibility.warnings);
   }
   if (sink.empty()) Validator(m, sink).Run();
   sink.ThrowIfAny();
+  core::ReportWarnings(m.warnings);
   return m;
 }
 

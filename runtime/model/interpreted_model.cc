@@ -93,41 +93,30 @@ Eigen::Vector4d InterpretedModel::TipFromJoints(const double* q) const {
 
 std::vector<double> InterpretedModel::GravityTorques(const double* q, double payload,
                                                      double pitch) const {
-  // The plant's acceleration with zero velocities, pressures, commands and end-stop forces is
-  // gravity over inertia; a unit-torque probe gives the inertia. Keeping one implementation of
-  // the gravity terms (PlantRhs) avoids a second copy drifting from it.
   const int J = sizes_.num_joints;
-  std::vector<double> x(sizes_.num_states, 0.0), u(sizes_.num_inputs, 0.0);
-  std::vector<double> rest(sizes_.num_states), probe(sizes_.num_states);
-  for (int j = 0; j < J; ++j) x[j] = q[j];
-  u[2 * J] = payload;
-  u[2 * J + 1] = pitch;
-  for (int j = 0; j < J; ++j) u[2 * J + 2 + j] = machine_.hydraulics.pump_pressure;
-  // At zero pressure the only hydraulic force left is the (smooth, tiny) end-stop spring,
-  // removed explicitly below.
-  PlantRhs(x.data(), u.data(), rest.data());
-  std::vector<double> torques(J, 0.0);
-  for (int j = 0; j < sizes_.num_links; ++j) {
-    std::fill(u.begin(), u.begin() + 2 * J, 0.0);
-    u[J + j] = 1.0;
-    PlantRhs(x.data(), u.data(), probe.data());
-    const double inverse_inertia = probe[J + j] - rest[J + j];
-    torques[j] = rest[J + j] / inverse_inertia;
-    u[J + j] = 0.0;
+  const std::vector<double> qd(J, 0.0);
+  std::vector<double> mass(J * J), velocity_terms(J), gravity(J);
+  Dynamics(q, qd.data(), payload, pitch, mass.data(), velocity_terms.data(), gravity.data());
+  return gravity;
+}
+
+std::array<double, 2> InterpretedModel::MechanicalEnergy(const double* q, const double* qd,
+                                                         double payload, double pitch) const {
+  const int J = sizes_.num_joints;
+  std::vector<double> mass(J * J), velocity_terms(J), gravity(J);
+  Dynamics(q, qd, payload, pitch, mass.data(), velocity_terms.data(), gravity.data());
+  double kinetic = 0;
+  for (int i = 0; i < J; ++i) {
+    for (int j = 0; j < J; ++j) kinetic += 0.5 * mass[i * J + j] * qd[i] * qd[j];
   }
-  // Remove the hydraulic contribution at zero pressure (end-stop spring only).
-  for (int j = 0; j < J; ++j) {
-    const int actuator = actuator_of_joint_[j];
-    const Actuator& act = machine_.hydraulics.actuators[actuator];
-    if (act.kind == ActuatorKind::kMotor) continue;
-    const double s = CylinderLength(actuator, q) - act.retracted_length;
-    const double end_force = act.count * plant::kEndStopStiffness *
-                             (internal::SmoothPositive(-s, plant::kEndStopSmoothing) -
-                              internal::SmoothPositive(s - act.stroke, plant::kEndStopSmoothing));
-    const std::vector<double> lever = LeverArms(actuator, q);
-    for (int i = 0; i < sizes_.num_links; ++i) torques[i] -= end_force * lever[i];
+  std::vector<BodyState<double>> bodies;
+  double potential = 0;
+  if (MovingBodies(q, payload, bodies)) {
+    const double g_x = -plant::kGravity * std::sin(pitch);
+    const double g_z = -plant::kGravity * std::cos(pitch);
+    for (const auto& b : bodies) potential -= b.mass * (g_x * b.center.x + g_z * b.center.z);
   }
-  return torques;
+  return {kinetic, potential};
 }
 
 void InterpretedModel::PlantJacobian(const double* x, const double* u, double* jacobian) const {

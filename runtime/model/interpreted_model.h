@@ -25,15 +25,18 @@
 //   ṗ_B = β/V_B (Q_B + A_B ṡ + Q_makeup(p_B) − Q_relief(p_B)), V_B = V_0 + A_B (S − s)
 //   F = p_A A_A − p_B A_B + F_endstop(s, ṡ) (spring and cushion damper past either end);
 //   generalized force F ∂L/∂q_i on every joint i
-//   M_jj(q) q̈_j = Σ F ∂L/∂q_j + Q_gravity,j(q) + τ_ext,j − b_j q̇_j
-// with s = L(q) − L_retracted the cylinder extension. M_jj is the diagonal of the chain's mass
-// matrix (inertia of everything distal to joint j about it); the off-diagonal coupling and
-// velocity terms are left out, which is accurate for hydraulic arms whose joint speeds are
-// below about 1 rad/s. Rocker and coupler masses are neglected. A motor (swing) has
-// ṡ = q̇, A_A = A_B = displacement, constant line volumes and no end stops.
+//   M(q) q̈ + h(q, q̇) = Σ F ∂L/∂q + Q_gravity(q) + τ_ext − b q̇
+// with s = L(q) − L_retracted the cylinder extension. M is the full mass matrix of every moving
+// body (links, payload, rockers, couplers, cylinder barrels and rods), h the Coriolis and
+// centrifugal terms (and the swing's couplings), both from the body positions through the
+// closed chains: M = Σ m J_cᵀJ_c + I J_φᵀJ_φ and h = Σ m J_cᵀ(J̇_c q̇) + I J_φᵀ(J̇_φ q̇), the
+// Jacobians by forward dual numbers and J̇q̇ as a second directional derivative by nested
+// ones (issue 39). A motor (swing) has ṡ = q̇, A_A = A_B = displacement, constant line volumes
+// and no end stops.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -87,6 +90,16 @@ V2<S> operator*(const K& k, const V2<S>& a) {
   return {k * a.x, k * a.z};
 }
 
+/// One moving body of the arm at a configuration: centre of mass in M, angle, mass, inertia
+/// about the centre of mass.
+template <typename S>
+struct BodyState {
+  V2<S> center;
+  S angle;
+  double mass = 0;
+  double inertia = 0;
+};
+
 /// Reference model of one machine. Holds a reference: the description must outlive it.
 class InterpretedModel {
  public:
@@ -129,6 +142,21 @@ class InterpretedModel {
   /// Generalized gravity forces on the link joints [N·m] for joint positions q, a payload [kg]
   /// and the pitch of frame M [rad] (swing: 0).
   std::vector<double> GravityTorques(const double* q, double payload, double pitch) const;
+
+  /// Every moving body at joint positions q (links, the payload point, rockers, couplers,
+  /// cylinder barrels and rods; bodies without mass left out); false if a linkage cannot close.
+  template <typename S>
+  bool MovingBodies(const S* q, double payload, std::vector<BodyState<S>>& bodies) const;
+
+  /// Rigid-body terms: mass matrix (J × J row-major), velocity terms h (Coriolis, centrifugal)
+  /// and generalized gravity forces Q_g, so that M q̈ + h = Q_g + actuator + external forces.
+  template <typename S>
+  void Dynamics(const S* q, const S* qd, double payload, double pitch, S* mass, S* velocity_terms,
+                S* gravity) const;
+
+  /// Kinetic and potential energy of the arm [J] (potential zero at M's origin).
+  std::array<double, 2> MechanicalEnergy(const double* q, const double* qd, double payload,
+                                         double pitch) const;
 
   /// Plant right-hand side ẋ = f(t, x, u) (the model is autonomous: t does not enter).
   template <typename S>
@@ -322,42 +350,8 @@ void InterpretedModel::PlantRhs(const S* x, const double* u, S* xdot) const {
   const double pitch = u[2 * J + 1];
   const Hydraulics& hyd = machine_.hydraulics;
 
-  std::vector<V2<S>> origins;
-  std::vector<S> angles;
-  LinkFrames(q, origins, angles);
-  // Bodies: every link's centre of mass, then the payload point riding on the last link.
-  std::vector<V2<S>> centers(n + 1);
-  std::vector<double> masses(n + 1), inertias(n + 1, 0.0);
-  for (int k = 0; k < n; ++k) {
-    centers[k] = origins[k] + internal::Rotate(angles[k], machine_.links[k].center_of_mass);
-    masses[k] = machine_.links[k].mass;
-    inertias[k] = machine_.links[k].inertia;
-  }
-  centers[n] = origins[n - 1] + internal::Rotate(angles[n - 1], payload_center_);
-  masses[n] = payload;
-  // Gravity expressed in frame M, which is pitched by `pitch` against the horizontal.
-  const double g_x = -plant::kGravity * std::sin(pitch);
-  const double g_z = -plant::kGravity * std::cos(pitch);
-
-  std::vector<S> generalized(J, S(0.0));
-  std::vector<S> inertia(J, S(0.0));
-  for (int j = 0; j < n; ++j) {
-    for (int body = 0; body <= n; ++body) {
-      const int link_of_body = body == n ? n - 1 : body;
-      if (link_of_body < j) continue;
-      const V2<S> r = centers[body] - origins[j];
-      // ∂c/∂q_j = perp(c − o_j) = (−r_z, r_x) for every body distal to joint j.
-      generalized[j] += masses[body] * (g_x * -r.z + g_z * r.x);
-      inertia[j] += masses[body] * (r.x * r.x + r.z * r.z) + inertias[body];
-    }
-  }
-  if (machine_.swing) {
-    inertia[J - 1] = S(machine_.swing->inertia);
-    for (int body = 0; body <= n; ++body) {
-      const S radial = centers[body].x + machine_.arm_pivot.x();
-      inertia[J - 1] += masses[body] * radial * radial;
-    }
-  }
+  std::vector<S> mass(J * J), velocity_terms(J), generalized(J);
+  Dynamics(q, qd, payload, pitch, mass.data(), velocity_terms.data(), generalized.data());
 
   const double p_tank = hyd.tank_pressure;
   for (int j = 0; j < J; ++j) {
@@ -409,11 +403,146 @@ void InterpretedModel::PlantRhs(const S* x, const double* u, S* xdot) const {
     const S force = pa[j] * area_a - pb[j] * area_b + end_force;
     for (int i = 0; i < J; ++i) generalized[i] += force * lever[i];
   }
+  std::vector<S> force(J);
   for (int j = 0; j < J; ++j) {
     const double friction =
         j < n ? machine_.links[j].viscous_friction : machine_.swing->viscous_friction;
     xdot[j] = qd[j];
-    xdot[J + j] = (generalized[j] + tau_ext[j] - friction * qd[j]) / inertia[j];
+    force[j] = generalized[j] + tau_ext[j] - friction * qd[j] - velocity_terms[j];
+  }
+  // M q̈ = force by Gaussian elimination (M is symmetric positive definite: no pivoting).
+  for (int k = 0; k < J; ++k) {
+    for (int i = k + 1; i < J; ++i) {
+      const S factor = mass[i * J + k] / mass[k * J + k];
+      for (int c = k; c < J; ++c) mass[i * J + c] = mass[i * J + c] - factor * mass[k * J + c];
+      force[i] = force[i] - factor * force[k];
+    }
+  }
+  for (int i = J - 1; i >= 0; --i) {
+    S value = force[i];
+    for (int c = i + 1; c < J; ++c) value = value - mass[i * J + c] * xdot[J + c];
+    xdot[J + i] = value / mass[i * J + i];
+  }
+}
+
+template <typename S>
+bool InterpretedModel::MovingBodies(const S* q, double payload,
+                                    std::vector<BodyState<S>>& bodies) const {
+  using std::atan2;
+  using std::sqrt;
+  const int n = sizes_.num_links;
+  std::vector<V2<S>> origins;
+  std::vector<S> angles;
+  LinkFrames(q, origins, angles);
+  bodies.clear();
+  for (int k = 0; k < n; ++k) {
+    const Link& link = machine_.links[k];
+    bodies.push_back({origins[k] + internal::Rotate(angles[k], link.center_of_mass), angles[k],
+                      link.mass, link.inertia});
+  }
+  bodies.push_back({origins[n - 1] + internal::Rotate(angles[n - 1], payload_center_),
+                    angles[n - 1], payload, 0.0});
+  bool ok = true;
+  for (int k = 1; k < n; ++k) {
+    if (!machine_.links[k].linkage) continue;
+    const FourBarLinkage& bar = *machine_.links[k].linkage;
+    V2<S> pivot;
+    S rocker_angle;
+    if (!SolveLinkage(k, origins, angles, pivot, rocker_angle)) return false;
+    if (bar.rocker_mass > 0) {
+      bodies.push_back({pivot + internal::Rotate(rocker_angle, bar.rocker_center_of_mass),
+                        rocker_angle, bar.rocker_mass, bar.rocker_inertia});
+    }
+    if (bar.coupler_mass > 0) {
+      const V2<S> f =
+          pivot + internal::Rotate(rocker_angle, Eigen::Vector2d(bar.rocker_length, 0.0));
+      const V2<S> g = origins[k] + internal::Rotate(angles[k], bar.child_coupler_point);
+      const V2<S> fg = g - f;
+      bodies.push_back({0.5 * (f + g), atan2(fg.z, fg.x), bar.coupler_mass, bar.coupler_inertia});
+    }
+  }
+  for (const Actuator& act : machine_.hydraulics.actuators) {
+    if (act.kind != ActuatorKind::kCylinder || (act.barrel_mass <= 0 && act.rod_mass <= 0)) {
+      continue;
+    }
+    const int joint_link = machine_.LinkIndex(act.joint);
+    const V2<S> base = PointInM(act.base_mount, joint_link, origins, angles, ok);
+    const V2<S> rod = PointInM(act.rod_mount, joint_link, origins, angles, ok);
+    if (!ok) return false;
+    const V2<S> axis = rod - base;
+    const S length = sqrt(axis.x * axis.x + axis.z * axis.z);
+    const S angle = atan2(axis.z, axis.x);
+    const V2<S> unit{axis.x / length, axis.z / length};
+    // Barrel and rod as slender uniform bars of twice their centre's distance from the pin.
+    if (act.barrel_mass > 0) {
+      bodies.push_back({base + act.barrel_center * unit, angle, act.count * act.barrel_mass,
+                        act.count * act.barrel_mass * act.barrel_center * act.barrel_center / 3});
+    }
+    if (act.rod_mass > 0) {
+      bodies.push_back({rod - act.rod_center * unit, angle, act.count * act.rod_mass,
+                        act.count * act.rod_mass * act.rod_center * act.rod_center / 3});
+    }
+  }
+  return true;
+}
+
+template <typename S>
+void InterpretedModel::Dynamics(const S* q, const S* qd, double payload, double pitch, S* mass,
+                                S* velocity_terms, S* gravity) const {
+  const int J = sizes_.num_joints, n = sizes_.num_links;
+  const double g_x = -plant::kGravity * std::sin(pitch);
+  const double g_z = -plant::kGravity * std::cos(pitch);
+  const S nan(std::numeric_limits<double>::quiet_NaN());
+  // Body Jacobians, one forward pass per link joint.
+  std::vector<std::vector<BodyState<Dual<S>>>> seeded(n);
+  std::vector<Dual<S>> qs(J);
+  for (int k = 0; k < n; ++k) {
+    for (int i = 0; i < J; ++i) qs[i] = Dual<S>(q[i], S(i == k ? 1.0 : 0.0));
+    if (!MovingBodies(qs.data(), payload, seeded[k])) {
+      for (int i = 0; i < J * J; ++i) mass[i] = nan;
+      for (int i = 0; i < J; ++i) velocity_terms[i] = gravity[i] = nan;
+      return;
+    }
+  }
+  // J̇q̇ = d²c(q + s q̇)/ds² at s = 0: nested dual numbers seeded with q̇ at both levels.
+  std::vector<Dual<Dual<S>>> qq(J);
+  for (int i = 0; i < J; ++i) {
+    qq[i] = Dual<Dual<S>>(Dual<S>(q[i], qd[i]), Dual<S>(qd[i], S(0.0)));
+  }
+  std::vector<BodyState<Dual<Dual<S>>>> curved;
+  MovingBodies(qq.data(), payload, curved);
+  for (int i = 0; i < J * J; ++i) mass[i] = S(0.0);
+  for (int i = 0; i < J; ++i) velocity_terms[i] = gravity[i] = S(0.0);
+  S swing_inertia(0.0), swing_momentum_rate(0.0);
+  for (std::size_t b = 0; b < curved.size(); ++b) {
+    const double m = curved[b].mass, inertia = curved[b].inertia;
+    const S ax = curved[b].center.x.d.d, az = curved[b].center.z.d.d, aphi = curved[b].angle.d.d;
+    for (int i = 0; i < n; ++i) {
+      const BodyState<Dual<S>>& bi = seeded[i][b];
+      for (int j = 0; j < n; ++j) {
+        const BodyState<Dual<S>>& bj = seeded[j][b];
+        mass[i * J + j] = mass[i * J + j] +
+                          m * (bi.center.x.d * bj.center.x.d + bi.center.z.d * bj.center.z.d) +
+                          inertia * bi.angle.d * bj.angle.d;
+      }
+      velocity_terms[i] = velocity_terms[i] + m * (bi.center.x.d * ax + bi.center.z.d * az) +
+                          inertia * bi.angle.d * aphi;
+      gravity[i] = gravity[i] + m * (g_x * bi.center.x.d + g_z * bi.center.z.d);
+    }
+    if (machine_.swing) {
+      const S radial = curved[b].center.x.v.v + machine_.arm_pivot.x();
+      const S radial_rate = curved[b].center.x.v.d;
+      swing_inertia = swing_inertia + m * radial * radial;
+      swing_momentum_rate = swing_momentum_rate + 2.0 * m * radial * radial_rate * qd[n];
+      for (int i = 0; i < n; ++i) {
+        velocity_terms[i] =
+            velocity_terms[i] - m * radial * seeded[i][b].center.x.d * qd[n] * qd[n];
+      }
+    }
+  }
+  if (machine_.swing) {
+    mass[n * J + n] = machine_.swing->inertia + swing_inertia;
+    velocity_terms[n] = swing_momentum_rate;
   }
 }
 

@@ -299,17 +299,25 @@ Plant::Plant(const model::MachineDescription& machine, const generated::MachineF
   const std::vector<double> gravity = reference.GravityTorques(initial.q.data(), 0.0, 0.0);
   const double tank = machine.hydraulics.tank_pressure;
   const double back = tank + 1e6;
-  for (int j = 0; j < J; ++j) {
+  // Distal joints first: a cylinder may also push on joints before the one it drives (a
+  // frame-mounted tilt cylinder moves with the boom), never on those after it.
+  std::vector<double> cylinder_force(J, 0.0);
+  for (int j = J - 1; j >= 0; --j) {
     y_[j] = initial.q[j];
     y_[3 * J + j] = y_[4 * J + j] = back;
     const int a = actuator_of_joint[j];
     const model::Actuator& act = machine.hydraulics.actuators[a];
     if (act.kind != model::ActuatorKind::kCylinder) continue;
+    double torque = -gravity[j];
+    for (int k = j + 1; k < J; ++k) {
+      torque -= cylinder_force[k] * reference.LeverArms(actuator_of_joint[k], initial.q.data())[j];
+    }
     const double lever = functions.lever_arm(a, initial.q.data());
     const double area_a = act.count * std::numbers::pi / 4 * act.bore * act.bore;
     const double area_b =
         act.count * std::numbers::pi / 4 * (act.bore * act.bore - act.rod * act.rod);
-    const double force = std::abs(lever) > 1e-6 ? -gravity[j] / lever : 0.0;
+    const double force = std::abs(lever) > 1e-6 ? torque / lever : 0.0;
+    cylinder_force[j] = force;
     double p_a = (force + back * area_b) / area_a, p_b = back;
     if (p_a < back) p_a = back, p_b = (back * area_a - force) / area_b;
     y_[3 * J + j] = std::clamp(p_a, tank, act.relief_pressure);
@@ -578,6 +586,8 @@ double Plant::ActuatorPressure(int actuator, bool cap_side) const {
   const int joint = functions_.actuator_joint[actuator];
   return cap_side ? state_.pressure_a[joint] : state_.pressure_b[joint];
 }
+
+double Plant::PumpPressure() const { return system_->held().pump_pressure; }
 
 double Plant::HydraulicPower() const {
   std::vector<double> ydot(y_.size());

@@ -47,9 +47,18 @@ TEST(GeneratedPlant, RightHandSideMatchesInterpreted) {
       std::vector<double> generated(x.size()), reference(x.size());
       m.generated->plant_rhs(0.0, x.data(), u.data(), generated.data());
       m.interpreted->PlantRhs(x.data(), u.data(), reference.data());
+      const std::size_t J = static_cast<std::size_t>(m.generated->num_joints);
       for (std::size_t r = 0; r < x.size(); ++r) {
         ASSERT_TRUE(std::isfinite(generated[r]));
-        ASSERT_NEAR(generated[r], reference[r], 1e-9 * std::max(1.0, std::abs(reference[r])))
+        // The accelerations solve M q̈ = force, by Cholesky in the generated code and Gaussian
+        // elimination in the reference, where the random cylinder forces (up to ~1e6 N, on a
+        // frame-mounted tilt cylinder acting on both joints) largely cancel: rounding then
+        // reaches ~1e-9 of the result. A modelling difference is of order one.
+        const double relative = (r >= J && r < 2 * J) ? 1e-7 : 1e-9;
+        // Pressure rates are differences of flow terms of order β/V·Q ~ 1e6 Pa/s: a result near
+        // zero is compared on that scale (1e3 Pa/s floor), not on its own.
+        const double floor = r >= 3 * J ? 1e3 : 1.0;
+        ASSERT_NEAR(generated[r], reference[r], relative * std::max(floor, std::abs(reference[r])))
             << m.generated->name << " row " << r;
       }
     }
@@ -110,28 +119,40 @@ TEST(GeneratedPlant, ClosedValveHoldsTheArmAtStaticBalance) {
     std::vector<double> x(g.num_states, 0.0), u(g.num_inputs, 0.0), xdot(g.num_states);
     for (int j = 0; j < J; ++j) x[j] = q[j];
     const double tank = m.description->hydraulics.tank_pressure;
-    // Solve each cylinder's cap-side pressure for the force that balances gravity (proximal
-    // joints first is unnecessary: each joint's torque balance involves only its own cylinder,
-    // since every cylinder spans exactly its own joint).
-    for (int j = 0; j < J; ++j) {
-      const auto& a = m.description->hydraulics.actuators[m.interpreted->ActuatorOfJoint(j)];
+    // Solve each cylinder's force that balances gravity, distal joints first: a cylinder may
+    // also push on the joints before the one it drives (a frame-mounted tilt cylinder), never
+    // on those after it, so the balance is triangular.
+    std::vector<double> cylinder_force(J, 0.0);
+    for (int j = J - 1; j >= 0; --j) {
+      double torque = -gravity[j];
+      for (int k = j + 1; k < J; ++k) {
+        const int other = m.interpreted->ActuatorOfJoint(k);
+        torque -= cylinder_force[k] * m.interpreted->LeverArms(other, q.data())[j];
+      }
+      const int actuator = m.interpreted->ActuatorOfJoint(j);
+      const auto& a = m.description->hydraulics.actuators[actuator];
       x[4 * J + j] = tank;
       if (a.kind == model::ActuatorKind::kMotor) {
         x[3 * J + j] = tank;
         continue;
       }
-      const double lever = g.lever_arm(m.interpreted->ActuatorOfJoint(j), q.data());
+      cylinder_force[j] = torque / g.lever_arm(actuator, q.data());
       const double area_a = a.count * M_PI / 4 * a.bore * a.bore;
       const double area_b = a.count * M_PI / 4 * (a.bore * a.bore - a.rod * a.rod);
-      const double force = -gravity[j] / lever;  // required cylinder force [N]
-      x[3 * J + j] = (force + tank * area_b) / area_a;
+      // The smooth end-stop spring pushes a little even mid-stroke: the pressure makes up the
+      // rest of the force.
+      const double extension = g.cylinder_length(actuator, q.data()) - a.retracted_length;
+      const double end_force =
+          a.count * model::plant::kEndStopStiffness *
+          (model::internal::SmoothPositive(-extension, model::plant::kEndStopSmoothing) -
+           model::internal::SmoothPositive(extension - a.stroke, model::plant::kEndStopSmoothing));
+      x[3 * J + j] = (cylinder_force[j] - end_force + tank * area_b) / area_a;
     }
     for (int j = 0; j < J; ++j) u[2 * J + 2 + j] = m.description->hydraulics.pump_pressure;
     g.plant_rhs(0.0, x.data(), u.data(), xdot.data());
     for (int j = 0; j < J; ++j) {
-      // Unbalanced, gravity alone would give several rad/s²; the smooth end-stop spring leaves
-      // a residue of order 1e-3.
-      EXPECT_NEAR(xdot[J + j], 0.0, 1e-2) << g.name << " joint " << j;  // [rad/s²]
+      // Unbalanced, gravity alone would give several rad/s²; balanced, only rounding remains.
+      EXPECT_NEAR(xdot[J + j], 0.0, 1e-6) << g.name << " joint " << j;  // [rad/s²]
       EXPECT_EQ(xdot[j], 0.0);
       EXPECT_EQ(xdot[2 * J + j], 0.0);
     }

@@ -1,5 +1,8 @@
 #include "runtime/core/diagnostics.h"
 
+#include <iostream>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -24,8 +27,19 @@ std::string SourceLocation::ToString() const {
 
 std::string Diagnostic::ToString() const {
   std::string text = where.ToString() + ": ";
+  if (severity == Severity::kWarning) text += "warning: ";
   if (!key_path.empty()) text += key_path + ": ";
   return text + message;
+}
+
+void ReportWarnings(const std::vector<Diagnostic>& warnings) {
+  static std::mutex mutex;
+  static std::set<std::string> reported;
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const Diagnostic& warning : warnings) {
+    const std::string line = warning.ToString();
+    if (reported.insert(line).second) std::cerr << line << '\n';
+  }
 }
 
 void DiagnosticSink::Add(SourceLocation where, std::string key_path, std::string message) {

@@ -19,15 +19,25 @@ struct SourceLocation {
   std::string ToString() const;
 };
 
+/// An error refuses the file; a warning (a value outside physical ranges that still loads, see
+/// runtime/model/plausibility.h) is reported and the file is used.
+enum class Severity { kError, kWarning };
+
 /// One problem in an input file.
 struct Diagnostic {
   SourceLocation where;
   std::string key_path;  ///< e.g. `arm.links[1].length`; empty for file-level problems
   std::string message;   ///< what is wrong and what was expected
+  Severity severity = Severity::kError;
 
-  /// `file:line:column: key.path: message` on one line.
+  /// `file:line:column: key.path: message` on one line; a warning reads
+  /// `file:line:column: warning: key.path: message` (the compilers' form).
   std::string ToString() const;
 };
+
+/// Writes each warning once per process to standard error (a description loaded by every job
+/// of a campaign warns once).
+void ReportWarnings(const std::vector<Diagnostic>& warnings);
 
 /// Collects diagnostics while a file is read, so that one run reports every problem.
 class DiagnosticSink {

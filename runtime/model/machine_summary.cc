@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "runtime/model/interpreted_model.h"
+#include "runtime/model/spec_sheet.h"
 
 namespace autoshovel::model {
 namespace {
@@ -13,6 +14,57 @@ constexpr int kGrid = 121;  // samples per joint for workspace sweeps
 constexpr int kMapColumns = 64, kMapRows = 20;
 
 double Lerp(double a, double b, double t) { return a + (b - a) * t; }
+
+// A loader's cylinder that slides a window over its joint with the boom (see ActuatorSummary):
+// stroke use, levers and margins over what it reaches, the windows at the boom's limits and at
+// carry, and how far its ends let the joint pass the joint's limits.
+void SummarizeSlidingWindow(const MachineDescription& m, const InterpretedModel& model,
+                            int actuator, int joint, const std::vector<double>& carry,
+                            ActuatorSummary& summary) {
+  constexpr int kBoomSamples = 41;
+  constexpr double kSearch = std::numbers::pi / 2;  // how far past the limits overruns are sought
+  const Link& link = m.links[joint];
+  const Link& boom = m.links[0];
+  summary.moves_with_earlier_joints = true;
+  summary.lever_min = 1e300;
+  summary.lever_max = 0;
+  double shortest = 1e300, longest = -1e300;
+  std::vector<double> q = carry;
+  for (int i = 0; i < kBoomSamples; ++i) {
+    q[0] = Lerp(boom.joint_min, boom.joint_max, double(i) / (kBoomSamples - 1));
+    const JointWindow wide = ReachableJointWindow(m, joint, q.data(), kSearch);
+    if (wide.empty) continue;
+    summary.overrun_below_min = std::max(summary.overrun_below_min, link.joint_min - wide.min);
+    summary.overrun_above_max = std::max(summary.overrun_above_max, wide.max - link.joint_max);
+    const double low = std::max(wide.min, link.joint_min), high = std::min(wide.max, link.joint_max);
+    for (int k = 0; k < kGrid && low <= high; ++k) {
+      q[joint] = Lerp(low, high, double(k) / (kGrid - 1));
+      const double length = model.CylinderLength(actuator, q.data());
+      shortest = std::min(shortest, length);
+      longest = std::max(longest, length);
+      const double lever = std::abs(model.LeverArms(actuator, q.data())[joint]);
+      summary.lever_min = std::min(summary.lever_min, lever);
+      summary.lever_max = std::max(summary.lever_max, lever);
+    }
+  }
+  if (longest < shortest) {  // reaches nothing within the limits (the validator refuses that)
+    summary.lever_min = 0;
+    return;
+  }
+  summary.length_at_joint_min = shortest;
+  summary.length_at_joint_max = longest;
+  summary.stroke_used = longest - shortest;
+  const auto window = [&](double boom_angle, double& low, double& high) {
+    std::vector<double> at = carry;
+    at[0] = boom_angle;
+    const JointWindow w = ReachableJointWindow(m, joint, at.data());
+    low = w.empty ? 0 : w.min;
+    high = w.empty ? 0 : w.max;
+  };
+  window(carry[0], summary.window_carry_min, summary.window_carry_max);
+  window(boom.joint_max, summary.window_top_min, summary.window_top_max);
+  window(boom.joint_min, summary.window_bottom_min, summary.window_bottom_max);
+}
 
 }  // namespace
 
@@ -79,24 +131,40 @@ MachineSummary Summarize(const MachineDescription& m) {
 
   // Carry pose: loaders carry low with the bucket racked back; excavators are summarised in
   // the middle of every joint range.
-  s.carry_pose.assign(J, 0.0);
+  s.carry_pose = CarryPose(m);
   if (m.kind == MachineKind::kWheelLoader) {
-    s.carry_pose[0] = Lerp(m.links[0].joint_min, m.links[0].joint_max, 0.2);
-    s.carry_pose[1] = m.links[1].joint_max;
-    s.carry_pose_definition = "boom at 20% of its range from the bottom, bucket racked back fully";
-    // Dump pose: boom at the top, bucket 45° below horizontal.
-    const double q2 = -std::numbers::pi / 4 - m.links[0].joint_max;
-    if (q2 >= m.links[1].joint_min && q2 <= m.links[1].joint_max) {
+    s.carry_pose_definition =
+        "boom at 20% of its range from the bottom, bucket racked back fully (as far as its "
+        "cylinder reaches there)";
+    // Dump pose (SAE J732, ISO 7131): boom at its upper limit, the bucket's discharge angle 45°,
+    // the angle of the floor (the longest flat section of the inside bottom: the profile's edge
+    // from the cutting edge, its first point, to the second) below horizontal. The floor runs
+    // from the heel up to the tip at angle β above the pin-to-tip line in the bucket frame, so
+    // the bucket frame is at φ₂ = −45° − β and the cutting edge is the bucket's lowest point.
+    const Eigen::Vector2d floor = m.bucket.profile[0] - m.bucket.profile[1];
+    s.dump_floor_to_edge_line = std::atan2(floor.y(), floor.x()) -
+                                std::atan2(m.bucket.profile[0].y(), m.bucket.profile[0].x());
+    const double phi2 = -std::numbers::pi / 4 - std::atan2(floor.y(), floor.x());
+    std::vector<double> dump_q = {m.links[0].joint_max, phi2 - m.links[0].joint_max};
+    double deepest = m.links[1].joint_min, shallowest = m.links[1].joint_max;
+    if (CylinderMovesWithEarlierJoints(m, 1)) {
+      const JointWindow w = ReachableJointWindow(m, 1, dump_q.data());
+      deepest = w.empty ? shallowest : std::max(deepest, w.min);
+      shallowest = w.empty ? deepest : std::min(shallowest, w.max);
+    }
+    s.dump_floor_at_limit = m.links[0].joint_max + deepest + std::atan2(floor.y(), floor.x());
+    const bool reachable = dump_q[1] >= deepest - 1e-9 && dump_q[1] <= shallowest + 1e-9;
+    if (reachable) {
       s.dump_pose_reachable = true;
-      const double dump_q[2] = {m.links[0].joint_max, q2};
-      const Eigen::Vector4d pose = model.TipFromJoints(dump_q);
+      s.dump_pose = dump_q;
+      const Eigen::Vector4d pose = model.TipFromJoints(dump_q.data());
       s.dump_clearance = pose[2];
+      // Reach is measured from the foremost point of the machine without its bucket; of the
+      // machine, a description knows the tyres: the front of the front tyres.
       const double tyre_front = m.chassis.hinge_to_front_axle + m.chassis.wheel_radius;
       s.dump_reach = pose[0] - tyre_front;
     }
   } else {
-    for (int k = 0; k < n; ++k)
-      s.carry_pose[k] = Lerp(m.links[k].joint_min, m.links[k].joint_max, 0.5);
     s.carry_pose_definition = "every joint in the middle of its range";
   }
 
@@ -111,21 +179,26 @@ MachineSummary Summarize(const MachineDescription& m) {
     const int actuator = static_cast<int>(i);
     if (!summary.is_motor) {
       const int joint = m.LinkIndex(a.joint);
-      std::vector<double> qs = s.carry_pose;
-      qs[joint] = m.links[joint].joint_min;
-      summary.length_at_joint_min = model.CylinderLength(actuator, qs.data());
-      qs[joint] = m.links[joint].joint_max;
-      summary.length_at_joint_max = model.CylinderLength(actuator, qs.data());
       summary.retracted_length = a.retracted_length;
       summary.stroke = a.stroke;
-      summary.stroke_used = std::abs(summary.length_at_joint_max - summary.length_at_joint_min);
-      summary.lever_min = 1e300;
-      for (int k = 0; k < kGrid; ++k) {
-        qs[joint] =
-            Lerp(m.links[joint].joint_min, m.links[joint].joint_max, double(k) / (kGrid - 1));
-        const double lever = std::abs(model.LeverArms(actuator, qs.data())[joint]);
-        summary.lever_min = std::min(summary.lever_min, lever);
-        summary.lever_max = std::max(summary.lever_max, lever);
+      if (m.kind == MachineKind::kWheelLoader && joint > 0 &&
+          CylinderMovesWithEarlierJoints(m, joint)) {
+        SummarizeSlidingWindow(m, model, actuator, joint, s.carry_pose, summary);
+      } else {
+        std::vector<double> qs = s.carry_pose;
+        qs[joint] = m.links[joint].joint_min;
+        summary.length_at_joint_min = model.CylinderLength(actuator, qs.data());
+        qs[joint] = m.links[joint].joint_max;
+        summary.length_at_joint_max = model.CylinderLength(actuator, qs.data());
+        summary.stroke_used = std::abs(summary.length_at_joint_max - summary.length_at_joint_min);
+        summary.lever_min = 1e300;
+        for (int k = 0; k < kGrid; ++k) {
+          qs[joint] =
+              Lerp(m.links[joint].joint_min, m.links[joint].joint_max, double(k) / (kGrid - 1));
+          const double lever = std::abs(model.LeverArms(actuator, qs.data())[joint]);
+          summary.lever_min = std::min(summary.lever_min, lever);
+          summary.lever_max = std::max(summary.lever_max, lever);
+        }
       }
       summary.lever_at_carry = model.LeverArms(actuator, s.carry_pose.data())[joint];
       const double piston_area = a.count * std::numbers::pi / 4 * a.bore * a.bore;

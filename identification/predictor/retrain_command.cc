@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <functional>
 #include <ostream>
+#include <set>
 #include <thread>
 
 #include "identification/predictor/svr_training.h"
 #include "runtime/core/file_output.h"
 #include "runtime/model/description.h"
+#include "runtime/prediction/model_provenance.h"
 #include "runtime/prediction/penetration_predictor.h"
 #include "runtime/prediction/shipped_models.h"
 #include "runtime/results/results_db.h"
@@ -74,22 +76,54 @@ void PrintScore(std::ostream& out, const char* name, const Score& s) {
   out << line;
 }
 
+int Threads(int requested) {
+  return requested > 0 ? requested
+                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+// Without a database: crowding runs on the machine's simulated plant (plant_training.h).
+int TrainOnThePlant(const RetrainOptions& o, std::ostream& out, std::ostream& err) {
+  PlantTrainingOptions p = o.plant;
+  p.machine = o.machine;
+  p.models_dir = o.models_dir;
+  p.out = o.out;
+  p.threads = Threads(o.threads);
+  p.command = kCommand;
+  p.compare_with = o.base;  // scored on the same test runs when given
+  return RunPlantTraining(p, out, err);
+}
+
 }  // namespace
+
+PlantTrainingOptions RetrainOptions::MainJobPlantTraining() {
+  PlantTrainingOptions p;
+  p.runs = 2000;
+  p.seed = 1;
+  p.run_options.min_speed = p.run_options.max_speed = 1.5;
+  p.scoop_deceleration = 0.6;
+  p.dug_face_fraction = 0.4;
+  p.travel_curve = true;
+  p.intake_factor = true;
+  return p;
+}
 
 int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream& err) {
   try {
     if (o.out.empty()) {
-      err << kCommand << ": give --out STEM for the new model (.model and .scale)\n";
+      err << kCommand << ": give --out STEM for the new model (.model, .scale and .meta.yaml)\n";
       return 2;
     }
-    const std::string base = o.base.empty() ? prediction::MainJobPredictor(o.models_dir) : o.base;
-    for (const char* ext : {".model", ".scale"}) {
-      if (std::filesystem::exists(o.out + ext)) {
-        err << kCommand << ": " << o.out << ext
+    for (const std::string& path :
+         {o.out + ".model", o.out + ".scale", prediction::ProvenancePath(o.out),
+          prediction::PenetrationPredictor::TravelModelPath(o.out, 0)}) {
+      if (std::filesystem::exists(path)) {
+        err << kCommand << ": " << path
             << " already exists; a model is never overwritten (choose another --out)\n";
         return 2;
       }
     }
+    if (o.database.empty()) return TrainOnThePlant(o, out, err);
+    const std::string base = o.base.empty() ? prediction::MainJobPredictor(o.models_dir) : o.base;
     if (std::filesystem::weakly_canonical(o.out + ".model") ==
         std::filesystem::weakly_canonical(base + ".model")) {
       err << kCommand << ": --out is the base model\n";
@@ -104,11 +138,21 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
     const prediction::PenetrationPredictor shipped = prediction::PenetrationPredictor::Load(base);
 
     std::vector<results::CrowdingSample> training, held_out;
-    int skipped = 0;
+    int skipped = 0, other_machines = 0;
     {
       // Read-only and checked with PRAGMA integrity_check; values through the typed reader.
       const results::ResultsDb db(o.database, results::ResultsDb::Access::kReadOnly);
+      // Samples of another machine's runs would teach this machine's model another machine's
+      // travel: only runs of --machine count.
+      std::set<std::string> runs_of_machine;
+      for (const results::RunInfo& run : db.Runs()) {
+        if (run.machine == machine.name) runs_of_machine.insert(run.run_id);
+      }
       for (const results::ResultsDb::StoredCrowdingSample& s : db.CrowdingSamples()) {
+        if (!runs_of_machine.contains(s.run_id)) {
+          ++other_machines;
+          continue;
+        }
         if (o.strategy != "all" && s.sample.strategy != o.strategy) {
           ++skipped;
           continue;
@@ -116,10 +160,11 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
         (HeldOut(s.run_id, s.cycle) ? held_out : training).push_back(s.sample);
       }
     }
-    out << o.database << ": " << training.size() + held_out.size() << " crowding samples ("
-        << (o.strategy == "all" ? "every strategy" : o.strategy) << "; " << skipped
-        << " of other strategies left out): " << training.size() << " to train, " << held_out.size()
-        << " held out\n";
+    out << o.database << ": " << training.size() + held_out.size() << " crowding samples of "
+        << machine.name << " (" << (o.strategy == "all" ? "every strategy" : o.strategy) << "; "
+        << skipped << " of other strategies and " << other_machines
+        << " of other machines' runs left out): " << training.size() << " to train, "
+        << held_out.size() << " held out\n";
     if (static_cast<int>(training.size()) < kMinTrainingSamples || held_out.empty()) {
       err << kCommand << ": too few samples to train (" << training.size() << "; at least "
           << kMinTrainingSamples << " and one held out): run a longer campaign first\n";
@@ -159,14 +204,21 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
                             o.strategy + ")");
     const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
     core::CreateFolders(parent);
-    const int threads = o.threads > 0
-                            ? o.threads
-                            : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    const int threads = Threads(o.threads);
     SvrGrid grid;
     grid.folds = std::min(grid.folds, static_cast<int>(train.x.size()));
     const SvrTrainingResult fit = TrainPenetrationSvr(train, grid, threads, scaling, o.out);
     const prediction::PenetrationPredictor retrained =
         prediction::PenetrationPredictor::Load(o.out);
+    prediction::ModelProvenance provenance;
+    provenance.machine = machine.name;
+    provenance.description = std::filesystem::path(machine.source_file).filename().string();
+    provenance.sha256 = machine.sha256;
+    provenance.plant_samples = "crowding samples logged by runs of " + machine.name + " in " +
+                               o.database + " (" + std::to_string(train.x.size()) + " trained on)";
+    provenance.plant_code = "as the database's runs ran it (not recorded there)";
+    provenance.trained_by = scaling.notes.back().substr(std::string("retrained by: ").size());
+    prediction::SaveProvenance(o.out, provenance);
 
     char line[300];
     std::snprintf(line, sizeof line,
@@ -179,7 +231,8 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
            "|\n| --- | --- | --- | --- | --- | --- | --- |\n";
     PrintScore(out, ("shipped " + base).c_str(), ScoreModel(shipped, held_out));
     PrintScore(out, ("retrained " + o.out).c_str(), ScoreModel(retrained, held_out));
-    out << "\nmodel: " << o.out << ".model, " << o.out << ".scale\n";
+    out << "\nmodel: " << o.out << ".model, " << o.out << ".scale, "
+        << prediction::ProvenancePath(o.out) << "\n";
     return 0;
   } catch (const std::exception& e) {
     err << kCommand << ": " << e.what() << "\n";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -24,12 +25,18 @@ struct CellStats {
   std::string strategies;  ///< strategy counts
 };
 
-CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err) {
+// `warned`: the warnings already printed (a model trained on another machine is said once).
+CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
+                  std::set<std::string>& warned) {
   CellStats c;
   std::vector<std::pair<std::string, int>> counts;
   for (int t = 1; t <= trials; ++t) {
     options.seed = static_cast<std::uint64_t>(t);
     ShovelJob job(options);
+    if (const std::string m = job.PredictorMachineMismatch();
+        !m.empty() && warned.insert(m).second) {
+      err << "autoshovel compare: warning: " << m << "\n";
+    }
     const CycleOutcome out = job.RunCycle(0, {}, nullptr);
     const results::CycleRecord& r = out.record;
     ++c.cycles;
@@ -81,6 +88,7 @@ ShovelRunOptions Base(const CompareOptions& o) {
 }
 
 int Table4(const CompareOptions& o, std::ostream& out, std::ostream& err) {
+  std::set<std::string> warned;
   struct Scenario {
     const char* label;
     const char* name;
@@ -100,7 +108,7 @@ int Table4(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       options.scenario = s.name;
       options.selection = method;
       options.policy = control::ScoopPolicy::kStairway;
-      const CellStats c = RunCell(options, o.trials, err);
+      const CellStats c = RunCell(options, o.trials, err, warned);
       char line[300];
       std::snprintf(line, sizeof line,
                     "| %s | %s | %s | %.2f (%.2f) | %d/%d | %d | %.2f | %.2f |\n",
@@ -114,6 +122,7 @@ int Table4(const CompareOptions& o, std::ostream& out, std::ostream& err) {
 }
 
 int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
+  std::set<std::string> warned;
   struct Row {
     const char* trigger_name;
     TriggerChoice trigger;
@@ -155,7 +164,7 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       options.trigger = row.trigger;
       options.policy = row.policy;
       options.stairway_steps = 3;
-      const CellStats c = RunCell(options, o.trials, err);
+      const CellStats c = RunCell(options, o.trials, err, warned);
       char line[400];
       std::snprintf(line, sizeof line,
                     "| %s | %s | %s | %.2f (%.2f) | %.1f (%.1f) | %.2f | %.1f (%.1f) | %.2f | %.1f "

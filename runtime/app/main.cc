@@ -26,6 +26,8 @@
 #include "runtime/app/train_segmentation.h"
 #include "runtime/app/truck_loading/truck_loading_job.h"
 #include "runtime/core/file_output.h"
+#include "runtime/machines/machine_library.h"
+#include "runtime/model/description.h"
 #include "runtime/planning/select_command.h"
 
 namespace {
@@ -67,6 +69,12 @@ int main(int argc, char** argv) {
   std::string models_dir = AUTOSHOVEL_DEFAULT_MODELS_DIR;
   app.add_option("--models", models_dir, "Folder of machine descriptions and materials")
       ->capture_default_str();
+  std::string materials_dir;
+  app.add_option("--materials", materials_dir,
+                 "Material folder for every description loaded (default: <description "
+                 "dir>/../materials, then <models>/materials)");
+  // --models and --materials may also follow the subcommand (`describe FILE --materials DIR`).
+  app.fallthrough();
 
   autoshovel::app::DescribeOptions describe;
   CLI::App* describe_cmd = app.add_subcommand(
@@ -84,13 +92,22 @@ int main(int argc, char** argv) {
   std::string gen_output = "generated", gen_materials;
   CLI::App* gen_cmd = app.add_subcommand(
       "gen",
-      "Validate machine descriptions and generate their C++ (kinematics, calibration "
-      "residuals, plant right-hand sides)");
+      "Validate machine descriptions, generate their C++ (kinematics, calibration residuals, "
+      "plant right-hand sides) and compile it into a machine library that every --machine "
+      "loads: no rebuild");
   gen_cmd->add_option("descriptions", gen_descriptions, "Description files (.yaml)")->required();
   gen_cmd->add_option("-o,--output", gen_output, "Output folder (gets <machine>/, registry)")
       ->capture_default_str();
   gen_cmd->add_option("--materials", gen_materials,
                       "Material folder (default: <description dir>/../materials)");
+  bool gen_no_compile = false;
+  std::string gen_cache;
+  gen_cmd->add_flag("--no-compile", gen_no_compile,
+                    "Only generate: do not compile the machine library that lets every command "
+                    "use the machine without rebuilding autoshovel");
+  gen_cmd->add_option("--cache", gen_cache,
+                      "Machine library cache (default: $AUTOSHOVEL_MACHINE_CACHE, else "
+                      "${XDG_CACHE_HOME:-~/.cache}/autoshovel/machines)");
 
   autoshovel::app::PlantStepOptions step;
   CLI::App* plant_cmd = app.add_subcommand("plant", "Experiments on the simulated machine");
@@ -300,16 +317,53 @@ int main(int argc, char** argv) {
 
   autoshovel::predictor::RetrainOptions retrain;
   CLI::App* retrain_cmd = train_cmd->add_subcommand(
-      "predictor", "Retrain the penetration predictor from a campaign's crowding samples");
-  retrain_cmd->add_option("database", retrain.database, "results.sqlite of a campaign or a run")
-      ->required();
+      "predictor",
+      "Train the penetration predictor on --machine's simulated plant, or retrain it from a "
+      "campaign's crowding samples (DATABASE); writes STEM.model, .scale and .meta.yaml (the "
+      "machine it was trained on)");
+  CLI::Option* database_opt =
+      retrain_cmd->add_option("database", retrain.database,
+                              "results.sqlite of a campaign or a run (without it: crowding runs "
+                              "on the machine's simulated plant)");
   retrain_cmd->add_option("-o,--out", retrain.out, "Path stem of the new model")->required();
-  retrain_cmd->add_option("--machine", retrain.machine, "Wheel loader")->capture_default_str();
-  retrain_cmd->add_option(
-      "--base", retrain.base,
-      "Model to compare with (default: the main job's, models/prediction/penetration_svr_fast)");
-  retrain_cmd->add_option("--strategy", retrain.strategy, "Samples of this scoop only, or all")
+  retrain_cmd->add_option("--machine", retrain.machine, "Wheel loader name or description")
       ->capture_default_str();
+  retrain_cmd->add_option("--base", retrain.base,
+                          "Model to compare with (default with a database: the main job's, "
+                          "models/prediction/penetration_svr_fast; without: none)");
+  retrain_cmd->add_option("--strategy", retrain.strategy, "Samples of this scoop only, or all")
+      ->capture_default_str()
+      ->needs(database_opt);
+  // Without a database: the main job's recipe (RetrainOptions::MainJobPlantTraining).
+  retrain_cmd->add_option("--runs", retrain.plant.runs, "Plant crowding runs (1 in 5 held out)")
+      ->check(autoshovel::app::IntegerIn(5, 1000000))
+      ->capture_default_str()
+      ->excludes(database_opt);
+  retrain_cmd->add_option("--seed", retrain.plant.seed, "Seed of the plant runs")
+      ->check(autoshovel::app::SeedRange())
+      ->capture_default_str()
+      ->excludes(database_opt);
+  retrain_cmd
+      ->add_option_function<double>(
+          "--attack-speed",
+          [&retrain](double v) {
+            retrain.plant.run_options.min_speed = retrain.plant.run_options.max_speed = v;
+          },
+          "Approach speed of the plant runs [m/s] (the main job's: 1.5)")
+      ->check(autoshovel::app::FiniteIn(0.1, 5, false))
+      ->excludes(database_opt);
+  retrain_cmd
+      ->add_option("--scoop-deceleration", retrain.plant.scoop_deceleration,
+                   "Fall of the speed reference once the arm moves [m/s^2] (0: release)")
+      ->check(autoshovel::app::FiniteIn(0, 10))
+      ->capture_default_str()
+      ->excludes(database_opt);
+  retrain_cmd
+      ->add_option("--dug-face-fraction", retrain.plant.dug_face_fraction,
+                   "Share of plant runs on a face a previous scoop has dug")
+      ->check(autoshovel::app::FiniteIn(0, 1))
+      ->capture_default_str()
+      ->excludes(database_opt);
   retrain_cmd->add_option("--threads", retrain.threads, "0: every core")
       ->check(autoshovel::app::IntegerIn(0, 1024))
       ->capture_default_str();
@@ -556,6 +610,20 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  // Every command that loads a description searches these (model::LoadOptions).
+  autoshovel::model::SetDefaultMaterialFolders(materials_dir, models_dir);
+  if (gen_materials.empty()) gen_materials = materials_dir;
+  if (gen_materials.empty() && *gen_cmd) {
+    // The generator takes one material folder: the descriptions' own when they have one, else
+    // the models folder's (a description written outside models/ finds the shipped materials).
+    bool own = false;
+    for (const std::string& d : gen_descriptions) {
+      std::error_code error;
+      own = own || std::filesystem::is_directory(
+                       std::filesystem::path(d).parent_path() / ".." / "materials", error);
+    }
+    if (!own) gen_materials = models_dir + "/materials";
+  }
 
   const int status = [&]() -> int {
     if (*compare_cmd) {
@@ -693,6 +761,12 @@ int main(int argc, char** argv) {
     if (*gen_cmd) {
       std::vector<std::string> arguments{"-o", gen_output};
       if (!gen_materials.empty()) arguments.insert(arguments.end(), {"--materials", gen_materials});
+      if (!gen_no_compile) {
+        // The library must be loadable by this very binary: gen checks its ABI tag now.
+        arguments.insert(arguments.end(),
+                         {"--compile", "--expect-abi", autoshovel::machines::RunningAbiTag()});
+      }
+      if (!gen_cache.empty()) arguments.insert(arguments.end(), {"--cache", gen_cache});
       arguments.insert(arguments.end(), gen_descriptions.begin(), gen_descriptions.end());
       return RunGenerator(arguments);
     }

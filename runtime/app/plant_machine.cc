@@ -10,6 +10,7 @@ namespace autoshovel::app {
 PlantMachine::PlantMachine(plant::Plant& plant)
     : plant_(plant),
       boom_actuator_(plant.machine().ActuatorOfJoint(0)),
+      bucket_actuator_(plant.machine().ActuatorOfJoint(1)),
       steering_override_(std::nan("")) {}
 
 control::Proprioception PlantMachine::Sense() const {
@@ -23,6 +24,12 @@ control::Proprioception PlantMachine::Sense() const {
   p.q_boom = s.q[0], p.q_bucket = s.q[1];
   p.qd_boom = s.qd[0], p.qd_bucket = s.qd[1];
   p.boom_pressure = boom_actuator_ >= 0 ? plant_.ActuatorPressure(boom_actuator_, true) : 0.0;
+  if (boom_actuator_ >= 0) p.boom_pressure_rod = plant_.ActuatorPressure(boom_actuator_, false);
+  p.pump_pressure = plant_.PumpPressure();
+  if (bucket_actuator_ >= 0) {
+    p.bucket_pressure_cap = plant_.ActuatorPressure(bucket_actuator_, true);
+    p.bucket_pressure_rod = plant_.ActuatorPressure(bucket_actuator_, false);
+  }
   if (faulty_joint_ >= 0) {
     double& q = faulty_joint_ == 0 ? p.q_boom : p.q_bucket;
     double& qd = faulty_joint_ == 0 ? p.qd_boom : p.qd_bucket;

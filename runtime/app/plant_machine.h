@@ -58,6 +58,7 @@ class PlantMachine : public control::ScoopMachine {
  private:
   plant::Plant& plant_;
   int boom_actuator_;
+  int bucket_actuator_;
   double steering_override_;
   bool all_finite_ = true;
   long commands_ = 0;

@@ -34,6 +34,7 @@
 #include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/plant/scenario_builder.h"
+#include "runtime/prediction/model_provenance.h"
 #include "runtime/prediction/penetration_predictor.h"
 #include "runtime/prediction/shipped_models.h"
 #include "runtime/prediction/volume_estimation.h"
@@ -310,6 +311,13 @@ std::string ShovelJob::PredictorMismatch() const {
                 "%.2f m/s; V2 is extrapolated (retrain with train_predictor --max-speed)",
                 scaling.max[0], state_->options.attack_speed);
   return why;
+}
+
+std::string ShovelJob::PredictorMachineMismatch() const {
+  const ShovelRunOptions& o = state_->options;
+  return prediction::ProvenanceMismatch(
+      o.predictor.empty() ? prediction::MainJobPredictor(o.models_dir) : o.predictor,
+      state_->setup.machine, o.machine);
 }
 
 std::string ShovelJob::ConfigYaml() const {
@@ -891,18 +899,20 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     }
     if (stage == Stage::kNavigate || stage == Stage::kScoop) {
       for (int j = 0; j < 2; ++j) {
-        const int actuator = machine.ActuatorOfJoint(j);
-        const double valve =
-            actuator >= 0 && actuator < static_cast<int>(machine_io.last_command().valve.size())
-                ? machine_io.last_command().valve[actuator]
-                : 0.0;
-        const std::string unanswered = supervisor.CheckJoint(
-            j, j == 0 ? "boom" : "bucket", plant.time(), valve,
-            j == 0 ? sensed.q_boom : sensed.q_bucket, j == 0 ? sensed.qd_boom : sensed.qd_bucket,
-            machine.links[j].joint_min, machine.links[j].joint_max);
-        if (!unanswered.empty()) {
-          safe_stop(unanswered);
+        const JointCheck check = supervisor.CheckJoint(
+            j, j == 0 ? "boom" : "bucket", plant.time(),
+            ReadJoint(machine, j, sensed, machine_io.last_command()), RangeOf(machine, j));
+        if (check.state == JointState::kDoesNotAnswer) {
+          safe_stop(check.message);
           return;
+        }
+        if (check.state == JointState::kStallsUnderLoad && check.first_report) {
+          // Not a fault: the scoop ends what it was doing (ScoopCycle::JointStalledUnderLoad).
+          say(check.message + " at t = " + Fixed(plant.time() - t0, 2) + " s" +
+              (scoop ? std::string(" (scoop ") + scoop->phase_name() + "): the " +
+                           (j == 0 ? "boom" : "bucket") + " is held where it stalled"
+                     : std::string()));
+          if (scoop) scoop->JointStalledUnderLoad(j, check.message);
         }
       }
     }
@@ -1301,6 +1311,10 @@ int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::pat
   log.Info("run " + info.run_id + ": " + std::to_string(options.cycles) + " cycles, seed " +
            std::to_string(options.seed));
   if (const std::string mismatch = job->PredictorMismatch(); !mismatch.empty()) {
+    err << "autoshovel run: warning: " << mismatch << "\n";
+    log.Warning(mismatch);
+  }
+  if (const std::string mismatch = job->PredictorMachineMismatch(); !mismatch.empty()) {
     err << "autoshovel run: warning: " << mismatch << "\n";
     log.Warning(mismatch);
   }

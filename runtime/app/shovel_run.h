@@ -172,6 +172,11 @@ class ShovelJob {
   /// Empty, or why the predictor does not fit the scoop profile: its training speeds end below
   /// the attack speed (it would extrapolate V2 for a machine it never saw).
   std::string PredictorMismatch() const;
+  /// Empty, or why the predictor may not fit this machine: it was trained on another machine
+  /// (name or description SHA-256 differs) or its provenance does not say
+  /// (prediction::ProvenanceMismatch, runtime/prediction/model_provenance.h). Commands driving
+  /// the job print it as a warning; it is not an error.
+  std::string PredictorMachineMismatch() const;
 
  private:
   CycleOutcome RunCycleAt(int index, int site, const std::filesystem::path& figures_dir,

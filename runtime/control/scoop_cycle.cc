@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <stdexcept>
+#include <utility>
 
 #include "runtime/control/joint_angle_filter.h"
 #include "runtime/model/interpreted_model.h"
@@ -145,6 +146,9 @@ struct ScoopCycle::Runtime {
   double boom_stalled_since = NAN;  ///< scoop: the boom slower than the stall rate since [s]
   bool drive_eased = false;         ///< scoop: eased for a stalled boom, until the next action
   bool drive_hold_started = false;  ///< the speed profile restarted from the speed at the hold
+  /// JointStalledUnderLoad's reports not yet acted on: (joint, reason).
+  std::vector<std::pair<int, std::string>> pending_stalls;
+  bool sequence_ended = false;  ///< scoop: a stalled boom ended the atomic actions
   std::vector<Eigen::Vector3d> last_predicted_path;              ///< of the last V2 [m]
   double last_v2 = NAN;                                          ///< [m³]
   std::optional<prediction::PenetrationFeatures> last_features;  ///< of the last V2
@@ -431,7 +435,9 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       }
       if (!rt.action) {
         rt.result.payload_at_actions.push_back(machine.PayloadVolume());
-        rt.action = rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
+        rt.action = rt.sequence_ended
+                        ? std::nullopt
+                        : rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
         if (rt.action) {
           rt.result.action_names.emplace_back(ToString(rt.action->kind));
           rt.targets = TargetsAfter(*rt.action, rt.targets, limits_);
@@ -538,6 +544,32 @@ void ScoopCycle::RequestStop(const std::string& reason) {
   rt_->drive_held = true;  // after the trigger: the steps no longer crowd on
 }
 
+void ScoopCycle::JointStalledUnderLoad(int joint, const std::string& reason) {
+  if (rt_ == nullptr || (joint != 0 && joint != 1)) return;
+  rt_->pending_stalls.emplace_back(joint, reason);
+}
+
+void ScoopCycle::HoldStalledJoint(const Proprioception& s, Runtime& rt, int joint,
+                                  const std::string& reason) const {
+  rt.result.stalls.push_back(std::string(PhaseName(static_cast<int>(rt.phase))) + ": " + reason);
+  if (joint == 0) {
+    rt.targets.boom = s.q_boom;
+    rt.drive_held = true;  // the drive pressing into the pile adds to what the boom must lift
+    if (rt.phase == Phase::kScoop) {
+      rt.action.reset();
+      rt.sequence_ended = true;
+    }
+    if ((rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd) && rt.stop_request.empty()) {
+      rt.stop_request = "boom_stall";
+    }
+    return;
+  }
+  // The bucket: held at the attitude it has when an attitude is being held, else where it is.
+  if (std::isfinite(rt.hold_attitude)) rt.hold_attitude = s.q_boom + s.q_bucket;
+  rt.targets.bucket = s.q_bucket;
+  if (rt.phase == Phase::kScoop) rt.action.reset();
+}
+
 bool ScoopCycle::done() const { return rt_ == nullptr || rt_->phase == Phase::kDone; }
 
 const char* ScoopCycle::phase_name() const {
@@ -557,6 +589,8 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
   // Everything below (PIDs, the tip path of Eq. (19), V2's start) sees the filtered angles.
   s.q_boom = rt.boom_filter->Update(s.q_boom, s.qd_boom, options_.tick);
   s.q_bucket = rt.bucket_filter->Update(s.q_bucket, s.qd_bucket, options_.tick);
+  for (const auto& [joint, reason] : rt.pending_stalls) HoldStalledJoint(s, rt, joint, reason);
+  rt.pending_stalls.clear();
   if (rt.phase == Phase::kScoop && std::isfinite(rt.hold_attitude)) {
     // Counted from when the bucket first reaches the held attitude: a rack-back that ended on
     // the cylinder's end stop starts the lift beyond it, which is not the lift's doing.

@@ -57,6 +57,15 @@ struct Proprioception {
   double q_boom = 0, q_bucket = 0;                     ///< joints (IMUs, Eq. 1) [rad]
   double qd_boom = 0, qd_bucket = 0;                   ///< [rad/s]
   double boom_pressure = 0;                            ///< boom cylinder cap side [Pa]
+  /// The other chambers [Pa]: what a positive valve opening feeds is the cap side, a negative
+  /// one the rod side. NaN where the machine has no transducer (the safety supervisor then
+  /// cannot tell a stall under load from a stuck valve: app/safety_supervisor.h).
+  double boom_pressure_rod = NAN;
+  double bucket_pressure_cap = NAN, bucket_pressure_rod = NAN;
+  /// The pump's output pressure [Pa]; NaN where not sensed. With a load-sensing pump it rises to
+  /// its limit only while an open valve feeds a chamber at that limit, which is how a stall
+  /// under load is told from a trapped chamber pressed up by an outside load.
+  double pump_pressure = NAN;
 };
 
 /// The machine as the scoop cycle sees it.
@@ -179,6 +188,9 @@ struct ScoopResult {
   /// The drive eased at least once because the boom stalled lifting
   /// (ScoopCycleOptions::boom_stall_time).
   bool drive_eased_for_boom = false;
+  /// Stalls under load the cycle was told of (JointStalledUnderLoad), each with the phase it
+  /// came in: "scoop: boom stalls under load at relief (…)".
+  std::vector<std::string> stalls;
   double boom_pressure_at_contact = 0;  ///< [Pa]
   double boom_pressure_at_trigger = 0;  ///< [Pa]
   double payload_after_scoop = 0;       ///< before levelling and shaking [m³]
@@ -240,6 +252,16 @@ class ScoopCycle {
   /// Stairway steps stop crowding on. The drive is held from then on. What the executive calls
   /// when an obstacle comes too close ahead; before contact it ends the cycle as failed.
   void RequestStop(const std::string& reason);
+  /// `joint` (0: boom, 1: bucket) stalls under load: its valve open, the chamber it feeds at the
+  /// most the supply holds, and it does not move (app/safety_supervisor.h tells this from a
+  /// stuck valve). Forcing on cannot lift the load and only blows oil over the relief valve, so
+  /// from the next tick the joint is held where it stalled (its target set to where it is) and
+  /// the drive stops pushing. In the scoop phase the running atomic action is over; a stalled
+  /// boom also ends the action sequence (the steps left would lift the same load): the cycle
+  /// goes on to level, shake and retreat, keeping what the bucket holds, and backing out frees
+  /// the bucket from the pile. While crowding, a stalled boom ends crowding as RequestStop does
+  /// (reason "boom_stall"). Recorded in ScoopResult::stalls.
+  void JointStalledUnderLoad(int joint, const std::string& reason);
   const char* phase_name() const;
   double tick() const { return options_.tick; }
 
@@ -259,6 +281,9 @@ class ScoopCycle {
   /// Scoop phase, every tick: whether the drive is to ease because the boom, opened to lift,
   /// has stalled for ScoopCycleOptions::boom_stall_time (latched until the next action).
   bool BoomPinnedByTheDrive(const Proprioception& s, Runtime& rt) const;
+  /// Acts on one JointStalledUnderLoad report (see there).
+  void HoldStalledJoint(const Proprioception& s, Runtime& rt, int joint,
+                        const std::string& reason) const;
 
   const model::MachineDescription& machine_;
   const generated::MachineFunctions& functions_;

@@ -134,6 +134,9 @@ class Plant {
   /// Cap-side (A) and rod-side (B) pressure of an actuator [Pa]: the boom cylinder pressure that
   /// the pressure-triggered baseline reads.
   double ActuatorPressure(int actuator, bool cap_side = true) const;
+  /// The load-sensing pump's output pressure now [Pa] (what a pump pressure transducer reads):
+  /// the highest fed chamber of an open valve plus the margin, up to the pump's maximum.
+  double PumpPressure() const;
   /// Hydraulic power drawn now [W] and wheel power now [W] (for tests of the energy integral).
   double HydraulicPower() const;
   double TravelPower() const;

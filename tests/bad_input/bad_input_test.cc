@@ -33,6 +33,7 @@
 #include "runtime/perception/segmentation.h"
 #include "runtime/planning/shovel_weights_file.h"
 #include "runtime/plant/scenario.h"
+#include "runtime/prediction/model_provenance.h"
 #include "runtime/prediction/penetration_predictor.h"
 
 namespace autoshovel {
@@ -168,6 +169,12 @@ const std::map<std::string, ReadFn>& Readers() {
        [](const std::string& p) { identification::ReadMasks(p, kMaskWidth, kMaskHeight); }},
       {"onnx", [](const std::string& p) { perception::Segmenter segmenter(p); }},
       {"svr", [](const std::string& p) { prediction::PenetrationPredictor::Load(p); }},
+      {"model_provenance",
+       [](const std::string& p) {
+         // The fixture is `<stem>.meta.yaml`; the reader takes the model's stem.
+         const std::string suffix = ".meta.yaml";
+         prediction::LoadProvenance(p.substr(0, p.size() - suffix.size()));
+       }},
       {"demonstrations", [](const std::string& p) { identification::ReadDemonstrations(p); }},
   };
   return readers;
@@ -229,7 +236,7 @@ INSTANTIATE_TEST_SUITE_P(Readers, BadInput,
                                            "campaign_spec", "shovel_weights", "camera_info",
                                            "log_format", "hydraulic_log", "arm_calibration", "pcd",
                                            "kitti_bin", "masks", "image_header", "onnx", "svr",
-                                           "demonstrations"),
+                                           "model_provenance", "demonstrations"),
                          [](const auto& param_info) { return param_info.param; });
 
 // Every reader folder is exercised by the test above.

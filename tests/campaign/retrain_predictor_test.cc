@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "identification/predictor/retrain_command.h"
+#include "runtime/model/description.h"
+#include "runtime/prediction/model_provenance.h"
 #include "runtime/prediction/penetration_predictor.h"
 #include "runtime/prediction/shipped_models.h"
 #include "runtime/results/results_db.h"
@@ -123,6 +125,15 @@ TEST(RetrainPredictor, LearnsASiteThatPenetratesFurther) {
   ASSERT_EQ(RunRetrainPredictor(o, out, err), 0) << err.str() << out.str();
   ASSERT_TRUE(fs::exists(dir / "site_svr.model"));
   ASSERT_TRUE(fs::exists(dir / "site_svr.scale"));
+  // Its provenance: the machine whose runs logged the samples (model_provenance.h).
+  const std::optional<prediction::ModelProvenance> provenance = prediction::LoadProvenance(o.out);
+  ASSERT_TRUE(provenance.has_value());
+  EXPECT_EQ(provenance->machine, "xcmg_968ev");
+  EXPECT_EQ(provenance->sha256,
+            model::LoadMachineDescription(kModels + "/loaders/xcmg_968ev.yaml").sha256);
+  EXPECT_NE(provenance->plant_samples.find("crowding samples logged by runs of xcmg_968ev in "),
+            std::string::npos)
+      << provenance->plant_samples;
   // Shipped: every held-out error is the 0.3 m offset, none within 0.2 m. Retrained: the
   // offset learnt; most within 0.1 m.
   const prediction::PenetrationPredictor retrained = prediction::PenetrationPredictor::Load(o.out);

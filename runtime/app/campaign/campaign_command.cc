@@ -407,9 +407,15 @@ int RunCampaign(const CampaignOptions& o, std::ostream& out, std::ostream& err) 
     if (StartedByMpirun()) return RunMpi(o, spec, jobs, dir, out, err);
     // Check that the jobs can be set up (scenario, machine, models) before starting workers.
     // Each yard under each fault case once (a fault may name a sensor the machine lacks).
+    // A predictor trained on another machine is warned about once (model_provenance.h).
+    std::set<std::string> warned;
     for (const CampaignJob& job : jobs) {
       if (job.week != 1 || job.shift != 1 || job.policy != spec.policies.front()) continue;
       ShovelJob probe(JobOptions(spec, job, o.models_dir));
+      const std::string mismatch = probe.PredictorMachineMismatch();
+      if (!mismatch.empty() && warned.insert(mismatch).second) {
+        err << kCommand << ": warning: " << mismatch << "\n";
+      }
     }
     if (!PrepareFolder(o, spec, jobs, dir, err)) return 2;
     return RunLocal(o, spec, dir, out, err);

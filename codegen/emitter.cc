@@ -326,12 +326,27 @@ MachineTexts MachineCode(const model::MachineDescription& m) {
     for (auto& a : Assign("acceleration", s.force)) all.push_back(a);
     for (auto& a : Assign("d_force", s.d_force_d_x, /*skip_zero=*/true)) all.push_back(a);
     for (auto& a : Assign("d_mass", s.d_mass_d_q, /*skip_zero=*/true)) all.push_back(a);
+    c << "namespace {\n\nvoid VelocityTerms(const double* x, const double* u, double* "
+         "velocity_terms) {\n"
+      << kUsingMath << PrintAssignments(Assign("velocity_terms", s.velocity_terms), "double")
+      << "}\n\n}  // namespace\n\n";
     c << "void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {\n"
       << kUsingMath << "  std::fill(jacobian, jacobian + kNumStates * kNumStates, 0.0);\n"
       << "  double mass[kNumJoints * kNumJoints];\n  double acceleration[kNumJoints];\n"
       << "  double d_force[kNumJoints * kNumStates] = {};\n"
       << "  double d_mass[kNumJoints * kNumJoints * kNumJoints] = {};\n"
-      << PrintAssignments(all, "double") << "  Factor(mass);\n  Solve(mass, acceleration);\n"
+      << PrintAssignments(all, "double")
+      << "  // -dh/dq by central differences (see codegen/symbolic_model.cc).\n"
+         "  for (int c = 0; c < kNumJoints; ++c) {\n"
+         "    double shifted[kNumStates];\n    std::copy(x, x + kNumStates, shifted);\n"
+         "    double plus[kNumJoints], minus[kNumJoints];\n"
+         "    const double step = 1e-6;\n"
+         "    shifted[c] = x[c] + step;\n    VelocityTerms(shifted, u, plus);\n"
+         "    shifted[c] = x[c] - step;\n    VelocityTerms(shifted, u, minus);\n"
+         "    for (int j = 0; j < kNumJoints; ++j) {\n"
+         "      d_force[j * kNumStates + c] -= (plus[j] - minus[j]) / (2.0 * step);\n"
+         "    }\n  }\n"
+         "  Factor(mass);\n  Solve(mass, acceleration);\n"
       << "  for (int c = 0; c < kNumStates; ++c) {\n"
          "    double column[kNumJoints];\n"
          "    for (int j = 0; j < kNumJoints; ++j) {\n"

@@ -391,8 +391,17 @@ void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
       s.jacobian.push_back(row >= J && row < 2 * J ? ex(0) : s.rhs[row].diff(xi));
     }
   }
+  // ∂force/∂x, except ∂h/∂q: h already holds second derivatives of the closed chain's body
+  // positions, and a third symbolic derivative swells the expressions past what GiNaC builds in
+  // reasonable time once rockers, couplers and cylinders have mass (minutes per machine). The
+  // emitted Jacobian adds −∂h/∂q by central differences of the emitted h instead (h is small
+  // beside the hydraulic forces in these rows, so the rounding stays far below the row's scale).
   for (int j = 0; j < J; ++j) {
-    for (const auto& xi : s.x) s.d_force_d_x.push_back(s.force[j].diff(xi));
+    const ex without_velocity_terms = s.force[j] + s.velocity_terms[j];
+    for (int i = 0; i < s.num_states; ++i) {
+      const ex& source = i < J ? without_velocity_terms : s.force[j];
+      s.d_force_d_x.push_back(source.diff(s.x[i]));
+    }
   }
   for (int k = 0; k < J; ++k) {
     for (const ex& entry : s.mass_matrix) s.d_mass_d_q.push_back(entry.diff(s.x[k]));

@@ -743,6 +743,111 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
 }
 
+namespace {
+
+void VelocityTerms(const double* x, const double* u, double* velocity_terms) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const double t0 = (x[2] + x[0] + x[1]);
+  const double t1 = sin(t0);
+  const double t2 = t1 * (-0.3);
+  const double t3 = cos(x[0]);
+  const double t4 = 5.7 * t3;
+  const double t5 = (x[0] + x[1]);
+  const double t6 = cos(t5);
+  const double t7 = 2.9 * t6;
+  const double t8 = cos(t0);
+  const double t9 = t8 * 0.7;
+  const double t10 = t1 * (-0.7);
+  const double t11 = t8 * (-0.3);
+  const double t12 = (t10 + t11);
+  const double t13 = t12 * x[6];
+  const double t14 = sin(t5);
+  const double t15 = t14 * (-2.9);
+  const double t16 = (t10 + t15 + t11);
+  const double t17 = x[5] * t16;
+  const double t18 = sin(x[0]);
+  const double t19 = t18 * (-5.7);
+  const double t20 = (t10 + t15 + t19 + t11);
+  const double t21 = (t17 + t20 * x[4] + t13);
+  const double t22 =
+      (((t12 * x[5] + t12 * x[4] + t13)) * x[6] + ((t17 + x[4] * t16 + t13)) * x[5] + x[4] * t21);
+  const double t23 = (x[4] * x[4]);
+  const double t24 = (-0.35 * t3 - t18 * 2.6);
+  const double t25 = t1 * (-0.0578571428571429);
+  const double t26 = (-2.9) * t6;
+  const double t27 = (-5.7) * t3;
+  const double t28 = (-0.567857142857143) * t8;
+  const double t29 = (t25 + t26 + t28);
+  const double t30 = x[5] * t29;
+  const double t31 = (t25 + t28);
+  const double t32 = t31 * x[6];
+  const double t33 = (x[4] * ((x[4] * ((t25 + t26 + t27 + t28)) + t30 + t32)) +
+                      x[5] * ((x[4] * t29 + t30 + t32)) + ((t32 + t31 * x[5] + t31 * x[4])) * x[6]);
+  const double t34 = t8 * 0.0578571428571429;
+  const double t35 = t1 * (-0.567857142857143);
+  const double t36 = (t34 + t15 + t19 + t35);
+  const double t37 = t8 * 0.567857142857143;
+  const double t38 = t1 * 0.0578571428571429;
+  const double t39 = (t34 + t15 + t35);
+  const double t40 = x[5] * t39;
+  const double t41 = (t34 + t35);
+  const double t42 = t41 * x[6];
+  const double t43 = (t40 + x[4] * t36 + t42);
+  const double t44 =
+      (x[5] * ((x[4] * t39 + t40 + t42)) + x[4] * t43 + ((t41 * x[5] + t42 + t41 * x[4])) * x[6]);
+  const double t45 = (x[7] * x[7]);
+  const double t46 = t6 * (-0.1);
+  const double t47 = t14 * (-1.1);
+  const double t48 = (t19 + t46 + t47);
+  const double t49 = (-t14 * 110.0 + t6 * 1210.0 + 6270.0 * t3 + 165.0);
+  const double t50 = t14 * (-0.1);
+  const double t51 = 1.1 * t6;
+  const double t52 = (t46 + t47);
+  const double t53 = x[5] * t52;
+  const double t54 = (t48 * x[4] + t53);
+  const double t55 = (x[4] * t54 + x[5] * ((x[4] * t52 + t53)));
+  const double t56 = t14 * 0.1;
+  const double t57 = t6 * (-1.1);
+  const double t58 = (t56 + t57);
+  const double t59 = t58 * x[5];
+  const double t60 = (x[5] * ((t59 + t58 * x[4])) + ((t59 + ((t56 + t57 + t27)) * x[4])) * x[4]);
+  const double t61 = (-t1 * 285.0 + 665.0 * t8 + t6 * 2755.0 + 142.5 + 5415.0 * t3);
+  const double t62 = (t37 + t4 + t7 + 0.15 + t38);
+  const double t63 = t1 * 0.3;
+  const double t64 = t8 * (-0.7);
+  const double t65 = (t63 + t26 + t64);
+  const double t66 = t65 * x[5];
+  const double t67 = (t63 + t64);
+  const double t68 = t67 * x[6];
+  const double t69 = (x[4] * ((((t63 + t26 + t27 + t64)) * x[4] + t66 + t68)) +
+                      x[6] * ((t67 * x[5] + t68 + t67 * x[4])) + ((t65 * x[4] + t66 + t68)) * x[5]);
+  velocity_terms[0] =
+      (950.0 * ((t2 + t4 + t7 + t9)) * t22 + t23 * t24 * ((-t18 * 0.35 + 2.6 * t3)) * 2200.0 +
+       ((t33 * t36 + ((t37 + t4 + t7 + t38)) * t44)) * u[8] -
+       t45 * t24 * ((5720.0 * t3 + 330.0 - t18 * 770.0)) - t45 * t48 * t49 +
+       ((t4 + t50 + t51)) * 1100.0 * t55 + t60 * 1100.0 * t48 +
+       t23 * t24 * 2200.0 * ((t18 * 0.35 - 2.6 * t3)) - t45 * t20 * t61 - t45 * t62 * u[8] * t36 +
+       950.0 * t20 * t69);
+  velocity_terms[1] =
+      (-t45 * t16 * t61 + ((t2 + t7 + t9)) * 950.0 * t22 + 950.0 * t69 * t16 + t60 * 1100.0 * t52 -
+       t45 * t62 * u[8] * t39 - t45 * t52 * t49 + ((t33 * t39 + ((t37 + t7 + t38)) * t44)) * u[8] +
+       ((t50 + t51)) * 1100.0 * t55);
+  velocity_terms[2] = (-t45 * t62 * t41 * u[8] + t12 * 950.0 * t69 + 950.0 * t22 * ((t2 + t9)) +
+                       u[8] * ((t33 * t41 + ((t37 + t38)) * t44)) - t45 * t12 * t61);
+  velocity_terms[3] =
+      (((330.0 + 12540.0 * t3 + 2420.0 * t6 - t14 * 220.0)) * x[7] * t54 +
+       t24 * x[7] * x[4] * ((11440.0 * t3 + 660.0 - t18 * 1540.0)) +
+       x[7] * ((-t1 * 570.0 + 285.0 + 10830.0 * t3 + 5510.0 * t6 + 1330.0 * t8)) * t21 +
+       t62 * 2.0 * x[7] * u[8] * t43);
+}
+
+}  // namespace
+
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
   using std::acos;
   using std::atan2;
@@ -1159,334 +1264,255 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t294 = (-2.9e+07 + x[19]);
   const double t295 = (t293 - 4e+05);
   const double t296 = (-0.35 * t0 - t1 * 2.6);
-  const double t297 = (t296 * t296);
-  const double t298 = 5.7 * t0;
-  const double t299 = t40 * (-0.1);
-  const double t300 = 1.1 * t38;
-  const double t301 = (t298 + t299 + t300);
-  const double t302 = t1 * (-0.35);
-  const double t303 = 2.6 * t0;
-  const double t304 = (t302 + t303);
-  const double t305 = t1 * (-5.7);
-  const double t306 = t38 * (-0.1);
-  const double t307 = t40 * (-1.1);
-  const double t308 = (t305 + t306 + t307);
-  const double t309 = t91 * 0.567857142857143;
-  const double t310 = 2.9 * t38;
-  const double t311 = t90 * 0.0578571428571429;
-  const double t312 = (t309 + t298 + t310 + t311);
-  const double t313 = t91 * 0.0578571428571429;
-  const double t314 = t40 * (-2.9);
-  const double t315 = t90 * (-0.567857142857143);
-  const double t316 = (t313 + t314 + t305 + t315);
-  const double t317 = (t316 * t316);
-  const double t318 = t90 * (-0.7);
-  const double t319 = t91 * (-0.3);
-  const double t320 = (t318 + t314 + t305 + t319);
-  const double t321 = t90 * (-0.3);
-  const double t322 = t91 * 0.7;
-  const double t323 = (t321 + t298 + t310 + t322);
-  const double t324 = (t318 + t314 + t319);
-  const double t325 = (t299 + t300);
-  const double t326 = (t309 + t310 + t311);
-  const double t327 = (t313 + t314 + t315);
-  const double t328 = (t321 + t310 + t322);
-  const double t329 = (t306 + t307);
-  const double t330 =
-      (1150.0 + 950.0 * t320 * t324 + t301 * t325 * 1100.0 + u[8] * ((t312 * t326 + t316 * t327)) +
-       t328 * 950.0 * t323 + 1100.0 * t308 * t329);
-  const double t331 = (t321 + t322);
-  const double t332 = (t318 + t319);
-  const double t333 = (t309 + t311);
-  const double t334 = (t313 + t315);
-  const double t335 =
-      (950.0 * t323 * t331 + 250.0 + t332 * 950.0 * t320 + ((t312 * t333 + t334 * t316)) * u[8]);
-  const double t336 = (t327 * t327);
-  const double t337 =
-      (t332 * 950.0 * t324 + 250.0 + t328 * 950.0 * t331 + ((t334 * t327 + t326 * t333)) * u[8]);
-  const double t338 = (t334 * t334);
-  const double t339 = (t298 + t299 + t300 + 0.15);
-  const double t340 = (-t40 * 110.0 + t38 * 1210.0 + 6270.0 * t0 + 165.0);
-  const double t341 = (t309 + t298 + t310 + 0.15 + t311);
-  const double t342 = (t321 + t298 + t310 + 0.15 + t322);
-  const double t343 = (-t90 * 285.0 + 665.0 * t91 + t38 * 2755.0 + 142.5 + 5415.0 * t0);
-  const double t344 = (5720.0 * t0 + 330.0 - t1 * 770.0);
-  const double t345 = (t302 + 0.15 + t303);
-  const double t346 = (x[4] * x[4]);
-  const double t347 = sin(u[9]);
-  const double t348 = t90 * 0.3;
-  const double t349 = (-2.9) * t38;
-  const double t350 = (-5.7) * t0;
-  const double t351 = t91 * (-0.7);
-  const double t352 = (t348 + t349 + t350 + t351);
-  const double t353 = (t348 + t349 + t351);
-  const double t354 = t353 * x[5];
-  const double t355 = (t348 + t351);
-  const double t356 = t355 * x[6];
-  const double t357 = (t352 * x[4] + t354 + t356);
-  const double t358 = (t355 * x[5] + t356 + t355 * x[4]);
-  const double t359 = x[6] * t358;
-  const double t360 = (t353 * x[4] + t354 + t356);
-  const double t361 = t360 * x[5];
-  const double t362 = (x[4] * t357 + t359 + t361);
-  const double t363 = (t1 * 0.35 - t303);
-  const double t364 = (t116 - 2.525);
-  const double t365 = (t364 * t364);
-  const double t366 = (t365 + 1e-06);
-  const double t367 = (t116 - 3.71);
-  const double t368 = (t367 * t367);
-  const double t369 = (t368 + 1e-06);
-  const double t370 =
+  const double t297 = 5.7 * t0;
+  const double t298 = t40 * (-0.1);
+  const double t299 = 1.1 * t38;
+  const double t300 = (t297 + t298 + t299);
+  const double t301 = t1 * (-0.35);
+  const double t302 = 2.6 * t0;
+  const double t303 = (t301 + t302);
+  const double t304 = t1 * (-5.7);
+  const double t305 = t38 * (-0.1);
+  const double t306 = t40 * (-1.1);
+  const double t307 = (t304 + t305 + t306);
+  const double t308 = t91 * 0.567857142857143;
+  const double t309 = 2.9 * t38;
+  const double t310 = t90 * 0.0578571428571429;
+  const double t311 = (t308 + t297 + t309 + t310);
+  const double t312 = t91 * 0.0578571428571429;
+  const double t313 = t40 * (-2.9);
+  const double t314 = t90 * (-0.567857142857143);
+  const double t315 = (t312 + t313 + t304 + t314);
+  const double t316 = t90 * (-0.7);
+  const double t317 = t91 * (-0.3);
+  const double t318 = (t316 + t313 + t304 + t317);
+  const double t319 = t90 * (-0.3);
+  const double t320 = t91 * 0.7;
+  const double t321 = (t319 + t297 + t309 + t320);
+  const double t322 = (t316 + t313 + t317);
+  const double t323 = (t298 + t299);
+  const double t324 = (t308 + t309 + t310);
+  const double t325 = (t312 + t313 + t314);
+  const double t326 = (t319 + t309 + t320);
+  const double t327 = (t305 + t306);
+  const double t328 =
+      (1150.0 + 950.0 * t318 * t322 + t300 * t323 * 1100.0 + u[8] * ((t311 * t324 + t315 * t325)) +
+       t326 * 950.0 * t321 + 1100.0 * t307 * t327);
+  const double t329 = (t319 + t320);
+  const double t330 = (t316 + t317);
+  const double t331 = (t308 + t310);
+  const double t332 = (t312 + t314);
+  const double t333 =
+      (950.0 * t321 * t329 + 250.0 + t330 * 950.0 * t318 + ((t311 * t331 + t332 * t315)) * u[8]);
+  const double t334 =
+      (t330 * 950.0 * t322 + 250.0 + t326 * 950.0 * t329 + ((t332 * t325 + t324 * t331)) * u[8]);
+  const double t335 = (t297 + t298 + t299 + 0.15);
+  const double t336 = (-t40 * 110.0 + t38 * 1210.0 + 6270.0 * t0 + 165.0);
+  const double t337 = (t308 + t297 + t309 + 0.15 + t310);
+  const double t338 = (t319 + t297 + t309 + 0.15 + t320);
+  const double t339 = (-t90 * 285.0 + 665.0 * t91 + t38 * 2755.0 + 142.5 + 5415.0 * t0);
+  const double t340 = (5720.0 * t0 + 330.0 - t1 * 770.0);
+  const double t341 = (t301 + 0.15 + t302);
+  const double t342 = (x[4] * x[4]);
+  const double t343 = sin(u[9]);
+  const double t344 = t90 * 0.3;
+  const double t345 = (-2.9) * t38;
+  const double t346 = (-5.7) * t0;
+  const double t347 = t91 * (-0.7);
+  const double t348 = (t344 + t345 + t346 + t347);
+  const double t349 = (t344 + t345 + t347);
+  const double t350 = t349 * x[5];
+  const double t351 = (t344 + t347);
+  const double t352 = t351 * x[6];
+  const double t353 = (t348 * x[4] + t350 + t352);
+  const double t354 = (t351 * x[5] + t352 + t351 * x[4]);
+  const double t355 = (t349 * x[4] + t350 + t352);
+  const double t356 = (x[4] * t353 + x[6] * t354 + t355 * x[5]);
+  const double t357 = (t1 * 0.35 - t302);
+  const double t358 = (t116 - 2.525);
+  const double t359 = (t358 * t358);
+  const double t360 = (t359 + 1e-06);
+  const double t361 = (t116 - 3.71);
+  const double t362 = (t361 * t361);
+  const double t363 = (t362 + 1e-06);
+  const double t364 =
       (t115 * t164 * 1e+06 * x[6] + t115 * 2e+06 * x[4] * t140 + t115 * 2e+06 * x[5] * t140);
-  const double t371 = (1.0 / sqrt(t369));
-  const double t372 = (1.0 / sqrt(t366));
-  const double t373 = (t371 * t367 + 2.0 - t372 * t364);
-  const double t374 = (4e+08 * t116 - 2e+08 * sqrt(t366) + 0.013823007675795093 * x[18] -
-                       1.247e+09 + sqrt(t369) * 2e+08 - 0.026546457922833753 * x[14] + t370 * t373);
-  const double t375 = t115 * t374 * t140 * (-0.5);
-  const double t376 = x[5] * t329;
-  const double t377 = (t308 * x[4] + t376);
-  const double t378 = (x[4] * t329 + t376);
-  const double t379 = (x[4] * t377 + x[5] * t378);
-  const double t380 = (x[7] * x[7]);
-  const double t381 = t40 * 0.1;
-  const double t382 = t38 * (-1.1);
-  const double t383 = (t381 + t382);
-  const double t384 = t383 * x[5];
-  const double t385 = (t384 + t383 * x[4]);
-  const double t386 = x[5] * t385;
-  const double t387 = (t381 + t382 + t350);
-  const double t388 = (t384 + t387 * x[4]);
-  const double t389 = (t386 + t388 * x[4]);
-  const double t390 = cos(u[9]);
-  const double t391 = (-4.005 + t70);
-  const double t392 = (t391 * t391);
-  const double t393 = (1e-06 + t392);
-  const double t394 = (t70 - 2.595);
-  const double t395 = (t394 * t394);
-  const double t396 = (1e-06 + t395);
-  const double t397 = (1.0 / sqrt(t393));
-  const double t398 = (1.0 / sqrt(t396));
-  const double t399 = (t397 * t391 - t398 * t394 + 2.0);
-  const double t400 = (t46 * 2e+06 * x[5] * t60 + t46 * 2e+06 * t62 * x[4]);
-  const double t401 = (-0.035342917352885174 * x[13] + 4e+08 * t70 - 1.32e+09 + sqrt(t393) * 2e+08 -
-                       sqrt(t396) * 2e+08 + x[17] * 0.01802488784997144 + t399 * t400);
-  const double t402 = t332 * x[6];
-  const double t403 = (t332 * x[5] + t332 * x[4] + t402);
-  const double t404 = x[5] * t324;
-  const double t405 = (t404 + x[4] * t324 + t402);
-  const double t406 = (t404 + t320 * x[4] + t402);
-  const double t407 = (t403 * x[6] + t405 * x[5] + x[4] * t406);
-  const double t408 = t90 * (-0.0578571428571429);
-  const double t409 = (-0.567857142857143) * t91;
-  const double t410 = (t408 + t349 + t350 + t409);
-  const double t411 = (t408 + t349 + t409);
-  const double t412 = x[5] * t411;
-  const double t413 = (t408 + t409);
-  const double t414 = t413 * x[6];
-  const double t415 = (x[4] * t410 + t412 + t414);
-  const double t416 = (x[4] * t411 + t412 + t414);
-  const double t417 = x[5] * t416;
-  const double t418 = (t414 + t413 * x[5] + t413 * x[4]);
-  const double t419 = t418 * x[6];
-  const double t420 = (x[4] * t415 + t417 + t419);
-  const double t421 = x[5] * t327;
-  const double t422 = t334 * x[6];
-  const double t423 = (x[4] * t327 + t421 + t422);
-  const double t424 = (t421 + x[4] * t316 + t422);
-  const double t425 = (t334 * x[5] + t422 + t334 * x[4]);
-  const double t426 = (x[5] * t423 + x[4] * t424 + t425 * x[6]);
-  const double t427 = (-3.775 + t14);
-  const double t428 = (t427 * t427);
-  const double t429 = (1e-06 + t428);
-  const double t430 = (1.0 / sqrt(t429));
-  const double t431 = (-2.03 + t14);
-  const double t432 = (t431 * t431);
-  const double t433 = (1e-06 + t432);
-  const double t434 = (1.0 / sqrt(t433));
-  const double t435 = (2.0 + t430 * t427 - t431 * t434);
-  const double t436 =
-      (-t7 * 2e+06 * x[4] * t435 * t12 - 2e+08 * sqrt(t429) + sqrt(t433) * 2e+08 -
+  const double t365 = (1.0 / sqrt(t363));
+  const double t366 = (1.0 / sqrt(t360));
+  const double t367 = (t365 * t361 + 2.0 - t366 * t358);
+  const double t368 = (4e+08 * t116 - 2e+08 * sqrt(t360) + 0.013823007675795093 * x[18] -
+                       1.247e+09 + sqrt(t363) * 2e+08 - 0.026546457922833753 * x[14] + t364 * t367);
+  const double t369 = t115 * t368 * t140 * (-0.5);
+  const double t370 = x[5] * t327;
+  const double t371 = (t307 * x[4] + t370);
+  const double t372 = (x[4] * t327 + t370);
+  const double t373 = (x[4] * t371 + x[5] * t372);
+  const double t374 = (x[7] * x[7]);
+  const double t375 = t40 * 0.1;
+  const double t376 = t38 * (-1.1);
+  const double t377 = (t375 + t376);
+  const double t378 = t377 * x[5];
+  const double t379 = (t378 + t377 * x[4]);
+  const double t380 = (t375 + t376 + t346);
+  const double t381 = (t378 + t380 * x[4]);
+  const double t382 = (x[5] * t379 + t381 * x[4]);
+  const double t383 = cos(u[9]);
+  const double t384 = (-4.005 + t70);
+  const double t385 = (t384 * t384);
+  const double t386 = (1e-06 + t385);
+  const double t387 = (t70 - 2.595);
+  const double t388 = (t387 * t387);
+  const double t389 = (1e-06 + t388);
+  const double t390 = (1.0 / sqrt(t386));
+  const double t391 = (1.0 / sqrt(t389));
+  const double t392 = (t390 * t384 - t391 * t387 + 2.0);
+  const double t393 = (t46 * 2e+06 * x[5] * t60 + t46 * 2e+06 * t62 * x[4]);
+  const double t394 = (-0.035342917352885174 * x[13] + 4e+08 * t70 - 1.32e+09 + sqrt(t386) * 2e+08 -
+                       sqrt(t389) * 2e+08 + x[17] * 0.01802488784997144 + t392 * t393);
+  const double t395 = t330 * x[6];
+  const double t396 = (t330 * x[5] + t330 * x[4] + t395);
+  const double t397 = x[5] * t322;
+  const double t398 = (t397 + x[4] * t322 + t395);
+  const double t399 = (t397 + t318 * x[4] + t395);
+  const double t400 = (t396 * x[6] + t398 * x[5] + x[4] * t399);
+  const double t401 = t90 * (-0.0578571428571429);
+  const double t402 = (-0.567857142857143) * t91;
+  const double t403 = (t401 + t345 + t346 + t402);
+  const double t404 = (t401 + t345 + t402);
+  const double t405 = x[5] * t404;
+  const double t406 = (t401 + t402);
+  const double t407 = t406 * x[6];
+  const double t408 = (x[4] * t403 + t405 + t407);
+  const double t409 = (x[4] * t404 + t405 + t407);
+  const double t410 = (t407 + t406 * x[5] + t406 * x[4]);
+  const double t411 = (x[4] * t408 + x[5] * t409 + t410 * x[6]);
+  const double t412 = x[5] * t325;
+  const double t413 = t332 * x[6];
+  const double t414 = (x[4] * t325 + t412 + t413);
+  const double t415 = (t412 + x[4] * t315 + t413);
+  const double t416 = (t332 * x[5] + t413 + t332 * x[4]);
+  const double t417 = (x[5] * t414 + x[4] * t415 + t416 * x[6]);
+  const double t418 = (-3.775 + t14);
+  const double t419 = (t418 * t418);
+  const double t420 = (1e-06 + t419);
+  const double t421 = (1.0 / sqrt(t420));
+  const double t422 = (-2.03 + t14);
+  const double t423 = (t422 * t422);
+  const double t424 = (1e-06 + t423);
+  const double t425 = (1.0 / sqrt(t424));
+  const double t426 = (2.0 + t421 * t418 - t422 * t425);
+  const double t427 =
+      (-t7 * 2e+06 * x[4] * t426 * t12 - 2e+08 * sqrt(t420) + sqrt(t424) * 2e+08 -
        0.015079644737231009 * x[16] + 1.161e+09 - 4e+08 * t14 + x[12] * 0.03078760800517998);
-  const double t437 = (11440.0 * t0 + 660.0 - t1 * 1540.0);
-  const double t438 = (330.0 + 12540.0 * t0 + 2420.0 * t38 - t40 * 220.0);
-  const double t439 = (-t90 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t38 + 1330.0 * t91);
-  const double t440 = t90 * (-665.0);
-  const double t441 = t91 * (-285.0);
-  const double t442 = t40 * (-2755.0);
-  const double t443 = (t440 + t441 + t442 - t1 * 5415.0);
-  const double t444 = (-t1 * 5720.0 - 770.0 * t0);
-  const double t445 = 0.1 * t38;
-  const double t446 = t40 * 1.1;
-  const double t447 = (t445 + t446);
-  const double t448 = t447 * x[5];
-  const double t449 = (t448 + t447 * x[4]);
-  const double t450 = x[5] * t449;
-  const double t451 = t1 * 5.7;
-  const double t452 = (t450 + x[4] * ((((t445 + t446 + t451)) * x[4] + t448)));
-  const double t453 = t115 * t184 * t374 * (-0.5);
-  const double t454 = pow(t366, (-1.5));
-  const double t455 = pow(t369, (-1.5));
-  const double t456 = (t115 * 2e+08 * t371 * t140 * t367 - t115 * 2e+08 * t372 * t140 * t364 +
-                       ((t365 * t115 * t454 * t140 - t368 * t115 * t455 * t140 +
-                         t115 * t371 * t140 - t115 * t372 * t140)) *
-                           t370 +
+  const double t428 = (11440.0 * t0 + 660.0 - t1 * 1540.0);
+  const double t429 = (330.0 + 12540.0 * t0 + 2420.0 * t38 - t40 * 220.0);
+  const double t430 = (-t90 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t38 + 1330.0 * t91);
+  const double t431 = t115 * t184 * t368 * (-0.5);
+  const double t432 = pow(t360, (-1.5));
+  const double t433 = pow(t363, (-1.5));
+  const double t434 = (t115 * 2e+08 * t365 * t140 * t361 - t115 * 2e+08 * t366 * t140 * t358 +
+                       ((t359 * t115 * t432 * t140 - t362 * t115 * t433 * t140 +
+                         t115 * t365 * t140 - t115 * t366 * t140)) *
+                           t364 +
                        4e+08 * t115 * t140 +
                        ((-t168 * t169 * 2e+06 * x[4] - t168 * t169 * 2e+06 * x[5] +
                          t197 * t115 * 1e+06 * x[6] + t115 * 2e+06 * t184 * x[5] +
                          t115 * 2e+06 * t184 * x[4] - t168 * t164 * 1e+06 * x[6] * t140)) *
-                           t373);
-  const double t457 = t456 * t115 * t140 * (-0.5);
-  const double t458 = pow(t396, (-1.5));
-  const double t459 = pow(t393, (-1.5));
-  const double t460 =
-      (-t398 * t46 * t394 * 2e+08 * t62 + 4e+08 * t46 * t62 + t46 * 2e+08 * t62 * t397 * t391 -
-       t400 * ((-t458 * t46 * t62 * t395 - t46 * t62 * t397 + t398 * t46 * t62 +
-                t46 * t392 * t62 * t459)) +
+                           t367);
+  const double t435 = t434 * t115 * t140 * (-0.5);
+  const double t436 = pow(t389, (-1.5));
+  const double t437 = pow(t386, (-1.5));
+  const double t438 =
+      (-t391 * t46 * t387 * 2e+08 * t62 + 4e+08 * t46 * t62 + t46 * 2e+08 * t62 * t390 * t384 -
+       t393 * ((-t436 * t46 * t62 * t388 - t46 * t62 * t390 + t391 * t46 * t62 +
+                t46 * t385 * t62 * t437)) +
        ((t46 * 2e+06 * x[5] * t78 + t46 * 2e+06 * x[4] * t81 - t79 * 2e+06 * t62 * x[5] * t60 -
          t79 * t80 * 2e+06 * x[4])) *
-           t399);
-  const double t461 = t40 * 2.9;
-  const double t462 = t90 * 0.567857142857143;
-  const double t463 = t91 * (-0.0578571428571429);
-  const double t464 = (t461 + t462 + t463);
-  const double t465 = t464 * x[5];
-  const double t466 = (t462 + t463);
-  const double t467 = t466 * x[6];
-  const double t468 = (t464 * x[4] + t465 + t467);
-  const double t469 = t468 * x[5];
-  const double t470 = (t466 * x[4] + t467 + t466 * x[5]);
-  const double t471 = x[6] * t470;
-  const double t472 = (((t465 + t467 + ((t461 + t462 + t463 + t451)) * x[4])) * x[4] + t469 + t471);
-  const double t473 = t168 * t169 * t374 * 0.5;
-  const double t474 = (-110.0) * t38;
-  const double t475 = t40 * (-1210.0);
-  const double t476 = (t474 + t475 - t1 * 6270.0);
-  const double t477 = t90 * 0.7;
-  const double t478 = t91 * 0.3;
-  const double t479 = (t477 + t478);
-  const double t480 = t479 * x[6];
-  const double t481 = (t461 + t477 + t478);
-  const double t482 = t481 * x[5];
-  const double t483 = (t479 * x[5] + t479 * x[4] + t480);
-  const double t484 = x[6] * t483;
-  const double t485 = (t480 + t481 * x[4] + t482);
-  const double t486 = t485 * x[5];
-  const double t487 = (x[4] * ((t480 + ((t461 + t477 + t451 + t478)) * x[4] + t482)) + t484 + t486);
-  const double t488 = t347 * t353 * (-9316.3175);
-  const double t489 = t383 * t380 * t340;
-  const double t490 = (-1100.0) * t379 * t329;
-  const double t491 = (-950.0) * t362 * t353;
-  const double t492 = t420 * t411;
-  const double t493 = (t469 + t468 * x[4] + t471);
-  const double t494 = (x[4] * t416 + t417 + t419);
-  const double t495 = t426 * t327;
-  const double t496 = t79 * t401 * t62 * 0.5 * t60;
-  const double t497 = (t359 + t361 + t360 * x[4]);
-  const double t498 = t389 * t383 * (-1100.0);
-  const double t499 = (x[4] * t449 + t450);
-  const double t500 =
-      (t46 * 2e+08 * t397 * t60 * t391 + 4e+08 * t46 * t60 - t398 * t46 * t394 * 2e+08 * t60 +
-       t399 * ((t46 * 2e+06 * x[4] * t78 + t46 * t83 * 2e+06 * x[5] -
+           t392);
+  const double t439 = t168 * t169 * t368 * 0.5;
+  const double t440 = t343 * t349 * (-9316.3175);
+  const double t441 = t79 * t394 * t62 * 0.5 * t60;
+  const double t442 =
+      (t46 * 2e+08 * t390 * t60 * t384 + 4e+08 * t46 * t60 - t391 * t46 * t387 * 2e+08 * t60 +
+       t392 * ((t46 * 2e+06 * x[4] * t78 + t46 * t83 * 2e+06 * x[5] -
                 t79 * 2e+06 * t62 * x[4] * t60 - t79 * 2e+06 * x[5] * t82)) -
-       ((-t458 * t46 * t395 * t60 + t398 * t46 * t60 + t46 * t392 * t459 * t60 -
-         t46 * t397 * t60)) *
-           t400);
-  const double t501 = (-950.0) * t407 * t324;
-  const double t502 = u[8] * ((-t347 * 9.80665 * t411 - t390 * 9.80665 * t327));
-  const double t503 = t380 * t341 * u[8] * t411;
-  const double t504 = t380 * t353 * t343;
-  const double t505 = (t440 + t441 + t442);
-  const double t506 = t383 * t347 * (-10787.314999999999);
-  const double t507 = (-10787.314999999999) * t390 * t329;
-  const double t508 = t390 * t324 * (-9316.3175);
-  const double t509 = t380 * u[8] * t316 * t327;
-  const double t510 = t46 * t401 * (-0.5) * t78;
-  const double t511 = (t484 + t485 * x[4] + t486);
-  const double t512 = (x[4] * t385 + t386);
-  const double t513 = (t474 + t475);
-  const double t514 = t332 * t390 * (-9316.3175);
-  const double t515 = (t440 + t441);
-  const double t516 = t355 * (-950.0) * t362;
-  const double t517 = t380 * t355 * t343;
-  const double t518 = t168 * 0.25 * t164 * t374 * t140;
-  const double t519 = (x[5] * t470 + x[4] * t470 + t471);
-  const double t520 = t334 * t426;
-  const double t521 = (t419 + t418 * x[4] + t418 * x[5]);
-  const double t522 = t413 * t420;
-  const double t523 = t380 * t334 * u[8] * t316;
-  const double t524 = t332 * (-950.0) * t407;
-  const double t525 = (-4e+08 * t115 * t164 -
+       ((-t436 * t46 * t388 * t60 + t391 * t46 * t60 + t46 * t385 * t437 * t60 -
+         t46 * t390 * t60)) *
+           t393);
+  const double t443 = u[8] * ((-t343 * 9.80665 * t404 - t383 * 9.80665 * t325));
+  const double t444 = t377 * t343 * (-10787.314999999999);
+  const double t445 = (-10787.314999999999) * t383 * t327;
+  const double t446 = t383 * t322 * (-9316.3175);
+  const double t447 = t46 * t394 * (-0.5) * t78;
+  const double t448 = t330 * t383 * (-9316.3175);
+  const double t449 = t168 * 0.25 * t164 * t368 * t140;
+  const double t450 = (-4e+08 * t115 * t164 -
                        2.0 *
                            ((t115 * 1e+06 * x[6] * t206 - t168 * x[6] * t207 * 5e+05 -
                              t168 * t164 * 1e+06 * x[4] * t140 - t168 * t164 * 1e+06 * x[5] * t140 +
                              t115 * 2e+06 * t209 * x[4] + t115 * 2e+06 * t209 * x[5])) *
-                           t373 +
-                       t370 * ((t115 * t164 * t372 - t365 * t115 * t454 * t164 -
-                                t115 * t371 * t164 + t368 * t115 * t455 * t164)) -
-                       t115 * 2e+08 * t371 * t164 * t367 + t115 * 2e+08 * t164 * t372 * t364);
-  const double t526 = t115 * 0.25 * t525 * t140;
-  const double t527 = (x[4] * t483 + x[5] * t483 + t484);
-  const double t528 = t115 * t209 * t374 * (-0.5);
-  const double t529 = t355 * t347 * (-9316.3175);
-  const double t530 = ((-t413 * t347 * 9.80665 - t390 * t334 * 9.80665)) * u[8];
-  const double t531 = (x[4] * t358 + x[5] * t358 + t359);
-  const double t532 = t413 * t380 * t341 * u[8];
-  const double t533 = (1.0 / (t114));
-  const double t534 = t533 * (-1e+06) * t169 * t373;
-  const double t535 = (1.0 / (t45));
-  const double t536 = t535 * (-1e+06) * t62 * t399 * t60;
-  const double t537 = (-5e+05) * t533 * t164 * t140 * t373;
-  const double t538 = t115 * 0.013273228961416876 * t140;
-  const double t539 = (-0.006911503837897547) * t115 * t140;
-  const double t540 = t380 * t334 * u[8] * t327;
-  const double t541 = t197 * t115 * t374 * (-0.25);
-  const double t542 = t456 * t115 * t164 * (-0.25);
-  const double t543 = (-220.0) * t38;
-  const double t544 = t40 * (-2420.0);
-  const double t545 = t90 * (-1330.0);
-  const double t546 = t40 * (-5510.0);
-  const double t547 = t91 * (-570.0);
-  const double t548 = 950.0 * t323 * t324;
-  const double t549 = t383 * 1100.0 * t308;
-  const double t550 = t301 * 1100.0 * t329;
-  const double t551 = 950.0 * t320 * t353;
-  const double t552 = t316 * t411;
-  const double t553 = t312 * t327;
-  const double t554 = (t548 + t549 + t325 * 1100.0 * t308 + t550 + 950.0 * t352 * t324 + t551 +
-                       1100.0 * t387 * t329 + u[8] * ((t326 * t316 + t552 + t553 + t410 * t327)) +
-                       t328 * 950.0 * t320);
-  const double t555 = t312 * t334;
-  const double t556 = t413 * t316;
-  const double t557 = t332 * 950.0 * t323;
-  const double t558 = t355 * 950.0 * t320;
-  const double t559 = (((t555 + t333 * t316 + t556 + t334 * t410)) * u[8] + t332 * 950.0 * t352 +
-                       t557 + 950.0 * t320 * t331 + t558);
-  const double t560 = t411 * t327;
-  const double t561 = t326 * t327;
-  const double t562 = (t328 * 1900.0 * t324 + ((t560 + t561)) * 2.0 * u[8] + t383 * 2200.0 * t329 +
-                       1900.0 * t353 * t324 + t325 * 2200.0 * t329);
-  const double t563 = t328 * t332 * 950.0;
-  const double t564 = t326 * t334;
-  const double t565 = t334 * t411;
-  const double t566 = t413 * t327;
-  const double t567 = t333 * t327;
-  const double t568 = t332 * 950.0 * t353;
-  const double t569 = t355 * 950.0 * t324;
-  const double t570 = 950.0 * t331 * t324;
-  const double t571 = (t563 + ((t564 + t565 + t566 + t567)) * u[8] + t568 + t569 + t570);
-  const double t572 = t333 * t334;
-  const double t573 = t413 * t334;
-  const double t574 = (2.0 * u[8] * ((t572 + t573)) + t332 * t355 * 1900.0 + t332 * 1900.0 * t331);
-  const double t575 =
-      (t548 + t549 + 950.0 * t353 * t324 + t328 * 950.0 * t324 + t550 + t551 +
-       ((t560 + t552 + t553 + t561)) * u[8] + t383 * 1100.0 * t329 + t325 * 1100.0 * t329);
-  const double t576 = (((t555 + t556 + t565 + t567)) * u[8] + t568 + t557 + t570 + t558);
-  const double t577 = (((t564 + t555 + t556 + t566)) * u[8] + t563 + t569 + t557 + t558);
-  const double t578 = t332 * 950.0 * t331;
-  const double t579 = t332 * t355 * 950.0;
-  const double t580 = (t578 + t557 + u[8] * ((t572 + t573 + t555 + t556)) + t579 + t558);
-  const double t581 = (t578 + t563 + ((t572 + t564 + t573 + t566)) * u[8] + t569 + t579);
+                           t367 +
+                       t364 * ((t115 * t164 * t366 - t359 * t115 * t432 * t164 -
+                                t115 * t365 * t164 + t362 * t115 * t433 * t164)) -
+                       t115 * 2e+08 * t365 * t164 * t361 + t115 * 2e+08 * t164 * t366 * t358);
+  const double t451 = t351 * t343 * (-9316.3175);
+  const double t452 = ((-t406 * t343 * 9.80665 - t383 * t332 * 9.80665)) * u[8];
+  const double t453 =
+      (t448 + t449 + t115 * 0.25 * t450 * t140 - t115 * t209 * t368 * 0.5 + t451 + t452);
+  const double t454 = (1.0 / (t114));
+  const double t455 = t454 * (-1e+06) * t169 * t367;
+  const double t456 = (1.0 / (t45));
+  const double t457 = t456 * (-1e+06) * t62 * t392 * t60;
+  const double t458 = (-5e+05) * t454 * t164 * t140 * t367;
+  const double t459 = t115 * 0.013273228961416876 * t140;
+  const double t460 = (-0.006911503837897547) * t115 * t140;
+  const double t461 =
+      (t448 - t197 * t115 * 0.25 * t368 - t434 * t115 * 0.25 * t164 + t449 + t451 + t452);
+  const double t462 = 950.0 * t321 * t322;
+  const double t463 = t377 * 1100.0 * t307;
+  const double t464 = t300 * 1100.0 * t327;
+  const double t465 = 950.0 * t318 * t349;
+  const double t466 = t315 * t404;
+  const double t467 = t311 * t325;
+  const double t468 = (t462 + t463 + t323 * 1100.0 * t307 + t464 + 950.0 * t348 * t322 + t465 +
+                       1100.0 * t380 * t327 + u[8] * ((t324 * t315 + t466 + t467 + t403 * t325)) +
+                       t326 * 950.0 * t318);
+  const double t469 = t311 * t332;
+  const double t470 = t406 * t315;
+  const double t471 = t330 * 950.0 * t321;
+  const double t472 = t351 * 950.0 * t318;
+  const double t473 = (((t469 + t331 * t315 + t470 + t332 * t403)) * u[8] + t330 * 950.0 * t348 +
+                       t471 + 950.0 * t318 * t329 + t472);
+  const double t474 = t404 * t325;
+  const double t475 = t324 * t325;
+  const double t476 = (t326 * 1900.0 * t322 + ((t474 + t475)) * 2.0 * u[8] + t377 * 2200.0 * t327 +
+                       1900.0 * t349 * t322 + t323 * 2200.0 * t327);
+  const double t477 = t326 * t330 * 950.0;
+  const double t478 = t324 * t332;
+  const double t479 = t332 * t404;
+  const double t480 = t406 * t325;
+  const double t481 = t331 * t325;
+  const double t482 = t330 * 950.0 * t349;
+  const double t483 = t351 * 950.0 * t322;
+  const double t484 = 950.0 * t329 * t322;
+  const double t485 = (t477 + ((t478 + t479 + t480 + t481)) * u[8] + t482 + t483 + t484);
+  const double t486 = t331 * t332;
+  const double t487 = t406 * t332;
+  const double t488 = (2.0 * u[8] * ((t486 + t487)) + t330 * t351 * 1900.0 + t330 * 1900.0 * t329);
+  const double t489 = t90 * (-665.0);
+  const double t490 = t91 * (-285.0);
+  const double t491 = t40 * (-2755.0);
+  const double t492 = (-110.0) * t38;
+  const double t493 = t40 * (-1210.0);
+  const double t494 =
+      (t462 + t463 + 950.0 * t349 * t322 + t326 * 950.0 * t322 + t464 + t465 +
+       ((t474 + t466 + t467 + t475)) * u[8] + t377 * 1100.0 * t327 + t323 * 1100.0 * t327);
+  const double t495 = (((t469 + t470 + t479 + t481)) * u[8] + t482 + t471 + t484 + t472);
+  const double t496 = (((t478 + t469 + t470 + t480)) * u[8] + t477 + t483 + t471 + t472);
+  const double t497 = t330 * 950.0 * t329;
+  const double t498 = t330 * t351 * 950.0;
+  const double t499 = (t497 + t471 + u[8] * ((t486 + t487 + t469 + t470)) + t498 + t472);
+  const double t500 = (t497 + t477 + ((t486 + t478 + t487 + t480)) * u[8] + t483 + t498);
   jacobian[4] = 1.0;
   jacobian[25] = 1.0;
   jacobian[46] = 1.0;
@@ -1643,194 +1669,172 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
        t295 * t285 * 127577.5907699572 * t229 * pow(t287, (-1.25)) +
        (1.0 / sqrt((t286 + 1e+10))) * t295 * 312.5 -
        t290 * t232 * pow(t291, (-1.25)) * 255155.1815399144 + t232 * 510310.3630798288 * t292);
-  mass[0] = (7650.0 + 2200.0 * t297 + (t301 * t301) * 1100.0 + (t304 * t304) * 2200.0 +
-             1100.0 * (t308 * t308) + (((t312 * t312) + t317)) * u[8] + 950.0 * (t320 * t320) +
-             (t323 * t323) * 950.0);
-  mass[1] = t330;
-  mass[2] = t335;
+  mass[0] = (7650.0 + 2200.0 * (t296 * t296) + (t300 * t300) * 1100.0 + (t303 * t303) * 2200.0 +
+             1100.0 * (t307 * t307) + (((t311 * t311) + (t315 * t315))) * u[8] +
+             950.0 * (t318 * t318) + (t321 * t321) * 950.0);
+  mass[1] = t328;
+  mass[2] = t333;
   mass[3] = 0.0;
-  mass[4] = t330;
-  mass[5] = ((t329 * t329) * 1100.0 + 1150.0 + 950.0 * (t324 * t324) + (t328 * t328) * 950.0 +
-             u[8] * ((t336 + (t326 * t326))) + 1100.0 * (t325 * t325));
-  mass[6] = t337;
+  mass[4] = t328;
+  mass[5] = ((t327 * t327) * 1100.0 + 1150.0 + 950.0 * (t322 * t322) + (t326 * t326) * 950.0 +
+             u[8] * (((t325 * t325) + (t324 * t324))) + 1100.0 * (t323 * t323));
+  mass[6] = t334;
   mass[7] = 0.0;
-  mass[8] = t335;
-  mass[9] = t337;
-  mass[10] =
-      (((t338 + (t333 * t333))) * u[8] + (t332 * t332) * 950.0 + 250.0 + (t331 * t331) * 950.0);
+  mass[8] = t333;
+  mass[9] = t334;
+  mass[10] = ((((t332 * t332) + (t331 * t331))) * u[8] + (t330 * t330) * 950.0 + 250.0 +
+              (t329 * t329) * 950.0);
   mass[11] = 0.0;
   mass[12] = 0.0;
   mass[13] = 0.0;
   mass[14] = 0.0;
-  mass[15] = (t339 * t340 + 60000.0 + (t341 * t341) * u[8] + t342 * t343 + t344 * t345);
+  mass[15] = (t335 * t336 + 60000.0 + (t337 * t337) * u[8] + t338 * t339 + t340 * t341);
   acceleration[0] =
-      (-t346 * t296 * t304 * 2200.0 - t296 * t347 * 21574.629999999997 - 950.0 * t320 * t362 -
-       t346 * t296 * 2200.0 * t363 + t375 - t301 * 1100.0 * t379 + t380 * t296 * t344 -
-       t389 * 1100.0 * t308 - t323 * t390 * 9316.3175 - x[4] * 6000.0 - t46 * t401 * t62 * 0.5 +
-       t380 * t341 * u[8] * t316 - t347 * t320 * 9316.3175 + u[4] + t380 * t320 * t343 -
-       t301 * t390 * 10787.314999999999 - t347 * t308 * 10787.314999999999 - 950.0 * t323 * t407 +
-       ((-t312 * t390 * 9.80665 - t347 * 9.80665 * t316)) * u[8] -
-       ((t420 * t316 + t312 * t426)) * u[8] + t380 * t308 * t340 -
-       t304 * t390 * 21574.629999999997 + t7 * t12 * t436);
+      (-t342 * t296 * t303 * 2200.0 - t296 * t343 * 21574.629999999997 - 950.0 * t318 * t356 -
+       t342 * t296 * 2200.0 * t357 + t369 - t300 * 1100.0 * t373 + t374 * t296 * t340 -
+       t382 * 1100.0 * t307 - t321 * t383 * 9316.3175 - x[4] * 6000.0 - t46 * t394 * t62 * 0.5 +
+       t374 * t337 * u[8] * t315 - t343 * t318 * 9316.3175 + u[4] + t374 * t318 * t339 -
+       t300 * t383 * 10787.314999999999 - t343 * t307 * 10787.314999999999 - 950.0 * t321 * t400 +
+       ((-t311 * t383 * 9.80665 - t343 * 9.80665 * t315)) * u[8] -
+       ((t411 * t315 + t311 * t417)) * u[8] + t374 * t307 * t336 -
+       t303 * t383 * 21574.629999999997 + t7 * t12 * t427);
   acceleration[1] =
-      (-t328 * t390 * 9316.3175 - t347 * t324 * 9316.3175 + t380 * t329 * t340 + t375 +
-       t380 * t324 * t343 - ((t420 * t327 + t326 * t426)) * u[8] - 2500.0 * x[5] -
-       950.0 * t362 * t324 - t389 * 1100.0 * t329 +
-       u[8] * ((-t326 * t390 * 9.80665 - t347 * 9.80665 * t327)) -
-       t347 * 10787.314999999999 * t329 - t328 * 950.0 * t407 + u[5] + t380 * t341 * u[8] * t327 -
-       t325 * t390 * 10787.314999999999 - t325 * 1100.0 * t379 - t46 * t401 * 0.5 * t60);
+      (-t326 * t383 * 9316.3175 - t343 * t322 * 9316.3175 + t374 * t327 * t336 + t369 +
+       t374 * t322 * t339 - ((t411 * t325 + t324 * t417)) * u[8] - 2500.0 * x[5] -
+       950.0 * t356 * t322 - t382 * 1100.0 * t327 +
+       u[8] * ((-t324 * t383 * 9.80665 - t343 * 9.80665 * t325)) -
+       t343 * 10787.314999999999 * t327 - t326 * 950.0 * t400 + u[5] + t374 * t337 * u[8] * t325 -
+       t323 * t383 * 10787.314999999999 - t323 * 1100.0 * t373 - t46 * t394 * 0.5 * t60);
   acceleration[2] =
-      (-t332 * 950.0 * t362 + t380 * t341 * t334 * u[8] - 950.0 * t407 * t331 + t380 * t332 * t343 +
-       ((-t347 * t334 * 9.80665 - t390 * t333 * 9.80665)) * u[8] - 800.0 * x[6] -
-       t390 * t331 * 9316.3175 + u[6] - u[8] * ((t420 * t334 + t333 * t426)) -
-       t332 * t347 * 9316.3175 - t115 * 0.25 * t164 * t374);
+      (-t330 * 950.0 * t356 + t374 * t337 * t332 * u[8] - 950.0 * t400 * t329 + t374 * t330 * t339 +
+       ((-t343 * t332 * 9.80665 - t383 * t331 * 9.80665)) * u[8] - 800.0 * x[6] -
+       t383 * t329 * 9316.3175 + u[6] - u[8] * ((t411 * t332 + t331 * t417)) -
+       t330 * t343 * 9316.3175 - t115 * 0.25 * t164 * t368);
   acceleration[3] =
-      (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 - t296 * x[7] * x[4] * t437 + u[7] -
-       t341 * 2.0 * x[7] * u[8] * t424 - t438 * x[7] * t377 - x[7] * t439 * t406);
+      (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 - t296 * x[7] * x[4] * t428 + u[7] -
+       t337 * 2.0 * x[7] * u[8] * t415 - t429 * x[7] * t371 - x[7] * t430 * t399);
   d_force[0] =
-      (((-t390 * 9.80665 * t316 - t347 * t410 * 9.80665)) * u[8] - t346 * 2200.0 * t297 -
-       t347 * 21574.629999999997 * t363 + t7 * t10 * t436 + t443 * t380 * t320 +
-       t79 * t401 * t80 * 0.5 + t380 * t296 * t444 - t452 * 1100.0 * t308 -
-       t346 * (t363 * t363) * 2200.0 + t453 - t320 * t390 * 9316.3175 + t457 -
-       t389 * 1100.0 * t387 - t390 * t308 * 10787.314999999999 + t380 * t317 * u[8] -
-       950.0 * t323 * t362 + t380 * t341 * u[8] * t410 - t11 * t13 * t436 -
-       t296 * t390 * 21574.629999999997 - 950.0 * t320 * t407 - t347 * t352 * 9316.3175 -
-       t346 * t296 * ((t1 * 2.6 + 0.35 * t0)) * 2200.0 + t380 * t352 * t343 -
-       t46 * t62 * t460 * 0.5 +
+      (((-t383 * 9.80665 * t315 - t343 * t403 * 9.80665)) * u[8] -
+       t343 * 21574.629999999997 * t357 + t7 * t10 * t427 + t79 * t394 * t80 * 0.5 + t431 -
+       t318 * t383 * 9316.3175 + t435 - t383 * t307 * 10787.314999999999 - t11 * t13 * t427 -
+       t296 * t383 * 21574.629999999997 - t343 * t348 * 9316.3175 - t46 * t62 * t438 * 0.5 +
        t7 *
-           ((-t7 * 2e+06 * t10 * x[4] * t435 + t7 * t431 * t434 * 2e+08 * t12 - 4e+08 * t7 * t12 +
-             t11 * t13 * 2e+06 * x[4] * t435 -
+           ((-t7 * 2e+06 * t10 * x[4] * t426 + t7 * t422 * t425 * 2e+08 * t12 - 4e+08 * t7 * t12 +
+             t11 * t13 * 2e+06 * x[4] * t426 -
              t7 * 2e+06 * x[4] * t12 *
-                 ((t7 * t430 * t12 - t7 * t428 * pow(t429, (-1.5)) * t12 +
-                   pow(t433, (-1.5)) * t7 * t432 * t12 - t7 * t434 * t12)) -
-             t7 * 2e+08 * t430 * t427 * t12)) *
-           t12 -
-       ((t420 * t410 + t472 * t316 + t316 * t426 + t420 * t312)) * u[8] -
-       t346 * t304 * 2200.0 * t363 + t380 * t363 * t344 - 950.0 * t352 * t362 + t380 * t387 * t340 +
-       t473 - 1100.0 * t308 * t379 - t347 * t387 * 10787.314999999999 + t380 * t308 * t476 -
-       t46 * t401 * 0.5 * t81 - t389 * t301 * 1100.0 - 950.0 * t320 * t487);
-  d_force[1] =
-      (t488 + t489 + t490 + t491 - ((t492 + t316 * t493 + t312 * t494 + t495)) * u[8] + t453 +
-       t496 - t497 * 950.0 * t323 + t457 + t498 - 1100.0 * t499 * t308 - t46 * t500 * t62 * 0.5 +
-       t501 + t502 + t503 + t504 + t380 * t320 * t505 + t506 + t507 + t508 + t473 + t509 + t510 -
-       950.0 * t320 * t511 - t301 * 1100.0 * t512 + t380 * t308 * t513);
-  d_force[2] = (t514 + t380 * t320 * t515 + t516 + t517 + t518 -
-                ((t519 * t316 + t520 + t521 * t312 + t522)) * u[8] + t523 + t524 + t526 -
-                950.0 * t320 * t527 + t528 + t529 + t530 - 950.0 * t323 * t531 + t532);
+                 ((t7 * t421 * t12 - t7 * t419 * pow(t420, (-1.5)) * t12 +
+                   pow(t424, (-1.5)) * t7 * t423 * t12 - t7 * t425 * t12)) -
+             t7 * 2e+08 * t421 * t418 * t12)) *
+           t12 +
+       t439 - t343 * t380 * 10787.314999999999 - t46 * t394 * 0.5 * t81);
+  d_force[1] = (t440 + t431 + t441 + t435 - t46 * t442 * t62 * 0.5 + t443 + t444 + t445 + t446 +
+                t439 + t447);
+  d_force[2] = t453;
   d_force[4] =
-      (t534 - t13 * 2e+06 * t435 / (t6)-t296 * t363 * x[4] * 4400.0 - t320 * 1900.0 * t357 -
-       t323 * 1900.0 * t406 - t296 * t304 * x[4] * 4400.0 - 6000.0 - t535 * t80 * t399 * 1e+06 -
-       2200.0 * t388 * t308 - t301 * 2200.0 * t377 - 2.0 * ((t312 * t424 + t415 * t316)) * u[8]);
-  d_force[5] = (t536 - t320 * 1900.0 * t360 + t534 - t405 * t323 * 1900.0 - 2200.0 * t308 * t385 -
-                t301 * 2200.0 * t378 - ((t416 * t316 + t312 * t423)) * 2.0 * u[8]);
-  d_force[6] = (-t320 * 1900.0 * t358 - 2.0 * u[8] * ((t418 * t316 + t425 * t312)) + t537 -
-                t323 * 1900.0 * t403);
-  d_force[7] = (t296 * 2.0 * t344 * x[7] + 2.0 * t308 * x[7] * t340 + t320 * 2.0 * x[7] * t343 +
-                t341 * 2.0 * x[7] * u[8] * t316);
+      (t455 - t13 * 2e+06 * t426 / (t6)-t296 * t357 * x[4] * 4400.0 - t318 * 1900.0 * t353 -
+       t321 * 1900.0 * t399 - t296 * t303 * x[4] * 4400.0 - 6000.0 - t456 * t80 * t392 * 1e+06 -
+       2200.0 * t381 * t307 - t300 * 2200.0 * t371 - 2.0 * ((t311 * t415 + t408 * t315)) * u[8]);
+  d_force[5] = (t457 - t318 * 1900.0 * t355 + t455 - t398 * t321 * 1900.0 - 2200.0 * t307 * t379 -
+                t300 * 2200.0 * t372 - ((t409 * t315 + t311 * t414)) * 2.0 * u[8]);
+  d_force[6] = (-t318 * 1900.0 * t354 - 2.0 * u[8] * ((t410 * t315 + t416 * t311)) + t458 -
+                t321 * 1900.0 * t396);
+  d_force[7] = (t296 * 2.0 * t340 * x[7] + 2.0 * t307 * x[7] * t336 + t318 * 2.0 * x[7] * t339 +
+                t337 * 2.0 * x[7] * u[8] * t315);
   d_force[12] = t7 * 0.03078760800517998 * t12;
   d_force[13] = t46 * t62 * 0.017671458676442587;
-  d_force[14] = t538;
+  d_force[14] = t459;
   d_force[16] = t7 * (-0.015079644737231009) * t12;
   d_force[17] = (-0.00901244392498572) * t46 * t62;
-  d_force[18] = t539;
-  d_force[20] =
-      (-950.0 * t487 * t324 + t488 + t380 * t329 * t476 + t489 + t490 - t46 * t460 * 0.5 * t60 +
-       t491 - t328 * 950.0 * t362 + t453 + t496 + t457 + t498 - t389 * t325 * 1100.0 + t501 + t502 +
-       t503 + t504 + t506 - u[8] * ((t472 * t327 + t492 + t495 + t420 * t326)) + t507 -
-       t452 * 1100.0 * t329 + t443 * t380 * t324 + t508 + t473 + t509 + t510);
-  d_force[21] =
-      (t380 * t329 * t513 + t488 + t489 - 950.0 * t511 * t324 + t490 + t380 * t336 * u[8] + t491 -
-       t325 * 1100.0 * t512 - t497 * t328 * 950.0 + t453 + t380 * t324 * t505 + t457 + t498 -
-       1100.0 * t499 * t329 + t501 + t502 + t503 - t46 * t500 * 0.5 * t60 + t504 -
-       ((t493 * t327 + t492 + t495 + t494 * t326)) * u[8] + t506 + t79 * t401 * 0.5 * t82 + t507 +
-       t508 - t46 * t401 * t83 * 0.5 + t473);
-  d_force[22] = (t514 + t516 + t517 + t518 + t380 * t515 * t324 -
-                 ((t521 * t326 + t520 + t519 * t327 + t522)) * u[8] + t540 + t524 + t526 -
-                 950.0 * t324 * t527 + t528 + t529 - t328 * 950.0 * t531 + t530 + t532);
-  d_force[24] = (-1900.0 * t357 * t324 + t536 - ((t415 * t327 + t326 * t424)) * 2.0 * u[8] + t534 -
-                 2200.0 * t388 * t329 - t325 * 2200.0 * t377 - t328 * 1900.0 * t406);
-  d_force[25] = (-2200.0 * t329 * t385 - 2500.0 - ((t326 * t423 + t416 * t327)) * 2.0 * u[8] +
-                 t534 - t535 * t399 * 1e+06 * t82 - 1900.0 * t360 * t324 - t325 * 2200.0 * t378 -
-                 t405 * t328 * 1900.0);
-  d_force[26] = (-((t418 * t327 + t425 * t326)) * 2.0 * u[8] + t537 - 1900.0 * t358 * t324 -
-                 t328 * 1900.0 * t403);
+  d_force[18] = t460;
+  d_force[20] = (t440 - t46 * t438 * 0.5 * t60 + t431 + t441 + t435 + t443 + t444 + t445 + t446 +
+                 t439 + t447);
+  d_force[21] = (t440 + t431 + t435 + t443 - t46 * t442 * 0.5 * t60 + t444 +
+                 t79 * t394 * 0.5 * t82 + t445 + t446 - t46 * t394 * t83 * 0.5 + t439);
+  d_force[22] = t453;
+  d_force[24] = (-1900.0 * t353 * t322 + t457 - ((t408 * t325 + t324 * t415)) * 2.0 * u[8] + t455 -
+                 2200.0 * t381 * t327 - t323 * 2200.0 * t371 - t326 * 1900.0 * t399);
+  d_force[25] = (-2200.0 * t327 * t379 - 2500.0 - ((t324 * t414 + t409 * t325)) * 2.0 * u[8] +
+                 t455 - t456 * t392 * 1e+06 * t82 - 1900.0 * t355 * t322 - t323 * 2200.0 * t372 -
+                 t398 * t326 * 1900.0);
+  d_force[26] = (-((t410 * t325 + t416 * t324)) * 2.0 * u[8] + t458 - 1900.0 * t354 * t322 -
+                 t326 * 1900.0 * t396);
   d_force[27] =
-      (2.0 * x[7] * t324 * t343 + 2.0 * x[7] * t329 * t340 + t341 * 2.0 * x[7] * u[8] * t327);
+      (2.0 * x[7] * t322 * t339 + 2.0 * x[7] * t327 * t336 + t337 * 2.0 * x[7] * u[8] * t325);
   d_force[33] = t46 * 0.017671458676442587 * t60;
-  d_force[34] = t538;
+  d_force[34] = t459;
   d_force[37] = (-0.00901244392498572) * t46 * t60;
-  d_force[38] = t539;
-  d_force[40] = (t514 + t541 + t516 + t542 + t517 + t443 * t380 * t332 + t518 + t523 -
-                 950.0 * t362 * t331 + t524 - ((t420 * t333 + t520 + t334 * t472 + t522)) * u[8] +
-                 t529 - t332 * 950.0 * t487 + t530 + t532);
-  d_force[41] = (t514 + t541 + t516 + t542 + t517 - t497 * 950.0 * t331 + t518 + t540 -
-                 t332 * 950.0 * t511 + t524 + t380 * t332 * t505 -
-                 ((t520 + t334 * t493 + t494 * t333 + t522)) * u[8] + t529 + t530 + t532);
-  d_force[42] =
-      (t514 + t516 + t517 + t380 * t338 * u[8] - t115 * 0.25 * t374 * t206 + t380 * t332 * t515 +
-       t524 + 0.125 * t168 * t374 * t207 - u[8] * ((t520 + t521 * t333 + t519 * t334 + t522)) -
-       t332 * 950.0 * t527 - 950.0 * t331 * t531 + 0.125 * t115 * t164 * t525 + t529 + t530 + t532);
-  d_force[44] = (-2.0 * ((t333 * t424 + t334 * t415)) * u[8] - 1900.0 * t331 * t406 + t537 -
-                 t332 * 1900.0 * t357);
-  d_force[45] = (-t405 * 1900.0 * t331 - t332 * 1900.0 * t360 -
-                 ((t333 * t423 + t334 * t416)) * 2.0 * u[8] + t537);
-  d_force[46] = (-250000.0 * t533 * t207 * t373 - 2.0 * u[8] * ((t425 * t333 + t418 * t334)) -
-                 t332 * 1900.0 * t358 - 800.0 - 1900.0 * t403 * t331);
-  d_force[47] = (t341 * 2.0 * t334 * x[7] * u[8] + t332 * 2.0 * x[7] * t343);
+  d_force[38] = t460;
+  d_force[40] = t461;
+  d_force[41] = t461;
+  d_force[42] = (t448 - t115 * 0.25 * t368 * t206 + 0.125 * t168 * t368 * t207 +
+                 0.125 * t115 * t164 * t450 + t451 + t452);
+  d_force[44] = (-2.0 * ((t331 * t415 + t332 * t408)) * u[8] - 1900.0 * t329 * t399 + t458 -
+                 t330 * 1900.0 * t353);
+  d_force[45] = (-t398 * 1900.0 * t329 - t330 * 1900.0 * t355 -
+                 ((t331 * t414 + t332 * t409)) * 2.0 * u[8] + t458);
+  d_force[46] = (-250000.0 * t454 * t207 * t367 - 2.0 * u[8] * ((t416 * t331 + t410 * t332)) -
+                 t330 * 1900.0 * t354 - 800.0 - 1900.0 * t396 * t329);
+  d_force[47] = (t337 * 2.0 * t332 * x[7] * u[8] + t330 * 2.0 * x[7] * t339);
   d_force[54] = t115 * t164 * 0.006636614480708438;
   d_force[58] = t115 * (-0.0034557519189487734) * t164;
-  d_force[60] =
-      (-((t543 - t1 * 12540.0 + t544)) * x[7] * t377 -
-       ((-1540.0 * t0 - t1 * 11440.0)) * t296 * x[7] * x[4] - t438 * t388 * x[7] -
-       ((t545 + t546 - 10830.0 * t1 + t547)) * x[7] * t406 - 2.0 * x[7] * u[8] * t316 * t424 -
-       t363 * x[7] * x[4] * t437 - x[7] * t439 * t357 - t341 * 2.0 * x[7] * t415 * u[8]);
-  d_force[61] = (-2.0 * x[7] * u[8] * t424 * t327 - t360 * x[7] * t439 -
-                 x[7] * ((t545 + t546 + t547)) * t406 - t438 * x[7] * t385 -
-                 t341 * 2.0 * x[7] * u[8] * t416 - ((t543 + t544)) * x[7] * t377);
-  d_force[62] = (-x[7] * t358 * t439 - ((t545 + t547)) * x[7] * t406 -
-                 2.0 * t334 * x[7] * u[8] * t424 - t418 * t341 * 2.0 * x[7] * u[8]);
-  d_force[64] = (-t320 * x[7] * t439 - t438 * t308 * x[7] - t341 * 2.0 * x[7] * u[8] * t316 -
-                 t296 * x[7] * t437);
-  d_force[65] = (-x[7] * t439 * t324 - t341 * 2.0 * x[7] * u[8] * t327 - t438 * x[7] * t329);
-  d_force[66] = (-t341 * 2.0 * t334 * x[7] * u[8] - t332 * x[7] * t439);
+  d_force[64] = (-t318 * x[7] * t430 - t429 * t307 * x[7] - t337 * 2.0 * x[7] * u[8] * t315 -
+                 t296 * x[7] * t428);
+  d_force[65] = (-x[7] * t430 * t322 - t337 * 2.0 * x[7] * u[8] * t325 - t429 * x[7] * t327);
+  d_force[66] = (-t337 * 2.0 * t332 * x[7] * u[8] - t330 * x[7] * t430);
   d_force[67] =
-      (-t439 * t406 - t341 * 2.0 * u[8] * t424 - t438 * t377 - t296 * x[4] * t437 - 20000.0);
+      (-t430 * t399 - t337 * 2.0 * u[8] * t415 - t429 * t371 - t296 * x[4] * t428 - 20000.0);
   d_force[75] = 0.0025;
   d_force[79] = (-0.0025);
   d_mass[0] =
-      (t296 * t304 * 4400.0 + ((t312 * t316 + t410 * t316)) * 2.0 * u[8] + t296 * t363 * 4400.0 +
-       t301 * 2200.0 * t308 + t320 * t323 * 1900.0 + 2200.0 * t387 * t308 + t320 * t352 * 1900.0);
-  d_mass[1] = t554;
-  d_mass[2] = t559;
-  d_mass[4] = t554;
-  d_mass[5] = t562;
-  d_mass[6] = t571;
-  d_mass[8] = t559;
-  d_mass[9] = t571;
-  d_mass[10] = t574;
-  d_mass[15] = (t296 * t344 + t444 * t345 + t320 * t343 + t341 * 2.0 * u[8] * t316 + t308 * t340 +
-                t443 * t342 + t339 * t476);
-  d_mass[16] = (t320 * 1900.0 * t353 + t323 * 1900.0 * t324 + ((t552 + t553)) * 2.0 * u[8] +
-                t383 * 2200.0 * t308 + t301 * 2200.0 * t329);
-  d_mass[17] = t575;
-  d_mass[18] = t576;
-  d_mass[20] = t575;
-  d_mass[21] = t562;
-  d_mass[22] = t571;
-  d_mass[24] = t576;
-  d_mass[25] = t571;
-  d_mass[26] = t574;
-  d_mass[31] = (t339 * t513 + t341 * 2.0 * u[8] * t327 + t324 * t343 + t329 * t340 + t342 * t505);
-  d_mass[32] = (t355 * t320 * 1900.0 + ((t555 + t556)) * 2.0 * u[8] + t332 * t323 * 1900.0);
-  d_mass[33] = t577;
-  d_mass[34] = t580;
-  d_mass[36] = t577;
-  d_mass[37] = (t328 * t332 * 1900.0 + 2.0 * ((t564 + t566)) * u[8] + t355 * 1900.0 * t324);
-  d_mass[38] = t581;
-  d_mass[40] = t580;
-  d_mass[41] = t581;
-  d_mass[42] = t574;
-  d_mass[47] = (t341 * 2.0 * t334 * u[8] + t342 * t515 + t332 * t343);
+      (t296 * t303 * 4400.0 + ((t311 * t315 + t403 * t315)) * 2.0 * u[8] + t296 * t357 * 4400.0 +
+       t300 * 2200.0 * t307 + t318 * t321 * 1900.0 + 2200.0 * t380 * t307 + t318 * t348 * 1900.0);
+  d_mass[1] = t468;
+  d_mass[2] = t473;
+  d_mass[4] = t468;
+  d_mass[5] = t476;
+  d_mass[6] = t485;
+  d_mass[8] = t473;
+  d_mass[9] = t485;
+  d_mass[10] = t488;
+  d_mass[15] = (t296 * t340 + ((-t1 * 5720.0 - 770.0 * t0)) * t341 + t318 * t339 +
+                t337 * 2.0 * u[8] * t315 + t307 * t336 +
+                ((t489 + t490 + t491 - t1 * 5415.0)) * t338 + t335 * ((t492 + t493 - t1 * 6270.0)));
+  d_mass[16] = (t318 * 1900.0 * t349 + t321 * 1900.0 * t322 + ((t466 + t467)) * 2.0 * u[8] +
+                t377 * 2200.0 * t307 + t300 * 2200.0 * t327);
+  d_mass[17] = t494;
+  d_mass[18] = t495;
+  d_mass[20] = t494;
+  d_mass[21] = t476;
+  d_mass[22] = t485;
+  d_mass[24] = t495;
+  d_mass[25] = t485;
+  d_mass[26] = t488;
+  d_mass[31] = (t335 * ((t492 + t493)) + t337 * 2.0 * u[8] * t325 + t322 * t339 + t327 * t336 +
+                t338 * ((t489 + t490 + t491)));
+  d_mass[32] = (t351 * t318 * 1900.0 + ((t469 + t470)) * 2.0 * u[8] + t330 * t321 * 1900.0);
+  d_mass[33] = t496;
+  d_mass[34] = t499;
+  d_mass[36] = t496;
+  d_mass[37] = (t326 * t330 * 1900.0 + 2.0 * ((t478 + t480)) * u[8] + t351 * 1900.0 * t322);
+  d_mass[38] = t500;
+  d_mass[40] = t499;
+  d_mass[41] = t500;
+  d_mass[42] = t488;
+  d_mass[47] = (t337 * 2.0 * t332 * u[8] + t338 * ((t489 + t490)) + t330 * t339);
+  // -dh/dq by central differences (see codegen/symbolic_model.cc).
+  for (int c = 0; c < kNumJoints; ++c) {
+    double shifted[kNumStates];
+    std::copy(x, x + kNumStates, shifted);
+    double plus[kNumJoints], minus[kNumJoints];
+    const double step = 1e-6;
+    shifted[c] = x[c] + step;
+    VelocityTerms(shifted, u, plus);
+    shifted[c] = x[c] - step;
+    VelocityTerms(shifted, u, minus);
+    for (int j = 0; j < kNumJoints; ++j) {
+      d_force[j * kNumStates + c] -= (plus[j] - minus[j]) / (2.0 * step);
+    }
+  }
   Factor(mass);
   Solve(mass, acceleration);
   for (int c = 0; c < kNumStates; ++c) {

@@ -533,6 +533,61 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
 }
 
+namespace {
+
+void VelocityTerms(const double* x, const double* u, double* velocity_terms) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const double t0 = (x[0] + x[1]);
+  const double t1 = sin(t0);
+  const double t2 = t1 * (-0.55);
+  const double t3 = cos(t0);
+  const double t4 = (-0.25) * t3;
+  const double t5 = sin(x[0]);
+  const double t6 = t5 * (-3.11);
+  const double t7 = (t2 + t4 + t6);
+  const double t8 = t1 * 0.25;
+  const double t9 = (-0.55) * t3;
+  const double t10 = (t8 + t9);
+  const double t11 = x[3] * t10;
+  const double t12 = cos(x[0]);
+  const double t13 = (-3.11) * t12;
+  const double t14 = (((t11 + x[2] * t10)) * x[3] + ((((t8 + t13 + t9)) * x[2] + t11)) * x[2]);
+  const double t15 = t1 * 0.16343387866394005;
+  const double t16 = (-0.4011545671438309) * t3;
+  const double t17 = (t15 + t16);
+  const double t18 = t17 * x[3];
+  const double t19 = (x[2] * ((t18 + ((t13 + t15 + t16)) * x[2])) + ((t18 + t17 * x[2])) * x[3]);
+  const double t20 = t1 * (-0.4011545671438309);
+  const double t21 = (-0.16343387866394005) * t3;
+  const double t22 = (t20 + t21 + t6);
+  const double t23 = t1 * (-0.16343387866394005);
+  const double t24 = 3.11 * t12;
+  const double t25 = 0.4011545671438309 * t3;
+  const double t26 = (t20 + t21);
+  const double t27 = t26 * x[3];
+  const double t28 = (((t26 * x[2] + t27)) * x[3] + ((t27 + t22 * x[2])) * x[2]);
+  const double t29 = t1 * (-0.25);
+  const double t30 = 0.55 * t3;
+  const double t31 = (t2 + t4);
+  const double t32 = x[3] * t31;
+  const double t33 = (((t32 + t7 * x[2])) * x[2] + x[3] * ((t32 + x[2] * t31)));
+  const double t34 = (x[2] * x[2]);
+  const double t35 = (-1.55 * t5 - 0.1 * t12);
+  velocity_terms[0] =
+      (1550.0 * t7 * t14 + ((t19 * t22 + ((t23 + t24 + t25)) * t28)) * u[4] +
+       1550.0 * ((t24 + t29 + t30)) * t33 + 2600.0 * ((-t5 * 0.1 + 1.55 * t12)) * t34 * t35 +
+       2600.0 * t34 * t35 * ((t5 * 0.1 - 1.55 * t12)));
+  velocity_terms[1] = (((t29 + t30)) * 1550.0 * t33 + 1550.0 * t14 * t31 +
+                       ((t28 * ((t23 + t25)) + t19 * t26)) * u[4]);
+}
+
+}  // namespace
+
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
   using std::acos;
   using std::atan2;
@@ -854,123 +909,97 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t213 = 0.55 * t38;
   const double t214 = (t206 + t212 + t213);
   const double t215 = (-1.55 * t1 - 0.1 * t0);
-  const double t216 = (t215 * t215);
-  const double t217 = (t209 + t210);
-  const double t218 = (t205 + t207);
-  const double t219 = (t201 + t202);
-  const double t220 = (t212 + t213);
-  const double t221 =
-      (((t211 * t217 + t208 * t218)) * u[4] + 600.0 + 1550.0 * t204 * t219 + t220 * 1550.0 * t214);
-  const double t222 = cos(u[5]);
-  const double t223 = (-2.51 + t7);
-  const double t224 = (t223 * t223);
-  const double t225 = (1e-06 + t224);
-  const double t226 = (t7 - 1.4);
-  const double t227 = (t226 * t226);
-  const double t228 = (1e-06 + t227);
-  const double t229 = (1.0 / sqrt(t228));
-  const double t230 = (1.0 / sqrt(t225));
-  const double t231 = (-t229 * t226 + 2.0 + t230 * t223);
-  const double t232 =
-      (-2e+08 * sqrt(t225) + x[6] * 0.04021238596594936 - t231 * t13 * t15 * 2e+06 * x[2] +
-       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t228) - 4e+08 * t7);
-  const double t233 = x[3] * t219;
-  const double t234 = (t233 + t204 * x[2]);
-  const double t235 = (t233 + x[2] * t219);
-  const double t236 = (t234 * x[2] + x[3] * t235);
-  const double t237 = (x[2] * x[2]);
-  const double t238 = (t1 * 0.1 - 1.55 * t0);
-  const double t239 = sin(u[5]);
-  const double t240 = t39 * 0.25;
-  const double t241 = (-0.55) * t38;
-  const double t242 = (t240 + t241);
-  const double t243 = x[3] * t242;
-  const double t244 = (t243 + x[2] * t242);
-  const double t245 = t244 * x[3];
-  const double t246 = (-3.11) * t0;
-  const double t247 = (t240 + t246 + t241);
-  const double t248 = (t247 * x[2] + t243);
-  const double t249 = (t245 + t248 * x[2]);
-  const double t250 = t39 * 0.16343387866394005;
-  const double t251 = (-0.4011545671438309) * t38;
-  const double t252 = (t250 + t251);
-  const double t253 = t252 * x[3];
-  const double t254 = (t246 + t250 + t251);
-  const double t255 = (t253 + t254 * x[2]);
-  const double t256 = (t253 + t252 * x[2]);
-  const double t257 = t256 * x[3];
-  const double t258 = (x[2] * t255 + t257);
-  const double t259 = t217 * x[3];
-  const double t260 = (t217 * x[2] + t259);
-  const double t261 = (t259 + t211 * x[2]);
-  const double t262 = (t260 * x[3] + t261 * x[2]);
-  const double t263 = (-1.59 + t114);
-  const double t264 = (t263 * t263);
-  const double t265 = (t264 + 1e-06);
-  const double t266 = (t63 * t104 * 2e+06 * x[3] + t63 * t85 * 2e+06 * x[2]);
-  const double t267 = (1.0 / sqrt(t265));
-  const double t268 = (t114 - 2.9000000000000004);
-  const double t269 = (t268 * t268);
-  const double t270 = (t269 + 1e-06);
-  const double t271 = (1.0 / sqrt(t270));
-  const double t272 = (t263 * t267 - t268 * t271 - 2.0);
-  const double t273 = (-sqrt(t265) * 2e+08 - 8.98e+08 - t266 * t272 - 0.06283185307179587 * x[7] +
-                       sqrt(t270) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t114);
-  const double t274 = t39 * 0.55;
-  const double t275 = 0.25 * t38;
-  const double t276 = (t274 + t275);
-  const double t277 = t276 * x[3];
-  const double t278 = (t277 + t276 * x[2]);
-  const double t279 = t278 * x[3];
-  const double t280 = 3.11 * t1;
-  const double t281 = (t279 + ((t277 + x[2] * ((t274 + t280 + t275)))) * x[2]);
-  const double t282 = 0.16343387866394005 * t38;
-  const double t283 = t39 * 0.4011545671438309;
-  const double t284 = (t282 + t283);
-  const double t285 = t284 * x[3];
-  const double t286 = (t284 * x[2] + t285);
-  const double t287 = t286 * x[3];
-  const double t288 = (((t285 + ((t282 + t283 + t280)) * x[2])) * x[2] + t287);
-  const double t289 = pow(t265, (-1.5));
-  const double t290 = pow(t270, (-1.5));
-  const double t291 =
+  const double t216 = (t209 + t210);
+  const double t217 = (t205 + t207);
+  const double t218 = (t201 + t202);
+  const double t219 = (t212 + t213);
+  const double t220 =
+      (((t211 * t216 + t208 * t217)) * u[4] + 600.0 + 1550.0 * t204 * t218 + t219 * 1550.0 * t214);
+  const double t221 = cos(u[5]);
+  const double t222 = (-2.51 + t7);
+  const double t223 = (t222 * t222);
+  const double t224 = (1e-06 + t223);
+  const double t225 = (t7 - 1.4);
+  const double t226 = (t225 * t225);
+  const double t227 = (1e-06 + t226);
+  const double t228 = (1.0 / sqrt(t227));
+  const double t229 = (1.0 / sqrt(t224));
+  const double t230 = (-t228 * t225 + 2.0 + t229 * t222);
+  const double t231 =
+      (-2e+08 * sqrt(t224) + x[6] * 0.04021238596594936 - t230 * t13 * t15 * 2e+06 * x[2] +
+       7.82e+08 - x[8] * 0.027488935718910694 + 2e+08 * sqrt(t227) - 4e+08 * t7);
+  const double t232 = x[3] * t218;
+  const double t233 = (t232 + t204 * x[2]);
+  const double t234 = (t232 + x[2] * t218);
+  const double t235 = (t233 * x[2] + x[3] * t234);
+  const double t236 = (x[2] * x[2]);
+  const double t237 = (t1 * 0.1 - 1.55 * t0);
+  const double t238 = sin(u[5]);
+  const double t239 = t39 * 0.25;
+  const double t240 = (-0.55) * t38;
+  const double t241 = (t239 + t240);
+  const double t242 = x[3] * t241;
+  const double t243 = (t242 + x[2] * t241);
+  const double t244 = (-3.11) * t0;
+  const double t245 = (t239 + t244 + t240);
+  const double t246 = (t245 * x[2] + t242);
+  const double t247 = (t243 * x[3] + t246 * x[2]);
+  const double t248 = t39 * 0.16343387866394005;
+  const double t249 = (-0.4011545671438309) * t38;
+  const double t250 = (t248 + t249);
+  const double t251 = t250 * x[3];
+  const double t252 = (t244 + t248 + t249);
+  const double t253 = (t251 + t252 * x[2]);
+  const double t254 = (t251 + t250 * x[2]);
+  const double t255 = (x[2] * t253 + t254 * x[3]);
+  const double t256 = t216 * x[3];
+  const double t257 = (t216 * x[2] + t256);
+  const double t258 = (t256 + t211 * x[2]);
+  const double t259 = (t257 * x[3] + t258 * x[2]);
+  const double t260 = (-1.59 + t114);
+  const double t261 = (t260 * t260);
+  const double t262 = (t261 + 1e-06);
+  const double t263 = (t63 * t104 * 2e+06 * x[3] + t63 * t85 * 2e+06 * x[2]);
+  const double t264 = (1.0 / sqrt(t262));
+  const double t265 = (t114 - 2.9000000000000004);
+  const double t266 = (t265 * t265);
+  const double t267 = (t266 + 1e-06);
+  const double t268 = (1.0 / sqrt(t267));
+  const double t269 = (t260 * t264 - t265 * t268 - 2.0);
+  const double t270 = (-sqrt(t262) * 2e+08 - 8.98e+08 - t263 * t269 - 0.06283185307179587 * x[7] +
+                       sqrt(t267) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t114);
+  const double t271 = pow(t262, (-1.5));
+  const double t272 = pow(t267, (-1.5));
+  const double t273 =
       (t63 * 4e+08 * t85 -
-       t272 * ((-t133 * t134 * 2e+06 * x[2] + t63 * t132 * 2e+06 * x[2] +
+       t269 * ((-t133 * t134 * 2e+06 * x[2] + t63 * t132 * 2e+06 * x[2] +
                 t63 * 2e+06 * x[3] * t151 - t133 * t104 * t85 * 2e+06 * x[3])) -
-       t263 * t63 * t85 * t267 * 2e+08 + t63 * t268 * t85 * 2e+08 * t271 -
-       ((t63 * t85 * t267 - t63 * t264 * t85 * t289 - t63 * t85 * t271 + t63 * t269 * t85 * t290)) *
-           t266);
-  const double t292 = t222 * (-15200.307499999999) * t219;
-  const double t293 = t239 * t242 * (-15200.307499999999);
-  const double t294 = (t287 + t286 * x[2]);
-  const double t295 = t258 * t252;
-  const double t296 = (t256 * x[2] + t257);
-  const double t297 = t217 * t262;
-  const double t298 = (-1550.0) * t249 * t242;
-  const double t299 = (t244 * x[2] + t245);
-  const double t300 = u[4] * ((-t217 * t222 * 9.80665 - t239 * t252 * 9.80665));
-  const double t301 = (t278 * x[2] + t279);
-  const double t302 = (-1550.0) * t219 * t236;
-  const double t303 = (-t263 * t63 * t104 * t267 * 2e+08 + t63 * 4e+08 * t104 -
-                       t266 * ((t63 * t104 * t267 - t63 * t104 * t271 + t63 * t104 * t269 * t290 -
-                                t63 * t104 * t264 * t289)) +
-                       t63 * t268 * t104 * 2e+08 * t271 -
-                       t272 * ((t63 * 2e+06 * x[2] * t162 - t133 * 2e+06 * x[3] * t152 +
+       t260 * t63 * t85 * t264 * 2e+08 + t63 * t265 * t85 * 2e+08 * t268 -
+       ((t63 * t85 * t264 - t63 * t261 * t85 * t271 - t63 * t85 * t268 + t63 * t266 * t85 * t272)) *
+           t263);
+  const double t274 = t221 * (-15200.307499999999) * t218;
+  const double t275 = t238 * t241 * (-15200.307499999999);
+  const double t276 = u[4] * ((-t216 * t221 * 9.80665 - t238 * t250 * 9.80665));
+  const double t277 = (-t260 * t63 * t104 * t264 * 2e+08 + t63 * 4e+08 * t104 -
+                       t263 * ((t63 * t104 * t264 - t63 * t104 * t268 + t63 * t104 * t266 * t272 -
+                                t63 * t104 * t261 * t271)) +
+                       t63 * t265 * t104 * 2e+08 * t268 -
+                       t269 * ((t63 * 2e+06 * x[2] * t162 - t133 * 2e+06 * x[3] * t152 +
                                 t63 * t160 * 2e+06 * x[3] - t133 * t104 * t85 * 2e+06 * x[2])));
-  const double t304 = t133 * t104 * t85 * t273 * 0.5;
-  const double t305 = (1.0 / (t62));
-  const double t306 = t305 * t104 * t85 * t272 * 1e+06;
-  const double t307 = 1550.0 * t214 * t219;
-  const double t308 = 1550.0 * t204 * t242;
-  const double t309 = t208 * t217;
-  const double t310 = t211 * t252;
-  const double t311 = (t307 + t308 + 1550.0 * t247 * t219 + t220 * 1550.0 * t204 +
-                       ((t211 * t218 + t309 + t217 * t254 + t310)) * u[4]);
-  const double t312 = t217 * t252;
-  const double t313 = t217 * t218;
-  const double t314 = (2.0 * ((t312 + t313)) * u[4] + t220 * 3100.0 * t219 + 3100.0 * t242 * t219);
-  const double t315 = (1550.0 * t242 * t219 + t307 + t308 + t220 * 1550.0 * t219 +
-                       ((t312 + t309 + t313 + t310)) * u[4]);
+  const double t278 = t133 * t104 * t85 * t270 * 0.5;
+  const double t279 = (1.0 / (t62));
+  const double t280 = t279 * t104 * t85 * t269 * 1e+06;
+  const double t281 = 1550.0 * t214 * t218;
+  const double t282 = 1550.0 * t204 * t241;
+  const double t283 = t208 * t216;
+  const double t284 = t211 * t250;
+  const double t285 = (t281 + t282 + 1550.0 * t245 * t218 + t219 * 1550.0 * t204 +
+                       ((t211 * t217 + t283 + t216 * t252 + t284)) * u[4]);
+  const double t286 = t216 * t250;
+  const double t287 = t216 * t217;
+  const double t288 = (2.0 * ((t286 + t287)) * u[4] + t219 * 3100.0 * t218 + 3100.0 * t241 * t218);
+  const double t289 = (1550.0 * t241 * t218 + t281 + t282 + t219 * 1550.0 * t218 +
+                       ((t286 + t283 + t287 + t284)) * u[4]);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[44] = (-12.5);
@@ -1062,72 +1091,77 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
       t184 * 1.2e+09;
   mass[0] =
       (2600.0 * (t200 * t200) + 1550.0 * (t204 * t204) + (((t208 * t208) + (t211 * t211))) * u[4] +
-       1550.0 * (t214 * t214) + 2600.0 * t216 + 2900.0);
-  mass[1] = t221;
-  mass[2] = t221;
-  mass[3] = ((t219 * t219) * 1550.0 + 600.0 + (((t217 * t217) + (t218 * t218))) * u[4] +
-             1550.0 * (t220 * t220));
+       1550.0 * (t214 * t214) + 2600.0 * (t215 * t215) + 2900.0);
+  mass[1] = t220;
+  mass[2] = t220;
+  mass[3] = ((t218 * t218) * 1550.0 + 600.0 + (((t216 * t216) + (t217 * t217))) * u[4] +
+             1550.0 * (t219 * t219));
   acceleration[0] =
-      (-2000.0 * x[2] - t214 * t222 * 15200.307499999999 + t13 * t15 * t232 - 1550.0 * t214 * t236 -
-       2600.0 * t237 * t215 * t238 - t215 * t239 * 25497.289999999997 -
-       2600.0 * t200 * t237 * t215 + ((-t239 * t211 * 9.80665 - t208 * t222 * 9.80665)) * u[4] -
-       1550.0 * t204 * t249 + u[2] - ((t258 * t211 + t208 * t262)) * u[4] - t63 * t85 * t273 * 0.5 -
-       t200 * t222 * 25497.289999999997 - t239 * t204 * 15200.307499999999);
-  acceleration[1] = (-t220 * t222 * 15200.307499999999 - ((t262 * t218 + t258 * t217)) * u[4] -
-                     t220 * 1550.0 * t236 - t63 * t104 * t273 * 0.5 +
-                     ((-t218 * t222 * 9.80665 - t239 * t217 * 9.80665)) * u[4] -
-                     1550.0 * t249 * t219 - 800.0 * x[3] + u[3] - t239 * t219 * 15200.307499999999);
+      (-2000.0 * x[2] - t214 * t221 * 15200.307499999999 + t13 * t15 * t231 - 1550.0 * t214 * t235 -
+       2600.0 * t236 * t215 * t237 - t215 * t238 * 25497.289999999997 -
+       2600.0 * t200 * t236 * t215 + ((-t238 * t211 * 9.80665 - t208 * t221 * 9.80665)) * u[4] -
+       1550.0 * t204 * t247 + u[2] - ((t255 * t211 + t208 * t259)) * u[4] - t63 * t85 * t270 * 0.5 -
+       t200 * t221 * 25497.289999999997 - t238 * t204 * 15200.307499999999);
+  acceleration[1] = (-t219 * t221 * 15200.307499999999 - ((t259 * t217 + t255 * t216)) * u[4] -
+                     t219 * 1550.0 * t235 - t63 * t104 * t270 * 0.5 +
+                     ((-t217 * t221 * 9.80665 - t238 * t216 * 9.80665)) * u[4] -
+                     1550.0 * t247 * t218 - 800.0 * x[3] + u[3] - t238 * t218 * 15200.307499999999);
   d_force[0] =
-      (-2600.0 * t216 * t237 - t281 * 1550.0 * t204 - t204 * t222 * 15200.307499999999 -
-       t239 * t238 * 25497.289999999997 - 2600.0 * t200 * t237 * t238 +
+      (-t204 * t221 * 15200.307499999999 - t238 * t237 * 25497.289999999997 +
        t13 * t15 *
            ((-t13 * t15 * 2e+06 *
-                 ((t13 * t15 * t230 + t13 * t15 * t227 * pow(t228, (-1.5)) - t13 * t15 * t229 -
-                   t13 * pow(t225, (-1.5)) * t15 * t224)) *
+                 ((t13 * t15 * t229 + t13 * t15 * t226 * pow(t227, (-1.5)) - t13 * t15 * t228 -
+                   t13 * pow(t224, (-1.5)) * t15 * t223)) *
                  x[2] -
-             t13 * 4e+08 * t15 - t13 * t15 * 2e+08 * t230 * t223 + t13 * t15 * 2e+08 * t229 * t226 -
-             t231 * t15 * 2e+06 * t16 * x[2] + t231 * 2e+06 * t10 * x[2] * t14)) -
-       t239 * t247 * 15200.307499999999 - 1550.0 * t204 * t236 - 2600.0 * t237 * (t238 * t238) +
-       t133 * t134 * t273 * 0.5 + u[4] * ((-t211 * t222 * 9.80665 - t239 * t254 * 9.80665)) -
-       1550.0 * t214 * t249 - ((t258 * t254 + t211 * t262 + t208 * t258 + t211 * t288)) * u[4] -
-       t63 * t132 * t273 * 0.5 - t291 * t63 * t85 * 0.5 - 1550.0 * t247 * t249 - t10 * t232 * t14 -
-       2600.0 * t237 * t215 * ((1.55 * t1 + 0.1 * t0)) - t215 * t222 * 25497.289999999997 +
-       t15 * t16 * t232);
-  d_force[1] = (t292 + t293 - ((t211 * t294 + t295 + t208 * t296 + t297)) * u[4] + t298 -
-                1550.0 * t214 * t299 + t300 - 1550.0 * t204 * t301 + t302 -
-                t63 * t273 * 0.5 * t162 - t63 * t85 * 0.5 * t303 + t304);
-  d_force[2] = (-2.0 * u[4] * ((t208 * t261 + t211 * t255)) + t305 * t134 * t272 * 1e+06 -
-                t248 * 3100.0 * t204 - t231 * 2e+06 * t14 / (t6)-2000.0 -
-                t200 * t215 * 5200.0 * x[2] - t234 * 3100.0 * t214 - t215 * 5200.0 * t238 * x[2]);
-  d_force[3] = (-2.0 * u[4] * ((t256 * t211 + t208 * t260)) + t306 - 3100.0 * t214 * t235 -
-                3100.0 * t204 * t244);
+             t13 * 4e+08 * t15 - t13 * t15 * 2e+08 * t229 * t222 + t13 * t15 * 2e+08 * t228 * t225 -
+             t230 * t15 * 2e+06 * t16 * x[2] + t230 * 2e+06 * t10 * x[2] * t14)) -
+       t238 * t245 * 15200.307499999999 + t133 * t134 * t270 * 0.5 +
+       u[4] * ((-t211 * t221 * 9.80665 - t238 * t252 * 9.80665)) - t63 * t132 * t270 * 0.5 -
+       t273 * t63 * t85 * 0.5 - t10 * t231 * t14 - t215 * t221 * 25497.289999999997 +
+       t15 * t16 * t231);
+  d_force[1] = (t274 + t275 + t276 - t63 * t270 * 0.5 * t162 - t63 * t85 * 0.5 * t277 + t278);
+  d_force[2] = (-2.0 * u[4] * ((t208 * t258 + t211 * t253)) + t279 * t134 * t269 * 1e+06 -
+                t246 * 3100.0 * t204 - t230 * 2e+06 * t14 / (t6)-2000.0 -
+                t200 * t215 * 5200.0 * x[2] - t233 * 3100.0 * t214 - t215 * 5200.0 * t237 * x[2]);
+  d_force[3] = (-2.0 * u[4] * ((t254 * t211 + t208 * t257)) + t280 - 3100.0 * t214 * t234 -
+                3100.0 * t204 * t243);
   d_force[6] = t13 * t15 * 0.04021238596594936;
   d_force[7] = t63 * 0.031415926535897934 * t85;
   d_force[8] = t13 * (-0.027488935718910694) * t15;
   d_force[9] = t63 * t85 * (-0.023561944901923454);
-  d_force[10] = (t292 + t293 - t291 * t63 * t104 * 0.5 + t298 + t300 + t302 -
-                 t63 * t273 * 0.5 * t151 - t281 * 1550.0 * t219 - t220 * 1550.0 * t249 -
-                 ((t258 * t218 + t295 + t217 * t288 + t297)) * u[4] + t304);
-  d_force[11] =
-      (t133 * t273 * 0.5 * t152 + t292 + t293 - u[4] * ((t295 + t296 * t218 + t294 * t217 + t297)) +
-       t298 + t300 + t302 - 1550.0 * t301 * t219 - t63 * t104 * 0.5 * t303 - t220 * 1550.0 * t299 -
-       t63 * t160 * t273 * 0.5);
-  d_force[12] = (t306 - 2.0 * u[4] * ((t261 * t218 + t217 * t255)) - t220 * t234 * 3100.0 -
-                 t248 * 3100.0 * t219);
-  d_force[13] = (-t220 * 3100.0 * t235 - 2.0 * u[4] * ((t256 * t217 + t260 * t218)) +
-                 t305 * t272 * 1e+06 * t152 - 3100.0 * t244 * t219 - 800.0);
+  d_force[10] = (t274 + t275 - t273 * t63 * t104 * 0.5 + t276 - t63 * t270 * 0.5 * t151 + t278);
+  d_force[11] = (t133 * t270 * 0.5 * t152 + t274 + t275 + t276 - t63 * t104 * 0.5 * t277 -
+                 t63 * t160 * t270 * 0.5);
+  d_force[12] = (t280 - 2.0 * u[4] * ((t258 * t217 + t216 * t253)) - t219 * t233 * 3100.0 -
+                 t246 * 3100.0 * t218);
+  d_force[13] = (-t219 * 3100.0 * t234 - 2.0 * u[4] * ((t254 * t216 + t257 * t217)) +
+                 t279 * t269 * 1e+06 * t152 - 3100.0 * t243 * t218 - 800.0);
   d_force[17] = t63 * 0.031415926535897934 * t104;
   d_force[19] = t63 * t104 * (-0.023561944901923454);
   d_mass[0] =
-      (t215 * 5200.0 * t238 + t247 * 3100.0 * t204 + 2.0 * ((t211 * t254 + t208 * t211)) * u[4] +
+      (t215 * 5200.0 * t237 + t245 * 3100.0 * t204 + 2.0 * ((t211 * t252 + t208 * t211)) * u[4] +
        3100.0 * t204 * t214 + t200 * t215 * 5200.0);
-  d_mass[1] = t311;
-  d_mass[2] = t311;
-  d_mass[3] = t314;
-  d_mass[4] = (((t309 + t310)) * 2.0 * u[4] + 3100.0 * t204 * t242 + 3100.0 * t214 * t219);
-  d_mass[5] = t315;
-  d_mass[6] = t315;
-  d_mass[7] = t314;
+  d_mass[1] = t285;
+  d_mass[2] = t285;
+  d_mass[3] = t288;
+  d_mass[4] = (((t283 + t284)) * 2.0 * u[4] + 3100.0 * t204 * t241 + 3100.0 * t214 * t218);
+  d_mass[5] = t289;
+  d_mass[6] = t289;
+  d_mass[7] = t288;
+  // -dh/dq by central differences (see codegen/symbolic_model.cc).
+  for (int c = 0; c < kNumJoints; ++c) {
+    double shifted[kNumStates];
+    std::copy(x, x + kNumStates, shifted);
+    double plus[kNumJoints], minus[kNumJoints];
+    const double step = 1e-6;
+    shifted[c] = x[c] + step;
+    VelocityTerms(shifted, u, plus);
+    shifted[c] = x[c] - step;
+    VelocityTerms(shifted, u, minus);
+    for (int j = 0; j < kNumJoints; ++j) {
+      d_force[j * kNumStates + c] -= (plus[j] - minus[j]) / (2.0 * step);
+    }
+  }
   Factor(mass);
   Solve(mass, acceleration);
   for (int c = 0; c < kNumStates; ++c) {

@@ -534,6 +534,61 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
 }
 
+namespace {
+
+void VelocityTerms(const double* x, const double* u, double* velocity_terms) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const double t0 = (x[0] + x[1]);
+  const double t1 = sin(t0);
+  const double t2 = t1 * 0.16343387866394005;
+  const double t3 = cos(t0);
+  const double t4 = (-0.4011545671438309) * t3;
+  const double t5 = (t2 + t4);
+  const double t6 = t5 * x[3];
+  const double t7 = cos(x[0]);
+  const double t8 = (-3.11) * t7;
+  const double t9 = (x[2] * ((t6 + ((t8 + t2 + t4)) * x[2])) + ((t6 + t5 * x[2])) * x[3]);
+  const double t10 = t1 * (-0.4011545671438309);
+  const double t11 = (-0.16343387866394005) * t3;
+  const double t12 = sin(x[0]);
+  const double t13 = t12 * (-3.11);
+  const double t14 = (t10 + t11 + t13);
+  const double t15 = t1 * (-0.16343387866394005);
+  const double t16 = 3.11 * t7;
+  const double t17 = 0.4011545671438309 * t3;
+  const double t18 = (t10 + t11);
+  const double t19 = t18 * x[3];
+  const double t20 = (((t18 * x[2] + t19)) * x[3] + ((t19 + t14 * x[2])) * x[2]);
+  const double t21 = (x[2] * x[2]);
+  const double t22 = (-1.55 * t12 - 0.1 * t7);
+  const double t23 = t1 * (-0.25);
+  const double t24 = 0.55 * t3;
+  const double t25 = t1 * (-0.55);
+  const double t26 = (-0.25) * t3;
+  const double t27 = (t25 + t26);
+  const double t28 = x[3] * t27;
+  const double t29 = (t25 + t26 + t13);
+  const double t30 = (((t28 + t29 * x[2])) * x[2] + x[3] * ((t28 + x[2] * t27)));
+  const double t31 = t1 * 0.25;
+  const double t32 = (-0.55) * t3;
+  const double t33 = (t31 + t32);
+  const double t34 = x[3] * t33;
+  const double t35 = (((t34 + x[2] * t33)) * x[3] + ((((t31 + t8 + t32)) * x[2] + t34)) * x[2]);
+  velocity_terms[0] =
+      (((t9 * t14 + ((t15 + t16 + t17)) * t20)) * u[4] +
+       2600.0 * ((-t12 * 0.1 + 1.55 * t7)) * t21 * t22 + ((t16 + t23 + t24)) * 1800.0 * t30 +
+       t29 * t35 * 1800.0 + 2600.0 * t21 * t22 * ((t12 * 0.1 - 1.55 * t7)));
+  velocity_terms[1] = (((t23 + t24)) * 1800.0 * t30 + t35 * 1800.0 * t27 +
+                       ((t20 * ((t15 + t17)) + t9 * t18)) * u[4]);
+}
+
+}  // namespace
+
 void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacobian) {
   using std::acos;
   using std::atan2;
@@ -855,123 +910,97 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t213 = 0.55 * t38;
   const double t214 = (t206 + t212 + t213);
   const double t215 = (-1.55 * t1 - 0.1 * t0);
-  const double t216 = (t215 * t215);
-  const double t217 = (t209 + t210);
-  const double t218 = (t205 + t207);
-  const double t219 = (t212 + t213);
-  const double t220 = (t201 + t202);
-  const double t221 =
-      (((t211 * t217 + t208 * t218)) * u[4] + 600.0 + t219 * t214 * 1800.0 + t204 * 1800.0 * t220);
-  const double t222 = cos(u[5]);
-  const double t223 = (-2.51 + t11);
-  const double t224 = (t223 * t223);
-  const double t225 = (1e-06 + t224);
-  const double t226 = (t11 - 1.4);
-  const double t227 = (t226 * t226);
-  const double t228 = (1e-06 + t227);
-  const double t229 = (1.0 / sqrt(t228));
-  const double t230 = (1.0 / sqrt(t225));
-  const double t231 = (-t229 * t226 + 2.0 + t230 * t223);
-  const double t232 =
-      (-2e+08 * sqrt(t225) - x[8] * 0.03817035074111599 - t231 * t8 * t10 * 2e+06 * x[2] +
-       7.82e+08 + 2e+08 * sqrt(t228) - 4e+08 * t11 + 0.05089380098815465 * x[6]);
-  const double t233 = (x[2] * x[2]);
-  const double t234 = (t1 * 0.1 - 1.55 * t0);
-  const double t235 = sin(u[5]);
-  const double t236 = t39 * 0.16343387866394005;
-  const double t237 = (-0.4011545671438309) * t38;
-  const double t238 = (t236 + t237);
-  const double t239 = t238 * x[3];
-  const double t240 = (-3.11) * t0;
-  const double t241 = (t240 + t236 + t237);
-  const double t242 = (t239 + t241 * x[2]);
-  const double t243 = (t239 + t238 * x[2]);
-  const double t244 = t243 * x[3];
-  const double t245 = (x[2] * t242 + t244);
-  const double t246 = t217 * x[3];
-  const double t247 = (t217 * x[2] + t246);
-  const double t248 = (t246 + t211 * x[2]);
-  const double t249 = (t247 * x[3] + t248 * x[2]);
-  const double t250 = (-1.59 + t114);
-  const double t251 = (t250 * t250);
-  const double t252 = (t251 + 1e-06);
-  const double t253 = (t63 * t104 * 2e+06 * x[3] + t63 * t85 * 2e+06 * x[2]);
-  const double t254 = (1.0 / sqrt(t252));
-  const double t255 = (t114 - 2.9000000000000004);
-  const double t256 = (t255 * t255);
-  const double t257 = (t256 + 1e-06);
-  const double t258 = (1.0 / sqrt(t257));
-  const double t259 = (t250 * t254 - t255 * t258 - 2.0);
-  const double t260 = (-sqrt(t252) * 2e+08 - 8.98e+08 - t253 * t259 - 0.06283185307179587 * x[7] +
-                       sqrt(t257) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t114);
-  const double t261 = t39 * 0.25;
-  const double t262 = (-0.55) * t38;
-  const double t263 = (t261 + t262);
-  const double t264 = x[3] * t263;
-  const double t265 = (t264 + x[2] * t263);
-  const double t266 = t265 * x[3];
-  const double t267 = (t261 + t240 + t262);
-  const double t268 = (t267 * x[2] + t264);
-  const double t269 = (t266 + t268 * x[2]);
-  const double t270 = x[3] * t220;
-  const double t271 = (t270 + t204 * x[2]);
-  const double t272 = (t270 + x[2] * t220);
-  const double t273 = (t271 * x[2] + x[3] * t272);
-  const double t274 = t39 * 0.55;
-  const double t275 = 0.25 * t38;
-  const double t276 = (t274 + t275);
-  const double t277 = t276 * x[3];
-  const double t278 = (t277 + t276 * x[2]);
-  const double t279 = t278 * x[3];
-  const double t280 = 3.11 * t1;
-  const double t281 = (t279 + ((t277 + x[2] * ((t274 + t280 + t275)))) * x[2]);
-  const double t282 = 0.16343387866394005 * t38;
-  const double t283 = t39 * 0.4011545671438309;
-  const double t284 = (t282 + t283);
-  const double t285 = t284 * x[3];
-  const double t286 = (t284 * x[2] + t285);
-  const double t287 = t286 * x[3];
-  const double t288 = (((t285 + ((t282 + t283 + t280)) * x[2])) * x[2] + t287);
-  const double t289 = pow(t252, (-1.5));
-  const double t290 = pow(t257, (-1.5));
-  const double t291 =
+  const double t216 = (t209 + t210);
+  const double t217 = (t205 + t207);
+  const double t218 = (t212 + t213);
+  const double t219 = (t201 + t202);
+  const double t220 =
+      (((t211 * t216 + t208 * t217)) * u[4] + 600.0 + t218 * t214 * 1800.0 + t204 * 1800.0 * t219);
+  const double t221 = cos(u[5]);
+  const double t222 = (-2.51 + t11);
+  const double t223 = (t222 * t222);
+  const double t224 = (1e-06 + t223);
+  const double t225 = (t11 - 1.4);
+  const double t226 = (t225 * t225);
+  const double t227 = (1e-06 + t226);
+  const double t228 = (1.0 / sqrt(t227));
+  const double t229 = (1.0 / sqrt(t224));
+  const double t230 = (-t228 * t225 + 2.0 + t229 * t222);
+  const double t231 =
+      (-2e+08 * sqrt(t224) - x[8] * 0.03817035074111599 - t230 * t8 * t10 * 2e+06 * x[2] +
+       7.82e+08 + 2e+08 * sqrt(t227) - 4e+08 * t11 + 0.05089380098815465 * x[6]);
+  const double t232 = (x[2] * x[2]);
+  const double t233 = (t1 * 0.1 - 1.55 * t0);
+  const double t234 = sin(u[5]);
+  const double t235 = t39 * 0.16343387866394005;
+  const double t236 = (-0.4011545671438309) * t38;
+  const double t237 = (t235 + t236);
+  const double t238 = t237 * x[3];
+  const double t239 = (-3.11) * t0;
+  const double t240 = (t239 + t235 + t236);
+  const double t241 = (t238 + t240 * x[2]);
+  const double t242 = (t238 + t237 * x[2]);
+  const double t243 = (x[2] * t241 + t242 * x[3]);
+  const double t244 = t216 * x[3];
+  const double t245 = (t216 * x[2] + t244);
+  const double t246 = (t244 + t211 * x[2]);
+  const double t247 = (t245 * x[3] + t246 * x[2]);
+  const double t248 = (-1.59 + t114);
+  const double t249 = (t248 * t248);
+  const double t250 = (t249 + 1e-06);
+  const double t251 = (t63 * t104 * 2e+06 * x[3] + t63 * t85 * 2e+06 * x[2]);
+  const double t252 = (1.0 / sqrt(t250));
+  const double t253 = (t114 - 2.9000000000000004);
+  const double t254 = (t253 * t253);
+  const double t255 = (t254 + 1e-06);
+  const double t256 = (1.0 / sqrt(t255));
+  const double t257 = (t248 * t252 - t253 * t256 - 2.0);
+  const double t258 = (-sqrt(t250) * 2e+08 - 8.98e+08 - t251 * t257 - 0.06283185307179587 * x[7] +
+                       sqrt(t255) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t114);
+  const double t259 = t39 * 0.25;
+  const double t260 = (-0.55) * t38;
+  const double t261 = (t259 + t260);
+  const double t262 = x[3] * t261;
+  const double t263 = (t262 + x[2] * t261);
+  const double t264 = (t259 + t239 + t260);
+  const double t265 = (t264 * x[2] + t262);
+  const double t266 = (t263 * x[3] + t265 * x[2]);
+  const double t267 = x[3] * t219;
+  const double t268 = (t267 + t204 * x[2]);
+  const double t269 = (t267 + x[2] * t219);
+  const double t270 = (t268 * x[2] + x[3] * t269);
+  const double t271 = pow(t250, (-1.5));
+  const double t272 = pow(t255, (-1.5));
+  const double t273 =
       (t63 * 4e+08 * t85 -
-       t259 * ((-t133 * t134 * 2e+06 * x[2] + t63 * t132 * 2e+06 * x[2] +
+       t257 * ((-t133 * t134 * 2e+06 * x[2] + t63 * t132 * 2e+06 * x[2] +
                 t63 * 2e+06 * x[3] * t151 - t133 * t104 * t85 * 2e+06 * x[3])) -
-       t250 * t63 * t85 * t254 * 2e+08 + t63 * t255 * t85 * 2e+08 * t258 -
-       ((t63 * t85 * t254 - t63 * t251 * t85 * t289 - t63 * t85 * t258 + t63 * t256 * t85 * t290)) *
-           t253);
-  const double t292 = (-17651.969999999998) * t222 * t220;
-  const double t293 = (t287 + t286 * x[2]);
-  const double t294 = t245 * t238;
-  const double t295 = (t243 * x[2] + t244);
-  const double t296 = t217 * t249;
-  const double t297 = (t265 * x[2] + t266);
-  const double t298 = u[4] * ((-t217 * t222 * 9.80665 - t235 * t238 * 9.80665));
-  const double t299 = t269 * (-1800.0) * t263;
-  const double t300 = (-1800.0) * t220 * t273;
-  const double t301 = (-17651.969999999998) * t235 * t263;
-  const double t302 = (-t250 * t63 * t104 * t254 * 2e+08 + t63 * 4e+08 * t104 -
-                       t253 * ((t63 * t104 * t254 - t63 * t104 * t258 + t63 * t104 * t256 * t290 -
-                                t63 * t104 * t251 * t289)) +
-                       t63 * t255 * t104 * 2e+08 * t258 -
-                       t259 * ((t63 * 2e+06 * x[2] * t162 - t133 * 2e+06 * x[3] * t152 +
+       t248 * t63 * t85 * t252 * 2e+08 + t63 * t253 * t85 * 2e+08 * t256 -
+       ((t63 * t85 * t252 - t63 * t249 * t85 * t271 - t63 * t85 * t256 + t63 * t254 * t85 * t272)) *
+           t251);
+  const double t274 = (-17651.969999999998) * t221 * t219;
+  const double t275 = u[4] * ((-t216 * t221 * 9.80665 - t234 * t237 * 9.80665));
+  const double t276 = (-17651.969999999998) * t234 * t261;
+  const double t277 = (-t248 * t63 * t104 * t252 * 2e+08 + t63 * 4e+08 * t104 -
+                       t251 * ((t63 * t104 * t252 - t63 * t104 * t256 + t63 * t104 * t254 * t272 -
+                                t63 * t104 * t249 * t271)) +
+                       t63 * t253 * t104 * 2e+08 * t256 -
+                       t257 * ((t63 * 2e+06 * x[2] * t162 - t133 * 2e+06 * x[3] * t152 +
                                 t63 * t160 * 2e+06 * x[3] - t133 * t104 * t85 * 2e+06 * x[2])));
-  const double t303 = (t278 * x[2] + t279);
-  const double t304 = t133 * t104 * t85 * t260 * 0.5;
-  const double t305 = (1.0 / (t62));
-  const double t306 = t305 * t104 * t85 * t259 * 1e+06;
-  const double t307 = t214 * 1800.0 * t220;
-  const double t308 = t204 * 1800.0 * t263;
-  const double t309 = t208 * t217;
-  const double t310 = t211 * t238;
-  const double t311 = (t307 + t308 + t219 * t204 * 1800.0 + t267 * 1800.0 * t220 +
-                       ((t211 * t218 + t309 + t217 * t241 + t310)) * u[4]);
-  const double t312 = t217 * t238;
-  const double t313 = t217 * t218;
-  const double t314 = (2.0 * ((t312 + t313)) * u[4] + 3600.0 * t263 * t220 + 3600.0 * t219 * t220);
-  const double t315 = (1800.0 * t263 * t220 + ((t312 + t309 + t313 + t310)) * u[4] + t307 +
-                       t219 * 1800.0 * t220 + t308);
+  const double t278 = t133 * t104 * t85 * t258 * 0.5;
+  const double t279 = (1.0 / (t62));
+  const double t280 = t279 * t104 * t85 * t257 * 1e+06;
+  const double t281 = t214 * 1800.0 * t219;
+  const double t282 = t204 * 1800.0 * t261;
+  const double t283 = t208 * t216;
+  const double t284 = t211 * t237;
+  const double t285 = (t281 + t282 + t218 * t204 * 1800.0 + t264 * 1800.0 * t219 +
+                       ((t211 * t217 + t283 + t216 * t240 + t284)) * u[4]);
+  const double t286 = t216 * t237;
+  const double t287 = t216 * t217;
+  const double t288 = (2.0 * ((t286 + t287)) * u[4] + 3600.0 * t261 * t219 + 3600.0 * t218 * t219);
+  const double t289 = (1800.0 * t261 * t219 + ((t286 + t283 + t287 + t284)) * u[4] + t281 +
+                       t218 * 1800.0 * t219 + t282);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[44] = (-12.5);
@@ -1064,73 +1093,77 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
       t184 * 1.2e+09;
   mass[0] =
       (2600.0 * (t200 * t200) + 1800.0 * (t204 * t204) + (((t208 * t208) + (t211 * t211))) * u[4] +
-       (t214 * t214) * 1800.0 + 2600.0 * t216 + 2900.0);
-  mass[1] = t221;
-  mass[2] = t221;
-  mass[3] = ((t219 * t219) * 1800.0 + 600.0 + (((t217 * t217) + (t218 * t218))) * u[4] +
-             (t220 * t220) * 1800.0);
+       (t214 * t214) * 1800.0 + 2600.0 * (t215 * t215) + 2900.0);
+  mass[1] = t220;
+  mass[2] = t220;
+  mass[3] = ((t218 * t218) * 1800.0 + 600.0 + (((t216 * t216) + (t217 * t217))) * u[4] +
+             (t219 * t219) * 1800.0);
   acceleration[0] =
-      (-t214 * t222 * 17651.969999999998 + t8 * t10 * t232 - 2000.0 * x[2] -
-       2600.0 * t233 * t215 * t234 - t215 * t235 * 25497.289999999997 -
-       2600.0 * t200 * t233 * t215 - t235 * t204 * 17651.969999999998 +
-       ((-t235 * t211 * 9.80665 - t208 * t222 * 9.80665)) * u[4] + u[2] -
-       ((t245 * t211 + t208 * t249)) * u[4] - t63 * t85 * t260 * 0.5 - t204 * t269 * 1800.0 -
-       t200 * t222 * 25497.289999999997 - t214 * 1800.0 * t273);
-  acceleration[1] = (-((t249 * t218 + t245 * t217)) * u[4] - t63 * t104 * t260 * 0.5 +
-                     ((-t218 * t222 * 9.80665 - t235 * t217 * 9.80665)) * u[4] -
-                     t219 * 1800.0 * t273 - 800.0 * x[3] - t235 * 17651.969999999998 * t220 -
-                     t219 * t222 * 17651.969999999998 + u[3] - t269 * 1800.0 * t220);
+      (-t214 * t221 * 17651.969999999998 + t8 * t10 * t231 - 2000.0 * x[2] -
+       2600.0 * t232 * t215 * t233 - t215 * t234 * 25497.289999999997 -
+       2600.0 * t200 * t232 * t215 - t234 * t204 * 17651.969999999998 +
+       ((-t234 * t211 * 9.80665 - t208 * t221 * 9.80665)) * u[4] + u[2] -
+       ((t243 * t211 + t208 * t247)) * u[4] - t63 * t85 * t258 * 0.5 - t204 * t266 * 1800.0 -
+       t200 * t221 * 25497.289999999997 - t214 * 1800.0 * t270);
+  acceleration[1] = (-((t247 * t217 + t243 * t216)) * u[4] - t63 * t104 * t258 * 0.5 +
+                     ((-t217 * t221 * 9.80665 - t234 * t216 * 9.80665)) * u[4] -
+                     t218 * 1800.0 * t270 - 800.0 * x[3] - t234 * 17651.969999999998 * t219 -
+                     t218 * t221 * 17651.969999999998 + u[3] - t266 * 1800.0 * t219);
   d_force[0] =
-      (-2600.0 * t216 * t233 + t10 * t30 * t232 - t235 * t267 * 17651.969999999998 -
-       t235 * t234 * 25497.289999999997 - 2600.0 * t200 * t233 * t234 +
+      (t10 * t30 * t231 - t234 * t264 * 17651.969999999998 - t234 * t233 * 25497.289999999997 +
        t8 * t10 *
            ((-t8 * t10 * 2e+06 *
-                 ((t8 * t10 * t230 + t8 * t10 * t227 * pow(t228, (-1.5)) - t8 * t10 * t229 -
-                   t8 * pow(t225, (-1.5)) * t10 * t224)) *
+                 ((t8 * t10 * t229 + t8 * t10 * t226 * pow(t227, (-1.5)) - t8 * t10 * t228 -
+                   t8 * pow(t224, (-1.5)) * t10 * t223)) *
                  x[2] -
-             t8 * 4e+08 * t10 - t8 * t10 * 2e+08 * t230 * t223 + t8 * t10 * 2e+08 * t229 * t226 -
-             t231 * t10 * 2e+06 * t30 * x[2] + t231 * 2e+06 * t28 * x[2] * t29)) -
-       t281 * t204 * 1800.0 - 2600.0 * t233 * (t234 * t234) + t133 * t134 * t260 * 0.5 -
-       t214 * t269 * 1800.0 + u[4] * ((-t211 * t222 * 9.80665 - t235 * t241 * 9.80665)) -
-       ((t245 * t241 + t211 * t249 + t208 * t245 + t211 * t288)) * u[4] - t267 * t269 * 1800.0 -
-       t63 * t132 * t260 * 0.5 - t291 * t63 * t85 * 0.5 - t28 * t232 * t29 -
-       2600.0 * t233 * t215 * ((1.55 * t1 + 0.1 * t0)) - t215 * t222 * 25497.289999999997 -
-       t204 * t222 * 17651.969999999998 - t204 * 1800.0 * t273);
-  d_force[1] = (t292 - ((t211 * t293 + t294 + t208 * t295 + t296)) * u[4] - t214 * t297 * 1800.0 +
-                t298 + t299 + t300 + t301 - t63 * t260 * 0.5 * t162 - t63 * t85 * 0.5 * t302 -
-                t204 * t303 * 1800.0 + t304);
-  d_force[2] = (-2.0 * u[4] * ((t208 * t248 + t211 * t242)) + t305 * t134 * t259 * 1e+06 -
-                t231 * 2e+06 * t29 / (t9)-2000.0 - t200 * t215 * 5200.0 * x[2] -
-                3600.0 * t268 * t204 - 3600.0 * t271 * t214 - t215 * 5200.0 * t234 * x[2]);
-  d_force[3] = (-3600.0 * t214 * t272 - 2.0 * u[4] * ((t243 * t211 + t208 * t247)) + t306 -
-                3600.0 * t204 * t265);
+             t8 * 4e+08 * t10 - t8 * t10 * 2e+08 * t229 * t222 + t8 * t10 * 2e+08 * t228 * t225 -
+             t230 * t10 * 2e+06 * t30 * x[2] + t230 * 2e+06 * t28 * x[2] * t29)) +
+       t133 * t134 * t258 * 0.5 + u[4] * ((-t211 * t221 * 9.80665 - t234 * t240 * 9.80665)) -
+       t63 * t132 * t258 * 0.5 - t273 * t63 * t85 * 0.5 - t28 * t231 * t29 -
+       t215 * t221 * 25497.289999999997 - t204 * t221 * 17651.969999999998);
+  d_force[1] = (t274 + t275 + t276 - t63 * t258 * 0.5 * t162 - t63 * t85 * 0.5 * t277 + t278);
+  d_force[2] = (-2.0 * u[4] * ((t208 * t246 + t211 * t241)) + t279 * t134 * t257 * 1e+06 -
+                t230 * 2e+06 * t29 / (t9)-2000.0 - t200 * t215 * 5200.0 * x[2] -
+                3600.0 * t265 * t204 - 3600.0 * t268 * t214 - t215 * 5200.0 * t233 * x[2]);
+  d_force[3] = (-3600.0 * t214 * t269 - 2.0 * u[4] * ((t242 * t211 + t208 * t245)) + t280 -
+                3600.0 * t204 * t263);
   d_force[6] = t8 * t10 * 0.05089380098815465;
   d_force[7] = t63 * 0.031415926535897934 * t85;
   d_force[8] = t8 * t10 * (-0.03817035074111599);
   d_force[9] = t63 * t85 * (-0.023561944901923454);
-  d_force[10] = (-t219 * t269 * 1800.0 + t292 - t291 * t63 * t104 * 0.5 + t298 + t299 + t300 +
-                 t301 - t63 * t260 * 0.5 * t151 - t281 * 1800.0 * t220 -
-                 ((t245 * t218 + t294 + t217 * t288 + t296)) * u[4] + t304);
-  d_force[11] =
-      (t133 * t260 * 0.5 * t152 + t292 - u[4] * ((t294 + t295 * t218 + t293 * t217 + t296)) + t298 -
-       t219 * t297 * 1800.0 + t299 + t300 - t303 * 1800.0 * t220 + t301 - t63 * t104 * 0.5 * t302 -
-       t63 * t160 * t260 * 0.5);
-  d_force[12] = (t306 - 2.0 * u[4] * ((t248 * t218 + t217 * t242)) - 3600.0 * t268 * t220 -
-                 3600.0 * t219 * t271);
-  d_force[13] = (-2.0 * u[4] * ((t243 * t217 + t247 * t218)) + t305 * t259 * 1e+06 * t152 - 800.0 -
-                 3600.0 * t219 * t272 - 3600.0 * t265 * t220);
+  d_force[10] = (t274 - t273 * t63 * t104 * 0.5 + t275 + t276 - t63 * t258 * 0.5 * t151 + t278);
+  d_force[11] = (t133 * t258 * 0.5 * t152 + t274 + t275 + t276 - t63 * t104 * 0.5 * t277 -
+                 t63 * t160 * t258 * 0.5);
+  d_force[12] = (t280 - 2.0 * u[4] * ((t246 * t217 + t216 * t241)) - 3600.0 * t265 * t219 -
+                 3600.0 * t218 * t268);
+  d_force[13] = (-2.0 * u[4] * ((t242 * t216 + t245 * t217)) + t279 * t257 * 1e+06 * t152 - 800.0 -
+                 3600.0 * t218 * t269 - 3600.0 * t263 * t219);
   d_force[17] = t63 * 0.031415926535897934 * t104;
   d_force[19] = t63 * t104 * (-0.023561944901923454);
   d_mass[0] =
-      (t215 * 5200.0 * t234 + 3600.0 * t204 * t214 + 2.0 * ((t211 * t241 + t208 * t211)) * u[4] +
-       t200 * t215 * 5200.0 + 3600.0 * t267 * t204);
-  d_mass[1] = t311;
-  d_mass[2] = t311;
-  d_mass[3] = t314;
-  d_mass[4] = (3600.0 * t204 * t263 + ((t309 + t310)) * 2.0 * u[4] + 3600.0 * t214 * t220);
-  d_mass[5] = t315;
-  d_mass[6] = t315;
-  d_mass[7] = t314;
+      (t215 * 5200.0 * t233 + 3600.0 * t204 * t214 + 2.0 * ((t211 * t240 + t208 * t211)) * u[4] +
+       t200 * t215 * 5200.0 + 3600.0 * t264 * t204);
+  d_mass[1] = t285;
+  d_mass[2] = t285;
+  d_mass[3] = t288;
+  d_mass[4] = (3600.0 * t204 * t261 + ((t283 + t284)) * 2.0 * u[4] + 3600.0 * t214 * t219);
+  d_mass[5] = t289;
+  d_mass[6] = t289;
+  d_mass[7] = t288;
+  // -dh/dq by central differences (see codegen/symbolic_model.cc).
+  for (int c = 0; c < kNumJoints; ++c) {
+    double shifted[kNumStates];
+    std::copy(x, x + kNumStates, shifted);
+    double plus[kNumJoints], minus[kNumJoints];
+    const double step = 1e-6;
+    shifted[c] = x[c] + step;
+    VelocityTerms(shifted, u, plus);
+    shifted[c] = x[c] - step;
+    VelocityTerms(shifted, u, minus);
+    for (int j = 0; j < kNumJoints; ++j) {
+      d_force[j * kNumStates + c] -= (plus[j] - minus[j]) / (2.0 * step);
+    }
+  }
   Factor(mass);
   Solve(mass, acceleration);
   for (int c = 0; c < kNumStates; ++c) {

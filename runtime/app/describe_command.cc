@@ -107,7 +107,7 @@ void PrintSpecSheet(const model::MachineDescription& m, std::ostream& out) {
         << indent << "full valve, from the command: valve delay "
         << Fixed(boom.valve.transport_delay, 2) << " s boom, "
         << Fixed(tilt.valve.transport_delay, 2) << " s tilt, spool lag included\n";
-    if (times.bucket_past_dump_limit > 2 * std::numbers::pi / 180) {
+    if (times.bucket_past_dump_limit > 10 * std::numbers::pi / 180) {
       out << indent << "warning: the bucket went " << Fixed(Deg(times.bucket_past_dump_limit), 0)
           << " deg past its dumped limit: no tilt cylinder end holds that limit (the plant has"
              " no other stop)\n";
@@ -255,7 +255,7 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
       out << "  " << std::string(16, ' ') << " uses " << Fixed(a.stroke_used, 3) << " of "
           << Fixed(a.stroke, 3) << " m (" << Fixed(100 * a.stroke_used / a.stroke, 1)
           << "%) posing the " << a.joint << " within its limits; "
-          << (a.overrun_below_min > 1e-3 || a.overrun_above_max > 1e-3
+          << (Deg(a.overrun_below_min) > 0.5 || Deg(a.overrun_above_max) > 0.5
                   ? "its ends let the " + a.joint + " pass its limits by up to " +
                         Fixed(Deg(a.overrun_below_min), 1) + " / " +
                         Fixed(Deg(a.overrun_above_max), 1) + " deg (no stop holds them)"

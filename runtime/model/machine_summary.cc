@@ -36,7 +36,8 @@ void SummarizeSlidingWindow(const MachineDescription& m, const InterpretedModel&
     if (wide.empty) continue;
     summary.overrun_below_min = std::max(summary.overrun_below_min, link.joint_min - wide.min);
     summary.overrun_above_max = std::max(summary.overrun_above_max, wide.max - link.joint_max);
-    const double low = std::max(wide.min, link.joint_min), high = std::min(wide.max, link.joint_max);
+    const double low = std::max(wide.min, link.joint_min),
+                 high = std::min(wide.max, link.joint_max);
     for (int k = 0; k < kGrid && low <= high; ++k) {
       q[joint] = Lerp(low, high, double(k) / (kGrid - 1));
       const double length = model.CylinderLength(actuator, q.data());

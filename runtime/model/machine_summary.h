@@ -29,17 +29,18 @@ struct ActuatorSummary {
   // shortest and longest lengths that pose the joint within its limits (the margins then say how
   // far the stroke goes past them); the windows and overruns below say where.
   bool moves_with_earlier_joints = false;
-  double window_carry_min = 0, window_carry_max = 0;  ///< joint reached at the carry boom angle [rad]
-  double window_top_min = 0, window_top_max = 0;      ///< at the boom's upper limit [rad]
+  double window_carry_min = 0,
+         window_carry_max = 0;                    ///< joint reached at the carry boom angle [rad]
+  double window_top_min = 0, window_top_max = 0;  ///< at the boom's upper limit [rad]
   double window_bottom_min = 0, window_bottom_max = 0;  ///< at the boom's lower limit [rad]
   /// How far the stroke lets the joint pass its lower / upper limit at the worst boom angle
   /// (the plant stops a joint only at its cylinder's ends: a limit the cylinder does not hold is
   /// passed) [rad].
   double overrun_below_min = 0, overrun_above_max = 0;
-  double lever_at_carry = 0;            ///< dL/dq at the carry pose [m/rad]
-  double torque_at_relief = 0;          ///< extending at relief pressure, at carry [N·m]
-  double transport_delay = 0;           ///< [s]
-  double spool_time_constant = 0;       ///< [s]
+  double lever_at_carry = 0;       ///< dL/dq at the carry pose [m/rad]
+  double torque_at_relief = 0;     ///< extending at relief pressure, at carry [N·m]
+  double transport_delay = 0;      ///< [s]
+  double spool_time_constant = 0;  ///< [s]
 };
 
 struct MachineSummary {
@@ -54,10 +55,10 @@ struct MachineSummary {
   // upper limit, the bucket's floor (the profile's edge from the cutting edge to the next point)
   // 45° below horizontal.
   bool dump_pose_reachable = false;
-  std::vector<double> dump_pose;   ///< joint positions of that pose [rad]
+  std::vector<double> dump_pose;       ///< joint positions of that pose [rad]
   double dump_floor_to_edge_line = 0;  ///< floor's angle above the pin-to-edge line [rad]
-  double dump_clearance = 0;       ///< cutting edge tip above the ground at that pose [m]
-  double dump_reach = 0;           ///< tip ahead of the front of the front tyres [m]
+  double dump_clearance = 0;           ///< cutting edge tip above the ground at that pose [m]
+  double dump_reach = 0;               ///< tip ahead of the front of the front tyres [m]
   /// The floor's angle to horizontal at full lift with the bucket dumped as far as it goes (its
   /// joint limit, or its tilt cylinder's end), negative down [rad].
   double dump_floor_at_limit = 0;

@@ -93,7 +93,8 @@ void Areas(const Actuator& a, double& cap, double& annulus) {
 
 bool CylinderMovesWithEarlierJoints(const MachineDescription& m, int joint) {
   const int actuator = m.ActuatorOfJoint(joint);
-  if (actuator < 0 || m.hydraulics.actuators[actuator].kind != ActuatorKind::kCylinder) return false;
+  if (actuator < 0 || m.hydraulics.actuators[actuator].kind != ActuatorKind::kCylinder)
+    return false;
   const InterpretedModel model(m);
   std::vector<double> q(m.num_joints(), 0.0);
   for (std::size_t k = 0; k < m.links.size(); ++k) {
@@ -134,7 +135,8 @@ JointWindow ReachableJointWindow(const MachineDescription& m, int joint, const d
   const double middle = (link.joint_min + link.joint_max) / 2;
   int seed = -1;
   for (int i = 0; i < n; ++i) {
-    if (inside(angle(i)) && (seed < 0 || std::abs(angle(i) - middle) < std::abs(angle(seed) - middle))) {
+    if (inside(angle(i)) &&
+        (seed < 0 || std::abs(angle(i) - middle) < std::abs(angle(seed) - middle))) {
       seed = i;
     }
   }

@@ -139,12 +139,12 @@ HydraulicCycleTimes SimulateHydraulicCycleTimes(const model::MachineDescription&
   // The plant stops the bucket only where its cylinder ends: watch how far it goes past its
   // dumped limit (a limit no stop holds), through the lowering.
   times.bucket_past_dump_limit = std::max(0.0, bucket.joint_min - plant.state().q[1]);
-  times.lower = Stopwatch(plant, command, options.tick, options.time_limit,
-                          [&](const MachineState& s) {
-                            times.bucket_past_dump_limit =
-                                std::max(times.bucket_past_dump_limit, bucket.joint_min - s.q[1]);
-                            return s.q[0] <= bottom + tol;
-                          });
+  times.lower =
+      Stopwatch(plant, command, options.tick, options.time_limit, [&](const MachineState& s) {
+        times.bucket_past_dump_limit =
+            std::max(times.bucket_past_dump_limit, bucket.joint_min - s.q[1]);
+        return s.q[0] <= bottom + tol;
+      });
   return times;
 }
 

@@ -131,9 +131,10 @@ TEST(GeneratedLinkage, FrameMountedTiltCylinderMatchesHandConstruction) {
       attitude_min = std::min(attitude_min, q0 + q_out[1]);
       attitude_max = std::max(attitude_max, q0 + q_out[1]);
     }
-    // The bucket's attitude changes far less than the boom turns (that is what a frame-mounted
-    // tilt cylinder is for); a boom-mounted one would keep q1 and turn the bucket with the boom.
-    EXPECT_LT(attitude_max - attitude_min, 0.5 * (g.joint_max[0] - g.joint_min[0])) << g.name;
+    // A boom-mounted tilt cylinder held still keeps q1, so the bucket's attitude would turn by
+    // the boom's whole travel; pinned to the frame it turns by clearly less (a Z-bar levels low
+    // and tips forward near the top, a parallel lift stays near level throughout).
+    EXPECT_LT(attitude_max - attitude_min, 0.75 * (g.joint_max[0] - g.joint_min[0])) << g.name;
     RecordProperty(std::string(g.name) + "_attitude_change_deg",
                    std::to_string((attitude_max - attitude_min) * 180 / M_PI));
   }

@@ -255,10 +255,10 @@ TEST(MachineSummary, DumpIsTakenWithTheBucketFloor45DegreesDown) {
   std::vector<V2<double>> origins;
   std::vector<double> angles;
   model.LinkFrames(s.dump_pose.data(), origins, angles);
-  const V2<double> floor = internal::Rotate(angles[1], V2<double>(tip.x() - heel.x(), tip.y() - heel.y()));
+  const V2<double> floor = internal::Rotate(angles[1], Eigen::Vector2d(tip - heel));
   EXPECT_NEAR(std::atan2(floor.z, floor.x), -kPi / 4, 1e-12);
   for (const Eigen::Vector2d& p : m.bucket.profile) {
-    EXPECT_GE(m.arm_pivot.y() + (origins[1] + internal::Rotate(angles[1], V2<double>(p.x(), p.y()))).z,
+    EXPECT_GE(m.arm_pivot.y() + (origins[1] + internal::Rotate(angles[1], p)).z,
               s.dump_clearance - 1e-12);
   }
   // The old definition's figure is higher by l2 (sin(45° + β) − sin 45°).
@@ -267,7 +267,7 @@ TEST(MachineSummary, DumpIsTakenWithTheBucketFloor45DegreesDown) {
 }
 
 TEST(MachineSummary, DumpBeyondTheBucketRangeIsNotReachableAndSaysHowFarTheFloorGets) {
-  MachineDescription m = PaperLoader();  // floor along the pin-to-edge line
+  MachineDescription m = PaperLoader();    // floor along the pin-to-edge line
   m.links[1].joint_min = -80 * kPi / 180;  // at full lift the floor gets to 30° down only
   const MachineSummary s = Summarize(m);
   EXPECT_FALSE(s.dump_pose_reachable);

@@ -120,7 +120,9 @@ TEST(HydraulicCycleTimes, FrameMountedTiltCylinderEndHoldsTheDumpedLimit) {
     EXPECT_GT(t.raise, 3.0) << name;
     EXPECT_GT(t.dump, 0.5) << name;
     EXPECT_GT(t.lower, 1.0) << name;
-    EXPECT_LT(t.bucket_past_dump_limit, 2 * kDeg) << name;
+    // Some degrees of rebound off the end stop (5.4° on the HL740-9S, whose lever arm is 0.12 m/rad
+    // at the limit and falls off past it), against 60–100° where no cylinder end holds the limit.
+    EXPECT_LT(t.bucket_past_dump_limit, 8 * kDeg) << name;
 
     // 0.1 m more stroke at the retracted end: nothing holds the limit, the bucket passes it.
     model::MachineDescription longer = m;
@@ -130,7 +132,7 @@ TEST(HydraulicCycleTimes, FrameMountedTiltCylinderEndHoldsTheDumpedLimit) {
     longer.sha256 = "longer-stroke-" + m.sha256;
     const HydraulicCycleTimes u =
         SimulateHydraulicCycleTimes(longer, machines::InterpretedFunctions(longer));
-    EXPECT_GT(u.bucket_past_dump_limit, 5 * kDeg) << name;
+    EXPECT_GT(u.bucket_past_dump_limit, 12 * kDeg) << name;
   }
 }
 

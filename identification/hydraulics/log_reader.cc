@@ -1,14 +1,15 @@
 #include "identification/hydraulics/log_reader.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
+#include "identification/hydraulics/column_expression.h"
+#include "identification/hydraulics/column_names.h"
+#include "identification/hydraulics/controldesk_header.h"
+#include "identification/hydraulics/delimited_text.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/input_file.h"
 #include "runtime/core/strings.h"
@@ -27,41 +28,14 @@ constexpr double kPi = 3.14159265358979323846;
   throw std::logic_error("unreachable");
 }
 
-std::string Trim(const std::string& text) {
-  const auto begin = text.find_first_not_of(" \t\r\n\"'");
+// Blanks and quotes trimmed (a spec's key, a pair).
+std::string Trim(const std::string& text) { return TrimCell(text); }
+
+// Blanks trimmed, quotes kept: they quote a name in an expression.
+std::string TrimBlanks(const std::string& text) {
+  const auto begin = text.find_first_not_of(" \t\r\n");
   if (begin == std::string::npos) return "";
-  const auto end = text.find_last_not_of(" \t\r\n\"'");
-  return text.substr(begin, end - begin + 1);
-}
-
-struct Cell {
-  std::string text;
-  int column = 1;  ///< 1-based character column of the cell's start
-};
-
-std::vector<Cell> Split(const std::string& line, char delimiter) {
-  std::vector<Cell> cells;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t end = line.find(delimiter, start);
-    const std::string raw = line.substr(start, end == std::string::npos ? end : end - start);
-    cells.push_back({Trim(raw), static_cast<int>(start) + 1});
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
-  return cells;
-}
-
-// A finite number spelled in full, or nothing ("nan", "inf", "", "1.2x" are not numbers here).
-std::optional<double> ParseFinite(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value)) {
-    return std::nullopt;
-  }
-  return value;
+  return text.substr(begin, text.find_last_not_of(" \t\r\n") - begin + 1);
 }
 
 bool AllNumbers(const std::vector<Cell>& cells) {
@@ -69,19 +43,33 @@ bool AllNumbers(const std::vector<Cell>& cells) {
                      [](const Cell& c) { return ParseFinite(c.text).has_value(); });
 }
 
-// A sample row: its first cell parses as a number (the rest is checked cell by cell later, so a
-// NaN in a data row is reported as such rather than taken for a header line).
-bool LooksLikeData(const std::vector<Cell>& cells) {
-  return cells.size() > 1 && ParseFinite(cells.front().text).has_value();
+// `--columns` pairs: split at commas outside quotes (a quoted name may hold one). With a quote
+// left open, at every comma: the pair with the open quote is then refused on its own.
+std::vector<std::string> SplitPairs(const std::string& spec) {
+  for (const bool by_quotes : {true, false}) {
+    std::vector<std::string> pairs(1);
+    char quote = 0;
+    for (const char c : spec) {
+      if (quote != 0) {
+        if (c == quote) quote = 0;
+      } else if (by_quotes && (c == '\'' || c == '"')) {
+        quote = c;
+      } else if (c == ',') {
+        pairs.emplace_back();
+        continue;
+      }
+      pairs.back() += c;
+    }
+    if (quote == 0) return pairs;
+  }
+  return {};  // unreachable: without quotes nothing is left open
 }
 
-char DetectDelimiter(const std::string& line) {
-  const std::size_t commas = std::count(line.begin(), line.end(), ',');
-  const std::size_t semicolons = std::count(line.begin(), line.end(), ';');
-  const std::size_t tabs = std::count(line.begin(), line.end(), '\t');
-  if (tabs > commas && tabs > semicolons) return '\t';
-  if (semicolons > commas) return ';';
-  return ',';
+// "command: 'Boom_up_duty -' at character 15: expected ..." for a malformed value.
+std::string ExpressionProblem(const std::string& key, const std::string& value,
+                              const ColumnExpressionError& e) {
+  return (key.empty() ? "" : key + ": ") + "'" + TrimBlanks(value) + "' at character " +
+         std::to_string(e.position) + ": " + e.what();
 }
 
 const std::map<std::string, std::vector<std::string>>& DefaultNames() {
@@ -109,11 +97,6 @@ void CheckKey(const std::string& key, const std::string& where) {
   if (!near.empty()) message += " (did you mean '" + near + "'?)";
   message += "; known: time, command, joint_angle, spool, pilot_pressure, pressure_a, pressure_b";
   Fail(where, 0, 0, message);
-}
-
-bool IsColumnNumber(const std::string& text) {
-  return !text.empty() &&
-         std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 std::string UnitSuffix(const std::string& key, const LogFormat& f) {
@@ -171,25 +154,6 @@ std::string ActuatorFromComment(const std::string& line) {
                      end == std::string::npos ? std::string::npos : end - at - tag.size());
 }
 
-// One column read as two quantities (`command=Time` with time in Time too) would fit a model
-// to nonsense without a word: refused, naming both quantities and the column.
-template <typename Origin>
-void CheckDistinctColumns(const std::string& path, const std::map<std::string, int>& column_of,
-                          const std::vector<std::string>& header_names, const Origin& origin,
-                          int line) {
-  std::map<int, std::string> quantity_of;  // cell index → the first quantity reading it
-  for (const auto& [key, c] : column_of) {
-    const auto [it, inserted] = quantity_of.emplace(c, key);
-    if (inserted) continue;
-    const std::string column =
-        std::to_string(c + 1) +
-        (c < static_cast<int>(header_names.size()) ? " ('" + header_names[c] + "')" : "");
-    Fail(path, line, 1,
-         origin(key) + it->second + " and " + key + " both read column " + column +
-             "; each quantity needs its own column");
-  }
-}
-
 }  // namespace
 
 const std::vector<std::string>& LogQuantityKeys() {
@@ -225,19 +189,22 @@ TimeUnits ParseTimeUnits(const std::string& name) {
 
 LogFormat ParseColumnsSpec(const std::string& spec, LogFormat format) {
   format.source = "--columns";
-  std::stringstream stream(spec);
-  std::string pair;
   std::map<std::string, std::string> given;  // in this spec (a --column-map may come before)
-  while (std::getline(stream, pair, ',')) {
-    pair = Trim(pair);
+  for (std::string pair : SplitPairs(spec)) {
+    pair = TrimBlanks(pair);
     if (pair.empty()) continue;
     const std::size_t eq = pair.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == pair.size()) {
       Fail("--columns", 0, 0, "expected quantity=column, got '" + pair + "'");
     }
     const std::string key = Trim(pair.substr(0, eq));
-    const std::string column = Trim(pair.substr(eq + 1));
+    const std::string column = TrimBlanks(pair.substr(eq + 1));
     CheckKey(key, "--columns");
+    try {
+      ParseColumnExpression(column);
+    } catch (const ColumnExpressionError& e) {
+      Fail("--columns", 0, 0, ExpressionProblem(key, column, e));
+    }
     // The last of two would silently win: the user meant one of them.
     if (given.count(key)) {
       Fail("--columns", 0, 0,
@@ -263,6 +230,12 @@ LogFormat ReadLogFormatYaml(const std::string& path) {
       if (IsRequired(key) || columns.Has(key)) {
         format.columns[key] = columns.String(key);
         format.column_sources[key] = path;
+        if (!columns.Has(key)) continue;
+        try {
+          ParseColumnExpression(format.columns[key]);
+        } catch (const ColumnExpressionError& e) {
+          columns.Error(key, ExpressionProblem("", format.columns[key], e));
+        }
       }
     }
     columns.Finish();
@@ -289,6 +262,137 @@ LogFormat ReadLogFormatYaml(const std::string& path) {
   return format;
 }
 
+namespace {
+
+// One quantity as the reader reads it: its expression, and the 0-based cell of each term.
+struct Quantity {
+  std::string key;
+  ColumnExpression expression;
+  std::vector<int> cells;
+  std::vector<double>* channel = nullptr;
+};
+
+// Columns by number, or by name in the names the log gives its columns; checked against the
+// log with messages naming where the map came from.
+class ColumnResolver {
+ public:
+  ColumnResolver(const std::string& path, const ColumnNames& names, std::size_t num_cells,
+                 int names_line, int first_data_line, std::string no_names_note)
+      : path_(path),
+        names_(names),
+        num_cells_(num_cells),
+        names_line_(names_line),
+        first_data_line_(first_data_line),
+        no_names_note_(std::move(no_names_note)) {}
+
+  // The cells of `expression`'s terms, in order. `origin` ("--columns: command: ") prefixes
+  // every message.
+  std::vector<int> Resolve(ColumnExpression& expression, const std::string& origin) const {
+    // A header such as `P-rod` reads as an expression (P minus rod): the whole value naming a
+    // column wins.
+    if (!expression.plain()) {
+      if (names_.Find(expression.text).size() == 1) {
+        ColumnReference whole;
+        whole.name = whole.text = expression.text;
+        whole.position = 1;
+        expression.terms = {{1, whole}};
+        expression.offset = 0;
+      }
+    }
+    std::vector<int> cells;
+    for (const ColumnTerm& term : expression.terms) {
+      const int cell = Cell(term.column, origin, !expression.plain());
+      if (std::find(cells.begin(), cells.end(), cell) != cells.end()) {
+        Fail(path_, Line(), 1,
+             origin + "column " + std::to_string(cell + 1) + " is read twice in '" +
+                 expression.text + "'; name each column once");
+      }
+      cells.push_back(cell);
+    }
+    return cells;
+  }
+
+  // The one cell answering to `name`, -1 if none; refuses a name of several columns.
+  int FindUnique(const std::string& name, const std::string& origin, bool in_expression) const {
+    const std::vector<int> cells = names_.Find(name);
+    if (cells.size() > 1) {
+      std::string message = origin + "'" + name + "' names columns " + ColumnRanges(cells) + " (" +
+                            names_.RowsNaming(name, cells) + "): give the column by number (" +
+                            (in_expression ? "$" : "") + std::to_string(cells.front() + 1);
+      const auto [unique, row] = names_.UniqueName(cells.front());
+      message += ")";
+      if (!unique.empty()) {
+        message += std::string(" or by ") +
+                   (row.find("path") != std::string::npos ? "its path name" : "another name") +
+                   " (e.g. '" + unique + "')";
+      }
+      Fail(path_, Line(), 1, message);
+    }
+    return cells.empty() ? -1 : cells.front();
+  }
+
+  int Line() const { return names_line_ >= 0 ? names_line_ + 1 : first_data_line_; }
+
+ private:
+  int Cell(const ColumnReference& column, const std::string& origin, bool in_expression) const {
+    if (column.by_number) {
+      if (column.number < 1 || column.number > static_cast<long>(num_cells_)) {
+        Fail(path_, first_data_line_, 1,
+             origin + "column " + (column.text[0] == '$' ? column.text.substr(1) : column.text) +
+                 " does not exist; the rows have " + std::to_string(num_cells_) + " cells");
+      }
+      return static_cast<int>(column.number) - 1;
+    }
+    const int cell = FindUnique(column.name, origin, in_expression);
+    if (cell >= 0) return cell;
+    std::string message = origin + "no column '" + column.name + "'";
+    if (names_line_ < 0) Fail(path_, Line(), 1, message + " (" + no_names_note_ + ")");
+    const std::string near = core::NearestWord(column.name, names_.All());
+    if (!near.empty()) message += " (did you mean '" + near + "'?)";
+    Fail(path_, Line(), 1, message);
+  }
+
+  const std::string& path_;
+  const ColumnNames& names_;
+  std::size_t num_cells_;
+  int names_line_;       // 0-based line of the names, -1: none
+  int first_data_line_;  // 1-based
+  std::string no_names_note_;
+};
+
+// The header row of an ordinary log: the last line before the data that has as many cells as a
+// data row and is not a comment (data loggers may put a units row after it: that one has no
+// known names). -1 when there is none.
+int FindHeaderRow(const std::vector<std::string>& lines, std::size_t first_data, char delimiter,
+                  std::size_t num_cells, const std::vector<std::string>& known_names,
+                  std::vector<Cell>& header) {
+  int header_line = -1;
+  for (int i = static_cast<int>(first_data) - 1; i >= 0; --i) {
+    if (TrimCell(lines[i]).empty() || lines[i][0] == '#') continue;
+    std::vector<Cell> cells = SplitCells(lines[i], delimiter);
+    if (cells.size() != num_cells || AllNumbers(cells)) continue;
+    const bool names_any = std::any_of(cells.begin(), cells.end(), [&](const Cell& cell) {
+      return std::find(known_names.begin(), known_names.end(), cell.text) != known_names.end();
+    });
+    if (names_any || header_line < 0) {
+      header_line = i;
+      header = std::move(cells);
+      if (names_any) break;
+    }
+  }
+  return header_line;
+}
+
+// "command 150 %" or, for an expression, "command 'a - b' = 150 %".
+std::string Describe(const Quantity& q, const std::string& cell_text, double value,
+                     const LogFormat& format) {
+  if (q.expression.plain()) return q.key + " " + cell_text + UnitSuffix(q.key, format);
+  return q.key + " '" + q.expression.text + "' = " + core::FormatNumber(value) +
+         UnitSuffix(q.key, format);
+}
+
+}  // namespace
+
 HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
                               std::size_t min_samples) {
   // Checked before opening: a named pipe would block the open, a folder would read as empty.
@@ -308,33 +412,26 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
   log.actuator = format.actuator;
 
   // Where the samples start.
-  std::size_t first_data = lines.size();
-  if (format.header_lines >= 0) {
-    first_data = static_cast<std::size_t>(format.header_lines);
-  } else {
-    for (std::size_t i = 0; i < lines.size(); ++i) {
-      if (Trim(lines[i]).empty() || lines[i][0] == '#') continue;
-      if (LooksLikeData(Split(lines[i], DetectDelimiter(lines[i])))) {
-        first_data = i;
-        break;
-      }
-    }
-  }
+  const LogLayout layout = FindLogLayout(lines, format.header_lines);
+  const std::size_t first_data = layout.first_data;
   if (first_data >= lines.size()) {
+    if (layout.names_line >= 0 && format.header_lines < 0) {
+      Fail(path, layout.names_line + 1, 1,
+           "ControlDesk export: a trace_names row but no trace_values row after it (no samples)");
+    }
     Fail(path, 0, 0,
          "no sample rows (rows whose cells are all numbers) after " + std::to_string(lines.size()) +
              " lines");
   }
+  const int first_data_line = static_cast<int>(first_data) + 1;
   const char delimiter = DetectDelimiter(lines[first_data]);
-  const std::size_t num_cells = Split(lines[first_data], delimiter).size();
+  const std::size_t num_cells = SplitCells(lines[first_data], delimiter).size();
   for (std::size_t i = 0; i < first_data && log.actuator.empty(); ++i) {
     log.actuator = ActuatorFromComment(lines[i]);
   }
 
-  // Columns: by number, or by name in the header line that names them all.
-  std::map<std::string, std::string> wanted = format.columns;
-  const bool defaults = wanted.empty();
-  std::map<std::string, int> column_of;  // key → 0-based cell index
+  // The map: explicit, or the plant-step names.
+  const bool defaults = format.columns.empty();
   // "--columns: " before a problem with an entry of an explicit map: the user sees which of
   // their options (or which sibling file) to correct.
   const auto origin = [&](const std::string& key) {
@@ -342,130 +439,158 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
     const std::string& source = it != format.column_sources.end() ? it->second : format.source;
     return source.empty() ? std::string() : source + ": ";
   };
-  for (const auto& [key, name] : wanted) {
+  std::vector<Quantity> quantities;
+  std::vector<std::string> referenced;  // every name the map uses, to recognise the header row
+  for (const auto& [key, value] : format.columns) {
     CheckKey(key, format.source.empty() ? path : format.source);
-    if (IsColumnNumber(name)) {
-      // Digits only, so the one failure left is overflow: a number that large is out of range.
-      const long number = name.size() > 9 ? 0 : std::stol(name);
-      if (number < 1 || number > static_cast<long>(num_cells)) {
-        Fail(path, static_cast<int>(first_data) + 1, 1,
-             origin(key) + key + ": column " + name + " does not exist; the rows have " +
-                 std::to_string(num_cells) + " cells");
-      }
-      column_of[key] = static_cast<int>(number) - 1;
+    Quantity q{key, {}, {}, nullptr};
+    try {
+      q.expression = ParseColumnExpression(value);
+    } catch (const ColumnExpressionError& e) {
+      Fail(path, 0, 0, origin(key) + ExpressionProblem(key, value, e));
     }
+    referenced.push_back(q.expression.text);
+    for (const ColumnTerm& term : q.expression.terms) {
+      if (!term.column.by_number) referenced.push_back(term.column.name);
+    }
+    quantities.push_back(std::move(q));
   }
-  // The header line: the last line before the data that has as many cells as a data row and
-  // is not a comment (data loggers may put a units row after it: that one has no known names).
-  int header_line = -1;
-  std::vector<Cell> header;
-  for (int i = static_cast<int>(first_data) - 1; i >= 0; --i) {
-    if (Trim(lines[i]).empty() || lines[i][0] == '#') continue;
-    std::vector<Cell> cells = Split(lines[i], delimiter);
-    if (cells.size() != num_cells || AllNumbers(cells)) continue;
-    bool names_any = false;
-    for (const Cell& cell : cells) {
-      for (const auto& [key, name] : wanted) names_any |= cell.text == name;
-      if (defaults) {
-        for (const auto& [key, names] : DefaultNames()) {
-          names_any |= std::find(names.begin(), names.end(), cell.text) != names.end();
-        }
-      }
-    }
-    if (names_any || header_line < 0) {
-      header_line = i;
-      header = std::move(cells);
-      if (names_any) break;
-    }
-  }
-  auto find_cell = [&](const std::string& name) {
-    for (std::size_t c = 0; c < header.size(); ++c) {
-      if (header[c].text == name) return static_cast<int>(c);
-    }
-    return -1;
-  };
-  std::vector<std::string> header_names;
-  for (const Cell& cell : header) header_names.push_back(cell.text);
   if (defaults) {
     for (const auto& [key, names] : DefaultNames()) {
-      for (const std::string& name : names) {
-        const int c = find_cell(name);
-        if (c >= 0 && !column_of.count(key)) column_of[key] = c, wanted[key] = name;
+      referenced.insert(referenced.end(), names.begin(), names.end());
+    }
+  }
+
+  // The names of the columns.
+  ColumnNames names;
+  int names_line = -1;
+  std::string no_names_note = "no header line found before the first sample row";
+  if (layout.controldesk) {
+    names = ControlDeskNames(path, lines, layout, delimiter, num_cells);
+    names_line = layout.names_line;
+    no_names_note = "no trace_names row before the trace_values row";
+  } else {
+    std::vector<Cell> header;
+    names_line = FindHeaderRow(lines, first_data, delimiter, num_cells, referenced, header);
+    for (std::size_t c = 0; c < header.size(); ++c) {
+      names.Add(static_cast<int>(c), header[c].text,
+                "header line " + std::to_string(names_line + 1));
+    }
+  }
+  const ColumnResolver resolver(path, names, num_cells, names_line, first_data_line, no_names_note);
+
+  if (defaults) {
+    for (const auto& [key, candidates] : DefaultNames()) {
+      for (const std::string& name : candidates) {
+        const int cell = resolver.FindUnique(name, key + ": ", false);
+        if (cell < 0) continue;
+        ColumnReference reference;
+        reference.name = reference.text = name;
+        reference.position = 1;
+        quantities.push_back({key, {name, {{1, reference}}, 0}, {cell}, nullptr});
+        break;
       }
     }
   } else {
-    for (const auto& [key, name] : wanted) {
-      if (column_of.count(key)) continue;
-      const int c = find_cell(name);
-      if (c < 0) {
-        std::string message = origin(key) + key + ": no column '" + name + "'";
-        if (header_line < 0) {
-          message += " (no header line found before the first sample row)";
-          Fail(path, static_cast<int>(first_data) + 1, 1, message);
-        }
-        const std::string near = core::NearestWord(name, header_names);
-        if (!near.empty()) message += " (did you mean '" + near + "'?)";
-        Fail(path, header_line + 1, 1, message);
-      }
-      column_of[key] = c;
+    for (Quantity& q : quantities) {
+      q.cells = resolver.Resolve(q.expression, origin(q.key) + q.key + ": ");
     }
   }
-  CheckDistinctColumns(path, column_of, header_names, origin,
-                       header_line >= 0 ? header_line + 1 : static_cast<int>(first_data) + 1);
+  // One column read as two quantities (`command=Time` with time in Time too) would fit a model
+  // to nonsense without a word: refused, naming both quantities and the column. Expressions of
+  // several columns may share one (`joint_angle=Arm_ang - Boom_ang` beside another quantity).
+  std::map<int, std::string> quantity_of;  // cell → the first quantity reading it alone
+  for (const Quantity& q : quantities) {
+    if (q.cells.size() != 1) continue;
+    const auto [it, inserted] = quantity_of.emplace(q.cells[0], q.key);
+    if (inserted) continue;
+    const std::string name = names.FirstName(q.cells[0]);
+    Fail(path, resolver.Line(), 1,
+         origin(q.key) + it->second + " and " + q.key + " both read column " +
+             std::to_string(q.cells[0] + 1) + (name.empty() ? "" : " ('" + name + "')") +
+             "; each quantity needs its own column");
+  }
   for (const char* key : {"time", "command", "joint_angle"}) {
-    if (column_of.count(key)) continue;
-    const int line = header_line >= 0 ? header_line + 1 : static_cast<int>(first_data) + 1;
-    Fail(path, line, 1,
+    if (std::any_of(quantities.begin(), quantities.end(),
+                    [&](const Quantity& q) { return q.key == key; })) {
+      continue;
+    }
+    Fail(path, resolver.Line(), 1,
          std::string("missing column for ") + key +
              (defaults ? " (expected one named " + DefaultNames().at(key).back() +
                              "; give a column map with --columns or --column-map)"
                        : " (add it to the column map)"));
   }
+  const auto by_key = [&](const std::string& key) -> const Quantity& {
+    return *std::find_if(quantities.begin(), quantities.end(),
+                         [&](const Quantity& q) { return q.key == key; });
+  };
+  for (Quantity& q : quantities) {
+    q.channel = Channel(log, q.key);
+    HydraulicLog::Source& source = log.sources[q.key];
+    source.expression = q.expression.text;
+    for (const int cell : q.cells) source.columns.push_back(cell + 1);
+  }
 
   // Samples.
   for (std::size_t i = first_data; i < lines.size(); ++i) {
-    if (Trim(lines[i]).empty() || lines[i][0] == '#') continue;
+    if (TrimCell(lines[i]).empty() || lines[i][0] == '#') continue;
     const int line = static_cast<int>(i) + 1;
-    const std::vector<Cell> cells = Split(lines[i], delimiter);
+    const std::vector<Cell> cells = SplitCells(lines[i], delimiter);
     if (cells.size() != num_cells) {
       Fail(path, line, 1,
            std::to_string(cells.size()) + " cells, expected " + std::to_string(num_cells) +
                " like the first sample row");
     }
-    for (const auto& [key, c] : column_of) {
-      const Cell& cell = cells[c];
-      const std::optional<double> value = ParseFinite(cell.text);
-      if (!value) {
-        Fail(path, line, cell.column,
-             key + " (column '" + wanted[key] + "') is not a finite number: '" + cell.text + "'");
+    if (layout.controldesk && !IsControlDeskSampleMarker(cells[0].text, i == first_data)) {
+      Fail(path, line, 1,
+           std::string("a ControlDesk sample row opens with ") +
+               (i == first_data ? "'trace_values' or " : "") + "an empty cell, got '" +
+               cells[0].text + "'");
+    }
+    for (const Quantity& q : quantities) {
+      double value = q.expression.offset;
+      for (std::size_t t = 0; t < q.cells.size(); ++t) {
+        const Cell& cell = cells[q.cells[t]];
+        const std::optional<double> number = ParseFinite(cell.text);
+        if (!number) {
+          Fail(path, line, cell.column,
+               q.key + " (column '" + q.expression.terms[t].column.text +
+                   "') is not a finite number: '" + cell.text + "'");
+        }
+        value += q.expression.terms[t].scale * *number;
       }
-      const double si = ToSi(key, *value, format);
+      const Cell& cell = cells[q.cells.front()];
+      if (!std::isfinite(value)) {
+        Fail(path, line, cell.column,
+             q.key + " '" + q.expression.text + "' is not finite on this row (overflow)");
+      }
+      const double si = ToSi(q.key, value, format);
       // Spool feedback may overshoot full stroke a little (sensor noise, overtravel).
-      const double limit = key == "command" ? 1.0 + 1e-9 : 1.2;
-      if ((key == "command" || key == "spool") && std::abs(si) > limit) {
-        const bool percent = (key == "command" ? format.command_units : format.spool_units) ==
+      const double limit = q.key == "command" ? 1.0 + 1e-9 : 1.2;
+      if ((q.key == "command" || q.key == "spool") && std::abs(si) > limit) {
+        const bool percent = (q.key == "command" ? format.command_units : format.spool_units) ==
                              CommandUnits::kPercent;
         Fail(path, line, cell.column,
-             key + " " + cell.text + UnitSuffix(key, format) + " is outside " +
-                 (key == "spool" ? (percent ? "[-120, 120] %" : "[-1.2, 1.2]")
-                                 : (percent ? "[-100, 100] %" : "[-1, 1]")) +
-                 (percent ? "" : " (is it in percent? use --" + key + "-units percent)"));
+             Describe(q, cell.text, value, format) + " is outside " +
+                 (q.key == "spool" ? (percent ? "[-120, 120] %" : "[-1.2, 1.2]")
+                                   : (percent ? "[-100, 100] %" : "[-1, 1]")) +
+                 (percent ? "" : " (is it in percent? use --" + q.key + "-units percent)"));
       }
-      Channel(log, key)->push_back(si);
+      q.channel->push_back(si);
     }
     const std::size_t n = log.time.size();
     if (n >= 2 && !(log.time[n - 1] > log.time[n - 2])) {
-      const Cell& cell = cells[column_of["time"]];
+      const Quantity& time = by_key("time");
+      const Cell& cell = cells[time.cells.front()];
+      const double scale = format.time_units == TimeUnits::kMilliseconds ? 1e-3 : 1.0;
+      const std::string now = Describe(time, cell.text, log.time[n - 1] / scale, format);
       Fail(path, line, cell.column,
            log.time[n - 1] == log.time[n - 2]
-               ? "time " + cell.text + UnitSuffix("time", format) +
-                     " repeats the previous sample's (duplicate timestamp)"
-               : "time " + cell.text + UnitSuffix("time", format) +
-                     " is before the previous sample's " +
-                     core::FormatNumber(
-                         log.time[n - 2] /
-                         (format.time_units == TimeUnits::kMilliseconds ? 1e-3 : 1.0)) +
-                     UnitSuffix("time", format) + " (time must increase)");
+               ? now + " repeats the previous sample's (duplicate timestamp)"
+               : now + " is before the previous sample's " +
+                     core::FormatNumber(log.time[n - 2] / scale) + UnitSuffix("time", format) +
+                     " (time must increase)");
     }
     log.row.push_back(line);
   }

@@ -107,12 +107,12 @@ TEST(FuzzRegressions, ArmCalibrationCsv) {
   }));
 }
 
-// Read in both formats, like the fuzz target: every refusal must be located, and an input counts
-// as refused when either format refuses it.
+// Read in each format the fuzz target reads it in: every refusal must be located, and an input
+// counts as refused when any format refuses it.
 TEST(FuzzRegressions, HydraulicLog) {
   ExpectBothKinds(CheckTarget("hydraulic_log", [](const std::string& path) {
     std::optional<core::InputError> first;
-    for (const identification::LogFormat& format : HydraulicLogFormats()) {
+    for (const identification::LogFormat& format : HydraulicLogFormatsOf(path)) {
       auto refusal = Refusal([&] { identification::ReadHydraulicLog(path, format); });
       if (refusal && !first) first = refusal;
       if (refusal) {

@@ -59,4 +59,51 @@ std::vector<std::string> WriteSimulatedCampaign(const model::MachineDescription&
                                                 int actuator, const std::string& dir,
                                                 unsigned long long seed);
 
+/// The step tests of a real excavator as its data acquisition exports them (dSPACE ControlDesk
+/// CSV at 100 Hz, /work/shared/realdata/README.md "excavator_valve_steps"): 28 header lines, then
+/// rows `trace_values,` (first) or `,` (later) followed by 28 columns: time [s]; cylinder
+/// pressures Arm head, Arm rod, Bkt head, Bkt rod, Boom rod, Boom head [bar]; duty Arm_in,
+/// Arm_out, Bkt_in, Bkt_out, Boom_dn, Boom_up [%]; valve driver feedback, same order [counts];
+/// pilot (EPPR) pressure, same order [bar]; joint angles Arm, Bkt, Boom [deg]. "in"/"up" is the
+/// extending direction (cap side), "out"/"dn" the retracting one.
+struct ControlDeskOptions {
+  double rate = 100;                  ///< [Hz]
+  double pilot_pressure_full = 35e5;  ///< pilot pressure at full command [Pa]
+  double rest = 1.0;                  ///< before the step [s]
+  double stall_hold = 1.0;            ///< command held on after the joint has stalled [s]
+  double max_step = 10.0;             ///< longest step: a slow low-duty run is cut there [s]
+  double after = 0.5;                 ///< logged after the command is off [s]
+  /// Where a step that does not start at the opposite stop starts: this fraction of the
+  /// stroke away from the stop it runs into.
+  double start_travel = 0.4;
+  double angle_noise = 0.02 * 3.14159265358979 / 180;       ///< 1σ [rad]
+  double pressure_noise = 1e5;                              ///< 1σ [Pa]
+  double pilot_noise = 0.2e5;                               ///< 1σ [Pa]
+  std::vector<int> duties = {40, 50, 60, 70, 80, 90, 100};  ///< [%]
+};
+
+/// The valve chain the campaign's machine has (its truth), per actuator: pilot delay and lag,
+/// transport delay, dead zone 0 and an opening curve per direction with a dead band near
+/// 35–40 % duty and saturation above 80 % (cf. the real logs). Returned as the text of an
+/// overlay of `machine` for `actuators`.
+std::string ControlDeskTruthOverlay(const model::MachineDescription& machine,
+                                    const std::vector<int>& actuators,
+                                    const std::string& command_line);
+
+/// The step-test campaign of `actuators` (boom and arm of an excavator): writes the truth
+/// overlay `DIR/truth.overlay.yaml`, loads `machine` with it and simulates, per actuator, both
+/// directions at every duty of `options` with a high- and a low-load pose (H/L: the other joints
+/// placed so that gravity loads the tested joint more or less), writing
+/// `<B|A>-<up|dn|in|out>-<duty>-<H|L>-S.csv`. Each file: rest, the step held until the joint
+/// has stalled at its end stop for `stall_hold` (or for `max_step`), the command off. The 100 %
+/// files start with the joint resting against the opposite stop. Noise is drawn from
+/// `seed`. Returns the log paths (the overlay is `DIR/truth.overlay.yaml`). Throws
+/// std::invalid_argument for a machine that is not a three-link excavator or an actuator that
+/// drives neither its boom nor its arm.
+std::vector<std::string> WriteControlDeskCampaign(const model::MachineDescription& machine,
+                                                  const generated::MachineFunctions& functions,
+                                                  const std::vector<int>& actuators,
+                                                  const std::string& dir, unsigned long long seed,
+                                                  const ControlDeskOptions& options = {});
+
 }  // namespace autoshovel::identification

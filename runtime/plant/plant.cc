@@ -27,7 +27,11 @@ struct Layout {
   int articulation() const { return arm + 6; }
   int travel_energy() const { return arm + 7; }
   int hydraulic_energy() const { return arm + 8; }
-  int size() const { return arm + 9; }
+  // Pilot lag states π, one per actuator whose valve has a pilot stage (valve_command.h), after
+  // everything else: a machine without pilot stages keeps the state vector it always had.
+  int pilots = 0;
+  int pilot(int k) const { return arm + 9 + k; }
+  int size() const { return arm + 9 + pilots; }
 };
 
 // Link frame origins in M (n + 1, the last is the tip) and link angles, Eq. (2).
@@ -52,7 +56,8 @@ void ArmGeometry(const model::MachineDescription& machine, const double* q,
 class Plant::System : public OdeSystem {
  public:
   struct Held {
-    std::vector<double> spool_reference;  // per joint
+    std::vector<double> spool_reference;  // per joint (0 for a joint whose valve has a pilot stage)
+    std::vector<double> pilot_input;      // per joint: delayed command into the pilot lag, or 0
     double drive = 0, brake = 0, articulation_rate = 0;
     double payload = 0;
     std::vector<double> section_supply;  // per joint's valve section, after its compensator [Pa]
@@ -63,8 +68,8 @@ class Plant::System : public OdeSystem {
     // pressures) are samples of quantities that vary continuously with the state; they are
     // updated at every tick without restarting the integrator's history.
     bool IsEventAgainst(const Held& o) const {
-      return spool_reference != o.spool_reference || drive != o.drive || brake != o.brake ||
-             articulation_rate != o.articulation_rate ||
+      return spool_reference != o.spool_reference || pilot_input != o.pilot_input ||
+             drive != o.drive || brake != o.brake || articulation_rate != o.articulation_rate ||
              resistance.in_contact != o.resistance.in_contact ||
              resistance.cut_side != o.resistance.cut_side;
     }
@@ -75,7 +80,13 @@ class Plant::System : public OdeSystem {
       : machine_(machine), functions_(functions), options_(options) {
     layout_.joints = functions.num_joints;
     layout_.arm = functions.num_states;
+    pilot_state_.assign(layout_.joints, -1);
+    for (int a = 0; a < functions.num_actuators; ++a) {
+      if (!HasPilotStage(machine.hydraulics.actuators[a].valve)) continue;
+      pilot_state_[functions.actuator_joint[a]] = layout_.pilot(layout_.pilots++);
+    }
     held_.spool_reference.assign(layout_.joints, 0.0);
+    held_.pilot_input.assign(layout_.joints, 0.0);
     u_.assign(functions.num_inputs, 0.0);
     arm_rhs_.assign(layout_.arm, 0.0);
     arm_jacobian_.assign(static_cast<std::size_t>(layout_.arm) * layout_.arm, 0.0);
@@ -97,7 +108,11 @@ class Plant::System : public OdeSystem {
     const int J = layout_.joints;
     const int n = static_cast<int>(machine_.links.size());
     for (int j = 0; j < J; ++j) {
-      u_[j] = held_.spool_reference[j];
+      // With a pilot stage the spool reference follows the pilot state through the opening law.
+      u_[j] = pilot_state_[j] < 0
+                  ? held_.spool_reference[j]
+                  : ValveOpening(machine_.hydraulics.actuators[actuator_of_joint(j)].valve,
+                                 y[pilot_state_[j]]);
       u_[J + j] = 0.0;
     }
     u_[2 * J] = held_.payload;
@@ -155,6 +170,13 @@ class Plant::System : public OdeSystem {
     }
     out.hydraulic_power = pump * flow / machine_.hydraulics.pump_efficiency;
     ydot[layout_.hydraulic_energy()] = out.hydraulic_power;
+    // Pilot lags: T_p π̇ = u(t − τ_p − τ_d) − π (the delayed command is held per segment).
+    for (int j = 0; j < J; ++j) {
+      const int k = pilot_state_[j];
+      if (k < 0) continue;
+      const model::Valve& valve = machine_.hydraulics.actuators[actuator_of_joint(j)].valve;
+      ydot[k] = (held_.pilot_input[j] - y[k]) / valve.pilot_time_constant;
+    }
 
     for (int i = layout_.speed(); i <= layout_.travel_energy(); ++i) ydot[i] = 0.0;
     if (!is_loader_) return;
@@ -208,6 +230,8 @@ class Plant::System : public OdeSystem {
     if (is_loader_) {
       for (int c : {layout_.speed(), layout_.wheel(), layout_.throttle()}) columns_.push_back(c);
     }
+    // Pilot states: their own lag and the spool reference they set through the opening law.
+    for (int k = 0; k < layout_.pilots; ++k) columns_.push_back(layout_.pilot(k));
     for (int c : columns_) {
       const double h = 1e-7 * std::max(1.0, std::abs(y[c]));
       work_[c] = y[c] + h;
@@ -218,6 +242,8 @@ class Plant::System : public OdeSystem {
   }
 
   int actuator_of_joint(int j) const { return actuator_of_joint_[j]; }
+  /// Index in y of joint j's pilot state, or -1 when its valve has no pilot stage.
+  int pilot_state(int j) const { return pilot_state_[j]; }
   void set_actuator_of_joint(std::vector<int> map) { actuator_of_joint_ = std::move(map); }
 
  private:
@@ -236,6 +262,7 @@ class Plant::System : public OdeSystem {
   Held held_;
   bool is_loader_ = true;
   std::vector<int> actuator_of_joint_;
+  std::vector<int> pilot_state_;  // per joint
   std::vector<double> u_, arm_rhs_, arm_jacobian_, base_, probe_, work_;
   std::vector<int> columns_;
   std::vector<Eigen::Vector2d> origins_;
@@ -259,7 +286,8 @@ Plant::Plant(const model::MachineDescription& machine, const generated::MachineF
   }
   system_->set_actuator_of_joint(actuator_of_joint);
   for (const model::Actuator& act : machine.hydraulics.actuators) {
-    valves_.emplace_back(act.valve.dead_zone, act.valve.transport_delay);
+    valves_.emplace_back(act.valve);
+    pilot_signals_.emplace_back(act.valve.pilot_delay, act.valve.pilot_time_constant);
   }
   command_.valve.assign(machine.hydraulics.actuators.size(), 0.0);
   // The margin of a load-sensing system equals the drop at which its valves are rated, so a
@@ -328,8 +356,8 @@ Plant::Plant(const model::MachineDescription& machine, const generated::MachineF
   y_[layout.heading()] = initial.heading;
   y_[layout.articulation()] = initial.articulation;
   state_.time = 0;
-  LoadSensing(system_->held().spool_reference, system_->held().section_supply,
-              system_->held().pump_pressure);
+  LoadSensing(OpeningReference(system_->held().spool_reference, system_->held().pilot_input),
+              system_->held().section_supply, system_->held().pump_pressure);
   integrator_->Reset(0.0, y_.data());
   dirty_ = false;
   UpdateState();
@@ -365,7 +393,10 @@ bool Plant::SetCommand(const core::ActuatorCommand& command, std::string* why) {
     return refuse("articulation rate must be finite");
   }
   command_ = command;
-  for (std::size_t a = 0; a < valves_.size(); ++a) valves_[a].Command(time(), command.valve[a]);
+  for (std::size_t a = 0; a < valves_.size(); ++a) {
+    valves_[a].Command(time(), command.valve[a]);
+    pilot_signals_[a].Command(time(), command.valve[a]);
+  }
   return true;
 }
 
@@ -408,9 +439,12 @@ void Plant::Advance(double dt) {
     double t_next = t_end;
     for (const auto& valve : valves_) t_next = std::min(t_next, valve.NextSwitchAfter(t));
     for (int a = 0; a < static_cast<int>(valves_.size()); ++a) {
-      held.spool_reference[functions_.actuator_joint[a]] = valves_[a].EffectiveAt(t);
+      const int joint = functions_.actuator_joint[a];
+      (valves_[a].raw() ? held.pilot_input : held.spool_reference)[joint] =
+          valves_[a].EffectiveAt(t);
     }
-    LoadSensing(held.spool_reference, held.section_supply, held.pump_pressure);
+    LoadSensing(OpeningReference(held.spool_reference, held.pilot_input), held.section_supply,
+                held.pump_pressure);
     const bool event = held.IsEventAgainst(system_->held()) || dirty_;
     system_->held() = held;
     if (event) {
@@ -422,6 +456,7 @@ void Plant::Advance(double dt) {
     t = t_next;
   }
   for (auto& valve : valves_) valve.Prune(t_end);
+  for (auto& pilot : pilot_signals_) pilot.Prune(t_end);
   state_.time = t_end;
   ++counters_.ticks;
   counters_.steps = integrator_->steps();
@@ -452,6 +487,27 @@ void Plant::Advance(double dt) {
   UpdateResistance();
   state_.payload_mass = bucket_terrain_->payload_mass();
   state_.payload_volume = bucket_terrain_->payload_volume();
+}
+
+std::vector<double> Plant::OpeningReference(const std::vector<double>& spool_reference,
+                                            const std::vector<double>& pilot_input) const {
+  // Where each spool is headed: the held reference, or with a pilot stage the opening law at
+  // the pilot's input (what the pilot settles to).
+  std::vector<double> opening = spool_reference;
+  for (int j = 0; j < static_cast<int>(opening.size()); ++j) {
+    if (system_->pilot_state(j) < 0) continue;
+    const model::Actuator& act = machine_.hydraulics.actuators[system_->actuator_of_joint(j)];
+    opening[j] = ValveOpening(act.valve, pilot_input[j]);
+  }
+  return opening;
+}
+
+double Plant::PilotSignal(int actuator) const { return pilot_signals_.at(actuator).At(time()); }
+
+double Plant::PilotState(int actuator) const {
+  const int joint = functions_.actuator_joint[actuator];
+  const int k = system_->pilot_state(joint);
+  return k >= 0 ? y_[k] : valves_.at(actuator).EffectiveAt(time());
 }
 
 void Plant::LoadSensing(const std::vector<double>& spool_reference,

@@ -2,10 +2,11 @@
 // terrain interaction and the energy counters, integrated by CVODE between control ticks.
 //
 // State y = [arm x (5J: q, q̇, spool, p_A, p_B, see interpreted_model.h) | v, ω, throttle,
-// x_hinge, y_hinge, ψ, γ, E_travel, E_hydraulic]. Per segment (between two discrete events) the
-// inputs are held: spool references (after dead zone and transport delay), drive command, brake,
-// articulation rate, payload mass and the magnitudes of the material's resistance. Inside the
-// segment the resistance follows the bucket tip velocity v = (v_s, v_z) in the arm plane, each
+// x_hinge, y_hinge, ψ, γ, E_travel, E_hydraulic | π per valve with a pilot stage]. Per segment
+// (between two discrete events) the inputs are held: spool references (after the opening law
+// and the delays) or the delayed commands into the pilot lags (valve_command.h), drive command,
+// brake, articulation rate, payload mass and the magnitudes of the material's resistance. Inside
+// the segment the resistance follows the bucket tip velocity v = (v_s, v_z) in the arm plane, each
 // component through a smooth sign v/sqrt(v² + ε²), so that it acts like Coulomb friction that
 // never pushes the bucket backwards:
 //   F_s = −σ(c v_s)·c·(R_cut if cutting else R_withdraw)      c = ±1: the cutting edge's side
@@ -149,6 +150,13 @@ class Plant {
   std::vector<OrientedBox> OwnBodies() const;
   /// Changes the transport delay of an actuator at run time (fault injection: delay drift).
   void SetTransportDelay(int actuator, double delay);
+  /// The pilot (EPPR) pressure of an actuator's valve now, as a fraction of the full pilot
+  /// pressure signed by direction (extend > 0): lag_{T_p}(u(t − τ_p)), what a transducer on the
+  /// pilot line reads (valve_command.h PilotSignal). Without a pilot stage: u(t − τ_p).
+  double PilotSignal(int actuator) const;
+  /// The pilot as the spool path sees it now: the CVODE pilot state π (PilotSignal τ_d later).
+  /// Without a pilot stage there is none: the held spool reference is returned.
+  double PilotState(int actuator) const;
 
  private:
   class System;
@@ -156,6 +164,8 @@ class Plant {
   void UpdateResistance();
   void LoadSensing(const std::vector<double>& spool_reference, std::vector<double>& section_supply,
                    double& pump_pressure) const;
+  std::vector<double> OpeningReference(const std::vector<double>& spool_reference,
+                                       const std::vector<double>& pilot_input) const;
 
   const model::MachineDescription& machine_;
   const generated::MachineFunctions& functions_;
@@ -164,7 +174,8 @@ class Plant {
   std::unique_ptr<System> system_;
   std::unique_ptr<OdeIntegrator> integrator_;
   std::unique_ptr<BucketTerrain> bucket_terrain_;
-  std::vector<DelayedValveCommand> valves_;  ///< per actuator
+  std::vector<DelayedValveCommand> valves_;        ///< per actuator
+  std::vector<plant::PilotSignal> pilot_signals_;  ///< per actuator, for PilotSignal()
   std::vector<double> y_;
   MachineState state_;
   ResistanceState resistance_;

@@ -13,10 +13,12 @@
 
 #include "generated/registry.h"
 #include "identification/common/overlay_file.h"
+#include "identification/hydraulics/chain_report.h"
 #include "identification/hydraulics/hydraulic_identification.h"
 #include "identification/hydraulics/log_reader.h"
 #include "identification/hydraulics/plant_logs.h"
 #include "identification/hydraulics/residual_plot.h"
+#include "identification/hydraulics/valve_chain_fit.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
@@ -238,6 +240,98 @@ std::string OverlayText(const model::MachineDescription& machine,
   return text.str();
 }
 
+// "MIN:MAX" → the pair, in the given scale; throws std::invalid_argument naming the option.
+std::pair<double, double> ParseRange(const std::string& text, const char* option, double scale) {
+  const auto colon = text.find(':');
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("");
+    std::size_t used = 0;
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    const double low = std::stod(a, &used);
+    if (used != a.size()) throw std::invalid_argument("");
+    const double high = std::stod(b, &used);
+    if (used != b.size() || !(low < high) || !std::isfinite(low) || !std::isfinite(high)) {
+      throw std::invalid_argument("");
+    }
+    return {low * scale, high * scale};
+  } catch (const std::exception&) {
+    throw std::invalid_argument(std::string(option) + ": expected MIN:MAX with MIN < MAX, got '" +
+                                text + "'");
+  }
+}
+
+double PressureScale(PressureUnits units) {
+  switch (units) {
+    case PressureUnits::kBar:
+      return 1e5;
+    case PressureUnits::kMegapascal:
+      return 1e6;
+    default:
+      return 1.0;
+  }
+}
+
+template <typename ProgressFn>
+int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescription& machine,
+             const std::vector<HydraulicLog>& logs,
+             const std::map<int, std::vector<HydraulicLog>>& by_actuator, std::size_t rows,
+             double read_seconds, Clock::time_point start, ProgressFn& progress,
+             std::ostream& out) {
+  (void)logs;
+  std::string command_line = kName;
+  // Name a few logs; a campaign of many would make the comment unreadable.
+  for (std::size_t i = 0; i < options.logs.size() && i < 3; ++i) {
+    command_line += " " + options.logs[i];
+  }
+  if (options.logs.size() > 3) {
+    command_line += " … (" + std::to_string(options.logs.size()) + " logs)";
+  }
+  command_line += " --machine " + machine.name + " --model chain";
+  ChainFitOptions fit;
+  fit.bootstrap = options.bootstrap;
+  fit.seed = options.seed;
+  fit.validate = options.cross_validate;
+  const LogFormat format = [&] {
+    std::ostringstream ignored;
+    return FormatFor(options.logs.front(), options, ignored);
+  }();
+  fit.events.relief = options.relief * PressureScale(format.pressure_units);
+  const double angle_scale =
+      format.angle_units == AngleUnits::kDegrees ? std::numbers::pi / 180 : 1.0;
+  if (!options.joint_range.empty()) {
+    std::tie(fit.events.joint_min, fit.events.joint_max) =
+        ParseRange(options.joint_range, "--joint-range", angle_scale);
+  }
+  if (!options.window.empty()) {
+    std::tie(fit.events.window_begin, fit.events.window_end) =
+        ParseRange(options.window, "--window", 1.0);
+  }
+  std::vector<NamedChain> results;
+  for (const auto& [a, group] : by_actuator) {
+    const model::Actuator& actuator = machine.hydraulics.actuators[a];
+    fit.progress = [&](const std::string& line) { progress(actuator.name + ": " + line); };
+    if (actuator.kind == model::ActuatorKind::kCylinder && actuator.bore > 0) {
+      const double cap = actuator.bore * actuator.bore;
+      fit.area_ratio = (cap - actuator.rod * actuator.rod) / cap;
+    }
+    results.push_back({actuator.name, IdentifyValveChain(group, fit)});
+  }
+  const double fit_seconds = Seconds(start) - read_seconds;
+  progress("fitted");
+  out << "valve chain identification of " << machine.name << " from " << options.logs.size()
+      << " log" << (options.logs.size() == 1 ? "" : "s") << "\n";
+  for (const NamedChain& r : results) PrintChainTable(r, out);
+  out << Throughput(rows, read_seconds, fit_seconds);
+  const std::string png =
+      options.png.empty() ? options.logs.front() + ".residuals.png" : options.png;
+  const std::string overlay =
+      options.overlay.empty() ? options.logs.front() + ".overlay.yaml" : options.overlay;
+  WriteChainPlot(results, png);
+  WriteFileAtomically(overlay, ChainOverlayText(OverlayHeader(machine, command_line), results));
+  out << "overlay: " << overlay << "\nresiduals: " << png << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream& out,
@@ -258,6 +352,24 @@ int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream
       return 2;
     }
 
+    if (!options.simulate.empty() && options.simulate_format == "controldesk") {
+      std::vector<int> actuators;
+      if (!options.actuator.empty()) {
+        actuators.push_back(FindActuator(machine, options.actuator));
+      } else {
+        for (int link : {0, 1}) actuators.push_back(machine.ActuatorOfJoint(link));
+      }
+      const auto start = Clock::now();
+      const std::vector<std::string> paths =
+          WriteControlDeskCampaign(machine, *functions, actuators, options.simulate, options.seed);
+      char took[64];
+      std::snprintf(took, sizeof took, " in %.1f s", Seconds(start));
+      out << "simulated " << paths.size() << " ControlDesk step tests of " << machine.name << " in "
+          << options.simulate << took << " (seed " << options.seed
+          << "); their valve chain: " << options.simulate << "/truth.overlay.yaml\n";
+      for (const std::string& p : paths) out << "  " << p << "\n";
+      return 0;
+    }
     if (!options.simulate.empty()) {
       std::vector<int> actuators;
       if (!options.actuator.empty()) {
@@ -312,6 +424,10 @@ int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream
                                ActuatorList(machine) + ")");
       }
       by_actuator[a].push_back(std::move(log));
+    }
+    if (options.model == "chain") {
+      return RunChain(options, machine, logs, by_actuator, rows, read_seconds, start, progress,
+                      out);
     }
     HydraulicIdentificationOptions fit_options;
     fit_options.cross_validate = options.cross_validate;

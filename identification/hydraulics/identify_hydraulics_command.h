@@ -37,8 +37,20 @@ struct IdentifyHydraulicsOptions {
   std::string png;             ///< empty: <first log>.residuals.png
   bool cross_validate = true;
   bool exclude_end_stops = true;
-  std::string simulate;         ///< write simulated logs into this folder instead
+  /// "chain" (default): the valve chain of valve_chain_fit.h (pilot stage, flow
+  /// characteristic, data-detected stalls); "linear": dead zone + linear flow through the
+  /// description's kinematics (hydraulic_identification.h).
+  std::string model = "chain";
+  int bootstrap = 20;       ///< chain: resamples of the logs for the intervals
+  double relief = 0;        ///< chain: stall pressure override, pressure units; 0: from each log
+  std::string joint_range;  ///< chain: "MIN:MAX" in the angle units; empty: all
+  std::string window;       ///< chain: "T0:T1" [s]; empty: all
+  std::string simulate;     ///< write simulated logs into this folder instead
   unsigned long long seed = 1;  ///< of the simulated noise
+  /// Layout of the simulated logs: "plant" (steps and a chirp, plant_logs.h
+  /// WriteSimulatedCampaign) or "controldesk" (an excavator's step tests with a known valve
+  /// chain, WriteControlDeskCampaign: boom and arm unless --actuator names one).
+  std::string simulate_format = "plant";
 };
 
 int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream& out,

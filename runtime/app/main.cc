@@ -254,9 +254,12 @@ int main(int argc, char** argv) {
   hydraulics_cmd->add_option(
       "--columns", hydraulics.columns,
       "Column map time=COL,command=COL,joint_angle=COL[,spool=,pressure_a=,pressure_b=,"
-      "pilot_pressure=]; COL: header name or 1-based number");
+      "pilot_pressure=]; COL: header name (ControlDesk: trace name, path or its last part), "
+      "1-based number, or expression such as 'Boom_up_duty - Boom_dn_duty', '-Arm_ang + 90', "
+      "'0.1*$3'");
   hydraulics_cmd->add_option("--column-map", hydraulics.column_map,
-                             "YAML column map (columns, units, header_lines, actuator)");
+                             "YAML column map (columns: names or expressions as in --columns, "
+                             "units, header_lines, actuator)");
   hydraulics_cmd->add_option("--command-units", hydraulics.command_units, "unit ([-1,1]) | percent")
       ->check(CLI::IsMember({"unit", "percent"}));
   hydraulics_cmd
@@ -281,9 +284,32 @@ int main(int argc, char** argv) {
   hydraulics_cmd->add_flag("--no-cross-validation", no_cross_validation,
                            "Skip fitting on some duty levels and predicting the others");
   hydraulics_cmd->add_flag("--keep-end-stops", keep_end_stops, "Fit samples at end stops too");
+  hydraulics_cmd
+      ->add_option("--model", hydraulics.model,
+                   "chain: pilot stage, flow characteristic, stalls from the data (default) | "
+                   "linear: dead zone + linear flow through the description's kinematics")
+      ->check(CLI::IsMember({"chain", "linear"}))
+      ->capture_default_str();
+  hydraulics_cmd
+      ->add_option("--bootstrap", hydraulics.bootstrap,
+                   "chain: resamples of the logs for the parameter intervals (0: none)")
+      ->check(autoshovel::app::IntegerIn(0, 10000))
+      ->capture_default_str();
+  hydraulics_cmd->add_option("--relief", hydraulics.relief,
+                             "chain: stall pressure override in the pressure units (default: the "
+                             "highest driving pressure of each log)");
+  hydraulics_cmd->add_option("--joint-range", hydraulics.joint_range,
+                             "chain: MIN:MAX joint angles to fit, in the angle units");
+  hydraulics_cmd->add_option("--window", hydraulics.window, "chain: T0:T1 time window to fit [s]");
   hydraulics_cmd->add_option("--simulate", hydraulics.simulate,
                              "Write simulated plant logs (steps 30/60/100 % both ways, a chirp) "
                              "into DIR and stop");
+  hydraulics_cmd
+      ->add_option("--format", hydraulics.simulate_format,
+                   "Layout of --simulate: plant (steps and a chirp) | controldesk (an excavator's "
+                   "boom and arm step tests with a known valve chain, truth.overlay.yaml)")
+      ->check(CLI::IsMember({"plant", "controldesk"}))
+      ->capture_default_str();
   hydraulics_cmd->add_option("--seed", hydraulics.seed, "Seed of --simulate")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();

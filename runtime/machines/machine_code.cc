@@ -48,6 +48,27 @@ const char* ToString(CodeSource source) {
 MachineCode ResolveMachineCode(const model::MachineDescription& machine,
                                const ResolveOptions& options) {
   const generated::MachineFunctions* built_in = generated::FindMachine(machine.name);
+  if (!machine.overlay_code_keys.empty()) {
+    // Code generated from the base file has these values compiled in and would silently run
+    // without them.
+    std::lock_guard<std::mutex> lock(resolve_mutex);
+    std::string key = "interpreted\n" + machine.name + '\n' + machine.sha256;
+    for (const std::string& overlay : machine.overlays) key += '\n' + overlay;
+    if (const auto it = resolved.find(key); it != resolved.end()) return it->second;
+    const generated::MachineFunctions& f = InterpretedFunctions(machine);
+    if (options.notes != nullptr) {
+      *options.notes << "autoshovel: machine '" << machine.name
+                     << "': using the interpreted model (slower): an overlay sets values the "
+                        "generated code compiles in ("
+                     << machine.overlay_code_keys.front()
+                     << (machine.overlay_code_keys.size() > 1
+                             ? " and " + std::to_string(machine.overlay_code_keys.size() - 1) +
+                                   " more"
+                             : std::string())
+                     << ")\n";
+    }
+    return resolved[key] = {&f, CodeSource::kInterpreted, "an overlay changes compiled-in values"};
+  }
   if (built_in != nullptr && machine.sha256 == built_in->source_sha256) {
     return {built_in, CodeSource::kCompiledIn, "generated/" + machine.name + "/"};
   }

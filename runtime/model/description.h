@@ -92,9 +92,26 @@ struct Swing {
   double viscous_friction = 0;  ///< [N·m·s/rad]
 };
 
+/// One point of a valve's opening curve: opening (fraction of the full spool opening) at a duty
+/// (fraction of the full command), both in [0, 1].
+struct OpeningPoint {
+  double duty = 0;
+  double opening = 0;
+};
+
+/// The valve chain (docs/simulation.md "Valve chain"): command u → pure delay τ_p + τ_d → pilot
+/// lag T_p → opening law of the direction → spool lag τ_s → orifice Q = K_v·x_s·√Δp.
 struct Valve {
   double dead_zone = 0;            ///< fraction of full command ignored around zero [-]
-  double transport_delay = 0;      ///< τ_d, command to spool start [s]
+  double transport_delay = 0;      ///< τ_d, pilot to spool start [s] (command to spool start
+                                   ///< when there is no pilot stage)
+  double pilot_delay = 0;          ///< τ_p, command to pilot pressure start [s]
+  double pilot_time_constant = 0;  ///< T_p, first-order pilot lag [s]; 0: no pilot stage
+  /// Opening against duty per direction (extend: u > 0, retract: u < 0): piecewise linear
+  /// through the points, 0 below the first, the last opening above the last. Empty: the dead
+  /// zone and the linear law (ApplyDeadZone) for that direction.
+  std::vector<OpeningPoint> opening_curve_extend;
+  std::vector<OpeningPoint> opening_curve_retract;
   double spool_time_constant = 0;  ///< τ_s, first-order spool lag [s]
   double flow_gain = 0;            ///< K_v in Q = K_v·x_s·sqrt(Δp) [m³/(s·√Pa)]
   double rated_flow = 0;           ///< as given: flow at full spool and rated drop [m³/s]
@@ -226,6 +243,10 @@ struct MachineDescription {
   std::string notes;                   ///< provenance, free text
   std::vector<std::string> estimated;  ///< key paths whose values are estimates
   std::vector<std::string> overlays;   ///< overlay files applied on top, in order
+  /// Overlay values that generated code compiles in (a valve's spool time constant and rated
+  /// flow), as "overlay file: key path": code generated from the base file would ignore them,
+  /// so a machine with any runs the interpreted model (runtime/machines/machine_code.h).
+  std::vector<std::string> overlay_code_keys;
 
   Chassis chassis;
   std::optional<ElectricMotor> electric_motor;
@@ -272,7 +293,8 @@ struct LoadOptions {
   /// both must match. Schema (every value optional, units as in the description):
   /// `machine`, `base_sha256`, `arm.links[]{name, length, imu_offset_deg}`,
   /// `hydraulics.actuators[]{name, dead_zone, transport_delay, spool_time_constant,
-  /// rated_flow_lpm}`, `sensors.camera.pose{xyz, rpy_deg}`, `sensors.lidars[]{name, pose}`.
+  /// rated_flow_lpm, pilot_delay, pilot_time_constant, opening_curve_extend,
+  /// opening_curve_retract}`, `sensors.camera.pose{xyz, rpy_deg}`, `sensors.lidars[]{name, pose}`.
   std::vector<std::string> overlays;
 };
 

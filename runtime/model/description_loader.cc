@@ -107,7 +107,85 @@ Link ReadLink(MapReader map) {
   return link;
 }
 
-Valve ReadValve(MapReader map) {
+// An opening curve `[[duty, opening], ...]` of a valve (models/README.md): at least two points,
+// duty and opening fractions in [0, 1], the first opening 0 (the dead band lies below the first
+// duty where the opening leaves 0), duty strictly increasing, opening non-decreasing and not
+// all 0. Each bad point is reported at its own location. Absent: empty.
+std::vector<OpeningPoint> ReadOpeningCurve(MapReader& map, std::string_view key,
+                                           core::DiagnosticSink& sink) {
+  std::vector<OpeningPoint> curve;
+  const std::optional<YAML::Node> node = map.Raw(key, /*required=*/false);
+  if (!node) return curve;
+  const std::string file = map.location().file;
+  const std::string path = map.PathOf(key);
+  auto fail = [&](const YAML::Node& at, const std::string& where, const std::string& message) {
+    sink.Add(core::LocationOf(file, at), where, message);
+  };
+  if (!node->IsSequence() || node->size() < 2) {
+    fail(*node, path,
+         "expected a list of at least 2 points [duty, opening] (fractions of full command and "
+         "full opening, in [0, 1])");
+    return curve;
+  }
+  bool ok = true;
+  for (std::size_t i = 0; i < node->size(); ++i) {
+    const YAML::Node p = (*node)[i];
+    const std::string where = path + "[" + std::to_string(i) + "]";
+    double duty = 0, opening = 0;
+    if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], duty) ||
+        !YAML::convert<double>::decode(p[1], opening) || !std::isfinite(duty) ||
+        !std::isfinite(opening)) {
+      fail(p, where, "expected a point [duty, opening] (fractions in [0, 1])");
+      ok = false;
+      continue;
+    }
+    const std::string text =
+        "[" + core::FormatNumber(duty) + ", " + core::FormatNumber(opening) + "]";
+    if (duty < 0 || duty > 1 || opening < 0 || opening > 1) {
+      fail(p, where, "duty and opening are fractions in [0, 1], got " + text);
+      ok = false;
+      continue;
+    }
+    if (curve.empty() && opening != 0) {
+      fail(p, where,
+           "the first point's opening must be 0 (the valve is closed up to where the curve "
+           "leaves 0: its dead band), got " +
+               text);
+      ok = false;
+    } else if (!curve.empty() && duty <= curve.back().duty) {
+      fail(p, where,
+           "duty must increase strictly along the curve, got " + text + " after duty " +
+               core::FormatNumber(curve.back().duty));
+      ok = false;
+    } else if (!curve.empty() && opening < curve.back().opening) {
+      fail(p, where,
+           "opening must not decrease along the curve (a valve opens monotonically), got " + text +
+               " after opening " + core::FormatNumber(curve.back().opening));
+      ok = false;
+    }
+    curve.push_back({duty, opening});
+  }
+  if (ok && curve.back().opening <= 0) {
+    fail(*node, path, "the valve never opens: the last point's opening must be > 0");
+    ok = false;
+  }
+  if (!ok) curve.clear();
+  return curve;
+}
+
+// With both opening curves given the dead zone applies to no direction: a non-zero one would be
+// silently ignored, so it is refused (at `key`, the value that made the conflict).
+void CheckDeadZoneAgainstCurves(const MapReader& map, std::string_view key, const Valve& v) {
+  if (v.opening_curve_extend.empty() || v.opening_curve_retract.empty() || v.dead_zone == 0) {
+    return;
+  }
+  map.Error(key, "dead_zone " + core::FormatNumber(v.dead_zone) +
+                     " has no effect when both opening_curve_extend and opening_curve_retract "
+                     "are given (each curve holds its own dead band): set dead_zone to 0 or "
+                     "drop a curve");
+}
+
+Valve ReadValve(MapReader map, core::DiagnosticSink& sink) {
   Valve v;
   v.dead_zone = map.Number("dead_zone", NumberRule{0, NumberRule::Bound::kInclusive, 0.5,
                                                    NumberRule::Bound::kExclusive, ""});
@@ -116,11 +194,17 @@ Valve ReadValve(MapReader map) {
   v.rated_flow = map.Number("rated_flow_lpm", NumberRule::Positive("l/min")) * kLitrePerMinute;
   v.rated_pressure_drop = map.Number("rated_pressure_drop_bar", NumberRule::Positive("bar")) * kBar;
   v.flow_gain = v.rated_flow / std::sqrt(v.rated_pressure_drop);
+  // The pilot stage and the opening curves (optional; absent: no stage, dead zone + linear law).
+  v.pilot_delay = map.Number("pilot_delay", NumberRule::Closed(0, 5, "s"), 0.0);
+  v.pilot_time_constant = map.Number("pilot_time_constant", NumberRule::Closed(0, 5, "s"), 0.0);
+  v.opening_curve_extend = ReadOpeningCurve(map, "opening_curve_extend", sink);
+  v.opening_curve_retract = ReadOpeningCurve(map, "opening_curve_retract", sink);
+  CheckDeadZoneAgainstCurves(map, "dead_zone", v);
   map.Finish();
   return v;
 }
 
-Actuator ReadActuator(MapReader map) {
+Actuator ReadActuator(MapReader map, core::DiagnosticSink& sink) {
   Actuator a;
   a.name = map.String("name");
   const std::string type = map.Enum("type", {"cylinder", "motor"});
@@ -145,12 +229,12 @@ Actuator ReadActuator(MapReader map) {
     a.rod_center = map.Number("rod_center", NumberRule::NonNegative("m"), a.retracted_length / 2);
   }
   a.relief_pressure = map.Number("relief_pressure_bar", NumberRule::Positive("bar")) * kBar;
-  a.valve = ReadValve(map.Map("valve"));
+  a.valve = ReadValve(map.Map("valve"), sink);
   map.Finish();
   return a;
 }
 
-Hydraulics ReadHydraulics(MapReader map) {
+Hydraulics ReadHydraulics(MapReader map, core::DiagnosticSink& sink) {
   Hydraulics h;
   h.pump_pressure = map.Number("pump_pressure_bar", NumberRule::Positive("bar")) * kBar;
   h.tank_pressure = map.Number("tank_pressure_bar", NumberRule::NonNegative("bar"), 2.0) * kBar;
@@ -158,7 +242,7 @@ Hydraulics ReadHydraulics(MapReader map) {
   h.pump_efficiency = map.Number("pump_efficiency", NumberRule{0, NumberRule::Bound::kExclusive, 1,
                                                                NumberRule::Bound::kInclusive, ""});
   for (auto& actuator : map.MapList("actuators", true))
-    h.actuators.push_back(ReadActuator(actuator));
+    h.actuators.push_back(ReadActuator(actuator, sink));
   map.Finish();
   return h;
 }
@@ -852,6 +936,11 @@ void ApplyOverlay(MachineDescription& m, const std::string& path, core::Diagnost
       if (item.Has("transport_delay")) {
         valve.transport_delay = item.Number("transport_delay", NumberRule::Closed(0, 5, "s"));
       }
+      for (const char* compiled : {"spool_time_constant", "rated_flow_lpm"}) {
+        if (item.Has(compiled)) {
+          m.overlay_code_keys.push_back(path + ": hydraulics.actuators[" + name + "]." + compiled);
+        }
+      }
       if (item.Has("spool_time_constant")) {
         valve.spool_time_constant = item.Number("spool_time_constant", NumberRule::Open(0, 5, "s"));
       }
@@ -860,6 +949,26 @@ void ApplyOverlay(MachineDescription& m, const std::string& path, core::Diagnost
             item.Number("rated_flow_lpm", NumberRule::Positive("l/min")) * kLitrePerMinute;
         valve.flow_gain = valve.rated_flow / std::sqrt(valve.rated_pressure_drop);
       }
+      if (item.Has("pilot_delay")) {
+        valve.pilot_delay = item.Number("pilot_delay", NumberRule::Closed(0, 5, "s"));
+      }
+      if (item.Has("pilot_time_constant")) {
+        valve.pilot_time_constant =
+            item.Number("pilot_time_constant", NumberRule::Closed(0, 5, "s"));
+      }
+      for (const char* key : {"opening_curve_extend", "opening_curve_retract"}) {
+        if (!item.Has(key)) continue;
+        std::vector<OpeningPoint> curve = ReadOpeningCurve(item, key, sink);
+        (std::string(key) == "opening_curve_extend" ? valve.opening_curve_extend
+                                                    : valve.opening_curve_retract) =
+            std::move(curve);
+      }
+      // Blamed on what this overlay gave: its curves (the dead zone may be the description's).
+      CheckDeadZoneAgainstCurves(item,
+                                 item.Has("dead_zone")               ? "dead_zone"
+                                 : item.Has("opening_curve_retract") ? "opening_curve_retract"
+                                                                     : "opening_curve_extend",
+                                 valve);
       item.Finish();
     }
     hydraulics->Finish();
@@ -946,7 +1055,7 @@ MachineDescription LoadMachineDescription(const std::string& path, const LoadOpt
     }
     arm.Finish();
   }
-  m.hydraulics = ReadHydraulics(root.Map("hydraulics"));
+  m.hydraulics = ReadHydraulics(root.Map("hydraulics"), sink);
   m.bucket = ReadBucket(root.Map("bucket"), file, sink);
   m.sensors = ReadSensors(root.Map("sensors"));
   root.Finish();

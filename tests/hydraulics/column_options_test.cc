@@ -89,6 +89,7 @@ TEST_F(SiblingMap, UnitOptionsOverrideTheSiblingWithANotice) {
   WriteSidecar(std::string(kValidSidecar) + "units: {angle: deg}\nactuator: stick\n");
   options_.angle_units = "rad";
   options_.actuator = "boom";
+  options_.model = "linear";  // its rated flow shows a unit mistake in l/min
   ASSERT_EQ(Run(), 0) << err_.str();
   EXPECT_EQ(err_.str(), "autoshovel identify hydraulics: note: " + log_ + " read with " +
                             sidecar() + ", --angle-units and --actuator overriding it\n");

@@ -149,6 +149,7 @@ TEST(IdentifyHydraulicsCommand, SimulateThenIdentifyWritesOverlayAndFigure) {
   ASSERT_EQ(options.logs.size(), 7u);
   options.overlay = dir + "/tilt.overlay.yaml";
   options.png = dir + "/tilt.png";
+  options.model = "linear";
   out.str("");
   ASSERT_EQ(RunIdentifyHydraulics(options, out, err), 0) << err.str();
   std::cout << out.str();
@@ -165,6 +166,27 @@ TEST(IdentifyHydraulicsCommand, SimulateThenIdentifyWritesOverlayAndFigure) {
   EXPECT_NE(text.find("      rated_flow_lpm: "), std::string::npos) << text;
   EXPECT_GT(std::filesystem::file_size(options.png), 10000u);
   EXPECT_NE(out.str().find("cross-validation"), std::string::npos);
+
+  // The same logs through the valve chain (the default): its overlay has the chain's keys, and
+  // the command -> motion delay (pilot lag aside, these logs have no pilot) is the truth's
+  // 0.50 s.
+  options.model = "chain";
+  options.bootstrap = 3;
+  options.overlay = dir + "/chain.overlay.yaml";
+  options.png = dir + "/chain.png";
+  out.str("");
+  ASSERT_EQ(RunIdentifyHydraulics(options, out, err), 0) << err.str();
+  std::stringstream chain;
+  chain << std::ifstream(options.overlay).rdbuf();
+  const std::string chain_text = chain.str();
+  for (const char* key : {"pilot_time_constant: ", "spool_time_constant: ", "dead_zone: 0",
+                          "opening_curve_extend: [[", "opening_curve_retract: [["}) {
+    EXPECT_NE(chain_text.find(key), std::string::npos) << key << "\n" << chain_text;
+  }
+  const std::size_t at = chain_text.find("transport_delay: ");
+  ASSERT_NE(at, std::string::npos) << chain_text;
+  EXPECT_NEAR(std::stod(chain_text.substr(at + 17)), 0.50, 0.02) << chain_text;
+  EXPECT_NE(out.str().find("leave one duty level out"), std::string::npos) << out.str();
 }
 
 }  // namespace

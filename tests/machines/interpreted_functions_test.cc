@@ -5,12 +5,16 @@
 #include "runtime/machines/interpreted_functions.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <vector>
 
 #include "generated/registry.h"
+#include "runtime/machines/machine_code.h"
 #include "runtime/model/interpreted_model.h"
 
 namespace autoshovel::machines {
@@ -263,6 +267,46 @@ TEST(InterpretedFunctions, PlantIsTheReferenceModelAndItsJacobianItsDerivative) 
       }
     }
   }
+}
+
+// An overlay that changes a value the generated code compiles in (the spool time constant, the
+// rated flow) must not run on that code, which would ignore it: the interpreted model runs, and
+// says so. An overlay of values applied outside the generated code keeps the compiled code.
+TEST(OverlayOnCompiledCode, CompiledInValuesSendTheMachineToTheInterpretedModel) {
+  const std::string dir = ::testing::TempDir() + "/overlay_code_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  const std::string base = kSource + "/models/excavators/excavator_25t.yaml";
+  const model::MachineDescription plain = model::LoadMachineDescription(base);
+  auto overlay = [&](const std::string& name, const std::string& body) {
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << "machine: excavator_25t\nbase_sha256: " << plain.sha256
+                        << "\nhydraulics:\n  actuators:\n    - name: boom_cylinders\n"
+                        << body;
+    model::LoadOptions options;
+    options.overlays = {path};
+    return model::LoadMachineDescription(base, options);
+  };
+  ResolveOptions resolve;
+  std::ostringstream notes;
+  resolve.notes = &notes;
+  const model::MachineDescription delay = overlay("delay.yaml", "      transport_delay: 0.2\n");
+  EXPECT_EQ(ResolveMachineCode(delay, resolve).source, CodeSource::kCompiledIn);
+  const model::MachineDescription spool = overlay("spool.yaml", "      spool_time_constant: 0.2\n");
+  const MachineCode code = ResolveMachineCode(spool, resolve);
+  EXPECT_EQ(code.source, CodeSource::kInterpreted);
+  EXPECT_NE(notes.str().find("spool_time_constant"), std::string::npos) << notes.str();
+  // And the interpreted code runs with the overlay's value: the boom spool's rate
+  // ẋ_s = (u − x_s)/τ_s (the plant's state 2J + actuator, codegen/symbolic_model.cc).
+  const generated::MachineFunctions& compiled = *ResolveMachineCode(plain, resolve).functions;
+  std::vector<double> y(static_cast<std::size_t>(compiled.num_states), 0.0);
+  std::vector<double> u(static_cast<std::size_t>(compiled.num_inputs), 0.5);
+  std::vector<double> a(y.size()), b(y.size());
+  compiled.plant_rhs(0.0, y.data(), u.data(), a.data());
+  code.functions->plant_rhs(0.0, y.data(), u.data(), b.data());
+  const std::size_t spool_rate = 2 * static_cast<std::size_t>(compiled.num_joints);
+  EXPECT_NEAR(b[spool_rate], 0.5 / 0.2, 1e-9);
+  EXPECT_NEAR(a[spool_rate], 0.5 / plain.hydraulics.actuators[0].valve.spool_time_constant, 1e-9);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

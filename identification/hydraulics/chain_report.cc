@@ -222,6 +222,11 @@ std::string ChainOverlayText(const std::string& header, const std::vector<NamedC
                   std::max(1e-3, mean(&DirectionFit::motion_lag)),
                   each(&DirectionFit::motion_lag, 1e3).c_str());
     text << line;
+    if (r.rated_flow_lpm > 0) {
+      std::snprintf(line, sizeof line, "      rated_flow_lpm: %.1f         # %s\n",
+                    r.rated_flow_lpm, r.rated_flow_note.c_str());
+      text << line;
+    }
     if (dirs.size() == 2)
       text << "      dead_zone: 0                # the opening curves hold the dead bands\n";
     for (const DirectionFit& d : dirs) {

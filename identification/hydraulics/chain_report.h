@@ -15,6 +15,10 @@ namespace autoshovel::identification {
 struct NamedChain {
   std::string actuator;
   ChainIdentification chain;
+  /// The flow that gives the highest logged level's joint rate through the description's
+  /// cylinder at the logs' centre angle, the first direction identified [l/min]; 0: none.
+  double rated_flow_lpm = 0;
+  std::string rated_flow_note;  ///< how it was found, for the overlay's comment
 };
 
 void PrintChainTable(const NamedChain& result, std::ostream& out);

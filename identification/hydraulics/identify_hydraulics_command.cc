@@ -17,6 +17,7 @@
 #include "identification/hydraulics/hydraulic_identification.h"
 #include "identification/hydraulics/log_reader.h"
 #include "identification/hydraulics/plant_logs.h"
+#include "identification/hydraulics/plant_replay.h"
 #include "identification/hydraulics/residual_plot.h"
 #include "identification/hydraulics/valve_chain_fit.h"
 #include "runtime/core/diagnostics.h"
@@ -273,7 +274,7 @@ double PressureScale(PressureUnits units) {
 
 template <typename ProgressFn>
 int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescription& machine,
-             const std::vector<HydraulicLog>& logs,
+             const generated::MachineFunctions& functions, const std::vector<HydraulicLog>& logs,
              const std::map<int, std::vector<HydraulicLog>>& by_actuator, std::size_t rows,
              double read_seconds, Clock::time_point start, ProgressFn& progress,
              std::ostream& out) {
@@ -314,7 +315,25 @@ int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescr
       const double cap = actuator.bore * actuator.bore;
       fit.area_ratio = (cap - actuator.rod * actuator.rod) / cap;
     }
-    results.push_back({actuator.name, IdentifyValveChain(group, fit)});
+    NamedChain named{actuator.name, IdentifyValveChain(group, fit), 0.0, ""};
+    // The rated flow that makes the description's cylinder move the joint at the identified
+    // rate of the highest level (full opening) at the logs' centre angle: the plant's flow at
+    // full spool and rated drop (docs/hydraulic_identification.md, "Into the plant").
+    if (!named.chain.directions.empty()) {
+      const DirectionFit& d = named.chain.directions.front();
+      const ActuatorKinematics kinematics(machine, functions, a);
+      const double lever = std::abs(kinematics.Lever(d.angle_center));
+      const double area = d.sign > 0 ? kinematics.area_extend() : kinematics.area_retract();
+      const double rate = d.rates.empty() ? 0.0 : d.rates.back().value;
+      named.rated_flow_lpm = rate * area * lever / kLpm;
+      char note[200];
+      std::snprintf(note, sizeof note,
+                    "l/min: %.2f deg/s at %.0f %% duty x %s area x lever %.3f m/rad at %.1f deg",
+                    rate * 180 / std::numbers::pi, d.levels.back() * 100,
+                    d.sign > 0 ? "cap" : "annulus", lever, d.angle_center * 180 / std::numbers::pi);
+      named.rated_flow_note = note;
+    }
+    results.push_back(std::move(named));
   }
   const double fit_seconds = Seconds(start) - read_seconds;
   progress("fitted");
@@ -425,9 +444,42 @@ int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream
       }
       by_actuator[a].push_back(std::move(log));
     }
+    if (!options.replay.empty()) {
+      model::LoadOptions load;
+      load.models_dir = options.models_dir;
+      load.overlays = {options.replay};
+      const model::MachineDescription replayed = model::LoadMachineDescription(
+          model::ResolveMachineDescription(options.machine, options.models_dir), load);
+      const generated::MachineFunctions& replay_functions = machines::MachineFunctionsFor(replayed);
+      std::vector<ReplayResult> replays;
+      out << "plant replay of " << replayed.name << " with " << options.replay << "\n"
+          << "  log                                 angle RMS  2 s after onset  start\n";
+      double worst = 0;
+      for (const auto& [a, group] : by_actuator) {
+        for (const HydraulicLog& log : group) {
+          progress("replaying " + log.file);
+          replays.push_back(ReplayOnPlant(replayed, replay_functions, a, log));
+          const ReplayResult& r = replays.back();
+          char line[256];
+          std::snprintf(line, sizeof line, "  %-34s %7.2f deg  %10.2f deg    %s\n",
+                        std::filesystem::path(r.file).filename().string().c_str(),
+                        r.angle_rms * 180 / std::numbers::pi,
+                        r.angle_rms_onset * 180 / std::numbers::pi,
+                        r.start_clamped ? "clamped into the joint range" : "as logged");
+          out << line;
+          worst = std::max(worst, r.angle_rms);
+        }
+      }
+      const std::string png =
+          options.png.empty() ? options.logs.front() + ".replay.png" : options.png;
+      WriteReplayPlot(replays, png);
+      out << "worst angle RMS " << worst * 180 / std::numbers::pi << " deg\nfigure: " << png
+          << "\n";
+      return 0;
+    }
     if (options.model == "chain") {
-      return RunChain(options, machine, logs, by_actuator, rows, read_seconds, start, progress,
-                      out);
+      return RunChain(options, machine, *functions, logs, by_actuator, rows, read_seconds, start,
+                      progress, out);
     }
     HydraulicIdentificationOptions fit_options;
     fit_options.cross_validate = options.cross_validate;

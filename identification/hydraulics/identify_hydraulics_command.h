@@ -45,7 +45,10 @@ struct IdentifyHydraulicsOptions {
   double relief = 0;        ///< chain: stall pressure override, pressure units; 0: from each log
   std::string joint_range;  ///< chain: "MIN:MAX" in the angle units; empty: all
   std::string window;       ///< chain: "T0:T1" [s]; empty: all
-  std::string simulate;     ///< write simulated logs into this folder instead
+  /// An overlay (as a fit writes): drive the plant of the description with it by the logs'
+  /// commands and compare the joint angle (plant_replay.h) instead of fitting.
+  std::string replay;
+  std::string simulate;         ///< write simulated logs into this folder instead
   unsigned long long seed = 1;  ///< of the simulated noise
   /// Layout of the simulated logs: "plant" (steps and a chirp, plant_logs.h
   /// WriteSimulatedCampaign) or "controldesk" (an excavator's step tests with a known valve

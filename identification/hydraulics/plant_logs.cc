@@ -1,5 +1,6 @@
 #include "identification/hydraulics/plant_logs.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -326,7 +327,10 @@ HydraulicLog SimulatePlantLog(const model::MachineDescription& machine,
   const int joint = functions.actuator_joint[actuator];
   if (joint < static_cast<int>(machine.num_links())) {
     const model::Link& link = machine.links[joint];
-    initial.q[joint] = link.joint_min + options.start_fraction * (link.joint_max - link.joint_min);
+    initial.q[joint] =
+        std::isfinite(options.start_angle)
+            ? std::clamp(options.start_angle, link.joint_min, link.joint_max)
+            : link.joint_min + options.start_fraction * (link.joint_max - link.joint_min);
   }
   plant::Plant plant(machine, functions, world, initial);
   std::mt19937_64 rng(options.seed);

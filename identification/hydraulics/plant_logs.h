@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,8 @@ namespace autoshovel::identification {
 struct PlantLogOptions {
   double rate = 100;             ///< logging (and control) rate [Hz]
   double start_fraction = 0.45;  ///< joint start position within its range [-]
+  /// If finite, the driven joint starts here instead (clamped into its range) [rad].
+  double start_angle = std::numeric_limits<double>::quiet_NaN();
   bool noise = true;
   unsigned long long seed = 1;
   // A typical data logger (as `autoshovel plant step --noise`): spool LVDT 0.5 % of full

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace autoshovel::identification {
 
@@ -97,13 +98,30 @@ LogEvents DetectStepEvents(const HydraulicLog& log, const StepEventOptions& opti
       if (sign * (q - furthest) > 0) furthest = q;
       if (step.onset == kNone && sign * (q - start) >= options.onset_angle) step.onset = k;
     }
+    // A stall's pressure also stands clear above the one the joint moved with (from the onset
+    // to where it first came within the band of its furthest angle): a slow step that never
+    // reaches its stop has its own moving pressure as the highest of its file, and would
+    // otherwise read as stalled over its last degrees of travel.
+    double moving_floor = -std::numeric_limits<double>::infinity();
+    if (events.has_pressure && step.onset != kNone) {
+      std::vector<double> moving;
+      std::size_t k = step.onset;
+      for (; k < step.off && sign * (furthest - log.joint_angle[k]) > options.stall_angle_band;
+           ++k) {
+        moving.push_back(drive[k]);
+      }
+      if (!moving.empty() && log.time[k - 1] - log.time[step.onset] >= 0.2) {
+        moving_floor = Median(moving) + (events.stall_pressure - pressure_floor);
+      }
+    }
     // Stall candidates: command on, at the far end of travel, pressure near relief.
     std::vector<char> candidate(step.off - step.on, 0);
     for (std::size_t k = step.on; k < step.off; ++k) {
       const bool at_end = sign * (furthest - log.joint_angle[k]) <= options.stall_angle_band;
       const bool moved = step.onset != kNone && k >= step.onset;
-      const bool pressed = events.has_pressure ? drive[k] >= pressure_floor
-                                               : std::abs(slow_rate[k]) <= 3 * options.rest_rate;
+      const bool pressed = events.has_pressure
+                               ? drive[k] >= pressure_floor && drive[k] >= moving_floor
+                               : std::abs(slow_rate[k]) <= 3 * options.rest_rate;
       candidate[k - step.on] = at_end && moved && pressed;
     }
     // Without pressure, a stall must last; with it, relief is evidence enough.

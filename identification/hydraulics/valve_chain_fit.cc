@@ -29,7 +29,6 @@ constexpr double kOnsetWindow = 2.0;     // validation window after motion onset
 constexpr double kOppositeSettle = 1.0;  // left out after a step of the other direction [s]
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPilotBefore = 0.1;  // pilot window around a command change [s]
-constexpr double kPilotAfter = 0.15;
 
 using Progress = std::function<void(const std::string&)>;
 void Report(const Progress& progress, const std::string& line) {
@@ -58,7 +57,8 @@ struct DirectionLog {
   std::vector<std::pair<std::size_t, std::size_t>> segments;
   std::vector<std::size_t> onsets;  ///< motion onsets of this direction's steps
   std::size_t used_count = 0;
-  double weight = 1;  ///< per residual
+  double weight = 1;       ///< per residual
+  double pilot_delay = 0;  ///< τ_p of stage 1 (0 without a pilot channel) [s]
   ChainSamples samples() const {
     ChainSamples s;
     s.time = log->time;
@@ -66,6 +66,7 @@ struct DirectionLog {
     s.angle = log->joint_angle;
     s.load = load;
     s.segments = segments;
+    s.pilot_delay = pilot_delay;
     return s;
   }
 };
@@ -146,22 +147,33 @@ DirectionLog PrepareDirection(const HydraulicLog& log, const LogEvents& events, 
     for (std::size_t k = step.on; k < n && log.time[k] <= until; ++k) other[k] = 1;
   }
   for (std::size_t k = 0; k < n; ++k) d.used[k] = !events.excluded[k] && !other[k];
-  // The pilot term looks at the command's steps: the delay and the rise are there, and a
-  // first-order lag fitted to the whole log would trade them for the slow drift of a held
-  // pilot pressure (the EPPR's overshoot settles over seconds).
+  // The pilot term looks at the rise after each step: from 0.1 s before it to where the
+  // pilot has crossed half the step's held value. The delay and the first, fast rise are
+  // there; after it the real EPPR rises on slowly (at 100 %: 17 bar in 20 ms, then 0.3 s to
+  // 34 bar), overshoots and settles over seconds, which a first-order lag fitted over the
+  // whole step would trade for a shorter delay and a longer lag. The slow part reaches the
+  // motion stage through its own lag. Rising edges only: the valve
+  // vents in 20 ms where it fills in 60-100 ms, and the delay a controller leads by is the
+  // filling one.
   d.pilot_used.assign(n, 0);
-  for (const CommandStep& step : events.steps) {
-    if ((step.level > 0 ? 1 : -1) != sign) continue;
-    // Rising edges only: the real EPPR valve vents in 20 ms where it fills in 60-100 ms, and
-    // the delay a controller must lead by is the one to pressure
-    // (docs/hydraulic_identification.md).
-    for (const std::size_t change : {step.on}) {
-      if (change >= n) continue;
-      const double t0 = log.time[change];
-      for (std::size_t k = 0; k < n; ++k) {
-        if (log.time[k] >= t0 - kPilotBefore && log.time[k] <= t0 + kPilotAfter) {
-          d.pilot_used[k] = 1;
-        }
+  if (!log.pilot_pressure.empty()) {
+    for (const CommandStep& step : events.steps) {
+      if ((step.level > 0 ? 1 : -1) != sign) continue;
+      std::vector<double> held;
+      double rest = log.pilot_pressure[step.on];
+      for (std::size_t k = step.on; k < step.off; ++k) {
+        if (log.time[k] >= log.time[step.on] + 1.0) held.push_back(log.pilot_pressure[k]);
+      }
+      if (held.empty()) {
+        for (std::size_t k = step.on; k < step.off; ++k) held.push_back(log.pilot_pressure[k]);
+      }
+      std::nth_element(held.begin(), held.begin() + held.size() / 2, held.end());
+      const double target = rest + 0.5 * (held[held.size() / 2] - rest);
+      std::size_t end_k = step.on;
+      while (end_k < step.off && log.pilot_pressure[end_k] < target) ++end_k;
+      end_k = std::min(step.off, end_k + 2);  // the crossing sample and the one after it
+      for (std::size_t k = 0; k < end_k; ++k) {
+        if (log.time[k] >= log.time[step.on] - kPilotBefore) d.pilot_used[k] = 1;
       }
     }
   }
@@ -203,6 +215,53 @@ struct PilotProblem {
   int iterations = 0;
 };
 
+// The pilot's static map p = p_0 + a·max(0, |u| − u_0) from the logs themselves: p_0 the
+// median at rest, and a, u_0 a straight line through each held step's median pilot (from 1 s
+// after the step on, the EPPR's overshoot settled). With one level, u_0 = 0.
+void SteadyPilotMap(const std::vector<const DirectionLog*>& files, int sign, double command_on,
+                    PilotProblem& state) {
+  std::vector<double> rest, level, steady;
+  for (const DirectionLog* f : files) {
+    const HydraulicLog& log = *f->log;
+    for (std::size_t k = 0; k < log.size(); ++k) {
+      if (std::abs(log.command[k]) <= command_on) rest.push_back(log.pilot_pressure[k] / kBar);
+    }
+    for (const CommandStep& step : f->events.steps) {
+      if ((step.level > 0 ? 1 : -1) != sign) continue;
+      std::vector<double> held;
+      for (std::size_t k = step.on; k < step.off; ++k) {
+        if (log.time[k] >= log.time[step.on] + 1.0) held.push_back(log.pilot_pressure[k] / kBar);
+      }
+      if (held.size() < 10) continue;
+      std::nth_element(held.begin(), held.begin() + held.size() / 2, held.end());
+      level.push_back(std::abs(step.level));
+      steady.push_back(held[held.size() / 2]);
+    }
+  }
+  double offset = 0;
+  if (!rest.empty()) {
+    std::nth_element(rest.begin(), rest.begin() + rest.size() / 2, rest.end());
+    offset = rest[rest.size() / 2];
+  }
+  state.params[kPilotOffset] = offset;
+  if (level.empty()) return;
+  const double n = static_cast<double>(level.size());
+  const double mx = std::accumulate(level.begin(), level.end(), 0.0) / n;
+  const double my = std::accumulate(steady.begin(), steady.end(), 0.0) / n - offset;
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < level.size(); ++i) {
+    sxx += (level[i] - mx) * (level[i] - mx);
+    sxy += (level[i] - mx) * (steady[i] - offset - my);
+  }
+  if (sxx > 1e-6 && sxy > 0) {
+    state.params[kPilotGain] = sxy / sxx;
+    state.params[kPilotThreshold] = std::clamp(mx - my / state.params[kPilotGain], -0.5, 0.95);
+  } else {
+    state.params[kPilotGain] = std::max(my / std::max(mx, 1e-3), 0.0);
+    state.params[kPilotThreshold] = 0.0;
+  }
+}
+
 // Fits the pilot stage on `files`; `free_delay_only` holds everything but τ_p.
 void FitPilot(const std::vector<const DirectionLog*>& files, int sign, PilotProblem& state,
               bool free_delay_only, int max_iterations, Eigen::MatrixXd* jtj = nullptr) {
@@ -219,9 +278,11 @@ void FitPilot(const std::vector<const DirectionLog*>& files, int sign, PilotProb
     problem.SetParameterLowerBound(p, i, lower[i]);
     problem.SetParameterUpperBound(p, i, upper[i]);
   }
-  if (free_delay_only) {
-    problem.SetManifold(p, new ceres::SubsetManifold(kPilotCount, {1, 2, 3, 4}));
-  }
+  // The static map (gain, threshold, offset) comes from the held steps (SteadyPilotMap): the
+  // windows around the steps see mostly the EPPR's overshoot, which would inflate the gain.
+  problem.SetManifold(
+      p, new ceres::SubsetManifold(kPilotCount, free_delay_only ? std::vector<int>{1, 2, 3, 4}
+                                                                : std::vector<int>{2, 3, 4}));
   ceres::Solver::Options solver;
   solver.max_num_iterations = max_iterations;
   solver.linear_solver_type = ceres::DENSE_QR;
@@ -324,8 +385,17 @@ void FitMotion(const std::vector<const DirectionLog*>& files, const std::vector<
   }
   std::vector<int> constant;
   if (free == MotionFree::kDelayOnly) {
+    // The delay, and the flow value of the level itself (when given as the one knot with data):
+    // the level's own steady rate must not be taken from the curve through the others, or the
+    // delay would absorb the curve's error at that level.
+    int own_knot = -1;
+    if (std::count(knot_has_data.begin(), knot_has_data.end(), 1) == 1) {
+      own_knot = static_cast<int>(std::find(knot_has_data.begin(), knot_has_data.end(), 1) -
+                                  knot_has_data.begin());
+    }
     for (int i = 0; i < size; ++i) {
-      if (i != kMotionDelay) constant.push_back(i);
+      const bool own = own_knot >= 0 && i == kMotionFixed + own_knot;
+      if (i != kMotionDelay && !own) constant.push_back(i);
     }
   } else {
     if (setup.pilot_fixed) constant.push_back(kPilotLag);
@@ -618,19 +688,7 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
   if (fit.has_pilot) {
     Report(options.progress, "valve chain (" + direction + "): command -> pilot");
     pilot.params = {0.07, 0.03, 35.0, 0.05, 0.0};
-    // Offset from the rests, gain from the steady pilot of the highest level.
-    std::vector<double> rest;
-    for (const DirectionLog* f : files) {
-      for (std::size_t k = 0; k < f->log->size(); ++k) {
-        if (std::abs(f->log->command[k]) <= options.events.command_on) {
-          rest.push_back(f->log->pilot_pressure[k] / kBar);
-        }
-      }
-    }
-    if (!rest.empty()) {
-      std::nth_element(rest.begin(), rest.begin() + rest.size() / 2, rest.end());
-      pilot.params[kPilotOffset] = rest[rest.size() / 2];
-    }
+    SteadyPilotMap(files, sign, options.events.command_on, pilot);
     double best = std::numeric_limits<double>::infinity(), best_delay = 0.07;
     for (double delay = 0.0037; delay <= 0.3; delay += 0.01) {  // off the grid: ScanAndFit
       PilotProblem trial = pilot;
@@ -658,8 +716,9 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
     Estimate* out[kPilotCount] = {&fit.pilot_delay, &fit.pilot_time_constant, &fit.pilot_gain,
                                   &fit.pilot_threshold, &fit.pilot_offset};
     for (int i = 0; i < kPilotCount; ++i) {
-      *out[i] = MakeEstimate(pilot.params[i], lower[i], upper[i], false);
-      if (!out[i]->at_bound && cov.rows() == kPilotCount) out[i]->sigma = std::sqrt(cov(i, i));
+      // The map (i ≥ 2) is read from the held steps, not fitted: shown as held.
+      *out[i] = MakeEstimate(pilot.params[i], lower[i], upper[i], i >= 2);
+      if (i < 2 && !out[i]->at_bound && cov.rows() == 2) out[i]->sigma = std::sqrt(cov(i, i));
     }
   } else {
     fit.pilot_delay.fixed = true;
@@ -705,6 +764,7 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
   for (const DirectionLog* f : files) {
     local.push_back(*f);
     DirectionLog& d = local.back();
+    d.pilot_delay = fit.has_pilot ? pilot.params[kPilotDelay] : 0.0;
     if (fit.has_pressure) {
       d.load.resize(d.load_raw.size());
       for (std::size_t k = 0; k < d.load_raw.size(); ++k) {
@@ -871,7 +931,10 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
       row.pilot_delay = kNaN;
     }
     MotionState level_state = state;
-    FitMotion(subset, index, setup, level_state, MotionFree::kDelayOnly, options.max_iterations);
+    std::vector<char> own(setup.knots.size(), 0);
+    for (std::size_t j = 0; j < setup.knots.size(); ++j) own[j] = setup.knots[j] == level;
+    FitMotion(subset, index, setup, level_state, MotionFree::kDelayOnly, options.max_iterations,
+              own);
     row.motion_delay =
         (fit.has_pilot ? pilot.params[kPilotDelay] : 0.0) + level_state.params[kMotionDelay];
     std::vector<double> thresholds;

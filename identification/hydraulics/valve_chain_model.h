@@ -135,6 +135,9 @@ struct ChainSamples {
   std::span<const double> angle;    ///< measured [rad]
   std::span<const double> load;     ///< p_L − p̄_L [Pa]; empty: no pressure
   std::vector<std::pair<std::size_t, std::size_t>> segments;  ///< integrated runs
+  /// τ_p, held (the pilot stage's, fitted on the pilot channel; 0 without one): the motion path
+  /// sees the command τ_p + τ_m late.
+  double pilot_delay = 0;
 };
 
 /// Motion-stage parameters of one direction, as a flat vector (the fit's parameter block).
@@ -176,7 +179,7 @@ void SimulateMotion(const ChainSamples& log, int sign, const T* params,
     rates[j] = sum;
   }
   const std::span<const T> rate_span(rates.data(), count);
-  const T delay = params[kMotionDelay];
+  const T delay = params[kMotionDelay] + log.pilot_delay;  // τ_p + τ_m
   const T& motion_lag = params[kMotionLag];
   const T& pilot_lag = params[kPilotLag];
   const T& dead_band = params[kDeadBand];

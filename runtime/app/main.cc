@@ -301,6 +301,9 @@ int main(int argc, char** argv) {
   hydraulics_cmd->add_option("--joint-range", hydraulics.joint_range,
                              "chain: MIN:MAX joint angles to fit, in the angle units");
   hydraulics_cmd->add_option("--window", hydraulics.window, "chain: T0:T1 time window to fit [s]");
+  hydraulics_cmd->add_option("--replay", hydraulics.replay,
+                             "Drive the description's plant with this overlay by the logs' "
+                             "commands and compare the angle (no fit)");
   hydraulics_cmd->add_option("--simulate", hydraulics.simulate,
                              "Write simulated plant logs (steps 30/60/100 % both ways, a chirp) "
                              "into DIR and stop");

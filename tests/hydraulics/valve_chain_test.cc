@@ -121,6 +121,7 @@ HydraulicLog StepLog(const Truth& truth, double level, double head_bar, unsigned
   samples.command = log.command;
   samples.load = load;
   samples.segments = {{0, n}};
+  samples.pilot_delay = t.pilot_delay;  // the motion path sees the command τ_p + τ_m late
   std::vector<double> angle(n, q_low);
   const double start = q_low;
   AngleScale scale{0.5 * (q_low + q_high), 0.5 * (q_high - q_low)};
@@ -224,7 +225,7 @@ TEST(ValveChain, RecoversTheChainFromStepLogs) {
   const ChainIdentification result = IdentifyValveChain(Campaign(truth), options);
   ASSERT_EQ(result.directions.size(), 1u);
   const DirectionFit& d = result.directions[0];
-  PrintChainTable({"synthetic boom", result}, std::cout);
+  PrintChainTable({"synthetic boom", result, 0.0, ""}, std::cout);
   ASSERT_EQ(d.levels.size(), truth.knots.size());
   // Delays per stage within 10 ms.
   EXPECT_NEAR(d.pilot_delay.value, truth.pilot_delay, 0.010);

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <vector>
 
+#include "identification/hydraulics/residual_plot.h"
 #include "identification/hydraulics/valve_chain_model.h"
 #include "runtime/plot/line_plot.h"
 
@@ -132,15 +133,6 @@ void PrintChainTable(const NamedChain& result, std::ostream& out) {
 
 void WriteChainPlot(const std::vector<NamedChain>& results, const std::string& path) {
   std::vector<plot::LinePlot> panels;
-  auto panel = [](const std::string& title, const std::string& y_label) {
-    plot::LinePlot p;
-    p.title = title;
-    p.x_label = "t [s]";
-    p.y_label = y_label;
-    p.width_px = 560;
-    p.height_px = 300;
-    return p;
-  };
   auto series = [](const std::string& name, const std::vector<double>& t,
                    const std::vector<double>& y, double scale, plot::Color color) {
     plot::PlotSeries s{name, {}, {}, color, 1, false, false};
@@ -157,7 +149,7 @@ void WriteChainPlot(const std::vector<NamedChain>& results, const std::string& p
         char title[160];
         std::snprintf(title, sizeof title, "%s: %s, RMS %.2f deg, R2 %.3f", r.actuator.c_str(),
                       Base(f.file).c_str(), f.angle_rms * kDeg, f.rate_r2);
-        plot::LinePlot angle = panel(title, "joint angle [deg]");
+        plot::LinePlot angle = TimePanel(title, "joint angle [deg]");
         angle.series = {series("measured", f.time, f.angle, kDeg, plot::kGrey),
                         series("chain model", f.time, f.angle_fit, kDeg, plot::kRed)};
         plot::PlotSeries left{"left out (stall, override)", {}, {}, plot::kOrange, 1, false, true};
@@ -168,7 +160,7 @@ void WriteChainPlot(const std::vector<NamedChain>& results, const std::string& p
         }
         if (!left.x.empty()) angle.series.push_back(left);
         panels.push_back(angle);
-        plot::LinePlot pilot = panel("pilot pressure", "pilot [bar]");
+        plot::LinePlot pilot = TimePanel("pilot pressure", "pilot [bar]");
         if (!f.pilot.empty()) {
           pilot.series = {series("measured", f.time, f.pilot, 1, plot::kGrey),
                           series("chain model", f.time, f.pilot_fit, 1, plot::kRed)};

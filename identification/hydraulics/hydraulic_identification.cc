@@ -819,13 +819,7 @@ ActuatorIdentification IdentifyActuator(const model::MachineDescription& machine
   // Excitation: every file must command the valve; some file must move the joint.
   bool moves = false;
   for (const HydraulicLog& log : logs) {
-    double largest = 0;
-    for (double u : log.command) largest = std::max(largest, std::abs(u));
-    if (largest <= 0.01) {
-      Fail(log, 0,
-           "no excitation: the command stays within +/-1 % over all " + std::to_string(log.size()) +
-               " rows (a step or chirp log is expected)");
-    }
+    RequireExcitation(log);
     const auto [low, high] = std::minmax_element(log.joint_angle.begin(), log.joint_angle.end());
     moves |= *high - *low > 0.2 * std::numbers::pi / 180;
   }

@@ -272,6 +272,20 @@ double PressureScale(PressureUnits units) {
   }
 }
 
+// The plant's convention: a positive command extends the cylinder. Whether that raises or
+// lowers the joint angle is the sign of the description's lever dL/dq (mid-range); a motor: +1.
+int JointSense(const model::MachineDescription& machine,
+               const generated::MachineFunctions& functions, int actuator) {
+  const ActuatorKinematics kinematics(machine, functions, actuator);
+  const int joint = functions.actuator_joint[actuator];
+  double mid = 0;
+  if (joint < static_cast<int>(machine.num_links())) {
+    const model::Link& link = machine.links[static_cast<std::size_t>(joint)];
+    mid = 0.5 * (link.joint_min + link.joint_max);
+  }
+  return kinematics.Lever(mid) < 0 ? -1 : 1;
+}
+
 template <typename ProgressFn>
 int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescription& machine,
              const generated::MachineFunctions& functions, const std::vector<HydraulicLog>& logs,
@@ -315,6 +329,7 @@ int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescr
       const double cap = actuator.bore * actuator.bore;
       fit.area_ratio = (cap - actuator.rod * actuator.rod) / cap;
     }
+    fit.events.joint_sense = JointSense(machine, functions, a);
     NamedChain named{actuator.name, IdentifyValveChain(group, fit), 0.0, ""};
     // The rated flow that makes the description's cylinder move the joint at the identified
     // rate of the highest level (full opening) at the logs' centre angle: the plant's flow at
@@ -458,15 +473,25 @@ int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream
       for (const auto& [a, group] : by_actuator) {
         for (const HydraulicLog& log : group) {
           progress("replaying " + log.file);
-          replays.push_back(ReplayOnPlant(replayed, replay_functions, a, log));
+          StepEventOptions events;
+          events.joint_sense = JointSense(replayed, replay_functions, a);
+          replays.push_back(ReplayOnPlant(replayed, replay_functions, a, log, events));
           const ReplayResult& r = replays.back();
+          char onset[32] = "           -";  // no motion onset in the command's direction
+          if (!std::isnan(r.angle_rms_onset)) {
+            std::snprintf(onset, sizeof onset, "%8.2f deg",
+                          r.angle_rms_onset * 180 / std::numbers::pi);
+          }
           char line[256];
-          std::snprintf(line, sizeof line, "  %-34s %7.2f deg  %10.2f deg    %s\n",
+          std::snprintf(line, sizeof line, "  %-34s %7.2f deg  %12s    %s\n",
                         std::filesystem::path(r.file).filename().string().c_str(),
-                        r.angle_rms * 180 / std::numbers::pi,
-                        r.angle_rms_onset * 180 / std::numbers::pi,
+                        r.angle_rms * 180 / std::numbers::pi, onset,
                         r.start_clamped ? "clamped into the joint range" : "as logged");
           out << line;
+          if (r.opposite_sense) {
+            out << "    the plant's joint moves the other way: the log's angle runs against "
+                   "the description's joint (negate joint_angle, or the command, for it)\n";
+          }
           worst = std::max(worst, r.angle_rms);
         }
       }

@@ -602,4 +602,15 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
   return log;
 }
 
+void RequireExcitation(const HydraulicLog& log) {
+  double largest = 0;
+  for (double u : log.command) largest = std::max(largest, std::abs(u));
+  if (largest > 0.01) return;
+  core::DiagnosticSink sink;
+  sink.Add({log.file, log.row.empty() ? 0 : log.row.front(), 1}, "",
+           "no excitation: the command stays within +/-1 % over all " + std::to_string(log.size()) +
+               " rows (a step or chirp log is expected)");
+  sink.ThrowIfAny();
+}
+
 }  // namespace autoshovel::identification

@@ -122,4 +122,8 @@ struct HydraulicLog {
 HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
                               std::size_t min_samples = 20);
 
+/// Refuses a log whose command never leaves ±1 % (core::InputError at its first row): neither
+/// model can learn anything from it.
+void RequireExcitation(const HydraulicLog& log);
+
 }  // namespace autoshovel::identification

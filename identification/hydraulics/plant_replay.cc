@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "identification/hydraulics/plant_logs.h"
+#include "identification/hydraulics/residual_plot.h"
 #include "runtime/plot/line_plot.h"
 
 namespace autoshovel::identification {
@@ -62,24 +64,29 @@ ReplayResult ReplayOnPlant(const model::MachineDescription& machine,
       }
     }
   }
+  for (const CommandStep& step : events.steps) {
+    const std::size_t last = std::min(step.off, n) - 1;
+    const double measured = log.joint_angle[last] - log.joint_angle[step.on];
+    const double replayed = simulated.joint_angle[last] - simulated.joint_angle[step.on];
+    if (std::abs(measured) > 0.02 && std::abs(replayed) > 0.02) {
+      result.opposite_sense = measured * replayed < 0;
+      break;
+    }
+  }
   result.angle_rms = n_all ? std::sqrt(all / n_all) : 0.0;
-  result.angle_rms_onset = n_onset ? std::sqrt(onset / n_onset) : 0.0;
+  result.angle_rms_onset =
+      n_onset ? std::sqrt(onset / n_onset) : std::numeric_limits<double>::quiet_NaN();
   return result;
 }
 
 void WriteReplayPlot(const std::vector<ReplayResult>& results, const std::string& path) {
   std::vector<plot::LinePlot> panels;
   for (const ReplayResult& r : results) {
-    plot::LinePlot p;
     char title[200];
     std::snprintf(title, sizeof title, "%s: RMS %.2f deg (2 s after onset %.2f)",
                   std::filesystem::path(r.file).filename().string().c_str(), r.angle_rms * kDeg,
                   r.angle_rms_onset * kDeg);
-    p.title = title;
-    p.x_label = "t [s]";
-    p.y_label = "angle change [deg]";
-    p.width_px = 560;
-    p.height_px = 300;
+    plot::LinePlot p = TimePanel(title, "angle change [deg]");
     plot::PlotSeries measured{"measured", r.time, {}, plot::kGrey, 1, false, false};
     plot::PlotSeries simulated{"plant replay", r.time, {}, plot::kRed, 1, false, false};
     plot::PlotSeries left{"left out (stall)", {}, {}, plot::kOrange, 1, false, true};

@@ -28,8 +28,11 @@ struct ReplayResult {
   std::vector<double> simulated;  ///< change from the first sample [rad]
   std::vector<char> excluded;     ///< stalled or outside the overrides
   double angle_rms = 0;           ///< over the used samples [rad]
-  double angle_rms_onset = 0;     ///< over 2 s after each motion onset [rad]
+  double angle_rms_onset = 0;     ///< over 2 s after each motion onset [rad]; NaN: no onset found
   bool start_clamped = false;     ///< the measured start was outside the joint's range
+  /// Over the log's first step the plant's joint and the logged angle moved opposite ways:
+  /// the log's angle (or command) runs against the description's joint sense.
+  bool opposite_sense = false;
 };
 
 /// Replays one log of `actuator` on the plant. Throws std::runtime_error when the plant refuses.

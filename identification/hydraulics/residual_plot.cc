@@ -21,7 +21,9 @@ plot::PlotSeries Series(const std::string& name, const std::vector<double>& t,
   return s;
 }
 
-plot::LinePlot Panel(const std::string& title, const std::string& y_label) {
+}  // namespace
+
+plot::LinePlot TimePanel(const std::string& title, const std::string& y_label) {
   plot::LinePlot p;
   p.title = title;
   p.x_label = "t [s]";
@@ -30,8 +32,6 @@ plot::LinePlot Panel(const std::string& title, const std::string& y_label) {
   p.height_px = 300;
   return p;
 }
-
-}  // namespace
 
 void WriteResidualPlot(const std::vector<ActuatorIdentification>& results,
                        const std::string& path) {
@@ -42,7 +42,7 @@ void WriteResidualPlot(const std::vector<ActuatorIdentification>& results,
   for (const auto& r : results) {
     for (const FileFit& f : r.files) {
       const std::string name = std::filesystem::path(f.file).filename().string();
-      plot::LinePlot angle = Panel(r.actuator + ": " + name, "joint angle [deg]");
+      plot::LinePlot angle = TimePanel(r.actuator + ": " + name, "joint angle [deg]");
       angle.series = {Series("measured", f.time, f.angle, kDeg, plot::kGrey),
                       Series("fitted", f.time, f.angle_fit, kDeg, plot::kRed)};
       // Samples left out at an end stop: dots on the measured angle.
@@ -57,7 +57,7 @@ void WriteResidualPlot(const std::vector<ActuatorIdentification>& results,
       if (any_spool) {
         char title[96];
         std::snprintf(title, sizeof title, "spool, RMS %.2f %%", f.spool_rms * 100);
-        plot::LinePlot spool = Panel(title, "spool [%]");
+        plot::LinePlot spool = TimePanel(title, "spool [%]");
         if (!f.spool.empty()) {
           spool.series = {Series("measured", f.time, f.spool, 100, plot::kGrey),
                           Series("fitted", f.time, f.spool_fit, 100, plot::kRed)};
@@ -68,7 +68,7 @@ void WriteResidualPlot(const std::vector<ActuatorIdentification>& results,
       for (std::size_t i = 0; i < residual.size(); ++i) residual[i] = f.angle_fit[i] - f.angle[i];
       char title[96];
       std::snprintf(title, sizeof title, "angle residual, RMS %.3f deg", f.angle_rms * kDeg);
-      plot::LinePlot residual_panel = Panel(title, "fitted - measured [deg]");
+      plot::LinePlot residual_panel = TimePanel(title, "fitted - measured [deg]");
       residual_panel.series = {Series("", f.time, residual, kDeg, plot::kBlue)};
       panels.push_back(residual_panel);
     }

@@ -89,7 +89,9 @@ LogEvents DetectStepEvents(const HydraulicLog& log, const StepEventOptions& opti
                                        options.stall_pressure_band * events.stall_pressure);
 
   for (CommandStep& step : events.steps) {
-    const int sign = Sign(step.level);
+    // The way the joint moves under this command: the description's sense (extending the
+    // cylinder may lower the angle, as on most sticks).
+    const int sign = Sign(step.level) * options.joint_sense;
     const double start = log.joint_angle[step.on];
     // Furthest angle reached in the command's direction, and the motion onset.
     double furthest = start;
@@ -201,7 +203,7 @@ std::vector<SignMismatch> FindSignMismatches(const HydraulicLog& log, const LogE
     const std::size_t last = step.off - 1;
     if (log.time[last] - log.time[step.on] < options.sign_check_duration) continue;
     const double change = log.joint_angle[last] - log.joint_angle[step.on];
-    if (std::abs(change) > threshold && Sign(change) != Sign(step.level)) {
+    if (std::abs(change) > threshold && Sign(change) != Sign(step.level) * options.joint_sense) {
       mismatches.push_back({s, step.level, change});
     }
   }

@@ -51,6 +51,9 @@ struct StepEventOptions {
   double window_begin = -std::numeric_limits<double>::infinity();  ///< override [s]
   double window_end = std::numeric_limits<double>::infinity();     ///< override [s]
   std::size_t min_segment = 10;  ///< shorter runs of usable samples are left out
+  /// +1 when a positive command (extending the cylinder, the plant's convention) raises the
+  /// joint angle, −1 when it lowers it (from the description's kinematics).
+  int joint_sense = 1;
   /// Steps shorter than this are not judged by the sign check [s].
   double sign_check_duration = 1.0;
 };

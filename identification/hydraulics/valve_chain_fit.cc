@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <memory>
@@ -59,6 +60,7 @@ struct DirectionLog {
   std::size_t used_count = 0;
   double weight = 1;       ///< per residual
   double pilot_delay = 0;  ///< τ_p of stage 1 (0 without a pilot channel) [s]
+  int joint_sense = 1;     ///< StepEventOptions::joint_sense
   ChainSamples samples() const {
     ChainSamples s;
     s.time = log->time;
@@ -67,6 +69,7 @@ struct DirectionLog {
     s.load = load;
     s.segments = segments;
     s.pilot_delay = pilot_delay;
+    s.joint_sense = joint_sense;
     return s;
   }
 };
@@ -132,6 +135,7 @@ DirectionLog PrepareDirection(const HydraulicLog& log, const LogEvents& events, 
                               const ChainFitOptions& options) {
   DirectionLog d;
   d.log = &log;
+  d.joint_sense = options.events.joint_sense;
   d.events = events;
   const std::size_t n = log.size();
   d.used.assign(n, 0);
@@ -1078,15 +1082,7 @@ ChainIdentification IdentifyValveChain(const std::vector<HydraulicLog>& logs,
                                        const ChainFitOptions& options) {
   ChainIdentification result;
   std::vector<LogEvents> events;
-  for (const HydraulicLog& log : logs) {
-    double largest = 0;
-    for (double u : log.command) largest = std::max(largest, std::abs(u));
-    if (largest <= 0.01) {
-      Fail(log, 0,
-           "no excitation: the command stays within +/-1 % over all " + std::to_string(log.size()) +
-               " rows (a step or chirp log is expected)");
-    }
-  }
+  for (const HydraulicLog& log : logs) RequireExcitation(log);
   for (const HydraulicLog& log : logs) {
     events.push_back(DetectStepEvents(log, options.events));
     const auto mismatches = FindSignMismatches(log, events.back(), options.events);
@@ -1096,10 +1092,12 @@ ChainIdentification IdentifyValveChain(const std::vector<HydraulicLog>& logs,
       std::ostringstream s;
       s << "the joint moves against the command: a " << (m.level > 0 ? "+" : "")
         << std::lround(m.level * 100) << " % step " << (m.angle_change > 0 ? "raises" : "lowers")
-        << " the angle by " << std::abs(m.angle_change) / kDeg
-        << " deg. Each command direction must move the joint its own way: negate the command "
-           "column (e.g. command=-NAME, or command=UP - DOWN from the two direction channels) "
-           "or the angle (joint_angle=-NAME)";
+        << " the angle by " << std::fixed << std::setprecision(1) << std::abs(m.angle_change) / kDeg
+        << " deg, where the description's joint "
+        << (options.events.joint_sense > 0 ? "rises" : "falls")
+        << " for a positive command (one that extends the cylinder). Each direction must move "
+           "the joint the description's way: negate the command column (e.g. command=-NAME, or "
+           "command=UP - DOWN from the two direction channels) or the angle (joint_angle=-NAME)";
       Fail(log, step.on, s.str());
     }
   }

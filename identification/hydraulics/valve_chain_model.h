@@ -138,6 +138,7 @@ struct ChainSamples {
   /// τ_p, held (the pilot stage's, fitted on the pilot channel; 0 without one): the motion path
   /// sees the command τ_p + τ_m late.
   double pilot_delay = 0;
+  int joint_sense = 1;  ///< −1: a positive command lowers the joint angle (step_events.h)
 };
 
 /// Motion-stage parameters of one direction, as a flat vector (the fit's parameter block).
@@ -217,7 +218,7 @@ void SimulateMotion(const ChainSamples& log, int sign, const T* params,
     if (segment >= log.segments.size()) return;
     const bool inside = k >= log.segments[segment].first;
     if (k == log.segments[segment].first) q = segment_start[segment];
-    const T velocity = double(sign) * supplied(spool, supply) * gain(q) * load(k);
+    const T velocity = double(sign * log.joint_sense) * supplied(spool, supply) * gain(q) * load(k);
     if (inside) visit(k, q, velocity);
     if (k + 1 >= n) break;
     const double h = log.time[k + 1] - log.time[k];
@@ -234,8 +235,8 @@ void SimulateMotion(const ChainSamples& log, int sign, const T* params,
     if (inside && k + 1 < log.segments[segment].second) {
       // Heun: the rate at the end of the step from an Euler predictor.
       const T predicted = q + h * velocity;
-      const T end_velocity =
-          double(sign) * supplied(next_spool, next_supply) * gain(predicted) * load(k + 1);
+      const T end_velocity = double(sign * log.joint_sense) * supplied(next_spool, next_supply) *
+                             gain(predicted) * load(k + 1);
       q = q + 0.5 * h * (velocity + end_velocity);
     }
     opening = next_opening;

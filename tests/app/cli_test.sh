@@ -85,7 +85,7 @@ head -4 "$tmp/arm.csv" >"$tmp/two.csv"
 "$autoshovel" --models "$source_dir/models" identify hydraulics "$tmp"/hyd/boom_cylinders_step_*.csv \
   --machine xcmg_968ev -o "$tmp/hyd.yaml" --png "$tmp/hyd.png" >"$tmp/out" \
   || fail "identify hydraulics: $(cat "$tmp/out")"
-grep -q "transport delay" "$tmp/out" || fail "hydraulics table: $(cat "$tmp/out")"
+grep -q "motion delay" "$tmp/out" || fail "hydraulics table: $(cat "$tmp/out")"
 grep -q "^    - name: boom_cylinders" "$tmp/hyd.yaml" || fail "overlay: $(cat "$tmp/hyd.yaml")"
 [ -s "$tmp/hyd.png" ] || fail "no hydraulics residual figure"
 "$autoshovel" --models "$source_dir/models" describe xcmg_968ev --overlay "$tmp/hyd.yaml" \

@@ -288,11 +288,10 @@ int JointSense(const model::MachineDescription& machine,
 
 template <typename ProgressFn>
 int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescription& machine,
-             const generated::MachineFunctions& functions, const std::vector<HydraulicLog>& logs,
+             const generated::MachineFunctions& functions,
              const std::map<int, std::vector<HydraulicLog>>& by_actuator, std::size_t rows,
              double read_seconds, Clock::time_point start, ProgressFn& progress,
              std::ostream& out) {
-  (void)logs;
   std::string command_line = kName;
   // Name a few logs; a campaign of many would make the comment unreadable.
   for (std::size_t i = 0; i < options.logs.size() && i < 3; ++i) {
@@ -503,7 +502,7 @@ int RunIdentifyHydraulics(const IdentifyHydraulicsOptions& options, std::ostream
       return 0;
     }
     if (options.model == "chain") {
-      return RunChain(options, machine, *functions, logs, by_actuator, rows, read_seconds, start,
+      return RunChain(options, machine, *functions, by_actuator, rows, read_seconds, start,
                       progress, out);
     }
     HydraulicIdentificationOptions fit_options;

@@ -636,7 +636,7 @@ void JacobianSigmas(const ceres::CRSMatrix& crs, const std::vector<double>& resi
   }
 }
 
-double fit_max_rate(const MotionState& state) {
+double HighestRate(const MotionState& state) {
   double sum = 0;
   for (std::size_t j = kMotionFixed; j < state.params.size(); ++j) sum += state.params[j];
   return sum;
@@ -826,7 +826,7 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
     fit.supply_capacity = estimate(kSupplyCapacity, 0.0, 2.0);
     fit.supply_delay = estimate(kSupplyDelay, 0.0, 6.0);
     fit.supply_lag = estimate(kSupplyLag, 0.02, 5.0);
-    if (fit.supply_capacity.value >= 0.99 * fit_max_rate(state)) {
+    if (fit.supply_capacity.value >= 0.99 * HighestRate(state)) {
       fit.notes.push_back(
           "no late supply seen (the first supply covers every level): its delay "
           "and lag say nothing");

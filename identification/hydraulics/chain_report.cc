@@ -66,6 +66,8 @@ void PrintChainTable(const NamedChain& result, std::ostream& out) {
     }
     out << "  pilot -> motion delay    " << Cell(d.motion_delay, kMs, "%6.1f") << " ms\n";
     out << "  motion lag               " << Cell(d.motion_lag, kMs, "%6.1f") << " ms\n";
+    out << "  motion lag growth        " << Cell(d.motion_lag_slope, kMs, "%6.1f")
+        << " ms at full opening\n";
     out << "  dead band                " << Cell(d.dead_band, 100, "%6.1f") << " %\n";
     out << "  load coefficient kappa   " << Cell(d.load_coefficient, 1, "%6.3f") << "\n";
     out << "  first supply capacity    " << Cell(d.supply_capacity, kDeg, "%6.2f") << " deg/s\n";
@@ -254,12 +256,13 @@ std::string ChainOverlayText(const std::string& header, const std::vector<NamedC
       std::snprintf(line, sizeof line,
                     "      # %s commands, not in the plant: joint rate at the highest level logged "
                     "%.2f deg/s; first "
-                    "supply %.2f deg/s, the rest %.0f ms late (lag %.0f ms); angle gain c1 %.3f "
+                    "supply %.2f deg/s, the rest %.0f ms late (lag %.0f ms); motion lag + %.0f ms "
+                    "at full opening; angle gain c1 %.3f "
                     "c2 %.3f; load coefficient %.3f\n",
                     d.sign > 0 ? "positive" : "negative", rates.back() * kDeg,
                     d.supply_capacity.value * kDeg, d.supply_delay.value * kMs,
-                    d.supply_lag.value * kMs, d.gain_linear.value, d.gain_quadratic.value,
-                    d.load_coefficient.value);
+                    d.supply_lag.value * kMs, d.motion_lag_slope.value * kMs, d.gain_linear.value,
+                    d.gain_quadratic.value, d.load_coefficient.value);
       text << line;
     }
   }

@@ -379,6 +379,7 @@ void FitMotion(const std::vector<const DirectionLog*>& files, const std::vector<
   lower[kSupplyCapacity] = 0.0, upper[kSupplyCapacity] = 2.0;
   lower[kSupplyDelay] = 0.0, upper[kSupplyDelay] = 6.0;
   lower[kSupplyLag] = 0.02, upper[kSupplyLag] = 5.0;
+  lower[kMotionLagSlope] = 0.0, upper[kMotionLagSlope] = 2.0;
   lower[kGainLinear] = lower[kGainQuadratic] = -4.0;
   upper[kGainLinear] = upper[kGainQuadratic] = 4.0;
   for (int j = 0; j < knots; ++j) lower[kMotionFixed + j] = 0.0, upper[kMotionFixed + j] = 20.0;
@@ -660,6 +661,8 @@ const char* MotionName(int i) {
       return "angle gain c2";
     case kSupplyCapacity:
       return "first supply capacity";
+    case kMotionLagSlope:
+      return "motion lag growth";
     case kSupplyDelay:
       return "late supply delay";
     case kSupplyLag:
@@ -824,6 +827,7 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
     fit.gain_linear = estimate(kGainLinear, -4.0, 4.0);
     fit.gain_quadratic = estimate(kGainQuadratic, -4.0, 4.0);
     fit.supply_capacity = estimate(kSupplyCapacity, 0.0, 2.0);
+    fit.motion_lag_slope = estimate(kMotionLagSlope, 0.0, 2.0);
     fit.supply_delay = estimate(kSupplyDelay, 0.0, 6.0);
     fit.supply_lag = estimate(kSupplyLag, 0.02, 5.0);
     if (fit.supply_capacity.value >= 0.99 * HighestRate(state)) {
@@ -1013,6 +1017,7 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
     SetInterval(fit.gain_linear, motion_samples[kGainLinear]);
     SetInterval(fit.gain_quadratic, motion_samples[kGainQuadratic]);
     SetInterval(fit.supply_capacity, motion_samples[kSupplyCapacity]);
+    SetInterval(fit.motion_lag_slope, motion_samples[kMotionLagSlope]);
     SetInterval(fit.supply_delay, motion_samples[kSupplyDelay]);
     SetInterval(fit.supply_lag, motion_samples[kSupplyLag]);
     for (std::size_t j = 0; j < setup.knots.size(); ++j) SetInterval(fit.rates[j], rate_samples[j]);

@@ -86,6 +86,7 @@ struct DirectionFit {
   Estimate pilot_delay, pilot_time_constant, pilot_gain /*bar*/, pilot_threshold,
       pilot_offset /*bar*/;
   Estimate motion_delay, motion_lag, dead_band, load_coefficient, gain_linear, gain_quadratic;
+  Estimate motion_lag_slope;  ///< T_m's growth at full opening [s] (valve_chain_model.h)
   /// The late supply (valve_chain_model.h): Q₁ [rad/s], τ_f, T_f [s].
   Estimate supply_capacity, supply_delay, supply_lag;
   std::vector<Estimate> rates;                    ///< O at the knots [rad/s]

@@ -4,7 +4,7 @@
 //   pilot:   p̂(t)  = p_0 + lag_{T_p}( a·max(0, s·u(t − τ_p) − u_0) )      command → pilot [bar]
 //   motion:  π(t)  = lag_{T_p}( max(0, s·u(t − τ_p − τ_m)) )                pilot, command units
 //            o(t)  = O(π(t))                                                flow characteristic
-//            x(t)  = lag_{T_m}( o(t) )                                      spool and flow build-up
+//            x(t)  = lag_{T_m + T_g·o/O_max}( o(t) )                       spool and flow build-up
 //            f(t)  = lag_{T_f}( max(0, O(s·u(t − τ_f)) − Q₁) )              late supply
 //            q̇(t)  = s·(min(x(t), Q₁) + f(t))·G(q)·L(p_L)                    joint rate
 //
@@ -16,6 +16,10 @@
 // increments), flat beyond the last knot (pump flow limit). This is the plant's chain
 // (runtime/plant/valve_command.h, docs/simulation.md) in joint space.
 //
+// The lag grows with the opening asked for (T_g at full opening): on the real excavator a
+// 50 % step reaches its rate within 0.1 s of moving and a 100 % step takes several tenths (the
+// pump swivelling to a larger displacement takes longer than the spool to open); one lag for
+// all levels made the fit trade the delay against it level by level.
 // The late supply: on the real excavator's boom, a high-duty step first reaches a plateau and
 // about 2 s later a second, twice as fast, while a low-duty step has one plateau (a second
 // pump joining when the demand exceeds the first, or the engine leaving its idle speed). The
@@ -153,6 +157,7 @@ enum MotionIndex : int {
   kSupplyCapacity,   ///< Q₁: the rate the first supply gives at once [rad/s]
   kSupplyDelay,      ///< τ_f: its delay after the command [s]
   kSupplyLag,        ///< T_f: its lag [s]
+  kMotionLagSlope,   ///< T_m grows by this at full opening [s]
   kMotionFixed,      ///< then one increment per knot [rad/s]
 };
 
@@ -227,7 +232,8 @@ void SimulateMotion(const ChainSamples& log, int sign, const T* params,
     const T mean = HeldMean(log.time, log.command, a, b, drive, cursor);
     pilot = LagStep(pilot, mean, h, pilot_lag);
     const T next_opening = Opening(pilot, dead_band, knots, rate_span);
-    const T next_spool = LagStep(spool, T(0.5) * (opening + next_opening), h, motion_lag);
+    const T lag_now = motion_lag + params[kMotionLagSlope] * (next_opening / rates.back());
+    const T next_spool = LagStep(spool, T(0.5) * (opening + next_opening), h, lag_now);
     const T supply_mean =
         HeldMean(log.time, log.command, T(log.time[k] - params[kSupplyDelay]),
                  T(log.time[k + 1] - params[kSupplyDelay]), demand, supply_cursor);

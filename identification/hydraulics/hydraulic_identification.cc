@@ -40,14 +40,6 @@ double Value(const ceres::Jet<double, N>& x) {
   return x.a;
 }
 
-[[noreturn]] void Fail(const HydraulicLog& log, std::size_t sample, const std::string& message) {
-  const int row = log.row.empty() ? 0 : log.row[std::min(sample, log.row.size() - 1)];
-  core::DiagnosticSink sink;
-  sink.Add({log.file, row, 1}, "", message);
-  sink.ThrowIfAny();
-  throw std::logic_error("unreachable");
-}
-
 std::array<double, kNumParams> ToArray(const ValveParameters& p) {
   return {p.dead_zone, p.transport_delay, p.spool_time_constant, p.rated_flow};
 }
@@ -826,10 +818,11 @@ ActuatorIdentification IdentifyActuator(const model::MachineDescription& machine
   if (!moves) {
     const auto [low, high] =
         std::minmax_element(logs[0].joint_angle.begin(), logs[0].joint_angle.end());
-    Fail(logs[0], 0,
-         "no excitation: the joint angle spans only " +
-             core::FormatNumber(std::round((*high - *low) * 180 / std::numbers::pi * 1e3) / 1e3) +
-             " deg (the valve never opened past its dead zone?); at least 0.2 deg is needed");
+    FailAtSample(
+        logs[0], 0,
+        "no excitation: the joint angle spans only " +
+            core::FormatNumber(std::round((*high - *low) * 180 / std::numbers::pi * 1e3) / 1e3) +
+            " deg (the valve never opened past its dead zone?); at least 0.2 deg is needed");
   }
 
   std::vector<PreparedFile> prepared;

@@ -602,6 +602,14 @@ HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
   return log;
 }
 
+void FailAtSample(const HydraulicLog& log, std::size_t sample, const std::string& message) {
+  const int row = log.row.empty() ? 0 : log.row[std::min(sample, log.row.size() - 1)];
+  core::DiagnosticSink sink;
+  sink.Add({log.file, row, 1}, "", message);
+  sink.ThrowIfAny();
+  throw std::logic_error("unreachable");
+}
+
 void RequireExcitation(const HydraulicLog& log) {
   double largest = 0;
   for (double u : log.command) largest = std::max(largest, std::abs(u));

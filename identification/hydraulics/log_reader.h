@@ -122,6 +122,10 @@ struct HydraulicLog {
 HydraulicLog ReadHydraulicLog(const std::string& path, const LogFormat& format,
                               std::size_t min_samples = 20);
 
+/// Throws core::InputError `file:row:1: message` at the row of `sample` (the last row if past it).
+[[noreturn]] void FailAtSample(const HydraulicLog& log, std::size_t sample,
+                               const std::string& message);
+
 /// Refuses a log whose command never leaves ±1 % (core::InputError at its first row): neither
 /// model can learn anything from it.
 void RequireExcitation(const HydraulicLog& log);

@@ -38,14 +38,6 @@ void Report(const Progress& progress, const std::string& line) {
 
 double RoundLevel(double level) { return std::round(std::abs(level) * 100) / 100; }
 
-[[noreturn]] void Fail(const HydraulicLog& log, std::size_t sample, const std::string& message) {
-  const int row = log.row.empty() ? 0 : log.row[std::min(sample, log.row.size() - 1)];
-  core::DiagnosticSink sink;
-  sink.Add({log.file, row, 1}, "", message);
-  sink.ThrowIfAny();
-  throw std::logic_error("unreachable");
-}
-
 // One log made ready for one direction's fit.
 struct DirectionLog {
   const HydraulicLog* log = nullptr;
@@ -785,8 +777,8 @@ DirectionFit FitDirection(const std::vector<DirectionLog>& all, int sign,
   for (const DirectionLog& d : local) files.push_back(&d);
   const Knots knots = KnotsOf(files, setup);
   if (knots.levels.empty()) {
-    Fail(*all.front().log, 0,
-         "no " + direction + " command step moves the joint: nothing to identify");
+    FailAtSample(*all.front().log, 0,
+                 "no " + direction + " command step moves the joint: nothing to identify");
   }
   setup.knots = knots.levels;
   fit.levels = knots.levels;
@@ -1103,7 +1095,7 @@ ChainIdentification IdentifyValveChain(const std::vector<HydraulicLog>& logs,
         << " for a positive command (one that extends the cylinder). Each direction must move "
            "the joint the description's way: negate the command column (e.g. command=-NAME, or "
            "command=UP - DOWN from the two direction channels) or the angle (joint_angle=-NAME)";
-      Fail(log, step.on, s.str());
+      FailAtSample(log, step.on, s.str());
     }
   }
   for (int sign : {1, -1}) {
@@ -1125,7 +1117,8 @@ ChainIdentification IdentifyValveChain(const std::vector<HydraulicLog>& logs,
     result.directions.push_back(FitDirection(prepared, sign, options));
   }
   if (result.directions.empty() && !logs.empty()) {
-    Fail(logs.front(), 0, "no command step in these logs moves the joint: nothing to identify");
+    FailAtSample(logs.front(), 0,
+                 "no command step in these logs moves the joint: nothing to identify");
   }
   return result;
 }

@@ -243,8 +243,9 @@ int main(int argc, char** argv) {
   identify_cmd->require_subcommand(1);
   CLI::App* hydraulics_cmd = identify_cmd->add_subcommand(
       "hydraulics",
-      "Valve dead zone, transport delay, spool time constant and rated flow per actuator from "
-      "step/chirp logs");
+      "Valve chain per actuator and direction from step logs: command -> pilot and pilot -> "
+      "motion delays and lags, flow characteristic, stalls read from the data (--model linear: "
+      "dead zone, delay, spool lag, rated flow)");
   hydraulics_cmd->add_option("logs", hydraulics.logs,
                              "Step or chirp logs (CSV), fitted jointly per actuator");
   hydraulics_cmd->add_option("--machine", hydraulics.machine, "Machine name or description")

@@ -232,7 +232,9 @@ void SimulateMotion(const ChainSamples& log, int sign, const T* params,
     const T mean = HeldMean(log.time, log.command, a, b, drive, cursor);
     pilot = LagStep(pilot, mean, h, pilot_lag);
     const T next_opening = Opening(pilot, dead_band, knots, rate_span);
-    const T lag_now = motion_lag + params[kMotionLagSlope] * (next_opening / rates.back());
+    // The fit's bounds let every flow value reach 0: no division by it.
+    const T top = rates.back() > 1e-9 ? rates.back() : T(1e-9);
+    const T lag_now = motion_lag + params[kMotionLagSlope] * (next_opening / top);
     const T next_spool = LagStep(spool, T(0.5) * (opening + next_opening), h, lag_now);
     const T supply_mean =
         HeldMean(log.time, log.command, T(log.time[k] - params[kSupplyDelay]),

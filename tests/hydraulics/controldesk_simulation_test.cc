@@ -18,6 +18,7 @@
 #include "identification/hydraulics/plant_logs.h"
 #include "runtime/model/description.h"
 #include "runtime/plant/valve_command.h"
+#include "tests/hydraulics/controldesk_campaign.h"
 
 namespace autoshovel::identification {
 namespace {
@@ -59,16 +60,7 @@ LogFormat BoomUpFormat() {
 
 TEST(ControlDeskSimulation, WritesTheRealLayoutWithItsTruthAndReadsBack) {
   const std::string dir = ::testing::TempDir() + "/controldesk_boom";
-  fs::remove_all(dir);
-  IdentifyHydraulicsOptions options;
-  options.machine = "excavator_25t";
-  options.models_dir = kModels;
-  options.actuator = "boom_cylinders";
-  options.simulate = dir;
-  options.simulate_format = "controldesk";
-  options.seed = 7;
-  std::ostringstream out, err;
-  ASSERT_EQ(RunIdentifyHydraulics(options, out, err), 0) << err.str();
+  testing::WriteBoomControlDeskCampaign(dir, kModels);
 
   // 2 directions × 7 duties × H/L, named as the real files.
   std::vector<std::string> names;

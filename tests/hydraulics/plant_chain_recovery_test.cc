@@ -40,6 +40,7 @@
 #include "identification/hydraulics/step_events.h"
 #include "identification/hydraulics/valve_chain_fit.h"
 #include "runtime/model/description.h"
+#include "tests/hydraulics/controldesk_campaign.h"
 
 namespace autoshovel::identification {
 namespace {
@@ -87,18 +88,7 @@ Recovery Campaign() {
   Recovery r;
   // The campaign as a user writes it: 2 directions × 40…100 % × high/low load.
   const std::string dir = ::testing::TempDir() + "/plant_chain_recovery";
-  fs::remove_all(dir);
-  IdentifyHydraulicsOptions options;
-  options.machine = "excavator_25t";
-  options.models_dir = kModels;
-  options.actuator = "boom_cylinders";
-  options.simulate = dir;
-  options.simulate_format = "controldesk";
-  options.seed = 7;
-  std::ostringstream out, err;
-  if (RunIdentifyHydraulics(options, out, err) != 0) {
-    throw std::runtime_error("--simulate failed: " + err.str());
-  }
+  testing::WriteBoomControlDeskCampaign(dir, kModels);
   model::LoadOptions load;
   load.overlays = {dir + "/truth.overlay.yaml"};
   const std::string source = model::ResolveMachineDescription("excavator_25t", kModels);

@@ -19,6 +19,7 @@
 #include "runtime/app/cli_checks.h"
 #include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
+#include "runtime/app/energy_audit_command.h"
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
@@ -600,10 +601,14 @@ int main(int argc, char** argv) {
   CLI::App* compare_cmd = app.add_subcommand(
       "compare",
       "Rerun the seed's Table 4 (shovel point selection) or Table 5 (trigger and "
-      "scooping strategy) in simulation, beside the seed's figures");
-  compare_cmd->add_option("table", compare.table, "table4 | table5")
+      "scooping strategy) in simulation, beside the seed's figures; `audit`: where a gravel "
+      "and a sand scoop's energy goes");
+  compare_cmd->add_option("table", compare.table, "table4 | table5 | audit")
       ->required()
-      ->check(CLI::IsMember({"table4", "table5"}));
+      ->check(CLI::IsMember({"table4", "table5", "audit"}));
+  std::string compare_output;
+  compare_cmd->add_option("-o,--output", compare_output,
+                          "audit: folder for the stacked energy plots and per-tick CSVs");
   compare_cmd->add_option("--trials", compare.trials, "Single-cycle runs per cell")
       ->check(autoshovel::app::IntegerIn(1, 1000))
       ->capture_default_str();
@@ -660,6 +665,9 @@ int main(int argc, char** argv) {
       compare.models_dir = models_dir;
       compare.pressure_threshold = compare_pressure_bar * 1e5;
       compare.attitude_feed_forward = !compare_no_feed_forward;
+      if (compare.table == "audit") {
+        return autoshovel::app::RunEnergyAudit(compare, compare_output, std::cout, std::cerr);
+      }
       return autoshovel::app::RunCompare(compare, std::cout, std::cerr);
     }
 

@@ -414,7 +414,9 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   start.hinge_xy = site.start_xy;
   start.heading = site.start_heading;
   start.time = st.cycle_clock;
-  plant::Plant plant(machine, *st.setup.functions, scenario.world, start);
+  plant::PlantOptions plant_options;
+  plant_options.energy_audit = o.energy_audit;
+  plant::Plant plant(machine, *st.setup.functions, scenario.world, start, plant_options);
   PlantMachine machine_io(plant);
   st.scene->Update();  // the terrain as the last cycle left it
 
@@ -1199,6 +1201,10 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
   double booked = 0;
   for (const control::PhaseRecord& p : r.phases) booked += p.energy / 1e3;
   rec.energy_kj.approach += std::max(0.0, rec.energy_kj.total - booked);
+  if (o.energy_audit) {
+    out.energy_audit_by_phase = plant.phase_energy_audit();
+    out.energy_audit_trace = plant.energy_audit_trace();
+  }
   rec.safety_margin_m = min_clearance;
   rec.safety_violations = violations;
   // Samples: V1, V1+V2, trigger; the tip in the frame of the machine at contact (x ahead, z up).

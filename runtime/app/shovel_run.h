@@ -16,12 +16,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "runtime/app/safety_supervisor.h"
 #include "runtime/control/scoop_cycle.h"
+#include "runtime/plant/energy_audit.h"
 #include "runtime/plant/fault_spec.h"
 #include "runtime/results/results_db.h"
 
@@ -128,6 +130,9 @@ struct ShovelRunOptions {
   double decision_rate = 20.0;     ///< navigation state machine and safety check [Hz]
   double control_rate = 100.0;     ///< [Hz]
   bool figures = true;             ///< per-cycle PNGs for the report
+  /// Integrate the plant's energy audit (plant/energy_audit.h) and return it with each cycle
+  /// (CycleOutcome::energy_audit_*). It never changes the run; it costs time.
+  bool energy_audit = false;
 };
 
 /// What one cycle did (one row of the results database, plus what the figures need).
@@ -147,6 +152,10 @@ struct CycleOutcome {
   long refused_frames = 0;     ///< late or out-of-order sensor frames not used
   double masked_fraction = 0;  ///< most of the camera image masked for lens dirt [-]
   bool blind_sector = false;   ///< a LiDAR was found blind in some sector
+  /// With ShovelRunOptions::energy_audit: where the cycle's energy went, per plant phase
+  /// ("travel" before the scoop cycle, then the scoop cycle's phases), and after every tick.
+  std::map<std::string, plant::EnergyAudit> energy_audit_by_phase;
+  std::vector<plant::EnergyAuditSample> energy_audit_trace;
 };
 
 /// The yard, the machine, the map and the models of one run; cycles are run one after another.

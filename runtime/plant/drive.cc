@@ -55,6 +55,9 @@ DriveRates EvaluateDrive(const model::MachineDescription& machine, const DriveCo
       (out.wheel_torque - brake_torque - r * out.traction_force) / k.wheel_inertia;
   out.speed_dot = (out.traction_force - rolling + input.soil_force_x) / mass;
   out.wheel_power = out.wheel_torque * state.wheel_speed;
+  out.brake_torque = brake_torque;
+  out.rolling_force = rolling;
+  out.mass = mass;
   return out;
 }
 

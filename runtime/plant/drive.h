@@ -49,6 +49,9 @@ struct DriveRates {
   double traction_force = 0;  ///< F_x [N]
   double normal_load = 0;     ///< N [N]
   double wheel_power = 0;     ///< T_wheel ω [W] (positive when driving)
+  double brake_torque = 0;    ///< T_brake [N·m]
+  double rolling_force = 0;   ///< F_roll [N]
+  double mass = 0;            ///< machine plus payload [kg]
   double slip = 0;            ///< s [-]
 };
 

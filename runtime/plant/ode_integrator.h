@@ -1,4 +1,4 @@
-// A stiff ODE integrator for the plant: CVODE (BDF, Newton iteration, dense direct linear
+// A stiff ODE integrator for the plant: CVODES (BDF, Newton iteration, dense direct linear
 // solver) with a caller-supplied Jacobian. This header keeps SUNDIALS out of its includers.
 //
 // The plant integrates piecewise: between two discrete events (a valve command reaching its
@@ -23,6 +23,11 @@ class OdeSystem {
   virtual void Rhs(double t, const double* y, double* ydot) = 0;
   /// Column-major n × n (SUNDIALS' dense layout): jacobian[col * n + row] = ∂f_row/∂y_col.
   virtual void Jacobian(double t, const double* y, double* jacobian) = 0;
+  /// Quadratures: integrals ∫ g(t, y) dt carried along with the solution (CVODES' quadrature
+  /// feature). They enter neither the Newton iteration nor the step-size control, so adding them
+  /// never changes the trajectory; they are as accurate as the BDF formula on the steps taken.
+  virtual int quadrature_size() const { return 0; }
+  virtual void Quadrature(double /*t*/, const double* /*y*/, double* /*integrand*/) {}
 };
 
 struct IntegratorOptions {
@@ -50,6 +55,9 @@ class OdeIntegrator {
   void Reset(double t, const double* y);
   /// Integrates to exactly `t_end` (a stop time: CVODE never steps past it) and writes y(t_end).
   void AdvanceTo(double t_end, double* y);
+  /// The quadratures at time(), accumulated since construction across resets (size
+  /// OdeSystem::quadrature_size()).
+  const std::vector<double>& quadratures() const { return quadratures_; }
 
   double time() const { return time_; }
   /// Statistics since construction: internal steps, right-hand side and Jacobian evaluations,
@@ -64,6 +72,7 @@ class OdeIntegrator {
   std::unique_ptr<Impl> impl_;
   double time_ = 0.0;
   long resets_ = 0;
+  std::vector<double> quadratures_;
 };
 
 }  // namespace autoshovel::plant

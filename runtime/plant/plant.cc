@@ -7,6 +7,7 @@
 
 #include "runtime/model/interpreted_model.h"
 #include "runtime/plant/earthmoving.h"
+#include "runtime/plant/energy_audit.h"
 
 namespace autoshovel::plant {
 
@@ -91,9 +92,14 @@ class Plant::System : public OdeSystem {
     arm_rhs_.assign(layout_.arm, 0.0);
     arm_jacobian_.assign(static_cast<std::size_t>(layout_.arm) * layout_.arm, 0.0);
     is_loader_ = machine.kind == model::MachineKind::kWheelLoader;
+    if (options.energy_audit) audit_model_ = std::make_unique<model::InterpretedModel>(machine);
   }
 
   int size() const override { return layout_.size(); }
+  int quadrature_size() const override { return audit_model_ ? kEnergyTermCount : 0; }
+  void Quadrature(double, const double* y, double* integrand) override {
+    AuditPowers(y, integrand);
+  }
   const Layout& layout() const { return layout_; }
   Held& held() { return held_; }
 
@@ -241,6 +247,108 @@ class Plant::System : public OdeSystem {
     }
   }
 
+  // The powers of the energy audit at state y (energy_audit.h gives the identities they obey).
+  void AuditPowers(const double* y, double* power) {
+    using model::internal::OrificeRoot;
+    using model::internal::SmoothPositive;
+    EnergyAudit& p = *reinterpret_cast<EnergyAudit*>(power);
+    static_assert(sizeof(EnergyAudit) == sizeof(double) * kEnergyTermCount);
+    p = EnergyAudit{};
+    audit_ydot_.resize(layout_.size());
+    const Outputs out = Evaluate(y, audit_ydot_.data());  // also sets u_ (τ_ext)
+    const int J = layout_.joints;
+    const double* q = y;
+    const double* qd = y + J;
+    const double* qdd = audit_ydot_.data() + J;
+    const model::Hydraulics& hyd = machine_.hydraulics;
+    const double pump = held_.pump_pressure, tank = hyd.tank_pressure;
+    double pump_flow = 0;
+    for (int j = 0; j < J; ++j) {
+      const int a = actuator_of_joint(j);
+      const model::Actuator& act = hyd.actuators[a];
+      const model::Valve& valve = act.valve;
+      const double xs = y[2 * J + j], pa = y[3 * J + j], pb = y[4 * J + j];
+      const double pa_dot = audit_ydot_[3 * J + j], pb_dot = audit_ydot_[4 * J + j];
+      const double supply = held_.section_supply[j];
+      const double open_a = SmoothPositive(xs, model::plant::kSpoolUnderlap);
+      const double open_b = SmoothPositive(-xs, model::plant::kSpoolUnderlap);
+      const double in_a = valve.flow_gain * open_a * OrificeRoot(supply - pa);
+      const double in_b = valve.flow_gain * open_b * OrificeRoot(supply - pb);
+      const double out_a = valve.flow_gain * open_b * OrificeRoot(pa - tank);
+      const double out_b = valve.flow_gain * open_a * OrificeRoot(pb - tank);
+      const double relief_gain = valve.rated_flow / model::plant::kReliefFullFlowOverpressure;
+      auto relief = [&](double pressure) {
+        return relief_gain *
+               (SmoothPositive(pressure - act.relief_pressure, model::plant::kReliefPressureWidth) -
+                SmoothPositive(tank - pressure, model::plant::kReliefPressureWidth));
+      };
+      const double in_a_pos = std::max(in_a, 0.0), in_b_pos = std::max(in_b, 0.0);
+      pump_flow += in_a_pos + in_b_pos;
+      p[EnergyTerm::kCompensator] += (pump - supply) * (in_a_pos + in_b_pos);
+      p[EnergyTerm::kMeterIn] += (supply - pa) * in_a_pos + (supply - pb) * in_b_pos;
+      p[EnergyTerm::kBackflow] += pa * (in_a_pos - in_a) + pb * (in_b_pos - in_b);
+      p[EnergyTerm::kMeterOut] += pa * out_a + pb * out_b;
+      p[EnergyTerm::kRelief] += pa * relief(pa) + pb * relief(pb);
+      double volume_a = act.line_volume, volume_b = act.line_volume;
+      if (act.kind == model::ActuatorKind::kCylinder) {
+        const double area_a = act.count * std::numbers::pi / 4.0 * act.bore * act.bore;
+        const double area_b =
+            act.count * std::numbers::pi / 4.0 * (act.bore * act.bore - act.rod * act.rod);
+        const double s = audit_model_->CylinderLength(a, q) - act.retracted_length;
+        volume_a = act.dead_volume + area_a * s;
+        volume_b = act.dead_volume + area_b * (act.stroke - s);
+        const std::vector<double> lever = audit_model_->LeverArms(a, q);
+        double s_dot = 0;
+        for (int i = 0; i < J; ++i) s_dot += lever[i] * qd[i];
+        namespace k = model::plant;
+        const double end_force =
+            act.count * k::kEndStopStiffness *
+                (SmoothPositive(-s, k::kEndStopSmoothing) -
+                 SmoothPositive(s - act.stroke, k::kEndStopSmoothing)) -
+            act.count * k::kEndStopDamping * s_dot *
+                (model::internal::SmoothStep(-s, k::kEndStopSmoothing) +
+                 model::internal::SmoothStep(s - act.stroke, k::kEndStopSmoothing));
+        p[EnergyTerm::kEndStops] -= end_force * s_dot;
+      }
+      p[EnergyTerm::kCompression] +=
+          (pa * volume_a * pa_dot + pb * volume_b * pb_dot) / hyd.bulk_modulus;
+    }
+    const double drawn = pump * pump_flow / hyd.pump_efficiency;
+    p[EnergyTerm::kPumpLoss] = drawn - pump * pump_flow;
+    // The arm: M q̈ + h = Q_g + Σ F ∂L/∂q + τ_ext − b q̇ (interpreted_model.h).
+    audit_mass_.assign(static_cast<std::size_t>(J) * J, 0.0);
+    audit_h_.assign(J, 0.0);
+    audit_gravity_.assign(J, 0.0);
+    audit_model_->Dynamics(q, qd, held_.payload, 0.0, audit_mass_.data(), audit_h_.data(),
+                           audit_gravity_.data());
+    const int n = static_cast<int>(machine_.links.size());
+    for (int i = 0; i < J; ++i) {
+      double inertial = audit_h_[i];
+      for (int c = 0; c < J; ++c) inertial += audit_mass_[i * J + c] * qdd[c];
+      p[EnergyTerm::kArmKinetic] += qd[i] * inertial;
+      p[EnergyTerm::kLifting] -= audit_gravity_[i] * qd[i];
+      const double b =
+          i < n ? machine_.links[i].viscous_friction : machine_.swing->viscous_friction;
+      p[EnergyTerm::kArmFriction] += b * qd[i] * qd[i];
+      p[EnergyTerm::kSoilByArm] -= u_[J + i] * qd[i];
+    }
+    if (!is_loader_) return;
+    const DriveRates& d = out.drive;
+    const double v = y[layout_.speed()], w = y[layout_.wheel()];
+    const double r = machine_.chassis.wheel_radius;
+    const double efficiency = machine_.electric_motor ? machine_.electric_motor->efficiency
+                                                      : machine_.diesel_engine->efficiency;
+    const double wheel = d.wheel_power, driving = std::max(wheel, 0.0);
+    p[EnergyTerm::kTravelDriveLoss] = driving / efficiency - driving;
+    p[EnergyTerm::kTravelNotRecovered] = driving - wheel;
+    p[EnergyTerm::kBrake] = d.brake_torque * w;
+    p[EnergyTerm::kTyreSlip] = d.traction_force * (w * r - v);
+    p[EnergyTerm::kRolling] = d.rolling_force * v;
+    p[EnergyTerm::kSoilByDrive] = -out.tip_force.x() * v;
+    p[EnergyTerm::kMachineKinetic] =
+        d.mass * v * d.speed_dot + options_.drive.wheel_inertia * w * d.wheel_speed_dot;
+  }
+
   int actuator_of_joint(int j) const { return actuator_of_joint_[j]; }
   /// Index in y of joint j's pilot state, or -1 when its valve has no pilot stage.
   int pilot_state(int j) const { return pilot_state_[j]; }
@@ -265,6 +373,8 @@ class Plant::System : public OdeSystem {
   std::vector<int> pilot_state_;  // per joint
   std::vector<double> u_, arm_rhs_, arm_jacobian_, base_, probe_, work_;
   std::vector<int> columns_;
+  std::unique_ptr<model::InterpretedModel> audit_model_;  // with PlantOptions::energy_audit
+  std::vector<double> audit_ydot_, audit_mass_, audit_h_, audit_gravity_;
   std::vector<Eigen::Vector2d> origins_;
   std::vector<double> angles_;
 };
@@ -470,6 +580,14 @@ void Plant::Advance(double dt) {
   Energy& booked = phase_energy_[phase_];
   booked.travel += std::max(after.travel - before.travel, 0.0);
   booked.hydraulic += std::max(after.hydraulic - before.hydraulic, 0.0);
+  if (options_.energy_audit) {
+    EnergyAudit now;
+    const std::vector<double>& integrals = integrator_->quadratures();
+    std::copy(integrals.begin(), integrals.end(), now.terms.begin());
+    phase_audit_[phase_] += now - audit_;
+    audit_ = now;
+    audit_trace_.push_back({t_end, phase_, now});
+  }
 
   // Terrain exchange between ticks (a contact change resets the integrator at the next tick).
   UpdateState();

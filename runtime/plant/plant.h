@@ -48,6 +48,7 @@
 #include "runtime/plant/bucket_terrain.h"
 #include "runtime/plant/drive.h"
 #include "runtime/plant/earthmoving.h"
+#include "runtime/plant/energy_audit.h"
 #include "runtime/plant/machine_state.h"
 #include "runtime/plant/ode_integrator.h"
 #include "runtime/plant/valve_command.h"
@@ -70,6 +71,10 @@ struct PlantOptions {
   double resistance_speed = 0.05;
   /// Soil–steel adhesion as a fraction of cohesion (no material file gives it) [-].
   double adhesion_fraction = 0.5;
+  /// Integrate the energy audit (energy_audit.h) as quadratures and keep it per phase and per
+  /// tick. Off by default: it costs one more right-hand side and the arm's dynamics per step;
+  /// it never changes the trajectory.
+  bool energy_audit = false;
 };
 
 /// Energy in J, cumulative.
@@ -123,6 +128,11 @@ class Plant {
   void SetPhase(const std::string& phase);
   const std::map<std::string, Energy>& phase_energy() const { return phase_energy_; }
   Energy energy() const;
+  /// With PlantOptions::energy_audit (else empty): where the energy went since the start, per
+  /// phase (booked like phase_energy), and after every tick.
+  const EnergyAudit& energy_audit() const { return audit_; }
+  const std::map<std::string, EnergyAudit>& phase_energy_audit() const { return phase_audit_; }
+  const std::vector<EnergyAuditSample>& energy_audit_trace() const { return audit_trace_; }
 
   const MachineState& state() const { return state_; }
   double time() const { return state_.time; }
@@ -183,6 +193,9 @@ class Plant {
   core::ActuatorCommand command_;
   std::string phase_ = "idle";
   std::map<std::string, Energy> phase_energy_;
+  EnergyAudit audit_;
+  std::map<std::string, EnergyAudit> phase_audit_;
+  std::vector<EnergyAuditSample> audit_trace_;
   double last_relax_time_ = 0;
   double load_sensing_margin_ = 0;
   std::vector<std::optional<ReeceTable>> reece_tables_;  ///< per material, built on first contact

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "runtime/plot/axis_ticks.h"
 #include "runtime/plot/image_file.h"
 
 namespace autoshovel::plot {
@@ -20,6 +21,9 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kLeft = 90, kRight = 25, kTop = 50, kBottom = 65;  // margins [px]
 const cv::Scalar kBlack(0, 0, 0);
 const cv::Scalar kGridColor(225, 225, 225);
+
+using internal::NiceStep;
+using internal::TickLabel;
 
 cv::Scalar ToScalar(Color c) { return cv::Scalar(c.b, c.g, c.r); }
 
@@ -35,15 +39,6 @@ struct Range {
   double Span() const { return hi - lo; }
 };
 
-// 1, 2 or 5 times a power of ten, near span / 5.
-double NiceStep(double span) {
-  const double raw = span / 5.0;
-  const double power = std::pow(10.0, std::floor(std::log10(raw)));
-  const double fraction = raw / power;
-  const double nice = fraction < 1.5 ? 1.0 : fraction < 3.5 ? 2.0 : fraction < 7.5 ? 5.0 : 10.0;
-  return nice * power;
-}
-
 void Widen(Range& r) {
   if (!r.Valid()) {
     r.lo = 0.0;
@@ -53,15 +48,6 @@ void Widen(Range& r) {
     r.lo -= pad;
     r.hi += pad;
   }
-}
-
-std::string TickLabel(double value, double step) {
-  const int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
-  if (std::abs(value) < step * 1e-6) value = 0.0;  // no "-0"
-  char buffer[48];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  if (std::strlen(buffer) > 8) std::snprintf(buffer, sizeof(buffer), "%.3g", value);  // fits
-  return buffer;
 }
 
 void DrawSegment(cv::Mat& image, cv::Point2d a, cv::Point2d b, const cv::Scalar& color,

@@ -125,6 +125,32 @@ TEST(ShovelCycle, PileBehindAParkedLoaderIsReachedRoundIt) {
   EXPECT_GE(out.record.fill_rate, 0.95);
 }
 
+// The energy audit over a whole closed-loop cycle (issue 41): per phase, its terms add up to what
+// the plant's energy counters booked to that phase within 1 %, and the scoop's audit shows the
+// work a scoop is made of.
+TEST(ShovelCycle, EnergyAuditAddsUpPerPhase) {
+  ShovelRunOptions options = Options("cone_pile");
+  options.energy_audit = true;
+  const CycleOutcome out = RunOne(options);
+  ASSERT_TRUE(out.record.completed) << out.failure;
+  ASSERT_FALSE(out.energy_audit_trace.empty());
+  for (const char* name : {"crowd", "scoop", "retreat"}) {
+    const control::PhaseRecord* phase = out.scoop.Phase(name);
+    ASSERT_NE(phase, nullptr) << name;
+    const auto it = out.energy_audit_by_phase.find(name);
+    ASSERT_NE(it, out.energy_audit_by_phase.end()) << name;
+    EXPECT_NEAR(it->second.total(), phase->energy, 0.01 * phase->energy + 10.0) << name;
+  }
+  const plant::EnergyAudit& scoop = out.energy_audit_by_phase.at("scoop");
+  EXPECT_GT(scoop[plant::EnergyTerm::kLifting], 20e3);  // a full bucket rose
+  EXPECT_GT(scoop.soil(), 20e3);                        // through the pile
+  EXPECT_GT(scoop.hydraulic(), scoop.cylinder_work());  // the hydraulics lose some
+  // The whole cycle: the audit's total is the energy the cycle record books.
+  plant::EnergyAudit cycle;
+  for (const auto& [name, audit] : out.energy_audit_by_phase) cycle += audit;
+  EXPECT_NEAR(cycle.total() / 1e3, out.record.energy_kj.total, 0.01 * out.record.energy_kj.total);
+}
+
 TEST(ShovelCycle, UnknownBinIsRefusedNamingTheBins) {
   ShovelRunOptions options = Options("mixing_station");
   options.bins = {"bin_42"};

@@ -106,7 +106,13 @@ void PrintSpecSheet(const model::MachineDescription& m, std::ostream& out) {
     out << "\n"
         << indent << "full valve, from the command: valve delay "
         << Fixed(boom.valve.transport_delay, 2) << " s boom, "
-        << Fixed(tilt.valve.transport_delay, 2) << " s tilt, spool lag included\n";
+        << Fixed(tilt.valve.transport_delay, 2) << " s tilt, spool lag included; "
+        << (m.hydraulics.pump_max_flow > 0
+                ? "pump delivers at most " + Fixed(m.hydraulics.pump_max_flow * 60000, 0) +
+                      " l/min (valves rated " + Fixed(boom.valve.rated_flow * 60000, 0) + " + " +
+                      Fixed(tilt.valve.rated_flow * 60000, 0) + ")"
+                : std::string("no pump flow limit (hydraulics.pump_max_flow_lpm)"))
+        << "\n";
     if (times.bucket_past_dump_limit > 10 * std::numbers::pi / 180) {
       out << indent << "warning: the bucket went " << Fixed(Deg(times.bucket_past_dump_limit), 0)
           << " deg past its dumped limit: no tilt cylinder end holds that limit (the plant has"

@@ -149,6 +149,9 @@ struct Hydraulics {
   double tank_pressure = 0;    ///< return pressure [Pa]
   double bulk_modulus = 0;     ///< effective oil bulk modulus β [Pa]
   double pump_efficiency = 0;  ///< hydraulic energy accounting η [-]
+  /// The pump's largest delivery, displacement × shaft speed [m³/s]; 0: unlimited (the valves'
+  /// rated flows are the only limit, as before the key existed).
+  double pump_max_flow = 0;
   std::vector<Actuator> actuators;
 };
 

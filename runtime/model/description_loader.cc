@@ -241,6 +241,7 @@ Hydraulics ReadHydraulics(MapReader map, core::DiagnosticSink& sink) {
   h.bulk_modulus = map.Number("oil_bulk_modulus_bar", NumberRule::Positive("bar")) * kBar;
   h.pump_efficiency = map.Number("pump_efficiency", NumberRule{0, NumberRule::Bound::kExclusive, 1,
                                                                NumberRule::Bound::kInclusive, ""});
+  h.pump_max_flow = map.Number("pump_max_flow_lpm", NumberRule::NonNegative("l/min"), 0.0) / 60000;
   for (auto& actuator : map.MapList("actuators", true))
     h.actuators.push_back(ReadActuator(actuator, sink));
   map.Finish();

@@ -138,6 +138,10 @@ PlausibilityFindings CheckPlausibility(const MachineDescription& m) {
           {0, 30, "bar", "a tank (return) pressure"});
   c.Check("hydraulics.oil_bulk_modulus_bar", h.bulk_modulus / kBar,
           {1000, 25000, "bar", "an oil bulk modulus"});
+  if (h.pump_max_flow > 0) {
+    c.Check("hydraulics.pump_max_flow_lpm", h.pump_max_flow * 60000,
+            {10, 3000, "l/min", "a working pump's delivery"});
+  }
   for (std::size_t i = 0; i < h.actuators.size(); ++i) {
     const Actuator& a = h.actuators[i];
     const std::string path = "hydraulics.actuators[" + std::to_string(i) + "]";

@@ -635,26 +635,70 @@ void Plant::LoadSensing(const std::vector<double>& spool_reference,
   // the pump follows the highest such demand, up to its maximum. A section whose demand exceeds
   // the maximum gets no flow (its load check valve closes: supply = load). Held over a segment:
   // a real pump and compensator respond in tens of milliseconds, a control tick is 10 ms.
+  //
+  // A pump with a largest delivery Q_max (Hydraulics::pump_max_flow) cannot keep the margin when
+  // the open spools ask for more: the sections' compensators sit after the spools and all see
+  // the same drop (post-compensated flow sharing, Rexroth LUDV), so the drop falls alike for
+  // every section to Δp' = margin·(Q_max/Q_ask)², Q_ask the flow the spools pass at the margin,
+  // and each section gets the same fraction Q_max/Q_ask of what it asked for. Q_ask is taken at
+  // the spools' positions at the segment's start (they move 10–15 % of a step per tick).
   const int J = static_cast<int>(spool_reference.size());
   const model::Hydraulics& hyd = machine_.hydraulics;
   section_supply.assign(J, 0.0);
-  pump_pressure = hyd.tank_pressure + load_sensing_margin_;  // standby
+  std::vector<double> fed(J, 0.0);
+  std::vector<bool> flowing(J, false);
+  double asked = 0;  // [m³/s] at the margin
   for (int j = 0; j < J; ++j) {
     const double xs = y_[2 * J + j];
     const double opening = spool_reference[j] != 0 ? spool_reference[j] : xs;
-    const double fed = opening >= 0 ? y_[3 * J + j] : y_[4 * J + j];
-    const double demand = fed + load_sensing_margin_;
-    double supply = demand <= hyd.pump_pressure ? demand : std::max(fed, hyd.tank_pressure);
+    fed[j] = opening >= 0 ? y_[3 * J + j] : y_[4 * J + j];
+    flowing[j] = fed[j] + load_sensing_margin_ <= hyd.pump_pressure;
+    if (flowing[j]) {
+      const model::Valve& valve = hyd.actuators[system_->actuator_of_joint(j)].valve;
+      asked += valve.flow_gain *
+               model::internal::SmoothPositive(std::abs(xs), model::plant::kSpoolUnderlap) *
+               model::internal::OrificeRoot(load_sensing_margin_);
+    }
+  }
+  double drop = load_sensing_margin_;
+  if (hyd.pump_max_flow > 0 && asked > hyd.pump_max_flow) {
+    // The drop at which the orifices pass the share: Δp' = margin·share² where the flow goes as
+    // √Δp, solved on the plant's own orifice law (laminar below 2 bar) by bisection.
+    const double target =
+        hyd.pump_max_flow / asked * model::internal::OrificeRoot(load_sensing_margin_);
+    double low = 0, high = load_sensing_margin_;
+    for (int k = 0; k < 40; ++k) {
+      const double mid = 0.5 * (low + high);
+      (model::internal::OrificeRoot(mid) < target ? low : high) = mid;
+    }
+    drop = 0.5 * (low + high);
+  }
+  // The compensators' dead band scales with the drop they hold: the same relative accuracy of
+  // the flow whether or not the pump is at its limit.
+  const double band =
+      load_sensing_margin_ > 0 ? kCompensatorBand * drop / load_sensing_margin_ : kCompensatorBand;
+  pump_pressure = hyd.tank_pressure + load_sensing_margin_;  // standby
+  bool any_open = false;
+  double highest = 0;
+  for (int j = 0; j < J; ++j) {
+    const double xs = y_[2 * J + j];
+    const double opening = spool_reference[j] != 0 ? spool_reference[j] : xs;
+    double supply = flowing[j] ? fed[j] + drop : std::max(fed[j], hyd.tank_pressure);
     // A compensator does not chase every pascal: within its dead band (kCompensatorBand) the
     // previous supply is kept, which also spares the integrator a reset at every tick.
     const std::vector<double>& previous = system_->held().section_supply;
-    if (static_cast<int>(previous.size()) == J &&
-        std::abs(previous[j] - supply) < kCompensatorBand) {
+    if (static_cast<int>(previous.size()) == J && std::abs(previous[j] - supply) < band) {
       supply = previous[j];
     }
     section_supply[j] = supply;
-    if (std::abs(opening) > 0.01) pump_pressure = std::max(pump_pressure, section_supply[j]);
+    if (std::abs(opening) > 0.01) {
+      // The pump runs at the highest open section's load plus the margin, or plus the reduced
+      // drop while it delivers all it can.
+      highest = any_open ? std::max(highest, section_supply[j]) : section_supply[j];
+      any_open = true;
+    }
   }
+  if (any_open) pump_pressure = std::max(pump_pressure, highest);
   pump_pressure = std::min(pump_pressure, hyd.pump_pressure);
 }
 

@@ -129,20 +129,70 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
     const char* policy_name;
     control::ScoopPolicy policy;
     double seed_crowd_time, seed_crowd_energy, seed_third;  ///< the seed's three figures
+    /// The seed's field figures for the same scoop, contact to the end of the scooping motion
+    /// (time s, travel + hydraulic energy kJ; Tables 6–7), per material {gravel, sand}; NaN
+    /// where the seed gives none.
+    double field_time[2], field_energy[2];
   };
+  // Field figures: Table 6 (station B: "Just in & out" on gravel 4.95 s / 201.86 kJ, Stairway #1
+  // 4.95 s / 231.86 kJ, Stairway #3 6.48 s / 243.5 kJ) and Table 7 (auto-selection by material:
+  // big gravel 4.96 s / 205.74 kJ, sand, all Stairway, 5.38 s / 241.65 kJ). The pressure trigger
+  // and perception alone were not run in the field.
   const Row rows[] = {
-      {"pressure", TriggerChoice::kPressure, "Stairway #3", control::ScoopPolicy::kStairwayFixed,
-       3.75, 57.9, 247.8},
-      {"V1+V2", TriggerChoice::kPredicted, "Stairway #3", control::ScoopPolicy::kStairwayFixed,
-       0.32, 12.7, 242.5},
-      {"V1+V2", TriggerChoice::kPredicted, "Stairway", control::ScoopPolicy::kStairway, 0.41, 11.9,
-       224.9},
-      {"V1+V2", TriggerChoice::kPredicted, "Just in & out", control::ScoopPolicy::kJustInOut, 0.36,
-       13.6, 195.4},
-      {"V1+V2", TriggerChoice::kPredicted, "auto-selection", control::ScoopPolicy::kAutoSelection,
-       0.39, 12.8, 213.7},
-      {"V1 only", TriggerChoice::kPerception, "auto-selection",
-       control::ScoopPolicy::kAutoSelection, NAN, NAN, NAN},
+      {"pressure",
+       TriggerChoice::kPressure,
+       "Stairway #3",
+       control::ScoopPolicy::kStairwayFixed,
+       3.75,
+       57.9,
+       247.8,
+       {NAN, NAN},
+       {NAN, NAN}},
+      {"V1+V2",
+       TriggerChoice::kPredicted,
+       "Stairway #3",
+       control::ScoopPolicy::kStairwayFixed,
+       0.32,
+       12.7,
+       242.5,
+       {6.48, 6.48},
+       {243.5, 243.5}},
+      {"V1+V2",
+       TriggerChoice::kPredicted,
+       "Stairway",
+       control::ScoopPolicy::kStairway,
+       0.41,
+       11.9,
+       224.9,
+       {4.95, 5.38},
+       {231.86, 241.65}},
+      {"V1+V2",
+       TriggerChoice::kPredicted,
+       "Just in & out",
+       control::ScoopPolicy::kJustInOut,
+       0.36,
+       13.6,
+       195.4,
+       {4.95, NAN},
+       {201.86, NAN}},
+      {"V1+V2",
+       TriggerChoice::kPredicted,
+       "auto-selection",
+       control::ScoopPolicy::kAutoSelection,
+       0.39,
+       12.8,
+       213.7,
+       {4.96, 5.38},
+       {205.74, 241.65}},
+      {"V1 only",
+       TriggerChoice::kPerception,
+       "auto-selection",
+       control::ScoopPolicy::kAutoSelection,
+       NAN,
+       NAN,
+       NAN,
+       {NAN, NAN},
+       {NAN, NAN}},
   };
   out << "Table 5: trigger and scooping strategy (" << o.trials
       << " trials per material; pressure threshold " << o.pressure_threshold / 1e5
@@ -152,10 +202,12 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       << (o.predictor.empty() ? std::string("models/") + prediction::kMainJobPredictor
                               : o.predictor)
       << "). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
-         "the third column as printed).\n\n";
+         "the third column as printed); contact → scoop end is the seed's field measure (bucket "
+         "contact to the end of the scooping motion, travel + hydraulic; Tables 6–7).\n\n";
   out << "| trigger | strategy | material | crowd s (seed) | crowd kJ (seed) | scoop s | scoop kJ "
-         "(seed 3rd) | trigger after contact s | fill % | strategies chosen |\n"
-         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+         "(seed 3rd) | contact → scoop end s (seed field) | contact → scoop end kJ (seed field) | "
+         "trigger after contact s | fill % | strategies chosen |\n"
+         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const Row& row : rows) {
     for (const char* bin : {"bin_1", "bin_4"}) {
       ShovelRunOptions options = Base(o);
@@ -165,15 +217,17 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       options.policy = row.policy;
       options.stairway_steps = 3;
       const CellStats c = RunCell(options, o.trials, err, warned);
-      char line[400];
-      std::snprintf(line, sizeof line,
-                    "| %s | %s | %s | %.2f (%.2f) | %.1f (%.1f) | %.2f | %.1f (%.1f) | %.2f | %.1f "
-                    "| %s |\n",
-                    row.trigger_name, row.policy_name,
-                    std::string(bin) == "bin_1" ? "gravel" : "sand", c.crowd_time,
-                    row.seed_crowd_time, c.crowd_energy, row.seed_crowd_energy, c.scoop_time,
-                    c.scoop_energy, row.seed_third, c.trigger_after_contact, 100 * c.fill,
-                    c.strategies.c_str());
+      const int m = std::string(bin) == "bin_1" ? 0 : 1;
+      char line[500];
+      std::snprintf(
+          line, sizeof line,
+          "| %s | %s | %s | %.2f (%.2f) | %.1f (%.1f) | %.2f | %.1f (%.1f) | %.2f (%.2f) | "
+          "%.1f (%.1f) | %.2f | %.1f | %s |\n",
+          row.trigger_name, row.policy_name, m == 0 ? "gravel" : "sand", c.crowd_time,
+          row.seed_crowd_time, c.crowd_energy, row.seed_crowd_energy, c.scoop_time, c.scoop_energy,
+          row.seed_third, c.crowd_time + c.scoop_time, row.field_time[m],
+          c.crowd_energy + c.scoop_energy, row.field_energy[m], c.trigger_after_contact,
+          100 * c.fill, c.strategies.c_str());
       out << line << std::flush;
     }
   }

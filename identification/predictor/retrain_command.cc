@@ -68,6 +68,30 @@ Score ScoreModel(const prediction::PenetrationPredictor& model,
   return s;
 }
 
+// The travel the runs themselves predicted at the trigger (CrowdingSample::predicted_penetration),
+// scored as ScoreModel scores a model: the predictor in the closed loop. Samples where either
+// travel is not measured (NULL: a database from before the column, a failed prediction) are
+// left out and counted in `skipped`; nothing is refused.
+Score ScoreLogged(const std::vector<results::CrowdingSample>& set, int* skipped) {
+  Score s;
+  double sq = 0;
+  *skipped = 0;
+  for (const results::CrowdingSample& c : set) {
+    if (!std::isfinite(c.predicted_penetration) || !std::isfinite(c.penetration)) {
+      ++*skipped;
+      continue;
+    }
+    const double e = std::abs(c.predicted_penetration - c.penetration);
+    s.within_010 += e <= 0.10, s.within_015 += e <= 0.15, s.within_020 += e <= 0.20;
+    sq += e * e, ++s.samples;
+  }
+  if (s.samples > 0) {
+    s.within_010 /= s.samples, s.within_015 /= s.samples, s.within_020 /= s.samples;
+  }
+  s.rmse = s.samples > 0 ? std::sqrt(sq / s.samples) : NAN;
+  return s;
+}
+
 void PrintScore(std::ostream& out, const char* name, const Score& s) {
   char line[200];
   std::snprintf(line, sizeof line, "| %s | %d | %.1f %% | %.1f %% | %.1f %% | %.3f | %d |\n", name,
@@ -231,6 +255,13 @@ int RunRetrainPredictor(const RetrainOptions& o, std::ostream& out, std::ostream
            "|\n| --- | --- | --- | --- | --- | --- | --- |\n";
     PrintScore(out, ("shipped " + base).c_str(), ScoreModel(shipped, held_out));
     PrintScore(out, ("retrained " + o.out).c_str(), ScoreModel(retrained, held_out));
+    int not_logged = 0;
+    const Score logged = ScoreLogged(held_out, &not_logged);
+    if (logged.samples > 0) PrintScore(out, "logged at the trigger (closed loop)", logged);
+    if (not_logged > 0) {
+      out << "logged at the trigger (closed loop): " << not_logged << " of " << held_out.size()
+          << " held-out samples left out (predicted or actual travel not logged: NULL)\n";
+    }
     out << "\nmodel: " << o.out << ".model, " << o.out << ".scale, "
         << prediction::ProvenancePath(o.out) << "\n";
     return 0;

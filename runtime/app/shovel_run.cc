@@ -1177,6 +1177,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     c.v1 = r.features_at_trigger.shoveled_volume;
     for (int k = 0; k < 6; ++k) c.heights[k] = r.features_at_trigger.heights[k];
     c.penetration = r.travel_after_trigger;
+    c.predicted_penetration = r.predicted_travel_at_trigger;
   }
   rec.trigger_time_s = std::isnan(r.trigger_time) ? NAN : r.trigger_time - t0;
   rec.payload_m3 = machine_io.PayloadVolume();
@@ -1276,9 +1277,14 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       " s after contact, cycle " + Fixed(rec.time_s.total, 1) + " s, " +
       Fixed(rec.energy_kj.total, 0) + " kJ, clearance " + Fixed(min_clearance, 2) +
       " m, path error " + Fixed(max_cross_track, 2) + " m, drove in " + Fixed(scoop_advance, 2) +
-      " m past the planned contact; map " + std::to_string(perception_calls) + "× (" +
-      Fixed(perception_seconds, 1) + " s), selection " + std::to_string(selections) + "× (" +
-      Fixed(selection_seconds, 1) + " s)" +
+      " m past the planned contact" +
+      (scoop && std::isfinite(r.predicted_travel_at_trigger) &&
+               std::isfinite(r.travel_after_trigger)
+           ? ", predicted travel " + Fixed(r.predicted_travel_at_trigger, 2) + " m, actual " +
+                 Fixed(r.travel_after_trigger, 2) + " m"
+           : "") +
+      "; map " + std::to_string(perception_calls) + "× (" + Fixed(perception_seconds, 1) +
+      " s), selection " + std::to_string(selections) + "× (" + Fixed(selection_seconds, 1) + " s)" +
       (out.safe_stops + out.refused_frames > 0 || out.blind_sector || out.masked_fraction > 0
            ? "; supervisor: " + std::to_string(out.safe_stops) + " stop(s), " +
                  std::to_string(out.recoveries) + " recover(ies), " +
@@ -1363,6 +1369,12 @@ int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::pat
   const std::filesystem::path fill_png = folder->FigurePath("fill_rate.png");
   results::WriteFillRatePlotPng(cycles, fill_png);
   figures.insert(figures.begin(), {"Fill rate per cycle", "figures/fill_rate.png", ""});
+  // The penetration predictor in the closed loop, when some cycle logged its travel.
+  if (results::WriteTravelPredictionPlotPng(results::RunCrowdingSamples(db, info.run_id),
+                                            folder->FigurePath("travel_prediction.png"))) {
+    figures.insert(figures.begin() + 1,
+                   {results::kTravelPredictionTitle, "figures/travel_prediction.png", ""});
+  }
   results::WriteReportHtml(db, info.run_id, figures, folder->ReportPath());
   const results::RunSummary summary = results::Summarize(cycles);
   char line[300];

@@ -152,6 +152,7 @@ struct ScoopCycle::Runtime {
   std::vector<Eigen::Vector3d> last_predicted_path;              ///< of the last V2 [m]
   double last_v2 = NAN;                                          ///< [m³]
   std::optional<prediction::PenetrationFeatures> last_features;  ///< of the last V2
+  double last_penetration = NAN;  ///< the predictor's travel of the last V2, NaN: failed [m]
   Eigen::Vector2d trigger_hinge = Eigen::Vector2d::Zero();
   double trigger_heading = 0;
   std::optional<JointPid> boom_pid, bucket_pid;
@@ -309,6 +310,7 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
     ++rt.result.prediction_failures;
     return 0;
   }
+  rt.last_penetration = d.penetration;
   try {
     const std::vector<double> q = {s.q_boom, s.q_bucket};
     prediction::ScoopPlan plan = prediction::ScoopPlanFromMachine(
@@ -367,6 +369,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
       const bool predict =
           trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
       rt.last_features.reset();
+      rt.last_penetration = NAN;
       in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
       in.intake_factor = predictor_ != nullptr ? predictor_->IntakeFactor(material_.name) : 1.0;
       rt.last_v2 = predict ? in.v2 : NAN;
@@ -403,6 +406,7 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         r.boom_pressure_at_trigger = s.boom_pressure;
         r.has_features_at_trigger = rt.last_features.has_value();
         if (rt.last_features) r.features_at_trigger = *rt.last_features;
+        r.predicted_travel_at_trigger = rt.last_features ? rt.last_penetration : NAN;
         rt.trigger_hinge = s.hinge_xy;
         rt.trigger_heading = s.heading;
         r.travel_after_trigger = 0;

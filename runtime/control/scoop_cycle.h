@@ -215,6 +215,10 @@ struct ScoopResult {
   bool has_features_at_trigger = false;
   prediction::PenetrationFeatures features_at_trigger;
   double travel_after_trigger = NAN;  ///< [m]
+  /// The predictor's travel for the features at the trigger [m]: NaN unless
+  /// has_features_at_trigger and the prediction succeeded. Against travel_after_trigger it shows
+  /// how the predictor does in the closed loop (issue 41, item 5).
+  double predicted_travel_at_trigger = NAN;
 
   const PhaseRecord* Phase(const std::string& name) const;
   /// Contact to the end of the scoop phase (the seed's Table 6/7 "time"): crowd + scoop.

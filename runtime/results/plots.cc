@@ -1,5 +1,6 @@
 #include "runtime/results/plots.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -86,6 +87,43 @@ void WriteFillRatePlotPng(const std::vector<CycleRecord>& cycles,
   }
   for (auto& [name, s] : by_strategy) plot.series.push_back(std::move(s));
   WriteLinePlotPng(plot, path);
+}
+
+bool WriteTravelPredictionPlotPng(const std::vector<CrowdingSample>& samples,
+                                  const std::filesystem::path& path) {
+  // A NaN after each point breaks the line: dots only.
+  PlotSeries dots{"", {}, {}, kBlue, 2, false, true};
+  double lo = INFINITY, hi = -INFINITY;
+  int n = 0;
+  for (const CrowdingSample& c : samples) {
+    if (!std::isfinite(c.predicted_penetration) || !std::isfinite(c.penetration)) continue;
+    dots.x.insert(dots.x.end(), {c.predicted_penetration, NAN});
+    dots.y.insert(dots.y.end(), {c.penetration, NAN});
+    lo = std::min({lo, c.predicted_penetration, c.penetration});
+    hi = std::max({hi, c.predicted_penetration, c.penetration});
+    ++n;
+  }
+  if (n == 0) return false;
+  dots.name = "cycles (" + std::to_string(n) + ")";
+  // The reference lines span the data and a margin, from 0 when no travel is negative.
+  lo = lo >= 0 ? std::max(0.0, lo - 0.25) : lo - 0.25;
+  hi += 0.25;
+  LinePlot plot;
+  plot.title = kTravelPredictionTitle;
+  plot.x_label = "predicted at the trigger [m]";
+  plot.y_label = "actual travel [m]";
+  plot.equal_aspect = true;
+  plot.series.push_back({"y = x", {lo, hi}, {lo, hi}, kGrey, 1, false, false});
+  for (const double band : {0.10, 0.20}) {
+    const Color color = band < 0.15 ? kGreen : kOrange;
+    char name[32];
+    std::snprintf(name, sizeof(name), "+/- %.2f m", band);
+    plot.series.push_back({name, {lo, hi}, {lo + band, hi + band}, color, 1, true, false});
+    plot.series.push_back({"", {lo, hi}, {lo - band, hi - band}, color, 1, true, false});
+  }
+  plot.series.push_back(std::move(dots));
+  WriteLinePlotPng(plot, path);
+  return true;
 }
 
 }  // namespace autoshovel::results

@@ -22,4 +22,14 @@ void WriteTipPathPlotPng(const CycleRecord& cycle, const std::filesystem::path& 
 void WriteFillRatePlotPng(const std::vector<CycleRecord>& cycles,
                           const std::filesystem::path& path);
 
+inline constexpr const char* kTravelPredictionTitle =
+    "Predicted against actual travel after the trigger";
+
+/// The penetration predictor in the closed loop (issue 41, item 5): a dot per crowding sample
+/// with both values at (predicted, actual) travel after the trigger [m], the line y = x and
+/// dashed bands at ±0.10 and ±0.20 m, equal aspect. Returns false and writes nothing when no
+/// sample has both.
+bool WriteTravelPredictionPlotPng(const std::vector<CrowdingSample>& samples,
+                                  const std::filesystem::path& path);
+
 }  // namespace autoshovel::results

@@ -125,6 +125,34 @@ RunSummary Summarize(const std::vector<CycleRecord>& cycles) {
   return summary;
 }
 
+TravelPredictionSummary SummarizeTravelPrediction(const std::vector<CrowdingSample>& samples) {
+  TravelPredictionSummary summary;
+  double sum = 0.0, sum_sq = 0.0;
+  for (const CrowdingSample& c : samples) {
+    if (!std::isfinite(c.predicted_penetration) || !std::isfinite(c.penetration)) continue;
+    const double error = c.predicted_penetration - c.penetration;
+    ++summary.cycles;
+    summary.within_010 += std::abs(error) <= 0.10;
+    summary.within_015 += std::abs(error) <= 0.15;
+    summary.within_020 += std::abs(error) <= 0.20;
+    sum += error;
+    sum_sq += error * error;
+  }
+  if (summary.cycles > 0) {
+    summary.rmse = std::sqrt(sum_sq / summary.cycles);
+    summary.mean_error = sum / summary.cycles;
+  }
+  return summary;
+}
+
+std::vector<CrowdingSample> RunCrowdingSamples(const ResultsDb& db, const std::string& run_id) {
+  std::vector<CrowdingSample> samples;
+  for (ResultsDb::StoredCrowdingSample& s : db.CrowdingSamples()) {  // ordered by run, cycle
+    if (s.run_id == run_id) samples.push_back(std::move(s.sample));
+  }
+  return samples;
+}
+
 void WriteReportHtml(const ResultsDb& db, const std::string& run_id,
                      const std::vector<ReportFigure>& figures, const fs::path& html_path) {
   // No figure from a damaged file: integrity first, then every value through the typed reader.
@@ -207,6 +235,23 @@ void WriteReportHtml(const ResultsDb& db, const std::string& run_id,
       << "</td><td>" << (c.completed ? "yes" : "<span class=\"bad\">no</span>") << "</td></tr>\n";
   }
   h << "</table>\n";
+
+  // The penetration predictor in the closed loop: only when some cycle logged both travels.
+  const TravelPredictionSummary travel = SummarizeTravelPrediction(RunCrowdingSamples(db, run_id));
+  if (travel.cycles > 0) {
+    auto share = [&travel](int count) {
+      return std::to_string(count) + " of " + std::to_string(travel.cycles) + " (" +
+             Percent(static_cast<double>(count) / travel.cycles) + ")";
+    };
+    h << "<h2>Predicted against actual travel after the trigger</h2>\n<table class=\"summary\">\n";
+    row("Cycles with both", std::to_string(travel.cycles));
+    row("|predicted &minus; actual| &le; 0.10 m", share(travel.within_010));
+    row("&le; 0.15 m", share(travel.within_015));
+    row("&le; 0.20 m", share(travel.within_020));
+    row("RMSE [m]", Number(travel.rmse, 3));
+    row("Mean error, predicted &minus; actual [m]", Number(travel.mean_error, 3));
+    h << "</table>\n";
+  }
 
   // Figures.
   if (!figures.empty()) h << "<h2>Figures</h2>\n";

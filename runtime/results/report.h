@@ -34,9 +34,28 @@ struct RunSummary {
 
 RunSummary Summarize(const std::vector<CycleRecord>& cycles);
 
+/// The penetration predictor in the closed loop (issue 41, item 5): the travel it predicted at
+/// the trigger against the travel measured after it, over the crowding samples that have both
+/// (the §7.4.1 buckets of `autoshovel train predictor`).
+struct TravelPredictionSummary {
+  int cycles = 0;                    ///< samples with both values finite; 0: nothing to show
+  int within_010 = 0;                ///< |predicted − actual| ≤ 0.10 m
+  int within_015 = 0;                ///< ≤ 0.15 m
+  int within_020 = 0;                ///< ≤ 0.20 m
+  double rmse = kNotMeasured;        ///< [m]
+  double mean_error = kNotMeasured;  ///< predicted − actual [m]
+};
+
+TravelPredictionSummary SummarizeTravelPrediction(const std::vector<CrowdingSample>& samples);
+
+/// The crowding samples of run `run_id`, by cycle.
+std::vector<CrowdingSample> RunCrowdingSamples(const ResultsDb& db, const std::string& run_id);
+
 /// Writes `html_path` for run `run_id` of `db`. Figures whose PNG does not exist are listed as
-/// missing (no broken image). Throws std::runtime_error naming the file when it cannot be
-/// written, ResultsDbError when the run is not in the database.
+/// missing (no broken image). When some of the run's cycles logged both the predicted and the
+/// actual travel after the trigger, a section gives SummarizeTravelPrediction of them. Throws
+/// std::runtime_error naming the file when it cannot be written, ResultsDbError when the run is not
+/// in the database.
 void WriteReportHtml(const ResultsDb& db, const std::string& run_id,
                      const std::vector<ReportFigure>& figures,
                      const std::filesystem::path& html_path);

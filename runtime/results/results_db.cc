@@ -117,9 +117,21 @@ CREATE TABLE IF NOT EXISTS crowding_samples (
   v1_m3          REAL,
   h1_m REAL, h2_m REAL, h3_m REAL, h4_m REAL, h5_m REAL, h6_m REAL,
   penetration_m  REAL,
+  predicted_penetration_m  REAL,
   PRIMARY KEY (run_id, cycle)
 ) WITHOUT ROWID;
 )sql";
+
+// The predictor's travel at the trigger (issue 41, item 5), added to crowding_samples after the
+// table, again without a schema version: a writer appends the column where it is missing (the
+// last, as in a new file, so that shards still merge with INSERT … SELECT *; older rows hold NULL,
+// "not logged"); a read-only reader of such a file reads every row as not logged.
+constexpr const char* kAddPredictedPenetration =
+    "ALTER TABLE crowding_samples ADD COLUMN predicted_penetration_m REAL";
+
+constexpr const char* kCrowdingColumns =
+    "run_id, cycle, strategy, trigger_cause, material, speed_mps, v1_m3, h1_m, h2_m, h3_m, h4_m, "
+    "h5_m, h6_m, penetration_m";
 
 // A short, printable excerpt of a refused text value.
 std::string Excerpt(const unsigned char* text, int bytes) {
@@ -486,6 +498,8 @@ void ResultsDb::CheckSchemaReadOnly() {
     throw ResultsDbError(file_.string() + ": results database without a schema version row");
   }
   const std::int64_t found = read.RequiredInteger(0);
+  has_predicted_penetration_ =
+      has_crowding_samples_ && HasColumn("crowding_samples", "predicted_penetration_m");
   if (found == 1) {
     throw ResultsDbError(file_.string() + ": results schema version 1; reading it needs a " +
                          "migration to version 2, which a read-only open does not do (open it " +
@@ -577,6 +591,33 @@ void ResultsDb::CreateOrCheckSchema() {
   }
   Execute("PRAGMA journal_mode = WAL");
   Execute(kCrowdingSamplesSchema);
+  AddPredictedPenetrationColumn();
+}
+
+bool ResultsDb::HasColumn(const std::string& table, const std::string& column) const {
+  Statement columns(*this, "SELECT name FROM pragma_table_info(?)");
+  columns.Bind(1, table);
+  ColumnReader read(columns.get(), file_, "pragma_table_info('" + table + "')");
+  while (columns.Step()) {
+    if (read.Text(0) == column) return true;
+  }
+  return false;
+}
+
+void ResultsDb::AddPredictedPenetrationColumn() {
+  if (HasColumn("crowding_samples", "predicted_penetration_m")) return;
+  // In one transaction; a concurrent opener (a campaign's workers) that added it first is seen
+  // again here.
+  Execute("BEGIN IMMEDIATE");
+  try {
+    if (!HasColumn("crowding_samples", "predicted_penetration_m")) {
+      Execute(kAddPredictedPenetration);
+    }
+    Execute("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
 }
 
 bool ResultsDb::BeginRun(const RunInfo& run) {
@@ -721,14 +762,15 @@ void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record)
     }
     if (record.crowding.present) {
       const CrowdingSample& c = record.crowding;
-      Statement crowding(*this,
-                         "INSERT INTO crowding_samples VALUES "
-                         "(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      Statement crowding(*this, std::string("INSERT INTO crowding_samples (") + kCrowdingColumns +
+                                    ", predicted_penetration_m) VALUES "
+                                    "(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
       crowding.Bind(1, run_id).Bind(2, static_cast<std::int64_t>(record.cycle));
       crowding.Bind(3, c.strategy).Bind(4, c.trigger).Bind(5, c.material);
       crowding.Bind(6, c.speed).Bind(7, c.v1);
       for (int k = 0; k < 6; ++k) crowding.Bind(8 + k, c.heights[k]);
       crowding.Bind(14, c.penetration);
+      crowding.Bind(15, c.predicted_penetration);  // NaN (not logged) -> NULL
       if (crowding.Run() != SQLITE_OK) {
         Fail("cannot write the crowding sample of cycle " + std::to_string(record.cycle));
       }
@@ -743,11 +785,10 @@ void ResultsDb::WriteCycle(const std::string& run_id, const CycleRecord& record)
 std::vector<ResultsDb::StoredCrowdingSample> ResultsDb::CrowdingSamples() const {
   std::vector<StoredCrowdingSample> out;
   if (!has_crowding_samples_) return out;  // a read-only file from before the table
-  Statement select(
-      *this,
-      "SELECT run_id, cycle, strategy, trigger_cause, material, speed_mps, v1_m3, h1_m, "
-      "h2_m, h3_m, h4_m, h5_m, h6_m, penetration_m FROM crowding_samples "
-      "ORDER BY run_id, cycle");
+  // A read-only file from before predicted_penetration_m: every row reads it as not logged.
+  Statement select(*this, std::string("SELECT ") + kCrowdingColumns + ", " +
+                              (has_predicted_penetration_ ? "predicted_penetration_m" : "NULL") +
+                              " FROM crowding_samples ORDER BY run_id, cycle");
   ColumnReader read(select.get(), file_, "crowding_samples");
   while (select.Step()) {
     StoredCrowdingSample s;
@@ -763,6 +804,7 @@ std::vector<ResultsDb::StoredCrowdingSample> ResultsDb::CrowdingSamples() const 
     s.sample.v1 = read.RealOrNotMeasured(6);
     for (int k = 0; k < 6; ++k) s.sample.heights[k] = read.RealOrNotMeasured(7 + k);
     s.sample.penetration = read.RealOrNotMeasured(13);
+    s.sample.predicted_penetration = read.RealOrNotMeasured(14);  // NULL: kNotMeasured, never 0
     out.push_back(std::move(s));
   }
   return out;

@@ -160,6 +160,9 @@ struct CrowdingSample {
   double v1 = kNotMeasured;           ///< V1 at the trigger [m³]
   std::array<double, 6> heights{};    ///< h1..h6 ahead of the tip [m]
   double penetration = kNotMeasured;  ///< forward travel from the trigger to the scoop's end [m]
+  /// The predictor's travel at the trigger [m]: what the run itself predicted for these inputs
+  /// (NULL: not logged, as in a file from before the column, or the prediction failed).
+  double predicted_penetration = kNotMeasured;
 };
 
 /// One shoveling cycle: a row of `cycles` and its `samples`.
@@ -252,10 +255,14 @@ class ResultsDb {
   [[noreturn]] void Fail(const std::string& what) const;
   void CreateOrCheckSchema();
   void CheckSchemaReadOnly();
+  bool HasColumn(const std::string& table, const std::string& column) const;
+  void AddPredictedPenetrationColumn();
 
   std::filesystem::path file_;
   sqlite3* db_ = nullptr;
   bool has_crowding_samples_ = true;  ///< false: a read-only file from before the table
+  /// false: a read-only file from before crowding_samples.predicted_penetration_m
+  bool has_predicted_penetration_ = true;
 };
 
 }  // namespace autoshovel::results

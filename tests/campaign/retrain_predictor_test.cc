@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <random>
 #include <sstream>
@@ -46,7 +47,9 @@ results::CycleRecord Cycle(int index) {
 // retrained model is compared with (RetrainOptions::base).
 const std::string kSiteBase = kModels + "/" + prediction::kBrakingScoopPredictor;
 
-void WriteSite(const fs::path& file, int n, double offset) {
+// With `logged_offset` finite, every cycle but each fourth also logs the travel a run would have
+// predicted at the trigger: the shipped model's plus `logged_offset` (the rest log none, NULL).
+void WriteSite(const fs::path& file, int n, double offset, double logged_offset = NAN) {
   const prediction::PenetrationPredictor shipped =
       prediction::PenetrationPredictor::Load(kSiteBase);
   results::ResultsDb db(file);
@@ -77,6 +80,7 @@ void WriteSite(const fs::path& file, int n, double offset) {
     const prediction::PenetrationPrediction p = shipped.Predict(f);
     ASSERT_TRUE(p.ok) << p.message;
     s.penetration = p.penetration + offset;
+    if (i % 4 != 0) s.predicted_penetration = p.penetration + logged_offset;
     db.WriteCycle("site", c);
   }
 }
@@ -114,7 +118,7 @@ TEST(CrowdingSamples, StoredWithTheCycleAndReadBack) {
 
 TEST(RetrainPredictor, LearnsASiteThatPenetratesFurther) {
   const fs::path dir = TempDir();
-  WriteSite(dir / "site.sqlite", 200, 0.3);
+  WriteSite(dir / "site.sqlite", 200, 0.3, 0.22);
   RetrainOptions o;
   o.database = (dir / "site.sqlite").string();
   o.models_dir = kModels;
@@ -145,6 +149,22 @@ TEST(RetrainPredictor, LearnsASiteThatPenetratesFurther) {
   std::sscanf(text.c_str() + text.find(" | ", row + 12), " | %lf | %lf", &n, &w10);
   EXPECT_GT(n, 20);
   EXPECT_GT(w10, 80.0) << text;
+  // The runs' own predictions, logged at the trigger: every error is 0.3 − 0.22 = 0.08 m, so all
+  // within 0.10 m; the held-out samples that logged none are left out and counted.
+  const std::size_t logged = text.find("| logged at the trigger (closed loop) | ");
+  ASSERT_NE(logged, std::string::npos) << text;
+  int held_out = 0, logged_n = 0, not_logged = 0;
+  ASSERT_NE(text.find(" to train, "), std::string::npos) << text;
+  std::sscanf(text.c_str() + text.find(" to train, ") + 11, "%d held out", &held_out);
+  std::sscanf(text.c_str() + logged + 40, "%d |", &logged_n);
+  EXPECT_NE(text.find("| 100.0 % | 100.0 % | 100.0 % | 0.080 | 0 |", logged), std::string::npos)
+      << text;
+  const std::size_t skipped = text.find("logged at the trigger (closed loop): ");
+  ASSERT_NE(skipped, std::string::npos) << text;
+  std::sscanf(text.c_str() + skipped + 37, "%d of", &not_logged);
+  EXPECT_GT(logged_n, 20);
+  EXPECT_GT(not_logged, 0);
+  EXPECT_EQ(logged_n + not_logged, held_out) << text;
 
   // Never over an existing model; too few samples is said so.
   std::ostringstream out2, err2;

@@ -159,5 +159,81 @@ TEST(Report, SafetyViolationsAreFlagged) {
   EXPECT_NE(ReadAll(dir / "report.html").find("<span class=\"bad\">2</span>"), std::string::npos);
 }
 
+// The penetration predictor in the closed loop (issue 41, item 5): the travel predicted at the
+// trigger against the travel measured after it. Cycles without both count for nothing; the
+// figure and the report's section exist only when some cycle has both.
+CycleRecord WithTravel(int c, double actual, double predicted) {
+  CycleRecord r = TestRecord(c, 0);
+  r.crowding.present = true;
+  r.crowding.strategy = "just_in_out";
+  r.crowding.trigger = "predicted_volume";
+  r.crowding.material = "big_gravel";
+  r.crowding.penetration = actual;
+  r.crowding.predicted_penetration = predicted;
+  return r;
+}
+
+TEST(Report, TravelPredictionSummaryCountsOnlyCyclesWithBoth) {
+  // Errors (predicted − actual): +0.05, −0.12, +0.18, −0.35; then two without both.
+  const std::vector<CrowdingSample> samples = {
+      WithTravel(0, 1.00, 1.05).crowding,         WithTravel(1, 1.00, 0.88).crowding,
+      WithTravel(2, 1.00, 1.18).crowding,         WithTravel(3, 1.00, 0.65).crowding,
+      WithTravel(4, 1.00, kNotMeasured).crowding, WithTravel(5, kNotMeasured, 0.9).crowding};
+  const TravelPredictionSummary s = SummarizeTravelPrediction(samples);
+  EXPECT_EQ(s.cycles, 4);
+  EXPECT_EQ(s.within_010, 1);
+  EXPECT_EQ(s.within_015, 2);
+  EXPECT_EQ(s.within_020, 3);
+  EXPECT_NEAR(s.rmse, std::sqrt((0.05 * 0.05 + 0.12 * 0.12 + 0.18 * 0.18 + 0.35 * 0.35) / 4),
+              1e-12);
+  EXPECT_NEAR(s.mean_error, -0.06, 1e-12);
+  const TravelPredictionSummary none = SummarizeTravelPrediction({samples[4], samples[5]});
+  EXPECT_EQ(none.cycles, 0);
+  EXPECT_TRUE(std::isnan(none.rmse));
+  EXPECT_TRUE(std::isnan(none.mean_error));
+}
+
+TEST(Report, TravelPredictionFigureAndSectionOnlyWhenLogged) {
+  const fs::path dir = ScratchDir("");
+  const std::string section = "Predicted against actual travel after the trigger";
+  {  // Crowding samples without a logged prediction (an older run), and a cycle without one.
+    ResultsDb db(dir / "without.sqlite");
+    db.BeginRun(TestRun());
+    db.WriteCycle("run-1", WithTravel(0, 0.9, kNotMeasured));
+    db.WriteCycle("run-1", TestRecord(1, 0));
+    EXPECT_FALSE(
+        WriteTravelPredictionPlotPng(RunCrowdingSamples(db, "run-1"), dir / "travel_without.png"));
+    EXPECT_FALSE(fs::exists(dir / "travel_without.png"));
+    WriteReportHtml(db, "run-1", {}, dir / "without.html");
+    EXPECT_EQ(ReadAll(dir / "without.html").find(section), std::string::npos);
+  }
+  ResultsDb db(dir / "with.sqlite");
+  db.BeginRun(TestRun());
+  db.BeginRun(TestRun("run-2"));
+  db.WriteCycle("run-1", WithTravel(0, 1.00, 1.05));
+  db.WriteCycle("run-1", WithTravel(1, 1.00, 0.88));
+  db.WriteCycle("run-1", TestRecord(2, 0));
+  db.WriteCycle("run-1", WithTravel(3, 1.00, 1.18));
+  db.WriteCycle("run-1", WithTravel(4, 1.00, 0.65));
+  db.WriteCycle("run-1", WithTravel(5, 1.00, kNotMeasured));
+  db.WriteCycle("run-2", WithTravel(0, 1.00, 3.00));  // another run's: not in run-1's report
+  const std::vector<CrowdingSample> samples = RunCrowdingSamples(db, "run-1");
+  ASSERT_EQ(samples.size(), 5u);
+  EXPECT_EQ(samples[1].predicted_penetration, 0.88);
+  ASSERT_TRUE(WriteTravelPredictionPlotPng(samples, dir / "travel.png"));
+  ExpectPng(dir / "travel.png");
+  WriteReportHtml(db, "run-1", {{kTravelPredictionTitle, dir / "travel.png", ""}},
+                  dir / "with.html");
+  const std::string html = ReadAll(dir / "with.html");
+  EXPECT_NE(html.find("<h2>" + section + "</h2>"), std::string::npos);
+  for (const char* expected :
+       {"<td>Cycles with both</td><td class=\"text\">4</td>", "1 of 4 (25.0&nbsp;%)",
+        "2 of 4 (50.0&nbsp;%)", "3 of 4 (75.0&nbsp;%)",
+        "<td>RMSE [m]</td><td class=\"text\">0.207</td>", "<td class=\"text\">-0.060</td>",
+        "<img src=\"travel.png\""}) {
+    EXPECT_NE(html.find(expected), std::string::npos) << "missing: " << expected;
+  }
+}
+
 }  // namespace
 }  // namespace autoshovel::results

@@ -495,6 +495,141 @@ TEST(ResultsDb, DamagedIndexPageFailsTheIntegrityCheckBeforeAnyRead) {
   EXPECT_EQ(Bytes(file), before);
 }
 
+// The predictor's travel at the trigger (issue 41, item 5): stored exactly, NaN as NULL and
+// read back as NaN (never 0), in the last column of crowding_samples.
+CycleRecord WithCrowding(int c, double penetration, double predicted) {
+  CycleRecord r = TestRecord(c, 2);
+  CrowdingSample& s = r.crowding;
+  s.present = true;
+  s.strategy = "just_in_out";
+  s.trigger = "predicted_volume";
+  s.material = "big_gravel";
+  s.speed = 1.5;
+  s.v1 = 0.75 + c;
+  s.heights = {0.5, 0.7, 0.9, 1.1, 1.3, 1.5};
+  s.penetration = penetration;
+  s.predicted_penetration = predicted;
+  return r;
+}
+
+TEST(ResultsDb, PredictedPenetrationRoundTripsAndNanIsNull) {
+  const auto file = ScratchDir("") / "results.sqlite";
+  {
+    ResultsDb db(file);
+    db.BeginRun(TestRun());
+    db.WriteCycle("run-1", WithCrowding(0, 0.93, 1.0 / 3.0));
+    db.WriteCycle("run-1", WithCrowding(1, 0.71, kNotMeasured));  // the prediction failed
+    db.WriteCycle("run-1", TestRecord(2, 0));                     // no crowding sample
+  }
+  EXPECT_EQ(Query(file, "SELECT group_concat(name) FROM pragma_table_info('crowding_samples')"),
+            "run_id,cycle,strategy,trigger_cause,material,speed_mps,v1_m3,h1_m,h2_m,h3_m,h4_m,"
+            "h5_m,h6_m,penetration_m,predicted_penetration_m");
+  EXPECT_EQ(Query(file,
+                  "SELECT predicted_penetration_m IS NULL FROM crowding_samples WHERE "
+                  "cycle = 1"),
+            "1");
+  EXPECT_EQ(Query(file,
+                  "SELECT typeof(predicted_penetration_m) FROM crowding_samples WHERE "
+                  "cycle = 0"),
+            "real");
+  for (const ResultsDb::Access access :
+       {ResultsDb::Access::kReadWrite, ResultsDb::Access::kReadOnly}) {
+    const ResultsDb db(file, access);
+    const auto samples = db.CrowdingSamples();
+    ASSERT_EQ(samples.size(), 2u);
+    EXPECT_EQ(samples[0].cycle, 0);
+    EXPECT_EQ(samples[0].sample.predicted_penetration, 1.0 / 3.0);  // bit for bit
+    EXPECT_EQ(samples[0].sample.penetration, 0.93);
+    EXPECT_EQ(samples[1].cycle, 1);
+    EXPECT_TRUE(std::isnan(samples[1].sample.predicted_penetration))
+        << samples[1].sample.predicted_penetration;
+    EXPECT_EQ(samples[1].sample.penetration, 0.71);
+  }
+  // Text where the travel belongs is refused naming the column, not read as 0.
+  Exec(file, "UPDATE crowding_samples SET predicted_penetration_m = 'n/a' WHERE cycle = 0");
+  const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+  EXPECT_NE(Refusal([&] { db.CrowdingSamples(); })
+                .find("table crowding_samples, run 'run-1', cycle 0, column "
+                      "predicted_penetration_m: text 'n/a' where a number belongs"),
+            std::string::npos)
+      << Refusal([&] { db.CrowdingSamples(); });
+}
+
+// crowding_samples as builds before issue 41 item 5 created it, with one row.
+constexpr const char* kOldCrowdingSamples = R"sql(
+DROP TABLE crowding_samples;
+CREATE TABLE crowding_samples (
+  run_id         TEXT NOT NULL,
+  cycle          INTEGER NOT NULL,
+  strategy       TEXT NOT NULL,
+  trigger_cause  TEXT NOT NULL,
+  material       TEXT NOT NULL,
+  speed_mps      REAL,
+  v1_m3          REAL,
+  h1_m REAL, h2_m REAL, h3_m REAL, h4_m REAL, h5_m REAL, h6_m REAL,
+  penetration_m  REAL,
+  PRIMARY KEY (run_id, cycle)
+) WITHOUT ROWID;
+INSERT INTO crowding_samples VALUES
+  ('run-1', 0, 'just_in_out', 'predicted_volume', 'big_gravel', 1.25, 0.8,
+   0.5, 0.7, 0.9, 1.1, 1.3, 1.5, 0.93);
+)sql";
+
+// An older file: read-only it reads as it is, every predicted travel not logged, and is left
+// untouched; opened by a writer it gains the column (its row keeps its values and reads NaN),
+// with the column order of a new file (campaign shards merge with INSERT … SELECT *).
+TEST(ResultsDb, OldCrowdingSamplesTableGainsThePredictedColumn) {
+  const auto dir = ScratchDir("");
+  const auto file = dir / "old.sqlite";
+  {
+    ResultsDb db(file);
+    db.BeginRun(TestRun());
+    db.WriteCycle("run-1", TestRecord(0, 2));
+  }
+  Exec(file, kOldCrowdingSamples);
+  ASSERT_EQ(Query(file, "SELECT count(*) FROM pragma_table_info('crowding_samples')"), "14");
+  auto check_old_row = [](const ResultsDb& db) {
+    const auto samples = db.CrowdingSamples();
+    ASSERT_EQ(samples.size(), 1u);
+    EXPECT_EQ(samples[0].run_id, "run-1");
+    EXPECT_EQ(samples[0].cycle, 0);
+    EXPECT_EQ(samples[0].sample.material, "big_gravel");
+    EXPECT_EQ(samples[0].sample.speed, 1.25);
+    EXPECT_EQ(samples[0].sample.heights[5], 1.5);
+    EXPECT_EQ(samples[0].sample.penetration, 0.93);
+    EXPECT_TRUE(std::isnan(samples[0].sample.predicted_penetration))
+        << samples[0].sample.predicted_penetration;
+  };
+  const std::string before = Bytes(file);
+  {
+    const ResultsDb db(file, ResultsDb::Access::kReadOnly);
+    check_old_row(db);
+  }
+  EXPECT_EQ(Bytes(file), before);  // a reader changes nothing
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM pragma_table_info('crowding_samples')"), "14");
+  {
+    ResultsDb db(file);
+    check_old_row(db);
+    db.WriteCycle("run-1", WithCrowding(1, 0.71, 0.625));
+    const auto samples = db.CrowdingSamples();
+    ASSERT_EQ(samples.size(), 2u);
+    EXPECT_EQ(samples[1].sample.predicted_penetration, 0.625);
+  }
+  EXPECT_EQ(Query(file,
+                  "SELECT predicted_penetration_m IS NULL FROM crowding_samples WHERE "
+                  "cycle = 0"),
+            "1");
+  EXPECT_EQ(Query(file, "SELECT version FROM schema_version"), "2");  // nothing else changed
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM cycles"), "2");
+  const auto fresh = dir / "new.sqlite";
+  { ResultsDb db(fresh); }
+  EXPECT_EQ(Query(file, "SELECT group_concat(name) FROM pragma_table_info('crowding_samples')"),
+            Query(fresh, "SELECT group_concat(name) FROM pragma_table_info('crowding_samples')"));
+  { ResultsDb again(file); }  // opening an upgraded file again changes nothing
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM pragma_table_info('crowding_samples')"), "15");
+  EXPECT_EQ(Query(file, "SELECT count(*) FROM crowding_samples"), "2");
+}
+
 TEST(ColumnReader, NamesTheFileTableRowAndColumn) {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(":memory:", &db), SQLITE_OK);

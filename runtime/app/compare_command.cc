@@ -84,6 +84,7 @@ ShovelRunOptions Base(const CompareOptions& o) {
   r.target_fill = o.target_fill;
   r.attitude_feed_forward = o.attitude_feed_forward;
   r.predictor = o.predictor;
+  r.machine = o.machine;
   return r;
 }
 
@@ -201,6 +202,7 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       << (o.attitude_feed_forward ? "feed-forward" : "PID only") << "; predictor "
       << (o.predictor.empty() ? std::string("models/") + prediction::kMainJobPredictor
                               : o.predictor)
+      << (o.machine.empty() ? std::string() : "; machine " + o.machine)
       << "). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
          "the third column as printed); contact → scoop end is the seed's field measure (bucket "
          "contact to the end of the scooping motion, travel + hydraulic; Tables 6–7).\n\n";

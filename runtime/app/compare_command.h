@@ -31,6 +31,9 @@ struct CompareOptions {
   double target_fill = 1.0;           ///< ShovelRunOptions::target_fill [-]
   bool attitude_feed_forward = true;  ///< ShovelRunOptions::attitude_feed_forward
   std::string predictor;              ///< SVR model prefix; empty: the shipped one
+  /// Name or path of a wheel-loader description to run instead of the scenario's (the
+  /// predictor warns when it was trained on another machine); empty: the scenario's.
+  std::string machine;
 };
 
 /// Prints the table; returns 0, or 2 on bad input.

@@ -97,7 +97,7 @@ std::string Fixed(double v, int digits) {
   return buffer;
 }
 
-void PrintTable(const Case& c, const CaseResult& r, std::ostream& out) {
+void PrintTable(const Case& c, const CaseResult& r, const std::string& machine, std::ostream& out) {
   const double n = std::max(1, r.completed);
   auto phase = [&](const char* name) {
     const auto it = r.phases.find(name);
@@ -114,7 +114,8 @@ void PrintTable(const Case& c, const CaseResult& r, std::ostream& out) {
   const double total = seed_phase.total();
 
   out << "Energy audit: " << c.policy_name << " on " << c.material << " (mixing_station " << c.bin
-      << "), " << r.completed << "/" << r.cycles << " cycles completed; strategies " <<
+      << (machine.empty() ? std::string() : ", machine " + machine) << "), " << r.completed << "/"
+      << r.cycles << " cycles completed; strategies " <<
       [&] {
         std::string s;
         for (const std::string& k : r.strategies) s += (s.empty() ? "" : " ") + k;
@@ -267,12 +268,16 @@ int RunEnergyAudit(const CompareOptions& o, const std::filesystem::path& output_
         options.target_fill = o.target_fill;
         options.attitude_feed_forward = o.attitude_feed_forward;
         options.predictor = o.predictor;
+        options.machine = o.machine;
         options.scenario = "mixing_station";
         options.bins = {c.bin};
         options.policy = c.policy;
         options.seed = static_cast<std::uint64_t>(t);
         options.energy_audit = true;
         ShovelJob job(options);
+        if (const std::string m = job.PredictorMachineMismatch(); !m.empty() && t == 1) {
+          err << "autoshovel compare audit: warning: " << m << "\n";
+        }
         const CycleOutcome cycle = job.RunCycle(0, {}, nullptr);
         ++r.cycles;
         err << "  " << c.material << " seed " << t << ": "
@@ -302,7 +307,7 @@ int RunEnergyAudit(const CompareOptions& o, const std::filesystem::path& output_
           }
         }
       }
-      PrintTable(c, r, out);
+      PrintTable(c, r, o.machine, out);
       if (!output_dir.empty()) WriteFigures(c, r, output_dir);
       out << std::flush;
     }

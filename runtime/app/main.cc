@@ -606,6 +606,8 @@ int main(int argc, char** argv) {
   compare_cmd->add_option("table", compare.table, "table4 | table5 | audit")
       ->required()
       ->check(CLI::IsMember({"table4", "table5", "audit"}));
+  compare_cmd->add_option("--machine", compare.machine,
+                          "Wheel-loader description (name or path) instead of the scenario's");
   std::string compare_output;
   compare_cmd->add_option("-o,--output", compare_output,
                           "audit: folder for the stacked energy plots and per-tick CSVs");

@@ -364,8 +364,10 @@ void BuildPlant(const MachineDescription& m, SymbolicMachine& s) {
     const ex open_b = Smooth(-xs, model::plant::kSpoolUnderlap);
     const ex pp = s.u[2 * J + 2 + j];  // this valve section's supply pressure (an input)
     const double pt = hyd.tank_pressure, kv = a.valve.flow_gain;
-    const ex flow_a = kv * (open_a * orifice(pp - pa) - open_b * orifice(pa - pt));
-    const ex flow_b = kv * (open_b * orifice(pp - pb) - open_a * orifice(pb - pt));
+    // From the supply only through the section's load check valve (plant_constants.h).
+    const double wc = model::plant::kCheckValveWidth;
+    const ex flow_a = kv * (open_a * orifice(Smooth(pp - pa, wc)) - open_b * orifice(pa - pt));
+    const ex flow_b = kv * (open_b * orifice(Smooth(pp - pb, wc)) - open_a * orifice(pb - pt));
     const double relief_gain = a.valve.rated_flow / model::plant::kReliefFullFlowOverpressure;
     auto relief = [&](const ex& p) {
       return relief_gain * (Smooth(p - a.relief_pressure, model::plant::kReliefPressureWidth) -

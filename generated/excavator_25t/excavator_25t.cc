@@ -388,250 +388,258 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::sqrt;
   double mass[kNumJoints * kNumJoints];
   double acceleration[kNumJoints];
-  const double t0 = cos(x[0]);
-  const double t1 = sin(x[0]);
-  const double t2 = (1.09 - 0.236 * t0 + t1 * 2.979);
-  const double t3 = 0.236 * t1;
-  const double t4 = t0 * 2.979;
-  const double t5 = (-0.356 + t3 + t4);
-  const double t6 = ((t2 * t2) + (t5 * t5));
-  const double t7 = sqrt(t6);
-  const double t8 = (x[12] - 2e+05);
-  const double t9 = (t8 * t8);
-  const double t10 = (1.0 / sqrt(t6));
-  const double t11 = (((t3 + t4)) * t2 + t5 * ((-t1 * 2.979 + 0.236 * t0)));
-  const double t12 = (x[12] - 3.7e+07);
-  const double t13 = (-x[12] + u[10]);
-  const double t14 = sqrt(((x[8] * x[8]) + 1e-06));
-  const double t15 = (t14 + x[8]);
-  const double t16 = (-t14 + x[8]);
-  const double t17 = (x[0] + x[1]);
-  const double t18 = cos(t17);
-  const double t19 = t18 * (-0.8);
-  const double t20 = sin(t17);
-  const double t21 = t20 * (-0.104);
-  const double t22 = (1.11 * t1 + t19 + 3.136 * t0 + t21);
-  const double t23 = (-t20 * 0.8 + 3.136 * t1 + 0.104 * t18 - 1.11 * t0);
-  const double t24 = ((t22 * t22) + (t23 * t23));
-  const double t25 = sqrt(t24);
-  const double t26 = (x[13] - 3.7e+07);
-  const double t27 = (u[11] - x[13]);
-  const double t28 = sqrt((1e-06 + (x[9] * x[9])));
-  const double t29 = (x[9] + t28);
-  const double t30 = (1.0 / sqrt(t24));
-  const double t31 = (-0.104) * t18;
-  const double t32 = t20 * 0.8;
-  const double t33 = (t22 * ((t31 + t32)) + ((t19 + t21)) * t23);
-  const double t34 = (t22 * ((t31 + t32 - 3.136 * t1 + 1.11 * t0)) + t23 * t22);
-  const double t35 = (x[13] - 2e+05);
-  const double t36 = (t35 * t35);
-  const double t37 = (-x[9] + t28);
-  const double t38 = (x[2] + x[0] + x[1]);
-  const double t39 = sin(t38);
-  const double t40 = cos(t38);
-  const double t41 = (0.315 * t18 + t20 * 0.15700000000000003 - 0.016 * t39 + 0.552 * t40);
-  const double t42 = (t41 * t41);
-  const double t43 = (-0.016) * t40;
-  const double t44 = t39 * (-0.552);
-  const double t45 = (t43 + t44 + 0.15700000000000003 * t18 - t20 * 0.315);
-  const double t46 = (t45 * t45);
-  const double t47 = (0.21712699999999996 + t42 + t46);
-  const double t48 = (t42 + t46);
-  const double t49 = (1.0 / sqrt(t48));
-  const double t50 = (1.0 / (t48));
-  const double t51 = (t47 * t47);
-  const double t52 = (-0.25 * t50 * t51 + 0.48441599999999996);
-  const double t53 = sqrt(t52);
-  const double t54 = (t47 * t49 * t41 + 2.0 * t53 * t45);
-  const double t55 = (2.0 * t41 * t53 - t47 * t49 * t45);
-  const double t56 = atan2(t54 * 0.5 * t49, t55 * t49 * (-0.5));
-  const double t57 = sin(t56);
-  const double t58 = (-0.623 * t18 + t20 * 3.081 + 0.696 * t57);
-  const double t59 = t20 * 0.623;
-  const double t60 = cos(t56);
-  const double t61 = 3.081 * t18;
-  const double t62 = (t59 + 0.696 * t60 + t61);
-  const double t63 = ((t58 * t58) + (t62 * t62));
-  const double t64 = sqrt(t63);
-  const double t65 = (1.0 / sqrt(t63));
-  const double t66 = 0.016 * t39;
-  const double t67 = t40 * (-0.552);
-  const double t68 = (-0.315 * t18 + t66 + t67 - t20 * 0.15700000000000003);
-  const double t69 = (t41 * t45 + t68 * t45);
-  const double t70 = pow(t48, (-1.5));
-  const double t71 = (1.0 / (t48 * t48));
-  const double t72 = (t47 * 2.0 * t50 * t69 - t71 * t51 * t69);
-  const double t73 = (1.0 / sqrt(t52));
-  const double t74 = (1.0 / (((t50 * (t55 * t55) + t50 * (t54 * t54)))));
-  const double t75 = (((t49 * ((t47 * 2.0 * t49 * t45 + 4.0 * t49 * t69 * t41 + 4.0 * t68 * t53 -
-                                t47 * 2.0 * t70 * t69 * t41 - t72 * t73 * t45)) -
-                        2.0 * t54 * t70 * t69)) *
-                          t55 * t49 * t74 +
-                      t54 * t49 *
-                          ((2.0 * t55 * t70 * t69 + ((t72 * t73 * t41 + t47 * 2.0 * t68 * t49 -
-                                                      t47 * 2.0 * t70 * t69 * t45 -
-                                                      4.0 * t53 * t45 + 4.0 * t49 * t69 * t45)) *
-                                                        t49)) *
-                          t74);
-  const double t76 = (((-t20 * 3.081 + 0.348 * t57 * t75 + 0.623 * t18)) * t62 +
-                      ((t59 + t61 - 0.348 * t75 * t60)) * t58);
-  const double t77 = (x[14] - 3.7e+07);
-  const double t78 = sqrt((1e-06 + (x[10] * x[10])));
-  const double t79 = (x[10] + t78);
-  const double t80 = (x[14] - u[12]);
-  const double t81 = (x[14] - 2e+05);
-  const double t82 = (t81 * t81);
-  const double t83 = (x[10] - t78);
-  const double t84 = (t66 + t67);
-  const double t85 = (t43 + t44);
-  const double t86 = (t84 * t45 + t85 * t41);
-  const double t87 = (t47 * 2.0 * t50 * t86 - t71 * t51 * t86);
-  const double t88 =
-      (-t54 *
-           ((t49 * ((-t47 * 2.0 * t49 * t84 - 4.0 * t49 * t86 * t45 - t87 * t73 * t41 +
-                     4.0 * t85 * t53 + t47 * 2.0 * t70 * t86 * t45)) -
-             2.0 * t55 * t70 * t86)) *
-           t49 * t74 +
-       ((-2.0 * t54 * t70 * t86 + ((-t47 * 2.0 * t70 * t41 * t86 + 4.0 * t49 * t41 * t86 +
-                                    t47 * 2.0 * t85 * t49 - t87 * t73 * t45 + 4.0 * t84 * t53)) *
-                                      t49)) *
-           t55 * t49 * t74);
-  const double t89 = (-0.696 * t58 * t60 * t88 + t62 * 0.696 * t57 * t88);
-  const double t90 = sqrt((1e-06 + (x[11] * x[11])));
-  const double t91 = (t90 + x[11]);
-  const double t92 = (u[13] - x[15]);
-  const double t93 = (x[15] - 2e+05);
-  const double t94 = (t93 * t93);
-  const double t95 = (-2.9e+07 + x[15]);
-  const double t96 = (x[11] - t90);
-  const double t97 = (x[16] - 3.7e+07);
-  const double t98 = (x[16] - 2e+05);
-  const double t99 = (t98 * t98);
-  const double t100 = (u[10] - x[16]);
-  const double t101 = (x[17] - 2e+05);
-  const double t102 = (t101 * t101);
-  const double t103 = (x[17] - 3.7e+07);
-  const double t104 = (x[17] - u[11]);
-  const double t105 = (x[18] - 3.7e+07);
-  const double t106 = (x[18] - 2e+05);
+  const double t0 = sqrt(((x[8] * x[8]) + 1e-06));
+  const double t1 = (t0 + x[8]);
+  const double t2 = (-x[12] + u[10]);
+  const double t3 = (sqrt(((t2 * t2) + 1e+08)) - x[12] + u[10]);
+  const double t4 = (x[12] - 2e+05);
+  const double t5 = (t4 * t4);
+  const double t6 = cos(x[0]);
+  const double t7 = sin(x[0]);
+  const double t8 = (1.09 - 0.236 * t6 + t7 * 2.979);
+  const double t9 = 0.236 * t7;
+  const double t10 = t6 * 2.979;
+  const double t11 = (-0.356 + t9 + t10);
+  const double t12 = ((t8 * t8) + (t11 * t11));
+  const double t13 = (1.0 / sqrt(t12));
+  const double t14 = (((t9 + t10)) * t8 + t11 * ((-t7 * 2.979 + 0.236 * t6)));
+  const double t15 = (x[12] - 3.7e+07);
+  const double t16 = (-t0 + x[8]);
+  const double t17 = sqrt(t12);
+  const double t18 = (x[0] + x[1]);
+  const double t19 = cos(t18);
+  const double t20 = t19 * (-0.8);
+  const double t21 = sin(t18);
+  const double t22 = t21 * (-0.104);
+  const double t23 = (1.11 * t7 + t20 + 3.136 * t6 + t22);
+  const double t24 = (-t21 * 0.8 + 3.136 * t7 + 0.104 * t19 - 1.11 * t6);
+  const double t25 = ((t23 * t23) + (t24 * t24));
+  const double t26 = sqrt(t25);
+  const double t27 = (x[13] - 3.7e+07);
+  const double t28 = (1.0 / sqrt(t25));
+  const double t29 = (-0.104) * t19;
+  const double t30 = t21 * 0.8;
+  const double t31 = (t23 * ((t29 + t30)) + ((t20 + t22)) * t24);
+  const double t32 = sqrt((1e-06 + (x[9] * x[9])));
+  const double t33 = (x[9] + t32);
+  const double t34 = (u[11] - x[13]);
+  const double t35 = (u[11] - x[13] + sqrt(((t34 * t34) + 1e+08)));
+  const double t36 = (t23 * ((t29 + t30 - 3.136 * t7 + 1.11 * t6)) + t24 * t23);
+  const double t37 = (x[13] - 2e+05);
+  const double t38 = (t37 * t37);
+  const double t39 = (-x[9] + t32);
+  const double t40 = (x[2] + x[0] + x[1]);
+  const double t41 = sin(t40);
+  const double t42 = cos(t40);
+  const double t43 = (0.315 * t19 + t21 * 0.15700000000000003 - 0.016 * t41 + 0.552 * t42);
+  const double t44 = (t43 * t43);
+  const double t45 = (-0.016) * t42;
+  const double t46 = t41 * (-0.552);
+  const double t47 = (t45 + t46 + 0.15700000000000003 * t19 - t21 * 0.315);
+  const double t48 = (t47 * t47);
+  const double t49 = (0.21712699999999996 + t44 + t48);
+  const double t50 = (t44 + t48);
+  const double t51 = (1.0 / sqrt(t50));
+  const double t52 = (1.0 / (t50));
+  const double t53 = (t49 * t49);
+  const double t54 = (-0.25 * t52 * t53 + 0.48441599999999996);
+  const double t55 = sqrt(t54);
+  const double t56 = (t49 * t51 * t43 + 2.0 * t55 * t47);
+  const double t57 = (2.0 * t43 * t55 - t49 * t51 * t47);
+  const double t58 = atan2(t56 * 0.5 * t51, t57 * t51 * (-0.5));
+  const double t59 = sin(t58);
+  const double t60 = (-0.623 * t19 + t21 * 3.081 + 0.696 * t59);
+  const double t61 = t21 * 0.623;
+  const double t62 = cos(t58);
+  const double t63 = 3.081 * t19;
+  const double t64 = (t61 + 0.696 * t62 + t63);
+  const double t65 = ((t60 * t60) + (t64 * t64));
+  const double t66 = (1.0 / sqrt(t65));
+  const double t67 = 0.016 * t41;
+  const double t68 = t42 * (-0.552);
+  const double t69 = (-0.315 * t19 + t67 + t68 - t21 * 0.15700000000000003);
+  const double t70 = (t43 * t47 + t69 * t47);
+  const double t71 = pow(t50, (-1.5));
+  const double t72 = (1.0 / (t50 * t50));
+  const double t73 = (t49 * 2.0 * t52 * t70 - t72 * t53 * t70);
+  const double t74 = (1.0 / sqrt(t54));
+  const double t75 = (1.0 / (((t52 * (t57 * t57) + t52 * (t56 * t56)))));
+  const double t76 = (((t51 * ((t49 * 2.0 * t51 * t47 + 4.0 * t51 * t70 * t43 + 4.0 * t69 * t55 -
+                                t49 * 2.0 * t71 * t70 * t43 - t73 * t74 * t47)) -
+                        2.0 * t56 * t71 * t70)) *
+                          t57 * t51 * t75 +
+                      t56 * t51 *
+                          ((2.0 * t57 * t71 * t70 + ((t73 * t74 * t43 + t49 * 2.0 * t69 * t51 -
+                                                      t49 * 2.0 * t71 * t70 * t47 -
+                                                      4.0 * t55 * t47 + 4.0 * t51 * t70 * t47)) *
+                                                        t51)) *
+                          t75);
+  const double t77 = (((-t21 * 3.081 + 0.348 * t59 * t76 + 0.623 * t19)) * t64 +
+                      ((t61 + t63 - 0.348 * t76 * t62)) * t60);
+  const double t78 = (x[14] - 3.7e+07);
+  const double t79 = (x[14] - 2e+05);
+  const double t80 = (t79 * t79);
+  const double t81 = sqrt((1e-06 + (x[10] * x[10])));
+  const double t82 = (x[10] - t81);
+  const double t83 = (t67 + t68);
+  const double t84 = (t45 + t46);
+  const double t85 = (t83 * t47 + t84 * t43);
+  const double t86 = (t49 * 2.0 * t52 * t85 - t72 * t53 * t85);
+  const double t87 =
+      (-t56 *
+           ((t51 * ((-t49 * 2.0 * t51 * t83 - 4.0 * t51 * t85 * t47 - t86 * t74 * t43 +
+                     4.0 * t84 * t55 + t49 * 2.0 * t71 * t85 * t47)) -
+             2.0 * t57 * t71 * t85)) *
+           t51 * t75 +
+       ((-2.0 * t56 * t71 * t85 + ((-t49 * 2.0 * t71 * t43 * t85 + 4.0 * t51 * t43 * t85 +
+                                    t49 * 2.0 * t84 * t51 - t86 * t74 * t47 + 4.0 * t83 * t55)) *
+                                      t51)) *
+           t57 * t51 * t75);
+  const double t88 = (-0.696 * t60 * t62 * t87 + t64 * 0.696 * t59 * t87);
+  const double t89 = (x[10] + t81);
+  const double t90 = (x[14] - u[12]);
+  const double t91 = (-sqrt((1e+08 + (t90 * t90))) + x[14] - u[12]);
+  const double t92 = sqrt(t65);
+  const double t93 = (u[13] - x[15]);
+  const double t94 = (sqrt(((t93 * t93) + 1e+08)) + u[13] - x[15]);
+  const double t95 = sqrt((1e-06 + (x[11] * x[11])));
+  const double t96 = (t95 + x[11]);
+  const double t97 = (x[15] - 2e+05);
+  const double t98 = (t97 * t97);
+  const double t99 = (-2.9e+07 + x[15]);
+  const double t100 = (x[11] - t95);
+  const double t101 = (x[16] - 3.7e+07);
+  const double t102 = (x[16] - 2e+05);
+  const double t103 = (t102 * t102);
+  const double t104 = (u[10] - x[16]);
+  const double t105 = (u[10] - x[16] + sqrt((1e+08 + (t104 * t104))));
+  const double t106 = (x[17] - 2e+05);
   const double t107 = (t106 * t106);
-  const double t108 = (x[18] - u[12]);
-  const double t109 = (u[13] - x[19]);
-  const double t110 = (x[19] - 2e+05);
-  const double t111 = (t110 * t110);
-  const double t112 = (-2.9e+07 + x[19]);
-  const double t113 = (-0.35 * t0 - t1 * 2.6);
-  const double t114 = 5.7 * t0;
-  const double t115 = t20 * (-0.1);
-  const double t116 = 1.1 * t18;
-  const double t117 = (t114 + t115 + t116);
-  const double t118 = t1 * (-0.35);
-  const double t119 = 2.6 * t0;
-  const double t120 = (t118 + t119);
-  const double t121 = t1 * (-5.7);
-  const double t122 = t18 * (-0.1);
-  const double t123 = t20 * (-1.1);
-  const double t124 = (t121 + t122 + t123);
-  const double t125 = t40 * 0.567857142857143;
-  const double t126 = 2.9 * t18;
-  const double t127 = t39 * 0.0578571428571429;
-  const double t128 = (t125 + t114 + t126 + t127);
-  const double t129 = t40 * 0.0578571428571429;
-  const double t130 = t20 * (-2.9);
-  const double t131 = t39 * (-0.567857142857143);
-  const double t132 = (t129 + t130 + t121 + t131);
-  const double t133 = t39 * (-0.7);
-  const double t134 = t40 * (-0.3);
-  const double t135 = (t133 + t130 + t121 + t134);
-  const double t136 = t39 * (-0.3);
-  const double t137 = t40 * 0.7;
-  const double t138 = (t136 + t114 + t126 + t137);
-  const double t139 = (t133 + t130 + t134);
-  const double t140 = (t115 + t116);
-  const double t141 = (t125 + t126 + t127);
-  const double t142 = (t129 + t130 + t131);
-  const double t143 = (t136 + t126 + t137);
-  const double t144 = (t122 + t123);
-  const double t145 =
-      (1150.0 + 950.0 * t135 * t139 + t117 * t140 * 1100.0 + u[8] * ((t128 * t141 + t132 * t142)) +
-       t143 * 950.0 * t138 + 1100.0 * t124 * t144);
-  const double t146 = (t136 + t137);
-  const double t147 = (t133 + t134);
-  const double t148 = (t125 + t127);
-  const double t149 = (t129 + t131);
-  const double t150 =
-      (950.0 * t138 * t146 + 250.0 + t147 * 950.0 * t135 + ((t128 * t148 + t149 * t132)) * u[8]);
-  const double t151 =
-      (t147 * 950.0 * t139 + 250.0 + t143 * 950.0 * t146 + ((t149 * t142 + t141 * t148)) * u[8]);
-  const double t152 = (-t20 * 110.0 + t18 * 1210.0 + 6270.0 * t0 + 165.0);
-  const double t153 = (t125 + t114 + t126 + 0.15 + t127);
-  const double t154 = (-t39 * 285.0 + 665.0 * t40 + t18 * 2755.0 + 142.5 + 5415.0 * t0);
-  const double t155 = (5720.0 * t0 + 330.0 - t1 * 770.0);
-  const double t156 = (x[4] * x[4]);
-  const double t157 = sin(u[9]);
-  const double t158 = t39 * 0.3;
-  const double t159 = (-2.9) * t18;
-  const double t160 = (-5.7) * t0;
-  const double t161 = t40 * (-0.7);
-  const double t162 = (t158 + t159 + t161);
-  const double t163 = t162 * x[5];
-  const double t164 = (t158 + t161);
-  const double t165 = t164 * x[6];
-  const double t166 =
-      (x[4] * ((((t158 + t159 + t160 + t161)) * x[4] + t163 + t165)) +
-       x[6] * ((t164 * x[5] + t165 + t164 * x[4])) + ((t162 * x[4] + t163 + t165)) * x[5]);
-  const double t167 = (t64 - 2.525);
-  const double t168 = ((t167 * t167) + 1e-06);
-  const double t169 = (t64 - 3.71);
-  const double t170 = ((t169 * t169) + 1e-06);
-  const double t171 =
-      (4e+08 * t64 - 2e+08 * sqrt(t168) + 0.013823007675795093 * x[18] - 1.247e+09 +
-       sqrt(t170) * 2e+08 - 0.026546457922833753 * x[14] +
-       ((t65 * t89 * 1e+06 * x[6] + t65 * 2e+06 * x[4] * t76 + t65 * 2e+06 * x[5] * t76)) *
-           (((1.0 / sqrt(t170)) * t169 + 2.0 - (1.0 / sqrt(t168)) * t167)));
-  const double t172 = t65 * t171 * t76 * (-0.5);
-  const double t173 = x[5] * t144;
-  const double t174 = (t124 * x[4] + t173);
-  const double t175 = (x[4] * t174 + x[5] * ((x[4] * t144 + t173)));
-  const double t176 = (x[7] * x[7]);
-  const double t177 = t20 * 0.1;
-  const double t178 = t18 * (-1.1);
-  const double t179 = (t177 + t178);
-  const double t180 = t179 * x[5];
-  const double t181 =
-      (x[5] * ((t180 + t179 * x[4])) + ((t180 + ((t177 + t178 + t160)) * x[4])) * x[4]);
-  const double t182 = cos(u[9]);
-  const double t183 = (-4.005 + t25);
-  const double t184 = (1e-06 + (t183 * t183));
-  const double t185 = (t25 - 2.595);
-  const double t186 = (1e-06 + (t185 * t185));
-  const double t187 = (-0.035342917352885174 * x[13] + 4e+08 * t25 - 1.32e+09 + sqrt(t184) * 2e+08 -
-                       sqrt(t186) * 2e+08 + x[17] * 0.01802488784997144 +
-                       (((1.0 / sqrt(t184)) * t183 - (1.0 / sqrt(t186)) * t185 + 2.0)) *
-                           ((t30 * 2e+06 * x[5] * t33 + t30 * 2e+06 * t34 * x[4])));
-  const double t188 = t147 * x[6];
-  const double t189 = x[5] * t139;
-  const double t190 = (t189 + t135 * x[4] + t188);
-  const double t191 = (((t147 * x[5] + t147 * x[4] + t188)) * x[6] +
-                       ((t189 + x[4] * t139 + t188)) * x[5] + x[4] * t190);
-  const double t192 = t39 * (-0.0578571428571429);
-  const double t193 = (-0.567857142857143) * t40;
-  const double t194 = (t192 + t159 + t193);
-  const double t195 = x[5] * t194;
-  const double t196 = (t192 + t193);
-  const double t197 = t196 * x[6];
-  const double t198 =
-      (x[4] * ((x[4] * ((t192 + t159 + t160 + t193)) + t195 + t197)) +
-       x[5] * ((x[4] * t194 + t195 + t197)) + ((t197 + t196 * x[5] + t196 * x[4])) * x[6]);
-  const double t199 = x[5] * t142;
-  const double t200 = t149 * x[6];
-  const double t201 = (t199 + x[4] * t132 + t200);
-  const double t202 = (x[5] * ((x[4] * t142 + t199 + t200)) + x[4] * t201 +
-                       ((t149 * x[5] + t200 + t149 * x[4])) * x[6]);
-  const double t203 = (-3.775 + t7);
-  const double t204 = (1e-06 + (t203 * t203));
-  const double t205 = (-2.03 + t7);
-  const double t206 = (1e-06 + (t205 * t205));
+  const double t108 = (x[17] - 3.7e+07);
+  const double t109 = (x[17] - u[11]);
+  const double t110 = (x[17] - sqrt(((t109 * t109) + 1e+08)) - u[11]);
+  const double t111 = (x[18] - 3.7e+07);
+  const double t112 = (x[18] - 2e+05);
+  const double t113 = (t112 * t112);
+  const double t114 = (x[18] - u[12]);
+  const double t115 = (sqrt((1e+08 + (t114 * t114))) + u[12] - x[18]);
+  const double t116 = (u[13] - x[19]);
+  const double t117 = (sqrt(((t116 * t116) + 1e+08)) + u[13] - x[19]);
+  const double t118 = (x[19] - 2e+05);
+  const double t119 = (t118 * t118);
+  const double t120 = (-2.9e+07 + x[19]);
+  const double t121 = (-0.35 * t6 - t7 * 2.6);
+  const double t122 = 5.7 * t6;
+  const double t123 = t21 * (-0.1);
+  const double t124 = 1.1 * t19;
+  const double t125 = (t122 + t123 + t124);
+  const double t126 = t7 * (-0.35);
+  const double t127 = 2.6 * t6;
+  const double t128 = (t126 + t127);
+  const double t129 = t7 * (-5.7);
+  const double t130 = t19 * (-0.1);
+  const double t131 = t21 * (-1.1);
+  const double t132 = (t129 + t130 + t131);
+  const double t133 = t42 * 0.567857142857143;
+  const double t134 = 2.9 * t19;
+  const double t135 = t41 * 0.0578571428571429;
+  const double t136 = (t133 + t122 + t134 + t135);
+  const double t137 = t42 * 0.0578571428571429;
+  const double t138 = t21 * (-2.9);
+  const double t139 = t41 * (-0.567857142857143);
+  const double t140 = (t137 + t138 + t129 + t139);
+  const double t141 = t41 * (-0.7);
+  const double t142 = t42 * (-0.3);
+  const double t143 = (t141 + t138 + t129 + t142);
+  const double t144 = t41 * (-0.3);
+  const double t145 = t42 * 0.7;
+  const double t146 = (t144 + t122 + t134 + t145);
+  const double t147 = (t141 + t138 + t142);
+  const double t148 = (t123 + t124);
+  const double t149 = (t133 + t134 + t135);
+  const double t150 = (t137 + t138 + t139);
+  const double t151 = (t144 + t134 + t145);
+  const double t152 = (t130 + t131);
+  const double t153 =
+      (1150.0 + 950.0 * t143 * t147 + t125 * t148 * 1100.0 + u[8] * ((t136 * t149 + t140 * t150)) +
+       t151 * 950.0 * t146 + 1100.0 * t132 * t152);
+  const double t154 = (t144 + t145);
+  const double t155 = (t141 + t142);
+  const double t156 = (t133 + t135);
+  const double t157 = (t137 + t139);
+  const double t158 =
+      (950.0 * t146 * t154 + 250.0 + t155 * 950.0 * t143 + ((t136 * t156 + t157 * t140)) * u[8]);
+  const double t159 =
+      (t155 * 950.0 * t147 + 250.0 + t151 * 950.0 * t154 + ((t157 * t150 + t149 * t156)) * u[8]);
+  const double t160 = (-t21 * 110.0 + t19 * 1210.0 + 6270.0 * t6 + 165.0);
+  const double t161 = (t133 + t122 + t134 + 0.15 + t135);
+  const double t162 = (-t41 * 285.0 + 665.0 * t42 + t19 * 2755.0 + 142.5 + 5415.0 * t6);
+  const double t163 = (5720.0 * t6 + 330.0 - t7 * 770.0);
+  const double t164 = (x[4] * x[4]);
+  const double t165 = sin(u[9]);
+  const double t166 = t41 * 0.3;
+  const double t167 = (-2.9) * t19;
+  const double t168 = (-5.7) * t6;
+  const double t169 = t42 * (-0.7);
+  const double t170 = (t166 + t167 + t169);
+  const double t171 = t170 * x[5];
+  const double t172 = (t166 + t169);
+  const double t173 = t172 * x[6];
+  const double t174 =
+      (x[4] * ((((t166 + t167 + t168 + t169)) * x[4] + t171 + t173)) +
+       x[6] * ((t172 * x[5] + t173 + t172 * x[4])) + ((t170 * x[4] + t171 + t173)) * x[5]);
+  const double t175 = (t92 - 2.525);
+  const double t176 = ((t175 * t175) + 1e-06);
+  const double t177 = (t92 - 3.71);
+  const double t178 = ((t177 * t177) + 1e-06);
+  const double t179 =
+      (4e+08 * t92 - 2e+08 * sqrt(t176) + 0.013823007675795093 * x[18] - 1.247e+09 +
+       sqrt(t178) * 2e+08 - 0.026546457922833753 * x[14] +
+       ((t66 * t88 * 1e+06 * x[6] + t66 * 2e+06 * x[4] * t77 + t66 * 2e+06 * x[5] * t77)) *
+           (((1.0 / sqrt(t178)) * t177 + 2.0 - (1.0 / sqrt(t176)) * t175)));
+  const double t180 = t66 * t179 * t77 * (-0.5);
+  const double t181 = x[5] * t152;
+  const double t182 = (t132 * x[4] + t181);
+  const double t183 = (x[4] * t182 + x[5] * ((x[4] * t152 + t181)));
+  const double t184 = (x[7] * x[7]);
+  const double t185 = t21 * 0.1;
+  const double t186 = t19 * (-1.1);
+  const double t187 = (t185 + t186);
+  const double t188 = t187 * x[5];
+  const double t189 =
+      (x[5] * ((t188 + t187 * x[4])) + ((t188 + ((t185 + t186 + t168)) * x[4])) * x[4]);
+  const double t190 = cos(u[9]);
+  const double t191 = (-4.005 + t26);
+  const double t192 = (1e-06 + (t191 * t191));
+  const double t193 = (t26 - 2.595);
+  const double t194 = (1e-06 + (t193 * t193));
+  const double t195 = (-0.035342917352885174 * x[13] + 4e+08 * t26 - 1.32e+09 + sqrt(t192) * 2e+08 -
+                       sqrt(t194) * 2e+08 + x[17] * 0.01802488784997144 +
+                       (((1.0 / sqrt(t192)) * t191 - (1.0 / sqrt(t194)) * t193 + 2.0)) *
+                           ((t28 * 2e+06 * x[5] * t31 + t28 * 2e+06 * t36 * x[4])));
+  const double t196 = t155 * x[6];
+  const double t197 = x[5] * t147;
+  const double t198 = (t197 + t143 * x[4] + t196);
+  const double t199 = (((t155 * x[5] + t155 * x[4] + t196)) * x[6] +
+                       ((t197 + x[4] * t147 + t196)) * x[5] + x[4] * t198);
+  const double t200 = t41 * (-0.0578571428571429);
+  const double t201 = (-0.567857142857143) * t42;
+  const double t202 = (t200 + t167 + t201);
+  const double t203 = x[5] * t202;
+  const double t204 = (t200 + t201);
+  const double t205 = t204 * x[6];
+  const double t206 =
+      (x[4] * ((x[4] * ((t200 + t167 + t168 + t201)) + t203 + t205)) +
+       x[5] * ((x[4] * t202 + t203 + t205)) + ((t205 + t204 * x[5] + t204 * x[4])) * x[6]);
+  const double t207 = x[5] * t150;
+  const double t208 = t157 * x[6];
+  const double t209 = (t207 + x[4] * t140 + t208);
+  const double t210 = (x[5] * ((x[4] * t150 + t207 + t208)) + x[4] * t209 +
+                       ((t157 * x[5] + t208 + t157 * x[4])) * x[6]);
+  const double t211 = (-3.775 + t17);
+  const double t212 = (1e-06 + (t211 * t211));
+  const double t213 = (-2.03 + t17);
+  const double t214 = (1e-06 + (t213 * t213));
   xdot[0] = x[4];
   xdot[1] = x[5];
   xdot[2] = x[6];
@@ -641,103 +649,107 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   xdot[10] = (-x[10] * 16.666666666666668 + u[2] * 16.666666666666668);
   xdot[11] = (-12.5 * x[11] + 12.5 * u[3]);
   xdot[12] = 1.2e+09 *
-             ((sqrt((t9 + 1e+10)) * 3.5e-09 - t10 * x[4] * 0.03078760800517998 * t11 -
-               sqrt(((t12 * t12) + 1e+10)) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
-               t13 * 2.8577380332470414e-06 * pow(((t13 * t13) + 4e+10), (-0.25)) * t15 +
-               pow((4e+10 + t9), (-0.25)) * t8 * 2.8577380332470414e-06 * t16)) /
-             (((t7 * 0.03078760800517998 - 0.059498844250515354)));
-  xdot[13] = ((-sqrt((1e+10 + (t26 * t26))) * 3.5e-09 +
-               2.8577380332470414e-06 * t27 * t29 * pow((4e+10 + (t27 * t27)), (-0.25)) -
-               t30 * 0.017671458676442587 * x[5] * t33 - t30 * t34 * 0.017671458676442587 * x[4] -
-               x[13] * 7e-09 + 0.1302 + sqrt((1e+10 + t36)) * 3.5e-09 -
-               pow((4e+10 + t36), (-0.25)) * t35 * 2.8577380332470414e-06 * t37)) *
-             1.2e+09 / (((0.017671458676442587 * t25 - 0.04285743526536852)));
-  xdot[14] = 1.2e+09 *
-             ((-t65 * x[4] * 0.013273228961416876 * t76 + 0.093 -
-               t65 * x[5] * 0.013273228961416876 * t76 - sqrt(((t77 * t77) + 1e+10)) * 2.5e-09 -
-               t79 * t80 * 2.0412414523193154e-06 * pow((4e+10 + (t80 * t80)), (-0.25)) +
-               pow((4e+10 + t82), (-0.25)) * t81 * t83 * 2.0412414523193154e-06 - x[14] * 5e-09 -
-               t65 * t89 * 0.006636614480708438 * x[6] + 2.5e-09 * sqrt((1e+10 + t82)))) /
-             (((-0.03151490312757761 + t64 * 0.013273228961416876)));
-  xdot[15] = (t91 * t92 * 510310.3630798288 * pow((4e+10 + (t92 * t92)), (-0.25)) + 1.825e+10 +
-              625.0 * sqrt((1e+10 + t94)) - 625.0 * sqrt(((t95 * t95) + 1e+10)) - 7.5e+08 * x[7] +
-              t96 * t93 * pow((4e+10 + t94), (-0.25)) * 510310.3630798288 - x[15] * 1250.0);
-  xdot[16] = ((0.015079644737231009 * t10 * x[4] * t11 - sqrt(((t97 * t97) + 1e+10)) * 3.5e-09 -
-               pow((4e+10 + t99), (-0.25)) * t98 * 2.8577380332470414e-06 * t15 -
-               pow((4e+10 + (t100 * t100)), (-0.25)) * 2.8577380332470414e-06 * t100 * t16 -
-               x[16] * 7e-09 + 0.1302 + sqrt((1e+10 + t99)) * 3.5e-09)) *
-             1.2e+09 / (((0.05992565888304706 - 0.015079644737231009 * t7)));
+             ((1.4288690166235207e-06 * t1 * t3 * pow((4e+10 + 0.25 * (t3 * t3)), (-0.25)) +
+               sqrt((t5 + 1e+10)) * 3.5e-09 - t13 * x[4] * 0.03078760800517998 * t14 -
+               sqrt(((t15 * t15) + 1e+10)) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
+               pow((4e+10 + t5), (-0.25)) * t4 * 2.8577380332470414e-06 * t16)) /
+             (((t17 * 0.03078760800517998 - 0.059498844250515354)));
+  xdot[13] = 1.2e+09 *
+             ((-sqrt((1e+10 + (t27 * t27))) * 3.5e-09 - t28 * 0.017671458676442587 * x[5] * t31 +
+               t33 * 1.4288690166235207e-06 * pow((4e+10 + (t35 * t35) * 0.25), (-0.25)) * t35 -
+               t28 * t36 * 0.017671458676442587 * x[4] - x[13] * 7e-09 + 0.1302 +
+               sqrt((1e+10 + t38)) * 3.5e-09 -
+               pow((4e+10 + t38), (-0.25)) * t37 * 2.8577380332470414e-06 * t39)) /
+             (((0.017671458676442587 * t26 - 0.04285743526536852)));
+  xdot[14] = ((-t66 * x[4] * 0.013273228961416876 * t77 + 0.093 -
+               t66 * x[5] * 0.013273228961416876 * t77 - sqrt(((t78 * t78) + 1e+10)) * 2.5e-09 +
+               pow((4e+10 + t80), (-0.25)) * t79 * t82 * 2.0412414523193154e-06 - x[14] * 5e-09 -
+               t66 * t88 * 0.006636614480708438 * x[6] -
+               t89 * 1.0206207261596577e-06 * pow((4e+10 + 0.25 * (t91 * t91)), (-0.25)) * t91 +
+               2.5e-09 * sqrt((1e+10 + t80)))) *
+             1.2e+09 / (((-0.03151490312757761 + t92 * 0.013273228961416876)));
+  xdot[15] =
+      (pow((4e+10 + 0.25 * (t94 * t94)), (-0.25)) * t94 * t96 * 255155.1815399144 + 1.825e+10 +
+       625.0 * sqrt((1e+10 + t98)) - 625.0 * sqrt(((t99 * t99) + 1e+10)) - 7.5e+08 * x[7] +
+       t100 * t97 * pow((4e+10 + t98), (-0.25)) * 510310.3630798288 - x[15] * 1250.0);
+  xdot[16] =
+      ((0.015079644737231009 * t13 * x[4] * t14 - sqrt(((t101 * t101) + 1e+10)) * 3.5e-09 -
+        pow((4e+10 + t103), (-0.25)) * t102 * 2.8577380332470414e-06 * t1 - x[16] * 7e-09 + 0.1302 +
+        sqrt((1e+10 + t103)) * 3.5e-09 -
+        pow((4e+10 + (t105 * t105) * 0.25), (-0.25)) * t105 * 1.4288690166235207e-06 * t16)) *
+      1.2e+09 / (((0.05992565888304706 - 0.015079644737231009 * t17)));
   xdot[17] = 1.2e+09 *
-             ((sqrt((t102 + 1e+10)) * 3.5e-09 - sqrt((1e+10 + (t103 * t103))) * 3.5e-09 +
-               t30 * t34 * x[4] * 0.00901244392498572 + 0.1302 -
-               pow((4e+10 + t102), (-0.25)) * t101 * 2.8577380332470414e-06 * t29 - x[17] * 7e-09 +
-               t30 * x[5] * t33 * 0.00901244392498572 -
-               pow((4e+10 + (t104 * t104)), (-0.25)) * 2.8577380332470414e-06 * t104 * t37)) /
-             (((0.03909483791956781 - t25 * 0.00901244392498572)));
+             ((sqrt((t107 + 1e+10)) * 3.5e-09 - sqrt((1e+10 + (t108 * t108))) * 3.5e-09 -
+               pow((4e+10 + 0.25 * (t110 * t110)), (-0.25)) * 1.4288690166235207e-06 * t110 * t39 +
+               t28 * t36 * x[4] * 0.00901244392498572 + 0.1302 -
+               pow((4e+10 + t107), (-0.25)) * t106 * 2.8577380332470414e-06 * t33 - x[17] * 7e-09 +
+               t28 * x[5] * t31 * 0.00901244392498572)) /
+             (((0.03909483791956781 - t26 * 0.00901244392498572)));
   xdot[18] =
-      ((-2.5e-09 * sqrt((1e+10 + (t105 * t105))) + 0.093 + t65 * 0.006911503837897547 * x[4] * t76 +
-        t65 * 0.006911503837897547 * x[5] * t76 + 2.5e-09 * sqrt((t107 + 1e+10)) +
-        0.0034557519189487734 * t65 * t89 * x[6] - x[18] * 5e-09 +
-        t83 * t108 * 2.0412414523193154e-06 * pow((4e+10 + (t108 * t108)), (-0.25)) -
-        pow((4e+10 + t107), (-0.25)) * t106 * t79 * 2.0412414523193154e-06)) *
-      1.2e+09 / (((0.0276416792385999 - 0.006911503837897547 * t64)));
-  xdot[19] = (1.825e+10 - t96 * 510310.3630798288 * t109 * pow(((t109 * t109) + 4e+10), (-0.25)) +
-              625.0 * sqrt((t111 + 1e+10)) - 625.0 * sqrt(((t112 * t112) + 1e+10)) -
-              pow((4e+10 + t111), (-0.25)) * t110 * t91 * 510310.3630798288 + 7.5e+08 * x[7] -
-              x[19] * 1250.0);
-  mass[0] = (7650.0 + 2200.0 * (t113 * t113) + (t117 * t117) * 1100.0 + (t120 * t120) * 2200.0 +
-             1100.0 * (t124 * t124) + (((t128 * t128) + (t132 * t132))) * u[8] +
-             950.0 * (t135 * t135) + (t138 * t138) * 950.0);
-  mass[1] = t145;
-  mass[2] = t150;
+      ((-2.5e-09 * sqrt((1e+10 + (t111 * t111))) + 0.093 + t66 * 0.006911503837897547 * x[4] * t77 +
+        t66 * 0.006911503837897547 * x[5] * t77 + 2.5e-09 * sqrt((t113 + 1e+10)) -
+        pow((4e+10 + (t115 * t115) * 0.25), (-0.25)) * t115 * t82 * 1.0206207261596577e-06 +
+        0.0034557519189487734 * t66 * t88 * x[6] - x[18] * 5e-09 -
+        pow((4e+10 + t113), (-0.25)) * t112 * t89 * 2.0412414523193154e-06)) *
+      1.2e+09 / (((0.0276416792385999 - 0.006911503837897547 * t92)));
+  xdot[19] =
+      (1.825e+10 - t100 * pow((4e+10 + 0.25 * (t117 * t117)), (-0.25)) * t117 * 255155.1815399144 +
+       625.0 * sqrt((t119 + 1e+10)) - 625.0 * sqrt(((t120 * t120) + 1e+10)) -
+       pow((4e+10 + t119), (-0.25)) * t118 * t96 * 510310.3630798288 + 7.5e+08 * x[7] -
+       x[19] * 1250.0);
+  mass[0] = (7650.0 + 2200.0 * (t121 * t121) + (t125 * t125) * 1100.0 + (t128 * t128) * 2200.0 +
+             1100.0 * (t132 * t132) + (((t136 * t136) + (t140 * t140))) * u[8] +
+             950.0 * (t143 * t143) + (t146 * t146) * 950.0);
+  mass[1] = t153;
+  mass[2] = t158;
   mass[3] = 0.0;
-  mass[4] = t145;
-  mass[5] = ((t144 * t144) * 1100.0 + 1150.0 + 950.0 * (t139 * t139) + (t143 * t143) * 950.0 +
-             u[8] * (((t142 * t142) + (t141 * t141))) + 1100.0 * (t140 * t140));
-  mass[6] = t151;
+  mass[4] = t153;
+  mass[5] = ((t152 * t152) * 1100.0 + 1150.0 + 950.0 * (t147 * t147) + (t151 * t151) * 950.0 +
+             u[8] * (((t150 * t150) + (t149 * t149))) + 1100.0 * (t148 * t148));
+  mass[6] = t159;
   mass[7] = 0.0;
-  mass[8] = t150;
-  mass[9] = t151;
-  mass[10] = ((((t149 * t149) + (t148 * t148))) * u[8] + (t147 * t147) * 950.0 + 250.0 +
-              (t146 * t146) * 950.0);
+  mass[8] = t158;
+  mass[9] = t159;
+  mass[10] = ((((t157 * t157) + (t156 * t156))) * u[8] + (t155 * t155) * 950.0 + 250.0 +
+              (t154 * t154) * 950.0);
   mass[11] = 0.0;
   mass[12] = 0.0;
   mass[13] = 0.0;
   mass[14] = 0.0;
-  mass[15] = (((t114 + t115 + t116 + 0.15)) * t152 + 60000.0 + (t153 * t153) * u[8] +
-              ((t136 + t114 + t126 + 0.15 + t137)) * t154 + t155 * ((t118 + 0.15 + t119)));
+  mass[15] = (((t122 + t123 + t124 + 0.15)) * t160 + 60000.0 + (t161 * t161) * u[8] +
+              ((t144 + t122 + t134 + 0.15 + t145)) * t162 + t163 * ((t126 + 0.15 + t127)));
   acceleration[0] =
-      (-t156 * t113 * t120 * 2200.0 - t113 * t157 * 21574.629999999997 - 950.0 * t135 * t166 -
-       t156 * t113 * 2200.0 * ((t1 * 0.35 - t119)) + t172 - t117 * 1100.0 * t175 +
-       t176 * t113 * t155 - t181 * 1100.0 * t124 - t138 * t182 * 9316.3175 - x[4] * 6000.0 -
-       t30 * t187 * t34 * 0.5 + t176 * t153 * u[8] * t132 - t157 * t135 * 9316.3175 + u[4] +
-       t176 * t135 * t154 - t117 * t182 * 10787.314999999999 - t157 * t124 * 10787.314999999999 -
-       950.0 * t138 * t191 + ((-t128 * t182 * 9.80665 - t157 * 9.80665 * t132)) * u[8] -
-       ((t198 * t132 + t128 * t202)) * u[8] + t176 * t124 * t152 -
-       t120 * t182 * 21574.629999999997 +
-       t10 * t11 *
-           ((-t10 * 2e+06 * x[4] * ((2.0 + (1.0 / sqrt(t204)) * t203 - t205 * (1.0 / sqrt(t206)))) *
-                 t11 -
-             2e+08 * sqrt(t204) + sqrt(t206) * 2e+08 - 0.015079644737231009 * x[16] + 1.161e+09 -
-             4e+08 * t7 + x[12] * 0.03078760800517998)));
+      (-t164 * t121 * t128 * 2200.0 - t121 * t165 * 21574.629999999997 - 950.0 * t143 * t174 -
+       t164 * t121 * 2200.0 * ((t7 * 0.35 - t127)) + t180 - t125 * 1100.0 * t183 +
+       t184 * t121 * t163 - t189 * 1100.0 * t132 - t146 * t190 * 9316.3175 - x[4] * 6000.0 -
+       t28 * t195 * t36 * 0.5 + t184 * t161 * u[8] * t140 - t165 * t143 * 9316.3175 + u[4] +
+       t184 * t143 * t162 - t125 * t190 * 10787.314999999999 - t165 * t132 * 10787.314999999999 -
+       950.0 * t146 * t199 + ((-t136 * t190 * 9.80665 - t165 * 9.80665 * t140)) * u[8] -
+       ((t206 * t140 + t136 * t210)) * u[8] + t184 * t132 * t160 -
+       t128 * t190 * 21574.629999999997 +
+       t13 * t14 *
+           ((-t13 * 2e+06 * x[4] * ((2.0 + (1.0 / sqrt(t212)) * t211 - t213 * (1.0 / sqrt(t214)))) *
+                 t14 -
+             2e+08 * sqrt(t212) + sqrt(t214) * 2e+08 - 0.015079644737231009 * x[16] + 1.161e+09 -
+             4e+08 * t17 + x[12] * 0.03078760800517998)));
   acceleration[1] =
-      (-t143 * t182 * 9316.3175 - t157 * t139 * 9316.3175 + t176 * t144 * t152 + t172 +
-       t176 * t139 * t154 - ((t198 * t142 + t141 * t202)) * u[8] - 2500.0 * x[5] -
-       950.0 * t166 * t139 - t181 * 1100.0 * t144 +
-       u[8] * ((-t141 * t182 * 9.80665 - t157 * 9.80665 * t142)) -
-       t157 * 10787.314999999999 * t144 - t143 * 950.0 * t191 + u[5] + t176 * t153 * u[8] * t142 -
-       t140 * t182 * 10787.314999999999 - t140 * 1100.0 * t175 - t30 * t187 * 0.5 * t33);
+      (-t151 * t190 * 9316.3175 - t165 * t147 * 9316.3175 + t184 * t152 * t160 + t180 +
+       t184 * t147 * t162 - ((t206 * t150 + t149 * t210)) * u[8] - 2500.0 * x[5] -
+       950.0 * t174 * t147 - t189 * 1100.0 * t152 +
+       u[8] * ((-t149 * t190 * 9.80665 - t165 * 9.80665 * t150)) -
+       t165 * 10787.314999999999 * t152 - t151 * 950.0 * t199 + u[5] + t184 * t161 * u[8] * t150 -
+       t148 * t190 * 10787.314999999999 - t148 * 1100.0 * t183 - t28 * t195 * 0.5 * t31);
   acceleration[2] =
-      (-t147 * 950.0 * t166 + t176 * t153 * t149 * u[8] - 950.0 * t191 * t146 + t176 * t147 * t154 +
-       ((-t157 * t149 * 9.80665 - t182 * t148 * 9.80665)) * u[8] - 800.0 * x[6] -
-       t182 * t146 * 9316.3175 + u[6] - u[8] * ((t198 * t149 + t148 * t202)) -
-       t147 * t157 * 9316.3175 - t65 * 0.25 * t89 * t171);
+      (-t155 * 950.0 * t174 + t184 * t161 * t157 * u[8] - 950.0 * t199 * t154 + t184 * t155 * t162 +
+       ((-t165 * t157 * 9.80665 - t190 * t156 * 9.80665)) * u[8] - 800.0 * x[6] -
+       t190 * t154 * 9316.3175 + u[6] - u[8] * ((t206 * t157 + t156 * t210)) -
+       t155 * t165 * 9316.3175 - t66 * 0.25 * t88 * t179);
   acceleration[3] =
       (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 -
-       t113 * x[7] * x[4] * ((11440.0 * t0 + 660.0 - t1 * 1540.0)) + u[7] -
-       t153 * 2.0 * x[7] * u[8] * t201 -
-       ((330.0 + 12540.0 * t0 + 2420.0 * t18 - t20 * 220.0)) * x[7] * t174 -
-       x[7] * ((-t39 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t18 + 1330.0 * t40)) * t190);
+       t121 * x[7] * x[4] * ((11440.0 * t6 + 660.0 - t7 * 1540.0)) + u[7] -
+       t161 * 2.0 * x[7] * u[8] * t209 -
+       ((330.0 + 12540.0 * t6 + 2420.0 * t19 - t21 * 220.0)) * x[7] * t182 -
+       x[7] * ((-t41 * 570.0 + 285.0 + 10830.0 * t6 + 5510.0 * t19 + 1330.0 * t42)) * t198);
   Factor(mass);
   Solve(mass, acceleration);
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
@@ -877,642 +889,668 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t14 = sqrt(t6);
   const double t15 = (t14 * 0.03078760800517998 - 0.059498844250515354);
   const double t16 = (1.0 / (t15));
-  const double t17 = (x[12] - 2e+05);
-  const double t18 = (t17 * t17);
-  const double t19 = (t18 + 1e+10);
-  const double t20 = (x[12] - 3.7e+07);
-  const double t21 = ((t20 * t20) + 1e+10);
-  const double t22 = (-x[12] + u[10]);
+  const double t17 = ((x[8] * x[8]) + 1e-06);
+  const double t18 = sqrt(t17);
+  const double t19 = (t18 + x[8]);
+  const double t20 = (-x[12] + u[10]);
+  const double t21 = ((t20 * t20) + 1e+08);
+  const double t22 = (sqrt(t21) - x[12] + u[10]);
   const double t23 = (t22 * t22);
-  const double t24 = (t23 + 4e+10);
+  const double t24 = (4e+10 + 0.25 * t23);
   const double t25 = pow(t24, (-0.25));
-  const double t26 = ((x[8] * x[8]) + 1e-06);
-  const double t27 = sqrt(t26);
-  const double t28 = (t27 + x[8]);
-  const double t29 = (4e+10 + t18);
-  const double t30 = pow(t29, (-0.25));
-  const double t31 = (-t27 + x[8]);
-  const double t32 = x[8] * (1.0 / sqrt(t26));
-  const double t33 = (t32 - 1.0);
-  const double t34 = (t32 + 1.0);
-  const double t35 = x[12] * 2.0;
-  const double t36 = (t35 - 4e+05);
-  const double t37 = (x[0] + x[1]);
-  const double t38 = cos(t37);
-  const double t39 = t38 * (-0.8);
-  const double t40 = sin(t37);
-  const double t41 = t40 * (-0.104);
-  const double t42 = (1.11 * t1 + t39 + 3.136 * t0 + t41);
-  const double t43 = (t42 * t42);
-  const double t44 = (-t40 * 0.8 + 3.136 * t1 + 0.104 * t38 - 1.11 * t0);
-  const double t45 = (t43 + (t44 * t44));
-  const double t46 = (1.0 / sqrt(t45));
-  const double t47 = (x[13] - 3.7e+07);
-  const double t48 = (1e+10 + (t47 * t47));
-  const double t49 = (u[11] - x[13]);
-  const double t50 = (1e-06 + (x[9] * x[9]));
-  const double t51 = sqrt(t50);
-  const double t52 = (x[9] + t51);
-  const double t53 = (t49 * t49);
-  const double t54 = (4e+10 + t53);
-  const double t55 = pow(t54, (-0.25));
-  const double t56 = (-0.104) * t38;
-  const double t57 = t40 * 0.8;
-  const double t58 = (t56 + t57);
-  const double t59 = (t39 + t41);
-  const double t60 = (t42 * t58 + t59 * t44);
-  const double t61 = (t56 + t57 - 3.136 * t1 + 1.11 * t0);
-  const double t62 = (t42 * t61 + t44 * t42);
-  const double t63 = (x[13] - 2e+05);
-  const double t64 = (t63 * t63);
-  const double t65 = (1e+10 + t64);
-  const double t66 = (4e+10 + t64);
-  const double t67 = pow(t66, (-0.25));
-  const double t68 = (-x[9] + t51);
-  const double t69 =
-      (-sqrt(t48) * 3.5e-09 + 2.8577380332470414e-06 * t49 * t52 * t55 -
-       t46 * 0.017671458676442587 * x[5] * t60 - t46 * t62 * 0.017671458676442587 * x[4] -
-       x[13] * 7e-09 + 0.1302 + sqrt(t65) * 3.5e-09 - t67 * t63 * 2.8577380332470414e-06 * t68);
-  const double t70 = sqrt(t45);
-  const double t71 = (0.017671458676442587 * t70 - 0.04285743526536852);
-  const double t72 = (1.0 / (t71 * t71));
-  const double t73 = (1.0 / (t71));
-  const double t74 = 0.8 * t38;
-  const double t75 = t40 * 0.104;
-  const double t76 = t42 * ((t74 + t75));
-  const double t77 = t44 * t58;
-  const double t78 = (t76 + t77 + t59 * t42 + t58 * t61);
-  const double t79 = pow(t45, (-1.5));
-  const double t80 = (t62 * t62);
-  const double t81 =
-      (t42 * ((-3.136 * t0 + t74 - 1.11 * t1 + t75)) + t44 * t61 + t43 + (t61 * t61));
-  const double t82 = (t60 * t60);
-  const double t83 = (t76 + t77 + (t59 * t59) + (t58 * t58));
-  const double t84 = (1.0 / sqrt(t50)) * x[9];
-  const double t85 = (t84 + 1.0);
-  const double t86 = (t84 - 1.0);
-  const double t87 = x[13] * 2.0;
-  const double t88 = (t87 - 4e+05);
-  const double t89 = (x[2] + x[0] + x[1]);
-  const double t90 = sin(t89);
-  const double t91 = cos(t89);
-  const double t92 = (0.315 * t38 + t40 * 0.15700000000000003 - 0.016 * t90 + 0.552 * t91);
-  const double t93 = (t92 * t92);
-  const double t94 = (-0.016) * t91;
-  const double t95 = t90 * (-0.552);
-  const double t96 = (t94 + t95 + 0.15700000000000003 * t38 - t40 * 0.315);
-  const double t97 = (t96 * t96);
-  const double t98 = (0.21712699999999996 + t93 + t97);
-  const double t99 = (t93 + t97);
-  const double t100 = (1.0 / sqrt(t99));
-  const double t101 = (1.0 / (t99));
-  const double t102 = (t98 * t98);
-  const double t103 = (-0.25 * t101 * t102 + 0.48441599999999996);
-  const double t104 = sqrt(t103);
-  const double t105 = (t98 * t100 * t92 + 2.0 * t104 * t96);
-  const double t106 = (2.0 * t92 * t104 - t98 * t100 * t96);
-  const double t107 = atan2(t105 * 0.5 * t100, t106 * t100 * (-0.5));
-  const double t108 = sin(t107);
-  const double t109 = (-0.623 * t38 + t40 * 3.081 + 0.696 * t108);
-  const double t110 = t40 * 0.623;
-  const double t111 = cos(t107);
-  const double t112 = 3.081 * t38;
-  const double t113 = (t110 + 0.696 * t111 + t112);
-  const double t114 = ((t109 * t109) + (t113 * t113));
-  const double t115 = (1.0 / sqrt(t114));
-  const double t116 = sqrt(t114);
-  const double t117 = (-0.03151490312757761 + t116 * 0.013273228961416876);
-  const double t118 = (1.0 / (t117 * t117));
-  const double t119 = (-3.081) * t40;
-  const double t120 = 0.016 * t90;
-  const double t121 = t91 * (-0.552);
-  const double t122 = (-0.315 * t38 + t120 + t121 - t40 * 0.15700000000000003);
-  const double t123 = (t92 * t96 + t122 * t96);
-  const double t124 = pow(t99, (-1.5));
-  const double t125 = (1.0 / (t99 * t99));
-  const double t126 = (t98 * 2.0 * t101 * t123 - t125 * t102 * t123);
-  const double t127 = (1.0 / sqrt(t103));
-  const double t128 = (t98 * 2.0 * t100 * t96 + 4.0 * t100 * t123 * t92 + 4.0 * t122 * t104 -
-                       t98 * 2.0 * t124 * t123 * t92 - t126 * t127 * t96);
-  const double t129 = (t100 * t128 - 2.0 * t105 * t124 * t123);
-  const double t130 = (t106 * t106);
-  const double t131 = (t105 * t105);
-  const double t132 = (t101 * t130 + t101 * t131);
-  const double t133 = (1.0 / (t132));
-  const double t134 = (t126 * t127 * t92 + t98 * 2.0 * t122 * t100 - t98 * 2.0 * t124 * t123 * t96 -
-                       4.0 * t104 * t96 + 4.0 * t100 * t123 * t96);
-  const double t135 = (2.0 * t106 * t124 * t123 + t134 * t100);
-  const double t136 = (t129 * t106 * t100 * t133 + t105 * t100 * t135 * t133);
-  const double t137 = 0.623 * t38;
-  const double t138 = (t119 + 0.348 * t108 * t136 + t137);
-  const double t139 = (t110 + t112 - 0.348 * t136 * t111);
-  const double t140 = (t138 * t113 + t139 * t109);
-  const double t141 = (x[14] - 3.7e+07);
-  const double t142 = ((t141 * t141) + 1e+10);
-  const double t143 = (1e-06 + (x[10] * x[10]));
-  const double t144 = sqrt(t143);
-  const double t145 = (x[10] + t144);
-  const double t146 = (x[14] - u[12]);
-  const double t147 = (t146 * t146);
-  const double t148 = (4e+10 + t147);
-  const double t149 = pow(t148, (-0.25));
-  const double t150 = (x[14] - 2e+05);
-  const double t151 = (t150 * t150);
-  const double t152 = (4e+10 + t151);
-  const double t153 = pow(t152, (-0.25));
-  const double t154 = (x[10] - t144);
-  const double t155 = (t120 + t121);
-  const double t156 = (t94 + t95);
-  const double t157 = (t155 * t96 + t156 * t92);
-  const double t158 = (t98 * 2.0 * t101 * t157 - t125 * t102 * t157);
-  const double t159 = (-t98 * 2.0 * t100 * t155 - 4.0 * t100 * t157 * t96 - t158 * t127 * t92 +
-                       4.0 * t156 * t104 + t98 * 2.0 * t124 * t157 * t96);
-  const double t160 = (t100 * t159 - 2.0 * t106 * t124 * t157);
-  const double t161 = (-t98 * 2.0 * t124 * t92 * t157 + 4.0 * t100 * t92 * t157 +
-                       t98 * 2.0 * t156 * t100 - t158 * t127 * t96 + 4.0 * t155 * t104);
-  const double t162 = (-2.0 * t105 * t124 * t157 + t161 * t100);
-  const double t163 = (-t105 * t160 * t100 * t133 + t162 * t106 * t100 * t133);
-  const double t164 = (-0.696 * t109 * t111 * t163 + t113 * 0.696 * t108 * t163);
-  const double t165 = (1e+10 + t151);
-  const double t166 =
-      (-t115 * x[4] * 0.013273228961416876 * t140 + 0.093 -
-       t115 * x[5] * 0.013273228961416876 * t140 - sqrt(t142) * 2.5e-09 -
-       t145 * t146 * 2.0412414523193154e-06 * t149 + t153 * t150 * t154 * 2.0412414523193154e-06 -
-       x[14] * 5e-09 - t115 * t164 * 0.006636614480708438 * x[6] + 2.5e-09 * sqrt(t165));
-  const double t167 = (1.0 / (t117));
-  const double t168 = pow(t114, (-1.5));
-  const double t169 = (t140 * t140);
-  const double t170 = (t136 * t136);
-  const double t171 = (1.0 / (t132 * t132));
-  const double t172 = (2.0 * t125 * t123 * t131 + t134 * t106 * t101 + 2.0 * t125 * t123 * t130 -
-                       t105 * t101 * t128);
-  const double t173 = 0.016 * t91;
-  const double t174 = t90 * 0.552;
-  const double t175 = (t173 + t174 - 0.15700000000000003 * t38 + t40 * 0.315);
-  const double t176 = (t122 * t92 + (t122 * t122) + t175 * t96 + t97);
-  const double t177 = pow(t99, (-2.5));
-  const double t178 = (t123 * t123);
-  const double t179 = (t126 * t126);
-  const double t180 = pow(t103, (-1.5));
-  const double t181 = (1.0 / (t99 * t99 * t99));
-  const double t182 = (-t176 * t125 * t102 + 4.0 * t101 * t178 + t98 * t176 * 2.0 * t101 +
-                       t181 * 4.0 * t102 * t178 - t98 * t125 * t178 * 8.0);
-  const double t183 =
-      (-t105 * 4.0 * t171 * t100 * t135 * t172 + t105 * 4.0 * t124 * t123 * t135 * t133 -
-       2.0 * t100 * t128 * t135 * t133 +
-       t105 * t100 * t133 *
-           ((t134 * t124 * t123 * 8.0 - t176 * t106 * t124 * 8.0 + 24.0 * t177 * t106 * t178 -
-             t100 * ((t98 * t175 * t100 * 8.0 + t179 * t180 * t92 + t126 * t127 * 8.0 * t96 -
-                      16.0 * t122 * t104 + 32.0 * t122 * t100 * t123 - 32.0 * t124 * t178 * t96 -
-                      t98 * 16.0 * t122 * t124 * t123 + t98 * 24.0 * t177 * t178 * t96 -
-                      t98 * t176 * t124 * 8.0 * t96 + 4.0 * t127 * t182 * t92 +
-                      t176 * 16.0 * t100 * t96)))) +
-       ((-t105 * 24.0 * t177 * t178 + t124 * t123 * t128 * 8.0 +
-         ((32.0 * t124 * t178 * t92 - t98 * t122 * t100 * 8.0 - t98 * 24.0 * t177 * t178 * t92 +
-           t98 * t176 * t124 * 8.0 * t92 + t179 * t180 * t96 - 32.0 * t100 * t123 * t96 +
-           4.0 * t127 * t182 * t96 - 16.0 * t175 * t104 + t126 * t122 * t127 * 8.0 -
-           t176 * 16.0 * t100 * t92 + t98 * 16.0 * t124 * t123 * t96)) *
-             t100 +
-         t176 * t105 * t124 * 8.0)) *
-           t106 * t100 * t133 -
-       4.0 * t129 * t171 * t106 * t100 * t172 + 4.0 * t129 * t106 * t124 * t123 * t133 +
-       t134 * 2.0 * t129 * t100 * t133);
+  const double t26 = (x[12] - 2e+05);
+  const double t27 = (t26 * t26);
+  const double t28 = (t27 + 1e+10);
+  const double t29 = (x[12] - 3.7e+07);
+  const double t30 = ((t29 * t29) + 1e+10);
+  const double t31 = (4e+10 + t27);
+  const double t32 = pow(t31, (-0.25));
+  const double t33 = (-t18 + x[8]);
+  const double t34 = x[8] * (1.0 / sqrt(t17));
+  const double t35 = (t34 + 1.0);
+  const double t36 = (t34 - 1.0);
+  const double t37 = (t20 * (1.0 / sqrt(t21)) + 1.0);
+  const double t38 = x[12] * 2.0;
+  const double t39 = (t38 - 4e+05);
+  const double t40 = (x[0] + x[1]);
+  const double t41 = cos(t40);
+  const double t42 = t41 * (-0.8);
+  const double t43 = sin(t40);
+  const double t44 = t43 * (-0.104);
+  const double t45 = (1.11 * t1 + t42 + 3.136 * t0 + t44);
+  const double t46 = (t45 * t45);
+  const double t47 = (-t43 * 0.8 + 3.136 * t1 + 0.104 * t41 - 1.11 * t0);
+  const double t48 = (t46 + (t47 * t47));
+  const double t49 = (1.0 / sqrt(t48));
+  const double t50 = (-0.104) * t41;
+  const double t51 = t43 * 0.8;
+  const double t52 = (t50 + t51 - 3.136 * t1 + 1.11 * t0);
+  const double t53 = (t45 * t52 + t47 * t45);
+  const double t54 = sqrt(t48);
+  const double t55 = (0.017671458676442587 * t54 - 0.04285743526536852);
+  const double t56 = (1.0 / (t55 * t55));
+  const double t57 = (x[13] - 3.7e+07);
+  const double t58 = (1e+10 + (t57 * t57));
+  const double t59 = (t50 + t51);
+  const double t60 = (t42 + t44);
+  const double t61 = (t45 * t59 + t60 * t47);
+  const double t62 = (1e-06 + (x[9] * x[9]));
+  const double t63 = sqrt(t62);
+  const double t64 = (x[9] + t63);
+  const double t65 = (u[11] - x[13]);
+  const double t66 = ((t65 * t65) + 1e+08);
+  const double t67 = (u[11] - x[13] + sqrt(t66));
+  const double t68 = (t67 * t67);
+  const double t69 = (4e+10 + t68 * 0.25);
+  const double t70 = pow(t69, (-0.25));
+  const double t71 = (x[13] - 2e+05);
+  const double t72 = (t71 * t71);
+  const double t73 = (1e+10 + t72);
+  const double t74 = (4e+10 + t72);
+  const double t75 = pow(t74, (-0.25));
+  const double t76 = (-x[9] + t63);
+  const double t77 =
+      (-sqrt(t58) * 3.5e-09 - t49 * 0.017671458676442587 * x[5] * t61 +
+       t64 * 1.4288690166235207e-06 * t70 * t67 - t49 * t53 * 0.017671458676442587 * x[4] -
+       x[13] * 7e-09 + 0.1302 + sqrt(t73) * 3.5e-09 - t75 * t71 * 2.8577380332470414e-06 * t76);
+  const double t78 = (1.0 / (t55));
+  const double t79 = 0.8 * t41;
+  const double t80 = t43 * 0.104;
+  const double t81 = t45 * ((t79 + t80));
+  const double t82 = t47 * t59;
+  const double t83 = (t81 + t82 + t60 * t45 + t59 * t52);
+  const double t84 = pow(t48, (-1.5));
+  const double t85 = (t53 * t53);
+  const double t86 =
+      (t45 * ((-3.136 * t0 + t79 - 1.11 * t1 + t80)) + t47 * t52 + t46 + (t52 * t52));
+  const double t87 = (t61 * t61);
+  const double t88 = (t81 + t82 + (t60 * t60) + (t59 * t59));
+  const double t89 = (1.0 / sqrt(t62)) * x[9];
+  const double t90 = (t89 - 1.0);
+  const double t91 = (t89 + 1.0);
+  const double t92 = x[13] * 2.0;
+  const double t93 = (t65 * (1.0 / sqrt(t66)) + 1.0);
+  const double t94 = (t92 - 4e+05);
+  const double t95 = (x[2] + x[0] + x[1]);
+  const double t96 = sin(t95);
+  const double t97 = cos(t95);
+  const double t98 = (0.315 * t41 + t43 * 0.15700000000000003 - 0.016 * t96 + 0.552 * t97);
+  const double t99 = (t98 * t98);
+  const double t100 = (-0.016) * t97;
+  const double t101 = t96 * (-0.552);
+  const double t102 = (t100 + t101 + 0.15700000000000003 * t41 - t43 * 0.315);
+  const double t103 = (t102 * t102);
+  const double t104 = (0.21712699999999996 + t99 + t103);
+  const double t105 = (t99 + t103);
+  const double t106 = (1.0 / sqrt(t105));
+  const double t107 = (1.0 / (t105));
+  const double t108 = (t104 * t104);
+  const double t109 = (-0.25 * t107 * t108 + 0.48441599999999996);
+  const double t110 = sqrt(t109);
+  const double t111 = (t104 * t106 * t98 + 2.0 * t110 * t102);
+  const double t112 = (2.0 * t98 * t110 - t104 * t106 * t102);
+  const double t113 = atan2(t111 * 0.5 * t106, t112 * t106 * (-0.5));
+  const double t114 = sin(t113);
+  const double t115 = (-0.623 * t41 + t43 * 3.081 + 0.696 * t114);
+  const double t116 = t43 * 0.623;
+  const double t117 = cos(t113);
+  const double t118 = 3.081 * t41;
+  const double t119 = (t116 + 0.696 * t117 + t118);
+  const double t120 = ((t115 * t115) + (t119 * t119));
+  const double t121 = sqrt(t120);
+  const double t122 = (-0.03151490312757761 + t121 * 0.013273228961416876);
+  const double t123 = (1.0 / (t122));
+  const double t124 = pow(t120, (-1.5));
+  const double t125 = 0.016 * t96;
+  const double t126 = t97 * (-0.552);
+  const double t127 = (t125 + t126);
+  const double t128 = (t100 + t101);
+  const double t129 = (t127 * t102 + t128 * t98);
+  const double t130 = (1.0 / (t105 * t105));
+  const double t131 = (t104 * 2.0 * t107 * t129 - t130 * t108 * t129);
+  const double t132 = (1.0 / sqrt(t109));
+  const double t133 = pow(t105, (-1.5));
+  const double t134 = (-t104 * 2.0 * t106 * t127 - 4.0 * t106 * t129 * t102 - t131 * t132 * t98 +
+                       4.0 * t128 * t110 + t104 * 2.0 * t133 * t129 * t102);
+  const double t135 = (t106 * t134 - 2.0 * t112 * t133 * t129);
+  const double t136 = (t112 * t112);
+  const double t137 = (t111 * t111);
+  const double t138 = (t107 * t136 + t107 * t137);
+  const double t139 = (1.0 / (t138));
+  const double t140 = (-t104 * 2.0 * t133 * t98 * t129 + 4.0 * t106 * t98 * t129 +
+                       t104 * 2.0 * t128 * t106 - t131 * t132 * t102 + 4.0 * t127 * t110);
+  const double t141 = (-2.0 * t111 * t133 * t129 + t140 * t106);
+  const double t142 = (-t111 * t135 * t106 * t139 + t141 * t112 * t106 * t139);
+  const double t143 = (-0.696 * t115 * t117 * t142 + t119 * 0.696 * t114 * t142);
+  const double t144 = (-3.081) * t43;
+  const double t145 = (-0.315 * t41 + t125 + t126 - t43 * 0.15700000000000003);
+  const double t146 = (t98 * t102 + t145 * t102);
+  const double t147 = (t104 * 2.0 * t107 * t146 - t130 * t108 * t146);
+  const double t148 = (t104 * 2.0 * t106 * t102 + 4.0 * t106 * t146 * t98 + 4.0 * t145 * t110 -
+                       t104 * 2.0 * t133 * t146 * t98 - t147 * t132 * t102);
+  const double t149 = (t106 * t148 - 2.0 * t111 * t133 * t146);
+  const double t150 =
+      (t147 * t132 * t98 + t104 * 2.0 * t145 * t106 - t104 * 2.0 * t133 * t146 * t102 -
+       4.0 * t110 * t102 + 4.0 * t106 * t146 * t102);
+  const double t151 = (2.0 * t112 * t133 * t146 + t150 * t106);
+  const double t152 = (t149 * t112 * t106 * t139 + t111 * t106 * t151 * t139);
+  const double t153 = 0.623 * t41;
+  const double t154 = (t144 + 0.348 * t114 * t152 + t153);
+  const double t155 = (t116 + t118 - 0.348 * t152 * t117);
+  const double t156 = (t154 * t119 + t155 * t115);
+  const double t157 = (t156 * t156);
+  const double t158 = (1.0 / sqrt(t120));
+  const double t159 = (t152 * t152);
+  const double t160 = (1.0 / (t138 * t138));
+  const double t161 = (2.0 * t130 * t146 * t137 + t150 * t112 * t107 + 2.0 * t130 * t146 * t136 -
+                       t111 * t107 * t148);
+  const double t162 = 0.016 * t97;
+  const double t163 = t96 * 0.552;
+  const double t164 = (t162 + t163 - 0.15700000000000003 * t41 + t43 * 0.315);
+  const double t165 = (t145 * t98 + (t145 * t145) + t164 * t102 + t103);
+  const double t166 = pow(t105, (-2.5));
+  const double t167 = (t146 * t146);
+  const double t168 = (t147 * t147);
+  const double t169 = pow(t109, (-1.5));
+  const double t170 = (1.0 / (t105 * t105 * t105));
+  const double t171 = (-t165 * t130 * t108 + 4.0 * t107 * t167 + t104 * t165 * 2.0 * t107 +
+                       t170 * 4.0 * t108 * t167 - t104 * t130 * t167 * 8.0);
+  const double t172 =
+      (-t111 * 4.0 * t160 * t106 * t151 * t161 + t111 * 4.0 * t133 * t146 * t151 * t139 -
+       2.0 * t106 * t148 * t151 * t139 +
+       t111 * t106 * t139 *
+           ((t150 * t133 * t146 * 8.0 - t165 * t112 * t133 * 8.0 + 24.0 * t166 * t112 * t167 -
+             t106 * ((t104 * t164 * t106 * 8.0 + t168 * t169 * t98 + t147 * t132 * 8.0 * t102 -
+                      16.0 * t145 * t110 + 32.0 * t145 * t106 * t146 - 32.0 * t133 * t167 * t102 -
+                      t104 * 16.0 * t145 * t133 * t146 + t104 * 24.0 * t166 * t167 * t102 -
+                      t104 * t165 * t133 * 8.0 * t102 + 4.0 * t132 * t171 * t98 +
+                      t165 * 16.0 * t106 * t102)))) +
+       ((-t111 * 24.0 * t166 * t167 + t133 * t146 * t148 * 8.0 +
+         ((32.0 * t133 * t167 * t98 - t104 * t145 * t106 * 8.0 - t104 * 24.0 * t166 * t167 * t98 +
+           t104 * t165 * t133 * 8.0 * t98 + t168 * t169 * t102 - 32.0 * t106 * t146 * t102 +
+           4.0 * t132 * t171 * t102 - 16.0 * t164 * t110 + t147 * t145 * t132 * 8.0 -
+           t165 * 16.0 * t106 * t98 + t104 * 16.0 * t133 * t146 * t102)) *
+             t106 +
+         t165 * t111 * t133 * 8.0)) *
+           t112 * t106 * t139 -
+       4.0 * t149 * t160 * t112 * t106 * t161 + 4.0 * t149 * t112 * t133 * t146 * t139 +
+       t150 * 2.0 * t149 * t106 * t139);
+  const double t173 =
+      (t119 * ((-t116 - t159 * 0.174 * t117 - 0.087 * t114 * t172 - t118)) + (t155 * t155) +
+       (t154 * t154) + ((t144 - t159 * 0.174 * t114 + 0.087 * t117 * t172 + t153)) * t115);
+  const double t174 = t98 * t127;
+  const double t175 = (t162 + t163);
+  const double t176 = t175 * t102;
+  const double t177 = (t145 * t127 + t174 + t176 + t128 * t102);
+  const double t178 = (-16.0) * t127 * t110;
+  const double t179 = t104 * t175 * t106 * 8.0;
+  const double t180 = (-4.0 * t107 * t146 * t129 + t130 * t108 * t177 - t104 * 2.0 * t107 * t177 -
+                       t170 * 4.0 * t108 * t146 * t129 + t104 * t130 * t146 * 8.0 * t129);
+  const double t181 =
+      t111 *
+      ((4.0 * t133 * t146 * t134 - t150 * 4.0 * t133 * t129 - 24.0 * t166 * t112 * t146 * t129 +
+        t112 * t133 * t177 * 8.0 +
+        ((16.0 * t177 * t106 * t102 - t104 * t133 * t146 * 8.0 * t127 + 16.0 * t106 * t146 * t127 +
+          t178 + t179 - 32.0 * t133 * t146 * t129 * t102 + t104 * 24.0 * t166 * t146 * t129 * t102 -
+          t104 * t133 * t177 * 8.0 * t102 + t131 * 4.0 * t132 * t102 + 16.0 * t145 * t106 * t129 +
+          t147 * t131 * t169 * t98 - t180 * 4.0 * t132 * t98 - t104 * t145 * t133 * 8.0 * t129 +
+          t147 * 4.0 * t128 * t132)) *
+            t106)) *
+      t106 * t139 * (-1.0);
+  const double t182 = (-16.0) * t175 * t110;
+  const double t183 = t104 * (-8.0) * t106 * t127;
   const double t184 =
-      (t113 * ((-t110 - t170 * 0.174 * t111 - 0.087 * t108 * t183 - t112)) + (t139 * t139) +
-       (t138 * t138) + ((t119 - t170 * 0.174 * t108 + 0.087 * t111 * t183 + t137)) * t109);
-  const double t185 = t92 * t155;
-  const double t186 = (t173 + t174);
-  const double t187 = t186 * t96;
-  const double t188 = (t122 * t155 + t185 + t187 + t156 * t96);
-  const double t189 = (-16.0) * t155 * t104;
-  const double t190 = t98 * t186 * t100 * 8.0;
-  const double t191 = (-4.0 * t101 * t123 * t157 + t125 * t102 * t188 - t98 * 2.0 * t101 * t188 -
-                       t181 * 4.0 * t102 * t123 * t157 + t98 * t125 * t123 * 8.0 * t157);
-  const double t192 =
-      t105 *
-      ((4.0 * t124 * t123 * t159 - t134 * 4.0 * t124 * t157 - 24.0 * t177 * t106 * t123 * t157 +
-        t106 * t124 * t188 * 8.0 +
-        ((16.0 * t188 * t100 * t96 - t98 * t124 * t123 * 8.0 * t155 + 16.0 * t100 * t123 * t155 +
-          t189 + t190 - 32.0 * t124 * t123 * t157 * t96 + t98 * 24.0 * t177 * t123 * t157 * t96 -
-          t98 * t124 * t188 * 8.0 * t96 + t158 * 4.0 * t127 * t96 + 16.0 * t122 * t100 * t157 +
-          t126 * t158 * t180 * t92 - t191 * 4.0 * t127 * t92 - t98 * t122 * t124 * 8.0 * t157 +
-          t126 * 4.0 * t156 * t127)) *
-            t100)) *
-      t100 * t133 * (-1.0);
-  const double t193 = (-16.0) * t186 * t104;
-  const double t194 = t98 * (-8.0) * t100 * t155;
-  const double t195 =
-      t106 * t100 * t133 *
-      ((t105 * t124 * t188 * 8.0 + t161 * 4.0 * t124 * t123 + 4.0 * t124 * t128 * t157 -
-        t105 * 24.0 * t177 * t123 * t157 +
-        ((-16.0 * t156 * t100 * t123 - 16.0 * t100 * t157 * t96 + t158 * 4.0 * t122 * t127 +
-          t98 * t124 * t188 * 8.0 * t92 + 32.0 * t124 * t123 * t92 * t157 +
-          t126 * 4.0 * t127 * t155 + t98 * t124 * 8.0 * t157 * t96 + t193 -
-          t191 * 4.0 * t127 * t96 + t126 * t158 * t180 * t96 + t98 * t156 * t124 * t123 * 8.0 -
-          16.0 * t188 * t100 * t92 - t98 * 24.0 * t177 * t123 * t92 * t157 + t194)) *
-            t100));
-  const double t196 =
-      (t105 * 4.0 * t171 * t160 * t100 * t172 + t192 - t162 * 4.0 * t171 * t106 * t100 * t172 +
-       t162 * 4.0 * t106 * t124 * t123 * t133 + 2.0 * t160 * t100 * t128 * t133 +
-       t162 * t134 * 2.0 * t100 * t133 - t105 * 4.0 * t160 * t124 * t123 * t133 + t195);
-  const double t197 = (-t139 * 0.696 * t111 * t163 + 0.174 * t196 * t109 * t111 +
-                       t138 * 0.696 * t108 * t163 - t113 * 0.348 * t136 * t111 * t163 -
-                       t113 * 0.174 * t196 * t108 - 0.348 * t108 * t136 * t109 * t163);
-  const double t198 =
-      (-15927874.753700253 * t115 * t118 * t166 * t140 +
-       t167 * 1.2e+09 *
-           ((t168 * t164 * 0.006636614480708438 * x[6] * t140 +
-             t168 * t169 * x[4] * 0.013273228961416876 + t168 * t169 * x[5] * 0.013273228961416876 -
-             t115 * t184 * x[5] * 0.013273228961416876 - t115 * t184 * x[4] * 0.013273228961416876 -
-             t197 * t115 * 0.006636614480708438 * x[6])));
-  const double t199 = (-2.0 * t125 * t130 * t157 - 2.0 * t125 * t131 * t157 + t106 * t101 * t159 +
-                       t161 * t105 * t101);
-  const double t200 = ((t156 * t156) + t185 + (t155 * t155) + t187);
-  const double t201 = (t157 * t157);
-  const double t202 = (t181 * 4.0 * t201 * t102 - t125 * t102 * t200 + t98 * 2.0 * t101 * t200 +
-                       4.0 * t201 * t101 - t98 * t125 * t201 * 8.0);
-  const double t203 = (t158 * t158);
-  const double t204 =
-      (t105 * 4.0 * t171 * t160 * t100 * t199 - t161 * 2.0 * t160 * t100 * t133 -
-       t162 * 4.0 * t171 * t106 * t100 * t199 + t105 * 4.0 * t160 * t124 * t133 * t157 +
-       ((t106 * t124 * t200 * 8.0 - 24.0 * t177 * t106 * t201 +
-         t100 * ((-t98 * 16.0 * t124 * t155 * t157 + 4.0 * t127 * t202 * t92 + t189 + t190 +
-                  t203 * t180 * t92 + t158 * t156 * t127 * 8.0 - t98 * t124 * t200 * 8.0 * t96 +
-                  t98 * 24.0 * t177 * t201 * t96 + 32.0 * t100 * t155 * t157 +
-                  16.0 * t100 * t200 * t96 - 32.0 * t201 * t124 * t96)) +
-         t124 * 8.0 * t159 * t157)) *
-           t105 * t100 * t133 +
-       t162 * 2.0 * t100 * t133 * t159 - t162 * 4.0 * t106 * t124 * t133 * t157 +
-       t106 *
-           ((-t105 * t124 * t200 * 8.0 -
-             t100 *
-                 ((32.0 * t201 * t124 * t92 - 16.0 * t100 * t200 * t92 + t158 * t127 * 8.0 * t155 +
-                   t98 * 16.0 * t156 * t124 * t157 + t203 * t180 * t96 + t193 +
-                   t98 * t124 * t200 * 8.0 * t92 + 4.0 * t127 * t202 * t96 + t194 -
-                   32.0 * t156 * t100 * t157 - t98 * 24.0 * t177 * t201 * t92)) +
-             t105 * 24.0 * t177 * t201 - t161 * t124 * 8.0 * t157)) *
-           t100 * t133);
-  const double t205 = (t163 * t163);
-  const double t206 = (-t204 * 0.174 * t109 * t111 - 0.348 * t108 * t205 * t109 +
-                       0.24220799999999998 * (t111 * t111) * t205 - t113 * 0.348 * t205 * t111 +
-                       t204 * t113 * 0.174 * t108 + (t108 * t108) * 0.24220799999999998 * t205);
-  const double t207 = (t164 * t164);
-  const double t208 =
-      (t105 * 4.0 * t171 * t100 * t135 * t199 + t192 - t161 * 2.0 * t100 * t135 * t133 +
-       4.0 * t129 * t171 * t106 * t100 * t199 + 4.0 * t129 * t106 * t124 * t133 * t157 -
-       2.0 * t129 * t100 * t133 * t159 + t105 * 4.0 * t124 * t135 * t133 * t157 + t195);
-  const double t209 = (t138 * 0.348 * t108 * t163 - 0.348 * t139 * t111 * t163 +
-                       ((-0.174 * t108 * t136 * t163 + 0.087 * t208 * t111)) * t109 +
-                       t113 * ((-0.087 * t108 * t208 - 0.174 * t136 * t111 * t163)));
-  const double t210 = t167 * t115 * (-15927874.753700253) * t140;
-  const double t211 = x[10] * (1.0 / sqrt(t143));
-  const double t212 = (t211 - 1.0);
-  const double t213 = (t211 + 1.0);
-  const double t214 = x[14] * 2.0;
-  const double t215 = (t214 - 4e+05);
-  const double t216 = (1e-06 + (x[11] * x[11]));
-  const double t217 = x[11] * (1.0 / sqrt(t216));
-  const double t218 = (t217 + 1.0);
-  const double t219 = (u[13] - x[15]);
-  const double t220 = (t219 * t219);
-  const double t221 = (4e+10 + t220);
-  const double t222 = pow(t221, (-0.25));
-  const double t223 = (t217 - 1.0);
-  const double t224 = (x[15] - 2e+05);
-  const double t225 = (t224 * t224);
-  const double t226 = (4e+10 + t225);
-  const double t227 = pow(t226, (-0.25));
-  const double t228 = sqrt(t216);
-  const double t229 = (t228 + x[11]);
-  const double t230 = x[15] * 2.0;
-  const double t231 = (t230 - 4e+05);
-  const double t232 = (x[11] - t228);
-  const double t233 = (-2.9e+07 + x[15]);
-  const double t234 = (x[16] - 3.7e+07);
-  const double t235 = ((t234 * t234) + 1e+10);
-  const double t236 = (x[16] - 2e+05);
-  const double t237 = (t236 * t236);
-  const double t238 = (4e+10 + t237);
-  const double t239 = pow(t238, (-0.25));
-  const double t240 = (u[10] - x[16]);
-  const double t241 = (t240 * t240);
-  const double t242 = (4e+10 + t241);
-  const double t243 = pow(t242, (-0.25));
-  const double t244 = (1e+10 + t237);
-  const double t245 = (0.05992565888304706 - 0.015079644737231009 * t14);
-  const double t246 = (1.0 / (t245));
-  const double t247 = x[16] * 2.0;
-  const double t248 = (t247 - 4e+05);
-  const double t249 = (0.03909483791956781 - t70 * 0.00901244392498572);
-  const double t250 = (1.0 / (t249));
-  const double t251 = (1.0 / (t249 * t249));
-  const double t252 = (x[17] - 2e+05);
-  const double t253 = (t252 * t252);
-  const double t254 = (t253 + 1e+10);
-  const double t255 = (x[17] - 3.7e+07);
-  const double t256 = (1e+10 + (t255 * t255));
-  const double t257 = (4e+10 + t253);
+      t112 * t106 * t139 *
+      ((t111 * t133 * t177 * 8.0 + t140 * 4.0 * t133 * t146 + 4.0 * t133 * t148 * t129 -
+        t111 * 24.0 * t166 * t146 * t129 +
+        ((-16.0 * t128 * t106 * t146 - 16.0 * t106 * t129 * t102 + t131 * 4.0 * t145 * t132 +
+          t104 * t133 * t177 * 8.0 * t98 + 32.0 * t133 * t146 * t98 * t129 +
+          t147 * 4.0 * t132 * t127 + t104 * t133 * 8.0 * t129 * t102 + t182 -
+          t180 * 4.0 * t132 * t102 + t147 * t131 * t169 * t102 + t104 * t128 * t133 * t146 * 8.0 -
+          16.0 * t177 * t106 * t98 - t104 * 24.0 * t166 * t146 * t98 * t129 + t183)) *
+            t106));
+  const double t185 =
+      (t111 * 4.0 * t160 * t135 * t106 * t161 + t181 - t141 * 4.0 * t160 * t112 * t106 * t161 +
+       t141 * 4.0 * t112 * t133 * t146 * t139 + 2.0 * t135 * t106 * t148 * t139 +
+       t141 * t150 * 2.0 * t106 * t139 - t111 * 4.0 * t135 * t133 * t146 * t139 + t184);
+  const double t186 = (-t155 * 0.696 * t117 * t142 + 0.174 * t185 * t115 * t117 +
+                       t154 * 0.696 * t114 * t142 - t119 * 0.348 * t152 * t117 * t142 -
+                       t119 * 0.174 * t185 * t114 - 0.348 * t114 * t152 * t115 * t142);
+  const double t187 = (x[14] - 3.7e+07);
+  const double t188 = ((t187 * t187) + 1e+10);
+  const double t189 = (x[14] - 2e+05);
+  const double t190 = (t189 * t189);
+  const double t191 = (4e+10 + t190);
+  const double t192 = pow(t191, (-0.25));
+  const double t193 = (1e-06 + (x[10] * x[10]));
+  const double t194 = sqrt(t193);
+  const double t195 = (x[10] - t194);
+  const double t196 = (x[10] + t194);
+  const double t197 = (x[14] - u[12]);
+  const double t198 = (1e+08 + (t197 * t197));
+  const double t199 = (-sqrt(t198) + x[14] - u[12]);
+  const double t200 = (t199 * t199);
+  const double t201 = (4e+10 + 0.25 * t200);
+  const double t202 = pow(t201, (-0.25));
+  const double t203 = (1e+10 + t190);
+  const double t204 = (-t158 * x[4] * 0.013273228961416876 * t156 + 0.093 -
+                       t158 * x[5] * 0.013273228961416876 * t156 - sqrt(t188) * 2.5e-09 +
+                       t192 * t189 * t195 * 2.0412414523193154e-06 - x[14] * 5e-09 -
+                       t158 * t143 * 0.006636614480708438 * x[6] -
+                       t196 * 1.0206207261596577e-06 * t202 * t199 + 2.5e-09 * sqrt(t203));
+  const double t205 = (1.0 / (t122 * t122));
+  const double t206 =
+      (t123 * 1.2e+09 *
+           ((t124 * t143 * 0.006636614480708438 * x[6] * t156 +
+             t124 * t157 * x[4] * 0.013273228961416876 + t124 * t157 * x[5] * 0.013273228961416876 -
+             t158 * t173 * x[5] * 0.013273228961416876 - t158 * t173 * x[4] * 0.013273228961416876 -
+             t186 * t158 * 0.006636614480708438 * x[6])) -
+       t204 * 15927874.753700253 * t158 * t205 * t156);
+  const double t207 = (-2.0 * t130 * t136 * t129 - 2.0 * t130 * t137 * t129 + t112 * t107 * t134 +
+                       t140 * t111 * t107);
+  const double t208 = ((t128 * t128) + t174 + (t127 * t127) + t176);
+  const double t209 = (t129 * t129);
+  const double t210 = (t170 * 4.0 * t209 * t108 - t130 * t108 * t208 + t104 * 2.0 * t107 * t208 +
+                       4.0 * t209 * t107 - t104 * t130 * t209 * 8.0);
+  const double t211 = (t131 * t131);
+  const double t212 =
+      (t111 * 4.0 * t160 * t135 * t106 * t207 - t140 * 2.0 * t135 * t106 * t139 -
+       t141 * 4.0 * t160 * t112 * t106 * t207 + t111 * 4.0 * t135 * t133 * t139 * t129 +
+       ((t112 * t133 * t208 * 8.0 - 24.0 * t166 * t112 * t209 +
+         t106 * ((-t104 * 16.0 * t133 * t127 * t129 + 4.0 * t132 * t210 * t98 + t178 + t179 +
+                  t211 * t169 * t98 + t131 * t128 * t132 * 8.0 - t104 * t133 * t208 * 8.0 * t102 +
+                  t104 * 24.0 * t166 * t209 * t102 + 32.0 * t106 * t127 * t129 +
+                  16.0 * t106 * t208 * t102 - 32.0 * t209 * t133 * t102)) +
+         t133 * 8.0 * t134 * t129)) *
+           t111 * t106 * t139 +
+       t141 * 2.0 * t106 * t139 * t134 - t141 * 4.0 * t112 * t133 * t139 * t129 +
+       t112 *
+           ((-t111 * t133 * t208 * 8.0 -
+             t106 *
+                 ((32.0 * t209 * t133 * t98 - 16.0 * t106 * t208 * t98 + t131 * t132 * 8.0 * t127 +
+                   t104 * 16.0 * t128 * t133 * t129 + t211 * t169 * t102 + t182 +
+                   t104 * t133 * t208 * 8.0 * t98 + 4.0 * t132 * t210 * t102 + t183 -
+                   32.0 * t128 * t106 * t129 - t104 * 24.0 * t166 * t209 * t98)) +
+             t111 * 24.0 * t166 * t209 - t140 * t133 * 8.0 * t129)) *
+           t106 * t139);
+  const double t213 = (t142 * t142);
+  const double t214 = (-t212 * 0.174 * t115 * t117 - 0.348 * t114 * t213 * t115 +
+                       0.24220799999999998 * (t117 * t117) * t213 - t119 * 0.348 * t213 * t117 +
+                       t212 * t119 * 0.174 * t114 + (t114 * t114) * 0.24220799999999998 * t213);
+  const double t215 = (t143 * t143);
+  const double t216 =
+      (t111 * 4.0 * t160 * t106 * t151 * t207 + t181 - t140 * 2.0 * t106 * t151 * t139 +
+       4.0 * t149 * t160 * t112 * t106 * t207 + 4.0 * t149 * t112 * t133 * t139 * t129 -
+       2.0 * t149 * t106 * t139 * t134 + t111 * 4.0 * t133 * t151 * t139 * t129 + t184);
+  const double t217 = (t154 * 0.348 * t114 * t142 - 0.348 * t155 * t117 * t142 +
+                       ((-0.174 * t114 * t152 * t142 + 0.087 * t216 * t117)) * t115 +
+                       t119 * ((-0.087 * t114 * t216 - 0.174 * t152 * t117 * t142)));
+  const double t218 = t123 * t158 * (-15927874.753700253) * t156;
+  const double t219 = x[10] * (1.0 / sqrt(t193));
+  const double t220 = (t219 - 1.0);
+  const double t221 = (t219 + 1.0);
+  const double t222 = x[14] * 2.0;
+  const double t223 = (t222 - 4e+05);
+  const double t224 = ((1.0 / sqrt(t198)) * t197 - 1.0);
+  const double t225 = (u[13] - x[15]);
+  const double t226 = ((t225 * t225) + 1e+08);
+  const double t227 = (sqrt(t226) + u[13] - x[15]);
+  const double t228 = (t227 * t227);
+  const double t229 = (4e+10 + 0.25 * t228);
+  const double t230 = pow(t229, (-0.25));
+  const double t231 = (1e-06 + (x[11] * x[11]));
+  const double t232 = x[11] * (1.0 / sqrt(t231));
+  const double t233 = (t232 + 1.0);
+  const double t234 = (t232 - 1.0);
+  const double t235 = (x[15] - 2e+05);
+  const double t236 = (t235 * t235);
+  const double t237 = (4e+10 + t236);
+  const double t238 = pow(t237, (-0.25));
+  const double t239 = (1.0 + (1.0 / sqrt(t226)) * t225);
+  const double t240 = sqrt(t231);
+  const double t241 = (t240 + x[11]);
+  const double t242 = x[15] * 2.0;
+  const double t243 = (t242 - 4e+05);
+  const double t244 = (x[11] - t240);
+  const double t245 = (-2.9e+07 + x[15]);
+  const double t246 = (x[16] - 3.7e+07);
+  const double t247 = ((t246 * t246) + 1e+10);
+  const double t248 = (x[16] - 2e+05);
+  const double t249 = (t248 * t248);
+  const double t250 = (4e+10 + t249);
+  const double t251 = pow(t250, (-0.25));
+  const double t252 = (1e+10 + t249);
+  const double t253 = (u[10] - x[16]);
+  const double t254 = (1e+08 + (t253 * t253));
+  const double t255 = (u[10] - x[16] + sqrt(t254));
+  const double t256 = (t255 * t255);
+  const double t257 = (4e+10 + t256 * 0.25);
   const double t258 = pow(t257, (-0.25));
-  const double t259 = (x[17] - u[11]);
-  const double t260 = (t259 * t259);
-  const double t261 = (4e+10 + t260);
-  const double t262 = pow(t261, (-0.25));
-  const double t263 =
-      (sqrt(t254) * 3.5e-09 - sqrt(t256) * 3.5e-09 + t46 * t62 * x[4] * 0.00901244392498572 +
-       0.1302 - t258 * t252 * 2.8577380332470414e-06 * t52 - x[17] * 7e-09 +
-       t46 * x[5] * t60 * 0.00901244392498572 - t262 * 2.8577380332470414e-06 * t259 * t68);
-  const double t264 = x[17] * 2.0;
-  const double t265 = (t264 - 4e+05);
-  const double t266 = (x[18] - 3.7e+07);
-  const double t267 = (1e+10 + (t266 * t266));
-  const double t268 = (x[18] - 2e+05);
-  const double t269 = (t268 * t268);
-  const double t270 = (t269 + 1e+10);
-  const double t271 = (x[18] - u[12]);
-  const double t272 = (t271 * t271);
-  const double t273 = (4e+10 + t272);
-  const double t274 = pow(t273, (-0.25));
-  const double t275 = (4e+10 + t269);
+  const double t259 = (0.05992565888304706 - 0.015079644737231009 * t14);
+  const double t260 = (1.0 / (t259));
+  const double t261 = (1.0 + (1.0 / sqrt(t254)) * t253);
+  const double t262 = x[16] * 2.0;
+  const double t263 = (t262 - 4e+05);
+  const double t264 = (0.03909483791956781 - t54 * 0.00901244392498572);
+  const double t265 = (1.0 / (t264 * t264));
+  const double t266 = (x[17] - 2e+05);
+  const double t267 = (t266 * t266);
+  const double t268 = (t267 + 1e+10);
+  const double t269 = (x[17] - 3.7e+07);
+  const double t270 = (1e+10 + (t269 * t269));
+  const double t271 = (x[17] - u[11]);
+  const double t272 = ((t271 * t271) + 1e+08);
+  const double t273 = (x[17] - sqrt(t272) - u[11]);
+  const double t274 = (t273 * t273);
+  const double t275 = (4e+10 + 0.25 * t274);
   const double t276 = pow(t275, (-0.25));
-  const double t277 =
-      (-2.5e-09 * sqrt(t267) + 0.093 + t115 * 0.006911503837897547 * x[4] * t140 +
-       t115 * 0.006911503837897547 * x[5] * t140 + 2.5e-09 * sqrt(t270) +
-       0.0034557519189487734 * t115 * t164 * x[6] - x[18] * 5e-09 +
-       t154 * t271 * 2.0412414523193154e-06 * t274 - t276 * t268 * t145 * 2.0412414523193154e-06);
-  const double t278 = (0.0276416792385999 - 0.006911503837897547 * t116);
-  const double t279 = (1.0 / (t278 * t278));
-  const double t280 = (1.0 / (t278));
-  const double t281 =
-      (8293804.6054770565 * t277 * t279 * t115 * t140 +
-       ((t115 * 0.006911503837897547 * t184 * x[5] + t115 * 0.006911503837897547 * t184 * x[4] -
-         t168 * 0.006911503837897547 * t169 * x[4] - t168 * 0.006911503837897547 * t169 * x[5] +
-         t197 * 0.0034557519189487734 * t115 * x[6] -
-         0.0034557519189487734 * t168 * t164 * x[6] * t140)) *
-           1.2e+09 * t280);
-  const double t282 = 8293804.6054770565 * t115 * t140 * t280;
-  const double t283 = x[18] * 2.0;
-  const double t284 = (t283 - 4e+05);
-  const double t285 = (x[19] - 2e+05);
-  const double t286 = (t285 * t285);
-  const double t287 = (4e+10 + t286);
-  const double t288 = pow(t287, (-0.25));
-  const double t289 = (u[13] - x[19]);
-  const double t290 = (t289 * t289);
-  const double t291 = (t290 + 4e+10);
-  const double t292 = pow(t291, (-0.25));
-  const double t293 = x[19] * 2.0;
-  const double t294 = (-2.9e+07 + x[19]);
-  const double t295 = (t293 - 4e+05);
-  const double t296 = (-0.35 * t0 - t1 * 2.6);
-  const double t297 = 5.7 * t0;
-  const double t298 = t40 * (-0.1);
-  const double t299 = 1.1 * t38;
-  const double t300 = (t297 + t298 + t299);
-  const double t301 = t1 * (-0.35);
-  const double t302 = 2.6 * t0;
-  const double t303 = (t301 + t302);
-  const double t304 = t1 * (-5.7);
-  const double t305 = t38 * (-0.1);
-  const double t306 = t40 * (-1.1);
-  const double t307 = (t304 + t305 + t306);
-  const double t308 = t91 * 0.567857142857143;
-  const double t309 = 2.9 * t38;
-  const double t310 = t90 * 0.0578571428571429;
-  const double t311 = (t308 + t297 + t309 + t310);
-  const double t312 = t91 * 0.0578571428571429;
-  const double t313 = t40 * (-2.9);
-  const double t314 = t90 * (-0.567857142857143);
-  const double t315 = (t312 + t313 + t304 + t314);
-  const double t316 = t90 * (-0.7);
-  const double t317 = t91 * (-0.3);
-  const double t318 = (t316 + t313 + t304 + t317);
-  const double t319 = t90 * (-0.3);
-  const double t320 = t91 * 0.7;
-  const double t321 = (t319 + t297 + t309 + t320);
-  const double t322 = (t316 + t313 + t317);
-  const double t323 = (t298 + t299);
-  const double t324 = (t308 + t309 + t310);
-  const double t325 = (t312 + t313 + t314);
-  const double t326 = (t319 + t309 + t320);
-  const double t327 = (t305 + t306);
-  const double t328 =
-      (1150.0 + 950.0 * t318 * t322 + t300 * t323 * 1100.0 + u[8] * ((t311 * t324 + t315 * t325)) +
-       t326 * 950.0 * t321 + 1100.0 * t307 * t327);
-  const double t329 = (t319 + t320);
-  const double t330 = (t316 + t317);
-  const double t331 = (t308 + t310);
-  const double t332 = (t312 + t314);
-  const double t333 =
-      (950.0 * t321 * t329 + 250.0 + t330 * 950.0 * t318 + ((t311 * t331 + t332 * t315)) * u[8]);
-  const double t334 =
-      (t330 * 950.0 * t322 + 250.0 + t326 * 950.0 * t329 + ((t332 * t325 + t324 * t331)) * u[8]);
-  const double t335 = (t297 + t298 + t299 + 0.15);
-  const double t336 = (-t40 * 110.0 + t38 * 1210.0 + 6270.0 * t0 + 165.0);
-  const double t337 = (t308 + t297 + t309 + 0.15 + t310);
-  const double t338 = (t319 + t297 + t309 + 0.15 + t320);
-  const double t339 = (-t90 * 285.0 + 665.0 * t91 + t38 * 2755.0 + 142.5 + 5415.0 * t0);
-  const double t340 = (5720.0 * t0 + 330.0 - t1 * 770.0);
-  const double t341 = (t301 + 0.15 + t302);
-  const double t342 = (x[4] * x[4]);
-  const double t343 = sin(u[9]);
-  const double t344 = t90 * 0.3;
-  const double t345 = (-2.9) * t38;
-  const double t346 = (-5.7) * t0;
-  const double t347 = t91 * (-0.7);
-  const double t348 = (t344 + t345 + t346 + t347);
-  const double t349 = (t344 + t345 + t347);
-  const double t350 = t349 * x[5];
-  const double t351 = (t344 + t347);
-  const double t352 = t351 * x[6];
-  const double t353 = (t348 * x[4] + t350 + t352);
-  const double t354 = (t351 * x[5] + t352 + t351 * x[4]);
-  const double t355 = (t349 * x[4] + t350 + t352);
-  const double t356 = (x[4] * t353 + x[6] * t354 + t355 * x[5]);
-  const double t357 = (t1 * 0.35 - t302);
-  const double t358 = (t116 - 2.525);
-  const double t359 = (t358 * t358);
-  const double t360 = (t359 + 1e-06);
-  const double t361 = (t116 - 3.71);
-  const double t362 = (t361 * t361);
-  const double t363 = (t362 + 1e-06);
-  const double t364 =
-      (t115 * t164 * 1e+06 * x[6] + t115 * 2e+06 * x[4] * t140 + t115 * 2e+06 * x[5] * t140);
-  const double t365 = (1.0 / sqrt(t363));
-  const double t366 = (1.0 / sqrt(t360));
-  const double t367 = (t365 * t361 + 2.0 - t366 * t358);
-  const double t368 = (4e+08 * t116 - 2e+08 * sqrt(t360) + 0.013823007675795093 * x[18] -
-                       1.247e+09 + sqrt(t363) * 2e+08 - 0.026546457922833753 * x[14] + t364 * t367);
-  const double t369 = t115 * t368 * t140 * (-0.5);
-  const double t370 = x[5] * t327;
-  const double t371 = (t307 * x[4] + t370);
-  const double t372 = (x[4] * t327 + t370);
-  const double t373 = (x[4] * t371 + x[5] * t372);
-  const double t374 = (x[7] * x[7]);
-  const double t375 = t40 * 0.1;
-  const double t376 = t38 * (-1.1);
-  const double t377 = (t375 + t376);
-  const double t378 = t377 * x[5];
-  const double t379 = (t378 + t377 * x[4]);
-  const double t380 = (t375 + t376 + t346);
-  const double t381 = (t378 + t380 * x[4]);
-  const double t382 = (x[5] * t379 + t381 * x[4]);
-  const double t383 = cos(u[9]);
-  const double t384 = (-4.005 + t70);
-  const double t385 = (t384 * t384);
-  const double t386 = (1e-06 + t385);
-  const double t387 = (t70 - 2.595);
-  const double t388 = (t387 * t387);
-  const double t389 = (1e-06 + t388);
-  const double t390 = (1.0 / sqrt(t386));
-  const double t391 = (1.0 / sqrt(t389));
-  const double t392 = (t390 * t384 - t391 * t387 + 2.0);
-  const double t393 = (t46 * 2e+06 * x[5] * t60 + t46 * 2e+06 * t62 * x[4]);
-  const double t394 = (-0.035342917352885174 * x[13] + 4e+08 * t70 - 1.32e+09 + sqrt(t386) * 2e+08 -
-                       sqrt(t389) * 2e+08 + x[17] * 0.01802488784997144 + t392 * t393);
-  const double t395 = t330 * x[6];
-  const double t396 = (t330 * x[5] + t330 * x[4] + t395);
-  const double t397 = x[5] * t322;
-  const double t398 = (t397 + x[4] * t322 + t395);
-  const double t399 = (t397 + t318 * x[4] + t395);
-  const double t400 = (t396 * x[6] + t398 * x[5] + x[4] * t399);
-  const double t401 = t90 * (-0.0578571428571429);
-  const double t402 = (-0.567857142857143) * t91;
-  const double t403 = (t401 + t345 + t346 + t402);
-  const double t404 = (t401 + t345 + t402);
-  const double t405 = x[5] * t404;
-  const double t406 = (t401 + t402);
-  const double t407 = t406 * x[6];
-  const double t408 = (x[4] * t403 + t405 + t407);
-  const double t409 = (x[4] * t404 + t405 + t407);
-  const double t410 = (t407 + t406 * x[5] + t406 * x[4]);
-  const double t411 = (x[4] * t408 + x[5] * t409 + t410 * x[6]);
-  const double t412 = x[5] * t325;
-  const double t413 = t332 * x[6];
-  const double t414 = (x[4] * t325 + t412 + t413);
-  const double t415 = (t412 + x[4] * t315 + t413);
-  const double t416 = (t332 * x[5] + t413 + t332 * x[4]);
-  const double t417 = (x[5] * t414 + x[4] * t415 + t416 * x[6]);
-  const double t418 = (-3.775 + t14);
-  const double t419 = (t418 * t418);
-  const double t420 = (1e-06 + t419);
-  const double t421 = (1.0 / sqrt(t420));
-  const double t422 = (-2.03 + t14);
-  const double t423 = (t422 * t422);
-  const double t424 = (1e-06 + t423);
-  const double t425 = (1.0 / sqrt(t424));
-  const double t426 = (2.0 + t421 * t418 - t422 * t425);
-  const double t427 =
-      (-t7 * 2e+06 * x[4] * t426 * t12 - 2e+08 * sqrt(t420) + sqrt(t424) * 2e+08 -
+  const double t277 = (4e+10 + t267);
+  const double t278 = pow(t277, (-0.25));
+  const double t279 =
+      (sqrt(t268) * 3.5e-09 - sqrt(t270) * 3.5e-09 - t276 * 1.4288690166235207e-06 * t273 * t76 +
+       t49 * t53 * x[4] * 0.00901244392498572 + 0.1302 -
+       t278 * t266 * 2.8577380332470414e-06 * t64 - x[17] * 7e-09 +
+       t49 * x[5] * t61 * 0.00901244392498572);
+  const double t280 = (1.0 / (t264));
+  const double t281 = x[17] * 2.0;
+  const double t282 = (t281 - 4e+05);
+  const double t283 = (t271 * (1.0 / sqrt(t272)) - 1.0);
+  const double t284 = (0.0276416792385999 - 0.006911503837897547 * t121);
+  const double t285 = (1.0 / (t284 * t284));
+  const double t286 = (x[18] - 3.7e+07);
+  const double t287 = (1e+10 + (t286 * t286));
+  const double t288 = (x[18] - 2e+05);
+  const double t289 = (t288 * t288);
+  const double t290 = (t289 + 1e+10);
+  const double t291 = (x[18] - u[12]);
+  const double t292 = (1e+08 + (t291 * t291));
+  const double t293 = (sqrt(t292) + u[12] - x[18]);
+  const double t294 = (t293 * t293);
+  const double t295 = (4e+10 + t294 * 0.25);
+  const double t296 = pow(t295, (-0.25));
+  const double t297 = (4e+10 + t289);
+  const double t298 = pow(t297, (-0.25));
+  const double t299 =
+      (-2.5e-09 * sqrt(t287) + 0.093 + t158 * 0.006911503837897547 * x[4] * t156 +
+       t158 * 0.006911503837897547 * x[5] * t156 + 2.5e-09 * sqrt(t290) -
+       t296 * t293 * t195 * 1.0206207261596577e-06 + 0.0034557519189487734 * t158 * t143 * x[6] -
+       x[18] * 5e-09 - t298 * t288 * t196 * 2.0412414523193154e-06);
+  const double t300 = (1.0 / (t284));
+  const double t301 =
+      (8293804.6054770565 * t285 * t299 * t158 * t156 +
+       ((t158 * 0.006911503837897547 * t173 * x[5] + t158 * 0.006911503837897547 * t173 * x[4] -
+         t124 * 0.006911503837897547 * t157 * x[4] - t124 * 0.006911503837897547 * t157 * x[5] +
+         t186 * 0.0034557519189487734 * t158 * x[6] -
+         0.0034557519189487734 * t124 * t143 * x[6] * t156)) *
+           1.2e+09 * t300);
+  const double t302 = 8293804.6054770565 * t158 * t156 * t300;
+  const double t303 = x[18] * 2.0;
+  const double t304 = (-1.0 + (1.0 / sqrt(t292)) * t291);
+  const double t305 = (t303 - 4e+05);
+  const double t306 = (u[13] - x[19]);
+  const double t307 = ((t306 * t306) + 1e+08);
+  const double t308 = (sqrt(t307) + u[13] - x[19]);
+  const double t309 = (t308 * t308);
+  const double t310 = (4e+10 + 0.25 * t309);
+  const double t311 = pow(t310, (-0.25));
+  const double t312 = (x[19] - 2e+05);
+  const double t313 = (t312 * t312);
+  const double t314 = (4e+10 + t313);
+  const double t315 = pow(t314, (-0.25));
+  const double t316 = x[19] * 2.0;
+  const double t317 = (-2.9e+07 + x[19]);
+  const double t318 = (t316 - 4e+05);
+  const double t319 = (1.0 + (1.0 / sqrt(t307)) * t306);
+  const double t320 = (-0.35 * t0 - t1 * 2.6);
+  const double t321 = 5.7 * t0;
+  const double t322 = t43 * (-0.1);
+  const double t323 = 1.1 * t41;
+  const double t324 = (t321 + t322 + t323);
+  const double t325 = t1 * (-0.35);
+  const double t326 = 2.6 * t0;
+  const double t327 = (t325 + t326);
+  const double t328 = t1 * (-5.7);
+  const double t329 = t41 * (-0.1);
+  const double t330 = t43 * (-1.1);
+  const double t331 = (t328 + t329 + t330);
+  const double t332 = t97 * 0.567857142857143;
+  const double t333 = 2.9 * t41;
+  const double t334 = t96 * 0.0578571428571429;
+  const double t335 = (t332 + t321 + t333 + t334);
+  const double t336 = t97 * 0.0578571428571429;
+  const double t337 = t43 * (-2.9);
+  const double t338 = t96 * (-0.567857142857143);
+  const double t339 = (t336 + t337 + t328 + t338);
+  const double t340 = t96 * (-0.7);
+  const double t341 = t97 * (-0.3);
+  const double t342 = (t340 + t337 + t328 + t341);
+  const double t343 = t96 * (-0.3);
+  const double t344 = t97 * 0.7;
+  const double t345 = (t343 + t321 + t333 + t344);
+  const double t346 = (t340 + t337 + t341);
+  const double t347 = (t322 + t323);
+  const double t348 = (t332 + t333 + t334);
+  const double t349 = (t336 + t337 + t338);
+  const double t350 = (t343 + t333 + t344);
+  const double t351 = (t329 + t330);
+  const double t352 =
+      (1150.0 + 950.0 * t342 * t346 + t324 * t347 * 1100.0 + u[8] * ((t335 * t348 + t339 * t349)) +
+       t350 * 950.0 * t345 + 1100.0 * t331 * t351);
+  const double t353 = (t343 + t344);
+  const double t354 = (t340 + t341);
+  const double t355 = (t332 + t334);
+  const double t356 = (t336 + t338);
+  const double t357 =
+      (950.0 * t345 * t353 + 250.0 + t354 * 950.0 * t342 + ((t335 * t355 + t356 * t339)) * u[8]);
+  const double t358 =
+      (t354 * 950.0 * t346 + 250.0 + t350 * 950.0 * t353 + ((t356 * t349 + t348 * t355)) * u[8]);
+  const double t359 = (t321 + t322 + t323 + 0.15);
+  const double t360 = (-t43 * 110.0 + t41 * 1210.0 + 6270.0 * t0 + 165.0);
+  const double t361 = (t332 + t321 + t333 + 0.15 + t334);
+  const double t362 = (t343 + t321 + t333 + 0.15 + t344);
+  const double t363 = (-t96 * 285.0 + 665.0 * t97 + t41 * 2755.0 + 142.5 + 5415.0 * t0);
+  const double t364 = (5720.0 * t0 + 330.0 - t1 * 770.0);
+  const double t365 = (t325 + 0.15 + t326);
+  const double t366 = (x[4] * x[4]);
+  const double t367 = sin(u[9]);
+  const double t368 = t96 * 0.3;
+  const double t369 = (-2.9) * t41;
+  const double t370 = (-5.7) * t0;
+  const double t371 = t97 * (-0.7);
+  const double t372 = (t368 + t369 + t370 + t371);
+  const double t373 = (t368 + t369 + t371);
+  const double t374 = t373 * x[5];
+  const double t375 = (t368 + t371);
+  const double t376 = t375 * x[6];
+  const double t377 = (t372 * x[4] + t374 + t376);
+  const double t378 = (t375 * x[5] + t376 + t375 * x[4]);
+  const double t379 = (t373 * x[4] + t374 + t376);
+  const double t380 = (x[4] * t377 + x[6] * t378 + t379 * x[5]);
+  const double t381 = (t1 * 0.35 - t326);
+  const double t382 = (t121 - 2.525);
+  const double t383 = (t382 * t382);
+  const double t384 = (t383 + 1e-06);
+  const double t385 = (t121 - 3.71);
+  const double t386 = (t385 * t385);
+  const double t387 = (t386 + 1e-06);
+  const double t388 =
+      (t158 * t143 * 1e+06 * x[6] + t158 * 2e+06 * x[4] * t156 + t158 * 2e+06 * x[5] * t156);
+  const double t389 = (1.0 / sqrt(t387));
+  const double t390 = (1.0 / sqrt(t384));
+  const double t391 = (t389 * t385 + 2.0 - t390 * t382);
+  const double t392 = (4e+08 * t121 - 2e+08 * sqrt(t384) + 0.013823007675795093 * x[18] -
+                       1.247e+09 + sqrt(t387) * 2e+08 - 0.026546457922833753 * x[14] + t388 * t391);
+  const double t393 = t158 * t392 * t156 * (-0.5);
+  const double t394 = x[5] * t351;
+  const double t395 = (t331 * x[4] + t394);
+  const double t396 = (x[4] * t351 + t394);
+  const double t397 = (x[4] * t395 + x[5] * t396);
+  const double t398 = (x[7] * x[7]);
+  const double t399 = t43 * 0.1;
+  const double t400 = t41 * (-1.1);
+  const double t401 = (t399 + t400);
+  const double t402 = t401 * x[5];
+  const double t403 = (t402 + t401 * x[4]);
+  const double t404 = (t399 + t400 + t370);
+  const double t405 = (t402 + t404 * x[4]);
+  const double t406 = (x[5] * t403 + t405 * x[4]);
+  const double t407 = cos(u[9]);
+  const double t408 = (-4.005 + t54);
+  const double t409 = (t408 * t408);
+  const double t410 = (1e-06 + t409);
+  const double t411 = (t54 - 2.595);
+  const double t412 = (t411 * t411);
+  const double t413 = (1e-06 + t412);
+  const double t414 = (1.0 / sqrt(t410));
+  const double t415 = (1.0 / sqrt(t413));
+  const double t416 = (t414 * t408 - t415 * t411 + 2.0);
+  const double t417 = (t49 * 2e+06 * x[5] * t61 + t49 * 2e+06 * t53 * x[4]);
+  const double t418 = (-0.035342917352885174 * x[13] + 4e+08 * t54 - 1.32e+09 + sqrt(t410) * 2e+08 -
+                       sqrt(t413) * 2e+08 + x[17] * 0.01802488784997144 + t416 * t417);
+  const double t419 = t354 * x[6];
+  const double t420 = (t354 * x[5] + t354 * x[4] + t419);
+  const double t421 = x[5] * t346;
+  const double t422 = (t421 + x[4] * t346 + t419);
+  const double t423 = (t421 + t342 * x[4] + t419);
+  const double t424 = (t420 * x[6] + t422 * x[5] + x[4] * t423);
+  const double t425 = t96 * (-0.0578571428571429);
+  const double t426 = (-0.567857142857143) * t97;
+  const double t427 = (t425 + t369 + t370 + t426);
+  const double t428 = (t425 + t369 + t426);
+  const double t429 = x[5] * t428;
+  const double t430 = (t425 + t426);
+  const double t431 = t430 * x[6];
+  const double t432 = (x[4] * t427 + t429 + t431);
+  const double t433 = (x[4] * t428 + t429 + t431);
+  const double t434 = (t431 + t430 * x[5] + t430 * x[4]);
+  const double t435 = (x[4] * t432 + x[5] * t433 + t434 * x[6]);
+  const double t436 = x[5] * t349;
+  const double t437 = t356 * x[6];
+  const double t438 = (x[4] * t349 + t436 + t437);
+  const double t439 = (t436 + x[4] * t339 + t437);
+  const double t440 = (t356 * x[5] + t437 + t356 * x[4]);
+  const double t441 = (x[5] * t438 + x[4] * t439 + t440 * x[6]);
+  const double t442 = (-3.775 + t14);
+  const double t443 = (t442 * t442);
+  const double t444 = (1e-06 + t443);
+  const double t445 = (1.0 / sqrt(t444));
+  const double t446 = (-2.03 + t14);
+  const double t447 = (t446 * t446);
+  const double t448 = (1e-06 + t447);
+  const double t449 = (1.0 / sqrt(t448));
+  const double t450 = (2.0 + t445 * t442 - t446 * t449);
+  const double t451 =
+      (-t7 * 2e+06 * x[4] * t450 * t12 - 2e+08 * sqrt(t444) + sqrt(t448) * 2e+08 -
        0.015079644737231009 * x[16] + 1.161e+09 - 4e+08 * t14 + x[12] * 0.03078760800517998);
-  const double t428 = (11440.0 * t0 + 660.0 - t1 * 1540.0);
-  const double t429 = (330.0 + 12540.0 * t0 + 2420.0 * t38 - t40 * 220.0);
-  const double t430 = (-t90 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t38 + 1330.0 * t91);
-  const double t431 = t115 * t184 * t368 * (-0.5);
-  const double t432 = pow(t360, (-1.5));
-  const double t433 = pow(t363, (-1.5));
-  const double t434 = (t115 * 2e+08 * t365 * t140 * t361 - t115 * 2e+08 * t366 * t140 * t358 +
-                       ((t359 * t115 * t432 * t140 - t362 * t115 * t433 * t140 +
-                         t115 * t365 * t140 - t115 * t366 * t140)) *
-                           t364 +
-                       4e+08 * t115 * t140 +
-                       ((-t168 * t169 * 2e+06 * x[4] - t168 * t169 * 2e+06 * x[5] +
-                         t197 * t115 * 1e+06 * x[6] + t115 * 2e+06 * t184 * x[5] +
-                         t115 * 2e+06 * t184 * x[4] - t168 * t164 * 1e+06 * x[6] * t140)) *
-                           t367);
-  const double t435 = t434 * t115 * t140 * (-0.5);
-  const double t436 = pow(t389, (-1.5));
-  const double t437 = pow(t386, (-1.5));
-  const double t438 =
-      (-t391 * t46 * t387 * 2e+08 * t62 + 4e+08 * t46 * t62 + t46 * 2e+08 * t62 * t390 * t384 -
-       t393 * ((-t436 * t46 * t62 * t388 - t46 * t62 * t390 + t391 * t46 * t62 +
-                t46 * t385 * t62 * t437)) +
-       ((t46 * 2e+06 * x[5] * t78 + t46 * 2e+06 * x[4] * t81 - t79 * 2e+06 * t62 * x[5] * t60 -
-         t79 * t80 * 2e+06 * x[4])) *
-           t392);
-  const double t439 = t168 * t169 * t368 * 0.5;
-  const double t440 = t343 * t349 * (-9316.3175);
-  const double t441 = t79 * t394 * t62 * 0.5 * t60;
-  const double t442 =
-      (t46 * 2e+08 * t390 * t60 * t384 + 4e+08 * t46 * t60 - t391 * t46 * t387 * 2e+08 * t60 +
-       t392 * ((t46 * 2e+06 * x[4] * t78 + t46 * t83 * 2e+06 * x[5] -
-                t79 * 2e+06 * t62 * x[4] * t60 - t79 * 2e+06 * x[5] * t82)) -
-       ((-t436 * t46 * t388 * t60 + t391 * t46 * t60 + t46 * t385 * t437 * t60 -
-         t46 * t390 * t60)) *
-           t393);
-  const double t443 = u[8] * ((-t343 * 9.80665 * t404 - t383 * 9.80665 * t325));
-  const double t444 = t377 * t343 * (-10787.314999999999);
-  const double t445 = (-10787.314999999999) * t383 * t327;
-  const double t446 = t383 * t322 * (-9316.3175);
-  const double t447 = t46 * t394 * (-0.5) * t78;
-  const double t448 = t330 * t383 * (-9316.3175);
-  const double t449 = t168 * 0.25 * t164 * t368 * t140;
-  const double t450 = (-4e+08 * t115 * t164 -
+  const double t452 = (11440.0 * t0 + 660.0 - t1 * 1540.0);
+  const double t453 = (330.0 + 12540.0 * t0 + 2420.0 * t41 - t43 * 220.0);
+  const double t454 = (-t96 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t41 + 1330.0 * t97);
+  const double t455 = t158 * t173 * t392 * (-0.5);
+  const double t456 = pow(t384, (-1.5));
+  const double t457 = pow(t387, (-1.5));
+  const double t458 = (t158 * 2e+08 * t389 * t156 * t385 - t158 * 2e+08 * t390 * t156 * t382 +
+                       ((t383 * t158 * t456 * t156 - t386 * t158 * t457 * t156 +
+                         t158 * t389 * t156 - t158 * t390 * t156)) *
+                           t388 +
+                       4e+08 * t158 * t156 +
+                       ((-t124 * t157 * 2e+06 * x[4] - t124 * t157 * 2e+06 * x[5] +
+                         t186 * t158 * 1e+06 * x[6] + t158 * 2e+06 * t173 * x[5] +
+                         t158 * 2e+06 * t173 * x[4] - t124 * t143 * 1e+06 * x[6] * t156)) *
+                           t391);
+  const double t459 = t458 * t158 * t156 * (-0.5);
+  const double t460 = pow(t413, (-1.5));
+  const double t461 = pow(t410, (-1.5));
+  const double t462 =
+      (-t415 * t49 * t411 * 2e+08 * t53 + 4e+08 * t49 * t53 + t49 * 2e+08 * t53 * t414 * t408 -
+       t417 * ((-t460 * t49 * t53 * t412 - t49 * t53 * t414 + t415 * t49 * t53 +
+                t49 * t409 * t53 * t461)) +
+       ((t49 * 2e+06 * x[5] * t83 + t49 * 2e+06 * x[4] * t86 - t84 * 2e+06 * t53 * x[5] * t61 -
+         t84 * t85 * 2e+06 * x[4])) *
+           t416);
+  const double t463 = t124 * t157 * t392 * 0.5;
+  const double t464 = t367 * t373 * (-9316.3175);
+  const double t465 = t84 * t418 * t53 * 0.5 * t61;
+  const double t466 =
+      (t49 * 2e+08 * t414 * t61 * t408 + 4e+08 * t49 * t61 - t415 * t49 * t411 * 2e+08 * t61 +
+       t416 * ((t49 * 2e+06 * x[4] * t83 + t49 * t88 * 2e+06 * x[5] -
+                t84 * 2e+06 * t53 * x[4] * t61 - t84 * 2e+06 * x[5] * t87)) -
+       ((-t460 * t49 * t412 * t61 + t415 * t49 * t61 + t49 * t409 * t461 * t61 -
+         t49 * t414 * t61)) *
+           t417);
+  const double t467 = u[8] * ((-t367 * 9.80665 * t428 - t407 * 9.80665 * t349));
+  const double t468 = t401 * t367 * (-10787.314999999999);
+  const double t469 = (-10787.314999999999) * t407 * t351;
+  const double t470 = t407 * t346 * (-9316.3175);
+  const double t471 = t49 * t418 * (-0.5) * t83;
+  const double t472 = t354 * t407 * (-9316.3175);
+  const double t473 = t124 * 0.25 * t143 * t392 * t156;
+  const double t474 = (-4e+08 * t158 * t143 -
                        2.0 *
-                           ((t115 * 1e+06 * x[6] * t206 - t168 * x[6] * t207 * 5e+05 -
-                             t168 * t164 * 1e+06 * x[4] * t140 - t168 * t164 * 1e+06 * x[5] * t140 +
-                             t115 * 2e+06 * t209 * x[4] + t115 * 2e+06 * t209 * x[5])) *
-                           t367 +
-                       t364 * ((t115 * t164 * t366 - t359 * t115 * t432 * t164 -
-                                t115 * t365 * t164 + t362 * t115 * t433 * t164)) -
-                       t115 * 2e+08 * t365 * t164 * t361 + t115 * 2e+08 * t164 * t366 * t358);
-  const double t451 = t351 * t343 * (-9316.3175);
-  const double t452 = ((-t406 * t343 * 9.80665 - t383 * t332 * 9.80665)) * u[8];
-  const double t453 =
-      (t448 + t449 + t115 * 0.25 * t450 * t140 - t115 * t209 * t368 * 0.5 + t451 + t452);
-  const double t454 = (1.0 / (t114));
-  const double t455 = t454 * (-1e+06) * t169 * t367;
-  const double t456 = (1.0 / (t45));
-  const double t457 = t456 * (-1e+06) * t62 * t392 * t60;
-  const double t458 = (-5e+05) * t454 * t164 * t140 * t367;
-  const double t459 = t115 * 0.013273228961416876 * t140;
-  const double t460 = (-0.006911503837897547) * t115 * t140;
-  const double t461 =
-      (t448 - t197 * t115 * 0.25 * t368 - t434 * t115 * 0.25 * t164 + t449 + t451 + t452);
-  const double t462 = 950.0 * t321 * t322;
-  const double t463 = t377 * 1100.0 * t307;
-  const double t464 = t300 * 1100.0 * t327;
-  const double t465 = 950.0 * t318 * t349;
-  const double t466 = t315 * t404;
-  const double t467 = t311 * t325;
-  const double t468 = (t462 + t463 + t323 * 1100.0 * t307 + t464 + 950.0 * t348 * t322 + t465 +
-                       1100.0 * t380 * t327 + u[8] * ((t324 * t315 + t466 + t467 + t403 * t325)) +
-                       t326 * 950.0 * t318);
-  const double t469 = t311 * t332;
-  const double t470 = t406 * t315;
-  const double t471 = t330 * 950.0 * t321;
-  const double t472 = t351 * 950.0 * t318;
-  const double t473 = (((t469 + t331 * t315 + t470 + t332 * t403)) * u[8] + t330 * 950.0 * t348 +
-                       t471 + 950.0 * t318 * t329 + t472);
-  const double t474 = t404 * t325;
-  const double t475 = t324 * t325;
-  const double t476 = (t326 * 1900.0 * t322 + ((t474 + t475)) * 2.0 * u[8] + t377 * 2200.0 * t327 +
-                       1900.0 * t349 * t322 + t323 * 2200.0 * t327);
-  const double t477 = t326 * t330 * 950.0;
-  const double t478 = t324 * t332;
-  const double t479 = t332 * t404;
-  const double t480 = t406 * t325;
-  const double t481 = t331 * t325;
-  const double t482 = t330 * 950.0 * t349;
-  const double t483 = t351 * 950.0 * t322;
-  const double t484 = 950.0 * t329 * t322;
-  const double t485 = (t477 + ((t478 + t479 + t480 + t481)) * u[8] + t482 + t483 + t484);
-  const double t486 = t331 * t332;
-  const double t487 = t406 * t332;
-  const double t488 = (2.0 * u[8] * ((t486 + t487)) + t330 * t351 * 1900.0 + t330 * 1900.0 * t329);
-  const double t489 = t90 * (-665.0);
-  const double t490 = t91 * (-285.0);
-  const double t491 = t40 * (-2755.0);
-  const double t492 = (-110.0) * t38;
-  const double t493 = t40 * (-1210.0);
-  const double t494 =
-      (t462 + t463 + 950.0 * t349 * t322 + t326 * 950.0 * t322 + t464 + t465 +
-       ((t474 + t466 + t467 + t475)) * u[8] + t377 * 1100.0 * t327 + t323 * 1100.0 * t327);
-  const double t495 = (((t469 + t470 + t479 + t481)) * u[8] + t482 + t471 + t484 + t472);
-  const double t496 = (((t478 + t469 + t470 + t480)) * u[8] + t477 + t483 + t471 + t472);
-  const double t497 = t330 * 950.0 * t329;
-  const double t498 = t330 * t351 * 950.0;
-  const double t499 = (t497 + t471 + u[8] * ((t486 + t487 + t469 + t470)) + t498 + t472);
-  const double t500 = (t497 + t477 + ((t486 + t478 + t487 + t480)) * u[8] + t483 + t498);
+                           ((t158 * 1e+06 * x[6] * t214 - t124 * x[6] * t215 * 5e+05 -
+                             t124 * t143 * 1e+06 * x[4] * t156 - t124 * t143 * 1e+06 * x[5] * t156 +
+                             t158 * 2e+06 * t217 * x[4] + t158 * 2e+06 * t217 * x[5])) *
+                           t391 +
+                       t388 * ((t158 * t143 * t390 - t383 * t158 * t456 * t143 -
+                                t158 * t389 * t143 + t386 * t158 * t457 * t143)) -
+                       t158 * 2e+08 * t389 * t143 * t385 + t158 * 2e+08 * t143 * t390 * t382);
+  const double t475 = t375 * t367 * (-9316.3175);
+  const double t476 = ((-t430 * t367 * 9.80665 - t407 * t356 * 9.80665)) * u[8];
+  const double t477 =
+      (t472 + t473 + t158 * 0.25 * t474 * t156 - t158 * t217 * t392 * 0.5 + t475 + t476);
+  const double t478 = (1.0 / (t120));
+  const double t479 = t478 * (-1e+06) * t157 * t391;
+  const double t480 = (1.0 / (t48));
+  const double t481 = t480 * (-1e+06) * t53 * t416 * t61;
+  const double t482 = (-5e+05) * t478 * t143 * t156 * t391;
+  const double t483 = t158 * 0.013273228961416876 * t156;
+  const double t484 = (-0.006911503837897547) * t158 * t156;
+  const double t485 =
+      (t472 - t186 * t158 * 0.25 * t392 - t458 * t158 * 0.25 * t143 + t473 + t475 + t476);
+  const double t486 = 950.0 * t345 * t346;
+  const double t487 = t401 * 1100.0 * t331;
+  const double t488 = t324 * 1100.0 * t351;
+  const double t489 = 950.0 * t342 * t373;
+  const double t490 = t339 * t428;
+  const double t491 = t335 * t349;
+  const double t492 = (t486 + t487 + t347 * 1100.0 * t331 + t488 + 950.0 * t372 * t346 + t489 +
+                       1100.0 * t404 * t351 + u[8] * ((t348 * t339 + t490 + t491 + t427 * t349)) +
+                       t350 * 950.0 * t342);
+  const double t493 = t335 * t356;
+  const double t494 = t430 * t339;
+  const double t495 = t354 * 950.0 * t345;
+  const double t496 = t375 * 950.0 * t342;
+  const double t497 = (((t493 + t355 * t339 + t494 + t356 * t427)) * u[8] + t354 * 950.0 * t372 +
+                       t495 + 950.0 * t342 * t353 + t496);
+  const double t498 = t428 * t349;
+  const double t499 = t348 * t349;
+  const double t500 = (t350 * 1900.0 * t346 + ((t498 + t499)) * 2.0 * u[8] + t401 * 2200.0 * t351 +
+                       1900.0 * t373 * t346 + t347 * 2200.0 * t351);
+  const double t501 = t350 * t354 * 950.0;
+  const double t502 = t348 * t356;
+  const double t503 = t356 * t428;
+  const double t504 = t430 * t349;
+  const double t505 = t355 * t349;
+  const double t506 = t354 * 950.0 * t373;
+  const double t507 = t375 * 950.0 * t346;
+  const double t508 = 950.0 * t353 * t346;
+  const double t509 = (t501 + ((t502 + t503 + t504 + t505)) * u[8] + t506 + t507 + t508);
+  const double t510 = t355 * t356;
+  const double t511 = t430 * t356;
+  const double t512 = (2.0 * u[8] * ((t510 + t511)) + t354 * t375 * 1900.0 + t354 * 1900.0 * t353);
+  const double t513 = t96 * (-665.0);
+  const double t514 = t97 * (-285.0);
+  const double t515 = t43 * (-2755.0);
+  const double t516 = (-110.0) * t41;
+  const double t517 = t43 * (-1210.0);
+  const double t518 =
+      (t486 + t487 + 950.0 * t373 * t346 + t350 * 950.0 * t346 + t488 + t489 +
+       ((t498 + t490 + t491 + t499)) * u[8] + t401 * 1100.0 * t351 + t347 * 1100.0 * t351);
+  const double t519 = (((t493 + t494 + t503 + t505)) * u[8] + t506 + t495 + t508 + t496);
+  const double t520 = (((t502 + t493 + t494 + t504)) * u[8] + t501 + t507 + t495 + t496);
+  const double t521 = t354 * 950.0 * t353;
+  const double t522 = t354 * t375 * 950.0;
+  const double t523 = (t521 + t495 + u[8] * ((t510 + t511 + t493 + t494)) + t522 + t496);
+  const double t524 = (t521 + t501 + ((t510 + t502 + t511 + t504)) * u[8] + t507 + t522);
   jacobian[4] = 1.0;
   jacobian[25] = 1.0;
   jacobian[46] = 1.0;
@@ -1525,302 +1563,302 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
       (((-t7 * t10 * x[4] * 0.03078760800517998 + t11 * t13 * x[4] * 0.03078760800517998)) *
            1.2e+09 * t16 -
        t7 * 36945129.606215976 *
-           ((sqrt(t19) * 3.5e-09 - t7 * x[4] * 0.03078760800517998 * t12 - sqrt(t21) * 3.5e-09 -
-             x[12] * 7e-09 + 0.1302 + t22 * 2.8577380332470414e-06 * t25 * t28 +
-             t30 * t17 * 2.8577380332470414e-06 * t31)) *
+           ((1.4288690166235207e-06 * t19 * t22 * t25 + sqrt(t28) * 3.5e-09 -
+             t7 * x[4] * 0.03078760800517998 * t12 - sqrt(t30) * 3.5e-09 - x[12] * 7e-09 + 0.1302 +
+             t32 * t26 * 2.8577380332470414e-06 * t33)) *
            t12 / (t15 * t15));
   jacobian[244] = (-36945129.606215976) * t7 * t16 * t12;
   jacobian[248] =
       1.2e+09 *
-      ((-t33 * t30 * t17 * 2.8577380332470414e-06 + t22 * 2.8577380332470414e-06 * t25 * t34)) *
-      t16;
-  jacobian[252] = 1.2e+09 *
-                  ((-2.8577380332470414e-06 * t25 * t28 -
-                    7.144345083117603e-07 * t17 * t36 * pow(t29, (-1.25)) * t31 -
-                    ((-7.4e+07 + t35)) * (1.0 / sqrt(t21)) * 1.75e-09 +
-                    t30 * 2.8577380332470414e-06 * t31 + (1.0 / sqrt(t19)) * t36 * 1.75e-09 +
-                    t23 * 1.4288690166235207e-06 * t28 * pow(t24, (-1.25)) - 7e-09)) *
-                  t16;
+      ((1.4288690166235207e-06 * t35 * t22 * t25 - t36 * t32 * t26 * 2.8577380332470414e-06)) * t16;
+  jacobian[252] =
+      ((1.7860862707794009e-07 * t37 * pow(t24, (-1.25)) * t19 * t23 -
+        7.144345083117603e-07 * t26 * t39 * pow(t31, (-1.25)) * t33 -
+        ((-7.4e+07 + t38)) * (1.0 / sqrt(t30)) * 1.75e-09 + t32 * 2.8577380332470414e-06 * t33 +
+        (1.0 / sqrt(t28)) * t39 * 1.75e-09 - t37 * 1.4288690166235207e-06 * t19 * t25 - 7e-09)) *
+      1.2e+09 * t16;
   jacobian[260] =
-      (-t46 * t69 * t62 * t72 * 21205750.411731105 +
-       t73 * 1.2e+09 *
-           ((-t46 * 0.017671458676442587 * x[5] * t78 + t79 * t80 * 0.017671458676442587 * x[4] +
-             t79 * t62 * 0.017671458676442587 * x[5] * t60 -
-             t46 * 0.017671458676442587 * x[4] * t81)));
+      (-t49 * t53 * t56 * 21205750.411731105 * t77 +
+       t78 * 1.2e+09 *
+           ((-t49 * 0.017671458676442587 * x[5] * t83 + t84 * t85 * 0.017671458676442587 * x[4] +
+             t84 * t53 * 0.017671458676442587 * x[5] * t61 -
+             t49 * 0.017671458676442587 * x[4] * t86)));
   jacobian[261] =
-      (-t46 * t69 * t72 * 21205750.411731105 * t60 +
-       t73 * 1.2e+09 *
-           ((t79 * 0.017671458676442587 * x[5] * t82 - t46 * t83 * 0.017671458676442587 * x[5] +
-             t79 * t62 * 0.017671458676442587 * x[4] * t60 -
-             t46 * 0.017671458676442587 * x[4] * t78)));
-  jacobian[264] = t73 * t46 * t62 * (-21205750.411731105);
-  jacobian[265] = t73 * t46 * t60 * (-21205750.411731105);
+      (-t49 * t56 * 21205750.411731105 * t61 * t77 +
+       t78 * 1.2e+09 *
+           ((t84 * 0.017671458676442587 * x[5] * t87 - t49 * t88 * 0.017671458676442587 * x[5] +
+             t84 * t53 * 0.017671458676442587 * x[4] * t61 -
+             t49 * 0.017671458676442587 * x[4] * t83)));
+  jacobian[264] = t78 * t49 * t53 * (-21205750.411731105);
+  jacobian[265] = t78 * t49 * t61 * (-21205750.411731105);
   jacobian[269] =
-      ((2.8577380332470414e-06 * t49 * t55 * t85 - t67 * t63 * 2.8577380332470414e-06 * t86)) *
-      t73 * 1.2e+09;
-  jacobian[273] = t73 * 1.2e+09 *
-                  ((-(1.0 / sqrt(t48)) * ((t87 - 7.4e+07)) * 1.75e-09 +
-                    pow(t54, (-1.25)) * t53 * t52 * 1.4288690166235207e-06 -
-                    2.8577380332470414e-06 * t52 * t55 - t67 * 2.8577380332470414e-06 * t68 +
-                    7.144345083117603e-07 * t63 * t88 * pow(t66, (-1.25)) * t68 +
-                    t88 * (1.0 / sqrt(t65)) * 1.75e-09 - 7e-09));
-  jacobian[280] = t198;
-  jacobian[281] = t198;
+      t78 * 1.2e+09 *
+      ((-t75 * t71 * 2.8577380332470414e-06 * t90 + 1.4288690166235207e-06 * t91 * t70 * t67));
+  jacobian[273] = t78 * 1.2e+09 *
+                  ((-(1.0 / sqrt(t58)) * ((t92 - 7.4e+07)) * 1.75e-09 -
+                    t93 * t64 * 1.4288690166235207e-06 * t70 - t75 * 2.8577380332470414e-06 * t76 +
+                    t93 * 1.7860862707794009e-07 * pow(t69, (-1.25)) * t68 * t64 +
+                    7.144345083117603e-07 * t71 * t94 * pow(t74, (-1.25)) * t76 +
+                    t94 * (1.0 / sqrt(t73)) * 1.75e-09 - 7e-09));
+  jacobian[280] = t206;
+  jacobian[281] = t206;
   jacobian[282] =
-      (t167 * 1.2e+09 *
-           ((t168 * t164 * 0.006636614480708438 * x[5] * t140 +
-             t168 * t164 * 0.006636614480708438 * x[4] * t140 -
-             t115 * 0.006636614480708438 * x[6] * t206 + t168 * 0.003318307240354219 * x[6] * t207 -
-             t115 * t209 * x[4] * 0.013273228961416876 -
-             t115 * t209 * x[5] * 0.013273228961416876)) -
-       t115 * 7963937.376850126 * t118 * t164 * t166);
-  jacobian[284] = t210;
-  jacobian[285] = t210;
-  jacobian[286] = t167 * (-7963937.376850126) * t115 * t164;
-  jacobian[290] = ((-t153 * t150 * t212 * 2.0412414523193154e-06 -
-                    t213 * t146 * 2.0412414523193154e-06 * t149)) *
-                  t167 * 1.2e+09;
-  jacobian[294] = t167 * 1.2e+09 *
-                  ((-t215 * t150 * 5.103103630798288e-07 * t154 * pow(t152, (-1.25)) +
-                    t153 * t154 * 2.0412414523193154e-06 + (1.0 / sqrt(t165)) * t215 * 1.25e-09 +
-                    pow(t148, (-1.25)) * t145 * 1.0206207261596577e-06 * t147 -
-                    t145 * 2.0412414523193154e-06 * t149 -
-                    (1.0 / sqrt(t142)) * 1.25e-09 * ((t214 - 7.4e+07)) - 5e-09));
+      (t123 * 1.2e+09 *
+           ((t124 * t143 * 0.006636614480708438 * x[5] * t156 +
+             t124 * t143 * 0.006636614480708438 * x[4] * t156 -
+             t158 * 0.006636614480708438 * x[6] * t214 + t124 * 0.003318307240354219 * x[6] * t215 -
+             t158 * t217 * x[4] * 0.013273228961416876 -
+             t158 * t217 * x[5] * 0.013273228961416876)) -
+       t204 * t158 * 7963937.376850126 * t205 * t143);
+  jacobian[284] = t218;
+  jacobian[285] = t218;
+  jacobian[286] = t123 * (-7963937.376850126) * t158 * t143;
+  jacobian[290] = t123 * 1.2e+09 *
+                  ((-t192 * t189 * t220 * 2.0412414523193154e-06 -
+                    t221 * 1.0206207261596577e-06 * t202 * t199));
+  jacobian[294] =
+      ((-t223 * t189 * 5.103103630798288e-07 * t195 * pow(t191, (-1.25)) -
+        1.275775907699572e-07 * pow(t201, (-1.25)) * t196 * t200 * t224 +
+        t192 * t195 * 2.0412414523193154e-06 + t196 * t224 * 1.0206207261596577e-06 * t202 +
+        (1.0 / sqrt(t203)) * t223 * 1.25e-09 - (1.0 / sqrt(t188)) * 1.25e-09 * ((t222 - 7.4e+07)) -
+        5e-09)) *
+      t123 * 1.2e+09;
   jacobian[307] = (-7.5e+08);
-  jacobian[311] = (t218 * t219 * 510310.3630798288 * t222 - t223 * t224 * t227 * 510310.3630798288);
-  jacobian[315] = (t220 * pow(t221, (-1.25)) * t229 * 255155.1815399144 +
-                   t231 * (1.0 / sqrt((1e+10 + t225))) * 312.5 - 1250.0 -
-                   t232 * t231 * t224 * 127577.5907699572 * pow(t226, (-1.25)) -
-                   t229 * 510310.3630798288 * t222 + t232 * t227 * 510310.3630798288 -
-                   ((t230 - 5.8e+07)) * (1.0 / sqrt(((t233 * t233) + 1e+10))) * 312.5);
+  jacobian[311] = (t230 * t233 * t227 * 255155.1815399144 - t234 * t235 * t238 * 510310.3630798288);
+  jacobian[315] =
+      (-t239 * t230 * t241 * 255155.1815399144 + t243 * (1.0 / sqrt((1e+10 + t236))) * 312.5 -
+       1250.0 + t239 * t241 * 31894.3976924893 * t228 * pow(t229, (-1.25)) -
+       t244 * t243 * t235 * 127577.5907699572 * pow(t237, (-1.25)) +
+       t244 * t238 * 510310.3630798288 -
+       ((t242 - 5.8e+07)) * (1.0 / sqrt(((t245 * t245) + 1e+10))) * 312.5);
   jacobian[320] =
-      (((0.015079644737231009 * t7 * x[4] * t12 - sqrt(t235) * 3.5e-09 -
-         t239 * t236 * 2.8577380332470414e-06 * t28 - t243 * 2.8577380332470414e-06 * t240 * t31 -
-         x[16] * 7e-09 + 0.1302 + sqrt(t244) * 3.5e-09)) *
-           t7 * 18095573.68467721 * t12 / (t245 * t245) +
-       1.2e+09 * t246 *
+      (((0.015079644737231009 * t7 * x[4] * t12 - sqrt(t247) * 3.5e-09 -
+         t251 * t248 * 2.8577380332470414e-06 * t19 - x[16] * 7e-09 + 0.1302 +
+         sqrt(t252) * 3.5e-09 - t258 * t255 * 1.4288690166235207e-06 * t33)) *
+           t7 * 18095573.68467721 * t12 / (t259 * t259) +
+       1.2e+09 * t260 *
            ((0.015079644737231009 * t7 * t10 * x[4] - 0.015079644737231009 * t11 * t13 * x[4])));
-  jacobian[324] = t7 * t246 * 18095573.68467721 * t12;
+  jacobian[324] = t7 * t260 * 18095573.68467721 * t12;
   jacobian[328] =
       1.2e+09 *
-      ((t33 * t243 * 2.8577380332470414e-06 * t240 - t239 * t236 * 2.8577380332470414e-06 * t34)) *
-      t246;
-  jacobian[336] = 1.2e+09 * t246 *
-                  ((-1.4288690166235207e-06 * pow(t242, (-1.25)) * t241 * t31 +
-                    t243 * 2.8577380332470414e-06 * t31 + (1.0 / sqrt(t244)) * t248 * 1.75e-09 +
-                    7.144345083117603e-07 * t236 * t248 * t28 * pow(t238, (-1.25)) -
-                    t239 * 2.8577380332470414e-06 * t28 -
-                    ((t247 - 7.4e+07)) * (1.0 / sqrt(t235)) * 1.75e-09 - 7e-09));
+      ((-t251 * t248 * 2.8577380332470414e-06 * t35 + t36 * t258 * t255 * 1.4288690166235207e-06)) *
+      t260;
+  jacobian[336] =
+      1.2e+09 * t260 *
+      ((t261 * t258 * 1.4288690166235207e-06 * t33 + (1.0 / sqrt(t252)) * t263 * 1.75e-09 +
+        7.144345083117603e-07 * t248 * t263 * t19 * pow(t250, (-1.25)) -
+        t251 * 2.8577380332470414e-06 * t19 - ((t262 - 7.4e+07)) * (1.0 / sqrt(t247)) * 1.75e-09 -
+        t256 * t261 * 1.7860862707794009e-07 * pow(t257, (-1.25)) * t33 - 7e-09));
   jacobian[340] =
-      (((t46 * x[5] * t78 * 0.00901244392498572 + t46 * x[4] * t81 * 0.00901244392498572 -
-         t79 * t62 * x[5] * t60 * 0.00901244392498572 - t79 * t80 * x[4] * 0.00901244392498572)) *
-           1.2e+09 * t250 +
-       t251 * t46 * 10814932.709982865 * t62 * t263);
+      (t265 * t49 * 10814932.709982865 * t53 * t279 +
+       ((t49 * x[5] * t83 * 0.00901244392498572 + t49 * x[4] * t86 * 0.00901244392498572 -
+         t84 * t53 * x[5] * t61 * 0.00901244392498572 - t84 * t85 * x[4] * 0.00901244392498572)) *
+           1.2e+09 * t280);
   jacobian[341] =
-      (t251 * t46 * 10814932.709982865 * t263 * t60 +
+      (t265 * t49 * 10814932.709982865 * t279 * t61 +
        1.2e+09 *
-           ((-t79 * t62 * x[4] * t60 * 0.00901244392498572 +
-             t46 * t83 * x[5] * 0.00901244392498572 + t46 * x[4] * t78 * 0.00901244392498572 -
-             t79 * x[5] * t82 * 0.00901244392498572)) *
-           t250);
-  jacobian[344] = t46 * 10814932.709982865 * t62 * t250;
-  jacobian[345] = t46 * 10814932.709982865 * t250 * t60;
+           ((-t84 * t53 * x[4] * t61 * 0.00901244392498572 +
+             t49 * t88 * x[5] * 0.00901244392498572 + t49 * x[4] * t83 * 0.00901244392498572 -
+             t84 * x[5] * t87 * 0.00901244392498572)) *
+           t280);
+  jacobian[344] = t49 * 10814932.709982865 * t53 * t280;
+  jacobian[345] = t49 * 10814932.709982865 * t280 * t61;
   jacobian[349] =
-      1.2e+09 * t250 *
-      ((-t258 * t252 * 2.8577380332470414e-06 * t85 - t262 * 2.8577380332470414e-06 * t259 * t86));
+      1.2e+09 *
+      ((-t278 * t266 * 2.8577380332470414e-06 * t91 - t276 * 1.4288690166235207e-06 * t273 * t90)) *
+      t280;
   jacobian[357] =
-      ((7.144345083117603e-07 * t252 * t265 * t52 * pow(t257, (-1.25)) -
-        t262 * 2.8577380332470414e-06 * t68 - ((-7.4e+07 + t264)) * (1.0 / sqrt(t256)) * 1.75e-09 +
-        t265 * (1.0 / sqrt(t254)) * 1.75e-09 +
-        t260 * 1.4288690166235207e-06 * pow(t261, (-1.25)) * t68 -
-        t258 * 2.8577380332470414e-06 * t52 - 7e-09)) *
-      1.2e+09 * t250;
-  jacobian[360] = t281;
-  jacobian[361] = t281;
-  jacobian[362] = (t277 * t279 * t115 * t164 * 4146902.3027385282 +
+      1.2e+09 *
+      ((7.144345083117603e-07 * t266 * t282 * t64 * pow(t277, (-1.25)) +
+        t276 * 1.4288690166235207e-06 * t283 * t76 -
+        ((-7.4e+07 + t281)) * (1.0 / sqrt(t270)) * 1.75e-09 -
+        1.7860862707794009e-07 * pow(t275, (-1.25)) * t274 * t283 * t76 +
+        t282 * (1.0 / sqrt(t268)) * 1.75e-09 - t278 * 2.8577380332470414e-06 * t64 - 7e-09)) *
+      t280;
+  jacobian[360] = t301;
+  jacobian[361] = t301;
+  jacobian[362] = (t285 * t299 * t158 * t143 * 4146902.3027385282 +
                    1.2e+09 *
-                       ((0.0034557519189487734 * t115 * x[6] * t206 -
-                         t168 * 0.0017278759594743867 * x[6] * t207 -
-                         0.0034557519189487734 * t168 * t164 * x[5] * t140 -
-                         0.0034557519189487734 * t168 * t164 * x[4] * t140 +
-                         t115 * 0.006911503837897547 * t209 * x[4] +
-                         t115 * 0.006911503837897547 * t209 * x[5])) *
-                       t280);
-  jacobian[364] = t282;
-  jacobian[365] = t282;
-  jacobian[366] = t115 * t164 * t280 * 4146902.3027385282;
-  jacobian[370] = 1.2e+09 *
-                  ((-t271 * t212 * 2.0412414523193154e-06 * t274 -
-                    t276 * t213 * t268 * 2.0412414523193154e-06)) *
-                  t280;
-  jacobian[378] = 1.2e+09 *
-                  ((-((-7.4e+07 + t283)) * 1.25e-09 * (1.0 / sqrt(t267)) -
-                    t154 * pow(t273, (-1.25)) * t272 * 1.0206207261596577e-06 +
-                    t154 * 2.0412414523193154e-06 * t274 - t276 * t145 * 2.0412414523193154e-06 +
-                    t268 * 5.103103630798288e-07 * t284 * t145 * pow(t275, (-1.25)) +
-                    t284 * 1.25e-09 * (1.0 / sqrt(t270)) - 5e-09)) *
-                  t280;
+                       ((0.0034557519189487734 * t158 * x[6] * t214 -
+                         t124 * 0.0017278759594743867 * x[6] * t215 -
+                         0.0034557519189487734 * t124 * t143 * x[5] * t156 -
+                         0.0034557519189487734 * t124 * t143 * x[4] * t156 +
+                         t158 * 0.006911503837897547 * t217 * x[4] +
+                         t158 * 0.006911503837897547 * t217 * x[5])) *
+                       t300);
+  jacobian[364] = t302;
+  jacobian[365] = t302;
+  jacobian[366] = t158 * t143 * t300 * 4146902.3027385282;
+  jacobian[370] = ((t296 * t293 * t220 * 1.0206207261596577e-06 -
+                    t298 * t221 * t288 * 2.0412414523193154e-06)) *
+                  1.2e+09 * t300;
+  jacobian[378] =
+      1.2e+09 * t300 *
+      ((-((-7.4e+07 + t303)) * 1.25e-09 * (1.0 / sqrt(t287)) +
+        1.275775907699572e-07 * t195 * t294 * t304 * pow(t295, (-1.25)) -
+        t296 * t195 * t304 * 1.0206207261596577e-06 - t298 * t196 * 2.0412414523193154e-06 +
+        t288 * 5.103103630798288e-07 * t305 * t196 * pow(t297, (-1.25)) +
+        t305 * 1.25e-09 * (1.0 / sqrt(t290)) - 5e-09));
   jacobian[387] = 7.5e+08;
-  jacobian[391] =
-      (-t288 * t285 * t218 * 510310.3630798288 + t223 * 510310.3630798288 * t289 * t292);
+  jacobian[391] = (t234 * t311 * t308 * 255155.1815399144 - t315 * t312 * t233 * 510310.3630798288);
   jacobian[399] =
-      (-((t293 - 5.8e+07)) * (1.0 / sqrt(((t294 * t294) + 1e+10))) * 312.5 - 1250.0 -
-       t288 * t229 * 510310.3630798288 +
-       t295 * t285 * 127577.5907699572 * t229 * pow(t287, (-1.25)) +
-       (1.0 / sqrt((t286 + 1e+10))) * t295 * 312.5 -
-       t290 * t232 * pow(t291, (-1.25)) * 255155.1815399144 + t232 * 510310.3630798288 * t292);
-  mass[0] = (7650.0 + 2200.0 * (t296 * t296) + (t300 * t300) * 1100.0 + (t303 * t303) * 2200.0 +
-             1100.0 * (t307 * t307) + (((t311 * t311) + (t315 * t315))) * u[8] +
-             950.0 * (t318 * t318) + (t321 * t321) * 950.0);
-  mass[1] = t328;
-  mass[2] = t333;
+      (-((t316 - 5.8e+07)) * (1.0 / sqrt(((t317 * t317) + 1e+10))) * 312.5 - 1250.0 -
+       t315 * t241 * 510310.3630798288 +
+       t318 * t312 * 127577.5907699572 * t241 * pow(t314, (-1.25)) -
+       t244 * t319 * 31894.3976924893 * t309 * pow(t310, (-1.25)) +
+       (1.0 / sqrt((t313 + 1e+10))) * t318 * 312.5 + t244 * t319 * t311 * 255155.1815399144);
+  mass[0] = (7650.0 + 2200.0 * (t320 * t320) + (t324 * t324) * 1100.0 + (t327 * t327) * 2200.0 +
+             1100.0 * (t331 * t331) + (((t335 * t335) + (t339 * t339))) * u[8] +
+             950.0 * (t342 * t342) + (t345 * t345) * 950.0);
+  mass[1] = t352;
+  mass[2] = t357;
   mass[3] = 0.0;
-  mass[4] = t328;
-  mass[5] = ((t327 * t327) * 1100.0 + 1150.0 + 950.0 * (t322 * t322) + (t326 * t326) * 950.0 +
-             u[8] * (((t325 * t325) + (t324 * t324))) + 1100.0 * (t323 * t323));
-  mass[6] = t334;
+  mass[4] = t352;
+  mass[5] = ((t351 * t351) * 1100.0 + 1150.0 + 950.0 * (t346 * t346) + (t350 * t350) * 950.0 +
+             u[8] * (((t349 * t349) + (t348 * t348))) + 1100.0 * (t347 * t347));
+  mass[6] = t358;
   mass[7] = 0.0;
-  mass[8] = t333;
-  mass[9] = t334;
-  mass[10] = ((((t332 * t332) + (t331 * t331))) * u[8] + (t330 * t330) * 950.0 + 250.0 +
-              (t329 * t329) * 950.0);
+  mass[8] = t357;
+  mass[9] = t358;
+  mass[10] = ((((t356 * t356) + (t355 * t355))) * u[8] + (t354 * t354) * 950.0 + 250.0 +
+              (t353 * t353) * 950.0);
   mass[11] = 0.0;
   mass[12] = 0.0;
   mass[13] = 0.0;
   mass[14] = 0.0;
-  mass[15] = (t335 * t336 + 60000.0 + (t337 * t337) * u[8] + t338 * t339 + t340 * t341);
+  mass[15] = (t359 * t360 + 60000.0 + (t361 * t361) * u[8] + t362 * t363 + t364 * t365);
   acceleration[0] =
-      (-t342 * t296 * t303 * 2200.0 - t296 * t343 * 21574.629999999997 - 950.0 * t318 * t356 -
-       t342 * t296 * 2200.0 * t357 + t369 - t300 * 1100.0 * t373 + t374 * t296 * t340 -
-       t382 * 1100.0 * t307 - t321 * t383 * 9316.3175 - x[4] * 6000.0 - t46 * t394 * t62 * 0.5 +
-       t374 * t337 * u[8] * t315 - t343 * t318 * 9316.3175 + u[4] + t374 * t318 * t339 -
-       t300 * t383 * 10787.314999999999 - t343 * t307 * 10787.314999999999 - 950.0 * t321 * t400 +
-       ((-t311 * t383 * 9.80665 - t343 * 9.80665 * t315)) * u[8] -
-       ((t411 * t315 + t311 * t417)) * u[8] + t374 * t307 * t336 -
-       t303 * t383 * 21574.629999999997 + t7 * t12 * t427);
+      (-t366 * t320 * t327 * 2200.0 - t320 * t367 * 21574.629999999997 - 950.0 * t342 * t380 -
+       t366 * t320 * 2200.0 * t381 + t393 - t324 * 1100.0 * t397 + t398 * t320 * t364 -
+       t406 * 1100.0 * t331 - t345 * t407 * 9316.3175 - x[4] * 6000.0 - t49 * t418 * t53 * 0.5 +
+       t398 * t361 * u[8] * t339 - t367 * t342 * 9316.3175 + u[4] + t398 * t342 * t363 -
+       t324 * t407 * 10787.314999999999 - t367 * t331 * 10787.314999999999 - 950.0 * t345 * t424 +
+       ((-t335 * t407 * 9.80665 - t367 * 9.80665 * t339)) * u[8] -
+       ((t435 * t339 + t335 * t441)) * u[8] + t398 * t331 * t360 -
+       t327 * t407 * 21574.629999999997 + t7 * t12 * t451);
   acceleration[1] =
-      (-t326 * t383 * 9316.3175 - t343 * t322 * 9316.3175 + t374 * t327 * t336 + t369 +
-       t374 * t322 * t339 - ((t411 * t325 + t324 * t417)) * u[8] - 2500.0 * x[5] -
-       950.0 * t356 * t322 - t382 * 1100.0 * t327 +
-       u[8] * ((-t324 * t383 * 9.80665 - t343 * 9.80665 * t325)) -
-       t343 * 10787.314999999999 * t327 - t326 * 950.0 * t400 + u[5] + t374 * t337 * u[8] * t325 -
-       t323 * t383 * 10787.314999999999 - t323 * 1100.0 * t373 - t46 * t394 * 0.5 * t60);
+      (-t350 * t407 * 9316.3175 - t367 * t346 * 9316.3175 + t398 * t351 * t360 + t393 +
+       t398 * t346 * t363 - ((t435 * t349 + t348 * t441)) * u[8] - 2500.0 * x[5] -
+       950.0 * t380 * t346 - t406 * 1100.0 * t351 +
+       u[8] * ((-t348 * t407 * 9.80665 - t367 * 9.80665 * t349)) -
+       t367 * 10787.314999999999 * t351 - t350 * 950.0 * t424 + u[5] + t398 * t361 * u[8] * t349 -
+       t347 * t407 * 10787.314999999999 - t347 * 1100.0 * t397 - t49 * t418 * 0.5 * t61);
   acceleration[2] =
-      (-t330 * 950.0 * t356 + t374 * t337 * t332 * u[8] - 950.0 * t400 * t329 + t374 * t330 * t339 +
-       ((-t343 * t332 * 9.80665 - t383 * t331 * 9.80665)) * u[8] - 800.0 * x[6] -
-       t383 * t329 * 9316.3175 + u[6] - u[8] * ((t411 * t332 + t331 * t417)) -
-       t330 * t343 * 9316.3175 - t115 * 0.25 * t164 * t368);
+      (-t354 * 950.0 * t380 + t398 * t361 * t356 * u[8] - 950.0 * t424 * t353 + t398 * t354 * t363 +
+       ((-t367 * t356 * 9.80665 - t407 * t355 * 9.80665)) * u[8] - 800.0 * x[6] -
+       t407 * t353 * 9316.3175 + u[6] - u[8] * ((t435 * t356 + t355 * t441)) -
+       t354 * t367 * 9316.3175 - t158 * 0.25 * t143 * t392);
   acceleration[3] =
-      (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 - t296 * x[7] * x[4] * t428 + u[7] -
-       t337 * 2.0 * x[7] * u[8] * t415 - t429 * x[7] * t371 - x[7] * t430 * t399);
+      (-20000.0 * x[7] - x[19] * 0.0025 + x[15] * 0.0025 - t320 * x[7] * x[4] * t452 + u[7] -
+       t361 * 2.0 * x[7] * u[8] * t439 - t453 * x[7] * t395 - x[7] * t454 * t423);
   d_force[0] =
-      (((-t383 * 9.80665 * t315 - t343 * t403 * 9.80665)) * u[8] -
-       t343 * 21574.629999999997 * t357 + t7 * t10 * t427 + t79 * t394 * t80 * 0.5 + t431 -
-       t318 * t383 * 9316.3175 + t435 - t383 * t307 * 10787.314999999999 - t11 * t13 * t427 -
-       t296 * t383 * 21574.629999999997 - t343 * t348 * 9316.3175 - t46 * t62 * t438 * 0.5 +
+      (((-t407 * 9.80665 * t339 - t367 * t427 * 9.80665)) * u[8] -
+       t367 * 21574.629999999997 * t381 + t7 * t10 * t451 + t84 * t418 * t85 * 0.5 + t455 -
+       t342 * t407 * 9316.3175 + t459 - t407 * t331 * 10787.314999999999 - t11 * t13 * t451 -
+       t320 * t407 * 21574.629999999997 - t367 * t372 * 9316.3175 - t49 * t53 * t462 * 0.5 +
        t7 *
-           ((-t7 * 2e+06 * t10 * x[4] * t426 + t7 * t422 * t425 * 2e+08 * t12 - 4e+08 * t7 * t12 +
-             t11 * t13 * 2e+06 * x[4] * t426 -
+           ((-t7 * 2e+06 * t10 * x[4] * t450 + t7 * t446 * t449 * 2e+08 * t12 - 4e+08 * t7 * t12 +
+             t11 * t13 * 2e+06 * x[4] * t450 -
              t7 * 2e+06 * x[4] * t12 *
-                 ((t7 * t421 * t12 - t7 * t419 * pow(t420, (-1.5)) * t12 +
-                   pow(t424, (-1.5)) * t7 * t423 * t12 - t7 * t425 * t12)) -
-             t7 * 2e+08 * t421 * t418 * t12)) *
+                 ((t7 * t445 * t12 - t7 * t443 * pow(t444, (-1.5)) * t12 +
+                   pow(t448, (-1.5)) * t7 * t447 * t12 - t7 * t449 * t12)) -
+             t7 * 2e+08 * t445 * t442 * t12)) *
            t12 +
-       t439 - t343 * t380 * 10787.314999999999 - t46 * t394 * 0.5 * t81);
-  d_force[1] = (t440 + t431 + t441 + t435 - t46 * t442 * t62 * 0.5 + t443 + t444 + t445 + t446 +
-                t439 + t447);
-  d_force[2] = t453;
+       t463 - t367 * t404 * 10787.314999999999 - t49 * t418 * 0.5 * t86);
+  d_force[1] = (t464 + t455 + t465 + t459 - t49 * t466 * t53 * 0.5 + t467 + t468 + t469 + t470 +
+                t463 + t471);
+  d_force[2] = t477;
   d_force[4] =
-      (t455 - t13 * 2e+06 * t426 / (t6)-t296 * t357 * x[4] * 4400.0 - t318 * 1900.0 * t353 -
-       t321 * 1900.0 * t399 - t296 * t303 * x[4] * 4400.0 - 6000.0 - t456 * t80 * t392 * 1e+06 -
-       2200.0 * t381 * t307 - t300 * 2200.0 * t371 - 2.0 * ((t311 * t415 + t408 * t315)) * u[8]);
-  d_force[5] = (t457 - t318 * 1900.0 * t355 + t455 - t398 * t321 * 1900.0 - 2200.0 * t307 * t379 -
-                t300 * 2200.0 * t372 - ((t409 * t315 + t311 * t414)) * 2.0 * u[8]);
-  d_force[6] = (-t318 * 1900.0 * t354 - 2.0 * u[8] * ((t410 * t315 + t416 * t311)) + t458 -
-                t321 * 1900.0 * t396);
-  d_force[7] = (t296 * 2.0 * t340 * x[7] + 2.0 * t307 * x[7] * t336 + t318 * 2.0 * x[7] * t339 +
-                t337 * 2.0 * x[7] * u[8] * t315);
+      (t479 - t13 * 2e+06 * t450 / (t6)-t320 * t381 * x[4] * 4400.0 - t342 * 1900.0 * t377 -
+       t345 * 1900.0 * t423 - t320 * t327 * x[4] * 4400.0 - 6000.0 - t480 * t85 * t416 * 1e+06 -
+       2200.0 * t405 * t331 - t324 * 2200.0 * t395 - 2.0 * ((t335 * t439 + t432 * t339)) * u[8]);
+  d_force[5] = (t481 - t342 * 1900.0 * t379 + t479 - t422 * t345 * 1900.0 - 2200.0 * t331 * t403 -
+                t324 * 2200.0 * t396 - ((t433 * t339 + t335 * t438)) * 2.0 * u[8]);
+  d_force[6] = (-t342 * 1900.0 * t378 - 2.0 * u[8] * ((t434 * t339 + t440 * t335)) + t482 -
+                t345 * 1900.0 * t420);
+  d_force[7] = (t320 * 2.0 * t364 * x[7] + 2.0 * t331 * x[7] * t360 + t342 * 2.0 * x[7] * t363 +
+                t361 * 2.0 * x[7] * u[8] * t339);
   d_force[12] = t7 * 0.03078760800517998 * t12;
-  d_force[13] = t46 * t62 * 0.017671458676442587;
-  d_force[14] = t459;
+  d_force[13] = t49 * t53 * 0.017671458676442587;
+  d_force[14] = t483;
   d_force[16] = t7 * (-0.015079644737231009) * t12;
-  d_force[17] = (-0.00901244392498572) * t46 * t62;
-  d_force[18] = t460;
-  d_force[20] = (t440 - t46 * t438 * 0.5 * t60 + t431 + t441 + t435 + t443 + t444 + t445 + t446 +
-                 t439 + t447);
-  d_force[21] = (t440 + t431 + t435 + t443 - t46 * t442 * 0.5 * t60 + t444 +
-                 t79 * t394 * 0.5 * t82 + t445 + t446 - t46 * t394 * t83 * 0.5 + t439);
-  d_force[22] = t453;
-  d_force[24] = (-1900.0 * t353 * t322 + t457 - ((t408 * t325 + t324 * t415)) * 2.0 * u[8] + t455 -
-                 2200.0 * t381 * t327 - t323 * 2200.0 * t371 - t326 * 1900.0 * t399);
-  d_force[25] = (-2200.0 * t327 * t379 - 2500.0 - ((t324 * t414 + t409 * t325)) * 2.0 * u[8] +
-                 t455 - t456 * t392 * 1e+06 * t82 - 1900.0 * t355 * t322 - t323 * 2200.0 * t372 -
-                 t398 * t326 * 1900.0);
-  d_force[26] = (-((t410 * t325 + t416 * t324)) * 2.0 * u[8] + t458 - 1900.0 * t354 * t322 -
-                 t326 * 1900.0 * t396);
+  d_force[17] = (-0.00901244392498572) * t49 * t53;
+  d_force[18] = t484;
+  d_force[20] = (t464 - t49 * t462 * 0.5 * t61 + t455 + t465 + t459 + t467 + t468 + t469 + t470 +
+                 t463 + t471);
+  d_force[21] = (t464 + t455 + t459 + t467 - t49 * t466 * 0.5 * t61 + t468 +
+                 t84 * t418 * 0.5 * t87 + t469 + t470 - t49 * t418 * t88 * 0.5 + t463);
+  d_force[22] = t477;
+  d_force[24] = (-1900.0 * t377 * t346 + t481 - ((t432 * t349 + t348 * t439)) * 2.0 * u[8] + t479 -
+                 2200.0 * t405 * t351 - t347 * 2200.0 * t395 - t350 * 1900.0 * t423);
+  d_force[25] = (-2200.0 * t351 * t403 - 2500.0 - ((t348 * t438 + t433 * t349)) * 2.0 * u[8] +
+                 t479 - t480 * t416 * 1e+06 * t87 - 1900.0 * t379 * t346 - t347 * 2200.0 * t396 -
+                 t422 * t350 * 1900.0);
+  d_force[26] = (-((t434 * t349 + t440 * t348)) * 2.0 * u[8] + t482 - 1900.0 * t378 * t346 -
+                 t350 * 1900.0 * t420);
   d_force[27] =
-      (2.0 * x[7] * t322 * t339 + 2.0 * x[7] * t327 * t336 + t337 * 2.0 * x[7] * u[8] * t325);
-  d_force[33] = t46 * 0.017671458676442587 * t60;
-  d_force[34] = t459;
-  d_force[37] = (-0.00901244392498572) * t46 * t60;
-  d_force[38] = t460;
-  d_force[40] = t461;
-  d_force[41] = t461;
-  d_force[42] = (t448 - t115 * 0.25 * t368 * t206 + 0.125 * t168 * t368 * t207 +
-                 0.125 * t115 * t164 * t450 + t451 + t452);
-  d_force[44] = (-2.0 * ((t331 * t415 + t332 * t408)) * u[8] - 1900.0 * t329 * t399 + t458 -
-                 t330 * 1900.0 * t353);
-  d_force[45] = (-t398 * 1900.0 * t329 - t330 * 1900.0 * t355 -
-                 ((t331 * t414 + t332 * t409)) * 2.0 * u[8] + t458);
-  d_force[46] = (-250000.0 * t454 * t207 * t367 - 2.0 * u[8] * ((t416 * t331 + t410 * t332)) -
-                 t330 * 1900.0 * t354 - 800.0 - 1900.0 * t396 * t329);
-  d_force[47] = (t337 * 2.0 * t332 * x[7] * u[8] + t330 * 2.0 * x[7] * t339);
-  d_force[54] = t115 * t164 * 0.006636614480708438;
-  d_force[58] = t115 * (-0.0034557519189487734) * t164;
-  d_force[64] = (-t318 * x[7] * t430 - t429 * t307 * x[7] - t337 * 2.0 * x[7] * u[8] * t315 -
-                 t296 * x[7] * t428);
-  d_force[65] = (-x[7] * t430 * t322 - t337 * 2.0 * x[7] * u[8] * t325 - t429 * x[7] * t327);
-  d_force[66] = (-t337 * 2.0 * t332 * x[7] * u[8] - t330 * x[7] * t430);
+      (2.0 * x[7] * t346 * t363 + 2.0 * x[7] * t351 * t360 + t361 * 2.0 * x[7] * u[8] * t349);
+  d_force[33] = t49 * 0.017671458676442587 * t61;
+  d_force[34] = t483;
+  d_force[37] = (-0.00901244392498572) * t49 * t61;
+  d_force[38] = t484;
+  d_force[40] = t485;
+  d_force[41] = t485;
+  d_force[42] = (t472 - t158 * 0.25 * t392 * t214 + 0.125 * t124 * t392 * t215 +
+                 0.125 * t158 * t143 * t474 + t475 + t476);
+  d_force[44] = (-2.0 * ((t355 * t439 + t356 * t432)) * u[8] - 1900.0 * t353 * t423 + t482 -
+                 t354 * 1900.0 * t377);
+  d_force[45] = (-t422 * 1900.0 * t353 - t354 * 1900.0 * t379 -
+                 ((t355 * t438 + t356 * t433)) * 2.0 * u[8] + t482);
+  d_force[46] = (-250000.0 * t478 * t215 * t391 - 2.0 * u[8] * ((t440 * t355 + t434 * t356)) -
+                 t354 * 1900.0 * t378 - 800.0 - 1900.0 * t420 * t353);
+  d_force[47] = (t361 * 2.0 * t356 * x[7] * u[8] + t354 * 2.0 * x[7] * t363);
+  d_force[54] = t158 * t143 * 0.006636614480708438;
+  d_force[58] = t158 * (-0.0034557519189487734) * t143;
+  d_force[64] = (-t342 * x[7] * t454 - t453 * t331 * x[7] - t361 * 2.0 * x[7] * u[8] * t339 -
+                 t320 * x[7] * t452);
+  d_force[65] = (-x[7] * t454 * t346 - t361 * 2.0 * x[7] * u[8] * t349 - t453 * x[7] * t351);
+  d_force[66] = (-t361 * 2.0 * t356 * x[7] * u[8] - t354 * x[7] * t454);
   d_force[67] =
-      (-t430 * t399 - t337 * 2.0 * u[8] * t415 - t429 * t371 - t296 * x[4] * t428 - 20000.0);
+      (-t454 * t423 - t361 * 2.0 * u[8] * t439 - t453 * t395 - t320 * x[4] * t452 - 20000.0);
   d_force[75] = 0.0025;
   d_force[79] = (-0.0025);
   d_mass[0] =
-      (t296 * t303 * 4400.0 + ((t311 * t315 + t403 * t315)) * 2.0 * u[8] + t296 * t357 * 4400.0 +
-       t300 * 2200.0 * t307 + t318 * t321 * 1900.0 + 2200.0 * t380 * t307 + t318 * t348 * 1900.0);
-  d_mass[1] = t468;
-  d_mass[2] = t473;
-  d_mass[4] = t468;
-  d_mass[5] = t476;
-  d_mass[6] = t485;
-  d_mass[8] = t473;
-  d_mass[9] = t485;
-  d_mass[10] = t488;
-  d_mass[15] = (t296 * t340 + ((-t1 * 5720.0 - 770.0 * t0)) * t341 + t318 * t339 +
-                t337 * 2.0 * u[8] * t315 + t307 * t336 +
-                ((t489 + t490 + t491 - t1 * 5415.0)) * t338 + t335 * ((t492 + t493 - t1 * 6270.0)));
-  d_mass[16] = (t318 * 1900.0 * t349 + t321 * 1900.0 * t322 + ((t466 + t467)) * 2.0 * u[8] +
-                t377 * 2200.0 * t307 + t300 * 2200.0 * t327);
-  d_mass[17] = t494;
-  d_mass[18] = t495;
-  d_mass[20] = t494;
-  d_mass[21] = t476;
-  d_mass[22] = t485;
-  d_mass[24] = t495;
-  d_mass[25] = t485;
-  d_mass[26] = t488;
-  d_mass[31] = (t335 * ((t492 + t493)) + t337 * 2.0 * u[8] * t325 + t322 * t339 + t327 * t336 +
-                t338 * ((t489 + t490 + t491)));
-  d_mass[32] = (t351 * t318 * 1900.0 + ((t469 + t470)) * 2.0 * u[8] + t330 * t321 * 1900.0);
-  d_mass[33] = t496;
-  d_mass[34] = t499;
-  d_mass[36] = t496;
-  d_mass[37] = (t326 * t330 * 1900.0 + 2.0 * ((t478 + t480)) * u[8] + t351 * 1900.0 * t322);
-  d_mass[38] = t500;
-  d_mass[40] = t499;
-  d_mass[41] = t500;
-  d_mass[42] = t488;
-  d_mass[47] = (t337 * 2.0 * t332 * u[8] + t338 * ((t489 + t490)) + t330 * t339);
+      (t320 * t327 * 4400.0 + ((t335 * t339 + t427 * t339)) * 2.0 * u[8] + t320 * t381 * 4400.0 +
+       t324 * 2200.0 * t331 + t342 * t345 * 1900.0 + 2200.0 * t404 * t331 + t342 * t372 * 1900.0);
+  d_mass[1] = t492;
+  d_mass[2] = t497;
+  d_mass[4] = t492;
+  d_mass[5] = t500;
+  d_mass[6] = t509;
+  d_mass[8] = t497;
+  d_mass[9] = t509;
+  d_mass[10] = t512;
+  d_mass[15] = (t320 * t364 + ((-t1 * 5720.0 - 770.0 * t0)) * t365 + t342 * t363 +
+                t361 * 2.0 * u[8] * t339 + t331 * t360 +
+                ((t513 + t514 + t515 - t1 * 5415.0)) * t362 + t359 * ((t516 + t517 - t1 * 6270.0)));
+  d_mass[16] = (t342 * 1900.0 * t373 + t345 * 1900.0 * t346 + ((t490 + t491)) * 2.0 * u[8] +
+                t401 * 2200.0 * t331 + t324 * 2200.0 * t351);
+  d_mass[17] = t518;
+  d_mass[18] = t519;
+  d_mass[20] = t518;
+  d_mass[21] = t500;
+  d_mass[22] = t509;
+  d_mass[24] = t519;
+  d_mass[25] = t509;
+  d_mass[26] = t512;
+  d_mass[31] = (t359 * ((t516 + t517)) + t361 * 2.0 * u[8] * t349 + t346 * t363 + t351 * t360 +
+                t362 * ((t513 + t514 + t515)));
+  d_mass[32] = (t375 * t342 * 1900.0 + ((t493 + t494)) * 2.0 * u[8] + t354 * t345 * 1900.0);
+  d_mass[33] = t520;
+  d_mass[34] = t523;
+  d_mass[36] = t520;
+  d_mass[37] = (t350 * t354 * 1900.0 + 2.0 * ((t502 + t504)) * u[8] + t375 * 1900.0 * t346);
+  d_mass[38] = t524;
+  d_mass[40] = t523;
+  d_mass[41] = t524;
+  d_mass[42] = t512;
+  d_mass[47] = (t361 * 2.0 * t356 * u[8] + t362 * ((t513 + t514)) + t354 * t363);
   // -dh/dq by central differences (see codegen/symbolic_model.cc).
   for (int c = 0; c < kNumJoints; ++c) {
     double shifted[kNumStates];

@@ -335,491 +335,496 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t11 = 0.1216 * t0;
   const double t12 = (t10 + t11);
   const double t13 = (t9 * t5 + t12 * t4);
-  const double t14 = sqrt(((x[4] * x[4]) + 1e-06));
-  const double t15 = (-t14 + x[4]);
-  const double t16 = (x[6] - 2e+05);
-  const double t17 = (t16 * t16);
-  const double t18 = (x[4] + t14);
-  const double t19 = (x[6] - u[6]);
-  const double t20 = (-2.3e+07 + x[6]);
-  const double t21 = sqrt(((x[5] * x[5]) + 1e-06));
-  const double t22 = (-t21 + x[5]);
-  const double t23 = (x[7] - 2e+05);
-  const double t24 = (t23 * t23);
-  const double t25 = (-2.3e+07 + x[7]);
-  const double t26 = (t21 + x[5]);
-  const double t27 = (x[7] - u[7]);
-  const double t28 = 0.4749 * t0;
-  const double t29 = (-0.4749) * t0;
-  const double t30 = (x[0] + x[1]);
-  const double t31 = sin(t30);
-  const double t32 = cos(t30);
-  const double t33 = (t29 + t2 * 0.5399000000000003 - t31 * 0.0898 + 0.3758 * t32);
+  const double t14 = (x[6] - u[6]);
+  const double t15 = (-x[6] + u[6] + sqrt(((t14 * t14) + 1e+08)));
+  const double t16 = sqrt(((x[4] * x[4]) + 1e-06));
+  const double t17 = (x[4] + t16);
+  const double t18 = (-t16 + x[4]);
+  const double t19 = (x[6] - 2e+05);
+  const double t20 = (t19 * t19);
+  const double t21 = (-2.3e+07 + x[6]);
+  const double t22 = 0.4749 * t0;
+  const double t23 = (-0.4749) * t0;
+  const double t24 = (x[0] + x[1]);
+  const double t25 = sin(t24);
+  const double t26 = cos(t24);
+  const double t27 = (t23 + t2 * 0.5399000000000003 - t25 * 0.0898 + 0.3758 * t26);
+  const double t28 = (t27 * t27);
+  const double t29 = 0.5399000000000003 * t0;
+  const double t30 = (-0.0898) * t26;
+  const double t31 = t25 * (-0.3758);
+  const double t32 = 0.4749 * t2;
+  const double t33 = (t29 + t30 + t31 + t32);
   const double t34 = (t33 * t33);
-  const double t35 = 0.5399000000000003 * t0;
-  const double t36 = (-0.0898) * t32;
-  const double t37 = t31 * (-0.3758);
-  const double t38 = 0.4749 * t2;
-  const double t39 = (t35 + t36 + t37 + t38);
-  const double t40 = (t39 * t39);
-  const double t41 = (-0.09333387000000004 + t34 + t40);
-  const double t42 = (t34 + t40);
-  const double t43 = (1.0 / sqrt(t42));
-  const double t44 = (t41 * t41);
-  const double t45 = (1.0 / (t42));
-  const double t46 = (-t44 * 0.25 * t45 + 0.26594649000000004);
-  const double t47 = sqrt(t46);
-  const double t48 = (-t41 * t33 * t43 + t39 * t47 * 2.0);
-  const double t49 = (t47 * 2.0 * t33 + t39 * t41 * t43);
-  const double t50 = atan2(t48 * t43 * (-0.5), 0.5 * t49 * t43);
-  const double t51 = sin(t50);
-  const double t52 = cos(t50);
-  const double t53 = (t28 + 0.0904 - 1.0001 * t51 + t2 * 2.4421 - 2e-04 * t52);
-  const double t54 = (t48 * t48);
-  const double t55 = (t49 * t49);
-  const double t56 = (t54 * t45 + t45 * t55);
-  const double t57 = (1.0 / (t56));
-  const double t58 = t32 * (-0.3758);
-  const double t59 = t31 * 0.0898;
-  const double t60 = (t28 - t2 * 0.5399000000000003 + t58 + t59);
-  const double t61 = (t39 * t60 + t39 * t33);
-  const double t62 = pow(t42, (-1.5));
-  const double t63 = t61 * t62 * (-2.0) * t49;
-  const double t64 = (1.0 / sqrt(t46));
-  const double t65 = (1.0 / (t42 * t42));
-  const double t66 = (t44 * t61 * t65 - t41 * 2.0 * t61 * t45);
-  const double t67 = (t39 * t61 * 4.0 * t43 - t39 * t41 * 2.0 * t61 * t62 + t41 * t60 * 2.0 * t43 +
-                      t39 * t47 * 4.0 + t64 * t66 * t33);
-  const double t68 = t67 * t43;
-  const double t69 = (t63 + t68);
-  const double t70 = t48 * 2.0 * t61 * t62;
-  const double t71 = (t41 * 2.0 * t61 * t62 * t33 - t39 * t41 * 2.0 * t43 - t61 * 4.0 * t33 * t43 +
-                      t60 * t47 * 4.0 + t39 * t64 * t66);
-  const double t72 = t71 * t43 * (-1.0);
-  const double t73 = (t70 + t72);
-  const double t74 = (t57 * t48 * t69 * t43 + t57 * t49 * t73 * t43);
-  const double t75 = (-0.4749) * t2;
-  const double t76 = 2.4421 * t0;
-  const double t77 = t2 * (-2.4421);
-  const double t78 = (t75 - 0.6968 + t76 + 2e-04 * t51 - 1.0001 * t52);
-  const double t79 = (t53 * ((-0.50005 * t52 * t74 + t75 + 1e-04 * t51 * t74 + t76)) +
-                      ((t29 + 1e-04 * t52 * t74 + t77 + 0.50005 * t51 * t74)) * t78);
-  const double t80 = ((t53 * t53) + (t78 * t78));
-  const double t81 = (1.0 / sqrt(t80));
-  const double t82 = (t36 + t37);
-  const double t83 = (t58 + t59);
-  const double t84 = (t82 * t33 + t39 * t83);
-  const double t85 = t84 * t62 * (-2.0) * t49;
-  const double t86 = (t41 * t84 * 2.0 * t45 - t84 * t44 * t65);
-  const double t87 = (-t39 * t41 * t84 * 2.0 * t62 + t47 * 4.0 * t82 + t41 * 2.0 * t43 * t83 +
-                      t39 * t84 * 4.0 * t43 - t64 * t33 * t86);
-  const double t88 = t43 * t87;
-  const double t89 = (t85 + t88);
-  const double t90 = (t47 * 4.0 * t83 - t84 * 4.0 * t33 * t43 - t39 * t64 * t86 -
-                      t41 * 2.0 * t82 * t43 + t41 * t84 * 2.0 * t62 * t33);
-  const double t91 = t43 * t90;
-  const double t92 = t48 * t84 * t62 * (-2.0);
-  const double t93 = (t91 + t92);
-  const double t94 = (-t57 * t48 * t89 * t43 + t57 * t49 * t43 * t93);
-  const double t95 = (((-0.50005 * t51 * t94 - 1e-04 * t94 * t52)) * t78 +
-                      ((-1e-04 * t51 * t94 + 0.50005 * t94 * t52)) * t53);
-  const double t96 = sqrt(t80);
-  const double t97 = (x[8] - 2e+05);
-  const double t98 = (t97 * t97);
-  const double t99 = (-2.3e+07 + x[8]);
-  const double t100 = (x[8] - u[6]);
-  const double t101 = (x[9] - 2e+05);
-  const double t102 = (t101 * t101);
-  const double t103 = (-2.3e+07 + x[9]);
-  const double t104 = (-x[9] + u[7]);
-  const double t105 = pow(t6, (-1.5));
-  const double t106 = (t1 + t3 - 0.5726 * t8 * t9 + 0.5726 * t13 * t105 * t5);
-  const double t107 = t31 * (-0.45);
-  const double t108 = (-0.22) * t32;
-  const double t109 = t2 * (-2.982);
-  const double t110 = (t107 + t108 + t109);
-  const double t111 = 0.0449 * t31;
-  const double t112 = (-0.1879) * t32;
-  const double t113 =
-      (-t61 * 0.25 * t62 * t49 - 2.71205 * t2 - 0.23745 * t0 + t111 + t67 * 0.125 * t43 + t112);
-  const double t114 = t31 * (-0.2090281052825221);
-  const double t115 = t32 * 0.4650337029259214;
-  const double t116 = t0 * 2.982;
-  const double t117 = (t114 + t115 + t116);
-  const double t118 = t31 * (-0.4650337029259214);
-  const double t119 = t32 * (-0.2090281052825221);
-  const double t120 = (t118 + t109 + t119);
-  const double t121 = t12 * t8 * (-0.5726);
-  const double t122 = (t10 + t121 + t11 + 0.5726 * t13 * t105 * t4);
-  const double t123 = (-t2 * 0.12 + 1.4 * t0);
-  const double t124 = (t75 + t76 + 0.128925 * t52 * t74);
-  const double t125 = (2.71205 * t0 - t31 * 0.1879 - 0.0449 * t32 + t48 * t61 * 0.25 * t62 -
-                       0.23745 * t2 - 0.125 * t71 * t43);
-  const double t126 = (1.0 / (t6));
-  const double t127 = (-1.2074 + t10 + t11);
-  const double t128 = (t9 * t126 * t4 + t12 * t126 * t127);
-  const double t129 =
-      (20.765148133333334 * t9 * t126 * t4 + t12 * 20.765148133333334 * t126 * t127);
-  const double t130 = t31 * (-0.3592);
-  const double t131 = (-1.8996) * t0;
-  const double t132 = 1.5032 * t32;
-  const double t133 = (2.159600000000001 * t2 + t63 + t130 + t131 + t68 + t132);
-  const double t134 =
-      (-0.9498 * t0 + 0.7516 * t32 + t2 * 1.0798000000000005 - t31 * 0.1796 + t48 * t43);
-  const double t135 = (t35 + t36 - 0.5 * t49 * t43 + t37 + t38);
-  const double t136 = ((t134 * t134) + (t135 * t135) * 4.0);
-  const double t137 = (1.0 / (t136));
+  const double t35 = (-0.09333387000000004 + t28 + t34);
+  const double t36 = (t28 + t34);
+  const double t37 = (1.0 / sqrt(t36));
+  const double t38 = (t35 * t35);
+  const double t39 = (1.0 / (t36));
+  const double t40 = (-t38 * 0.25 * t39 + 0.26594649000000004);
+  const double t41 = sqrt(t40);
+  const double t42 = (-t35 * t27 * t37 + t33 * t41 * 2.0);
+  const double t43 = (t41 * 2.0 * t27 + t33 * t35 * t37);
+  const double t44 = atan2(t42 * t37 * (-0.5), 0.5 * t43 * t37);
+  const double t45 = sin(t44);
+  const double t46 = cos(t44);
+  const double t47 = (t22 + 0.0904 - 1.0001 * t45 + t2 * 2.4421 - 2e-04 * t46);
+  const double t48 = (-0.4749) * t2;
+  const double t49 = 2.4421 * t0;
+  const double t50 = (t48 - 0.6968 + t49 + 2e-04 * t45 - 1.0001 * t46);
+  const double t51 = ((t47 * t47) + (t50 * t50));
+  const double t52 = sqrt(t51);
+  const double t53 = (x[7] - u[7]);
+  const double t54 = (x[7] - u[7] - sqrt((1e+08 + (t53 * t53))));
+  const double t55 = sqrt(((x[5] * x[5]) + 1e-06));
+  const double t56 = (t55 + x[5]);
+  const double t57 = (-t55 + x[5]);
+  const double t58 = (x[7] - 2e+05);
+  const double t59 = (t58 * t58);
+  const double t60 = (-2.3e+07 + x[7]);
+  const double t61 = (t42 * t42);
+  const double t62 = (t43 * t43);
+  const double t63 = (t61 * t39 + t39 * t62);
+  const double t64 = (1.0 / (t63));
+  const double t65 = t26 * (-0.3758);
+  const double t66 = t25 * 0.0898;
+  const double t67 = (t22 - t2 * 0.5399000000000003 + t65 + t66);
+  const double t68 = (t33 * t67 + t33 * t27);
+  const double t69 = pow(t36, (-1.5));
+  const double t70 = t68 * t69 * (-2.0) * t43;
+  const double t71 = (1.0 / sqrt(t40));
+  const double t72 = (1.0 / (t36 * t36));
+  const double t73 = (t38 * t68 * t72 - t35 * 2.0 * t68 * t39);
+  const double t74 = (t33 * t68 * 4.0 * t37 - t33 * t35 * 2.0 * t68 * t69 + t35 * t67 * 2.0 * t37 +
+                      t33 * t41 * 4.0 + t71 * t73 * t27);
+  const double t75 = t74 * t37;
+  const double t76 = (t70 + t75);
+  const double t77 = t42 * 2.0 * t68 * t69;
+  const double t78 = (t35 * 2.0 * t68 * t69 * t27 - t33 * t35 * 2.0 * t37 - t68 * 4.0 * t27 * t37 +
+                      t67 * t41 * 4.0 + t33 * t71 * t73);
+  const double t79 = t78 * t37 * (-1.0);
+  const double t80 = (t77 + t79);
+  const double t81 = (t64 * t42 * t76 * t37 + t64 * t43 * t80 * t37);
+  const double t82 = t2 * (-2.4421);
+  const double t83 = (t47 * ((-0.50005 * t46 * t81 + t48 + 1e-04 * t45 * t81 + t49)) +
+                      ((t23 + 1e-04 * t46 * t81 + t82 + 0.50005 * t45 * t81)) * t50);
+  const double t84 = (1.0 / sqrt(t51));
+  const double t85 = (t30 + t31);
+  const double t86 = (t65 + t66);
+  const double t87 = (t85 * t27 + t33 * t86);
+  const double t88 = t87 * t69 * (-2.0) * t43;
+  const double t89 = (t35 * t87 * 2.0 * t39 - t87 * t38 * t72);
+  const double t90 = (-t33 * t35 * t87 * 2.0 * t69 + t41 * 4.0 * t85 + t35 * 2.0 * t37 * t86 +
+                      t33 * t87 * 4.0 * t37 - t71 * t27 * t89);
+  const double t91 = t37 * t90;
+  const double t92 = (t88 + t91);
+  const double t93 = (t41 * 4.0 * t86 - t87 * 4.0 * t27 * t37 - t33 * t71 * t89 -
+                      t35 * 2.0 * t85 * t37 + t35 * t87 * 2.0 * t69 * t27);
+  const double t94 = t37 * t93;
+  const double t95 = t42 * t87 * t69 * (-2.0);
+  const double t96 = (t94 + t95);
+  const double t97 = (-t64 * t42 * t92 * t37 + t64 * t43 * t37 * t96);
+  const double t98 = (((-0.50005 * t45 * t97 - 1e-04 * t97 * t46)) * t50 +
+                      ((-1e-04 * t45 * t97 + 0.50005 * t97 * t46)) * t47);
+  const double t99 = (x[8] - 2e+05);
+  const double t100 = (t99 * t99);
+  const double t101 = (-2.3e+07 + x[8]);
+  const double t102 = (x[8] - u[6]);
+  const double t103 = (-sqrt(((t102 * t102) + 1e+08)) + x[8] - u[6]);
+  const double t104 = (x[9] - 2e+05);
+  const double t105 = (t104 * t104);
+  const double t106 = (-2.3e+07 + x[9]);
+  const double t107 = (-x[9] + u[7]);
+  const double t108 = (-x[9] + u[7] + sqrt(((t107 * t107) + 1e+08)));
+  const double t109 = pow(t6, (-1.5));
+  const double t110 = (t1 + t3 - 0.5726 * t8 * t9 + 0.5726 * t13 * t109 * t5);
+  const double t111 = t25 * (-0.45);
+  const double t112 = (-0.22) * t26;
+  const double t113 = t2 * (-2.982);
+  const double t114 = (t111 + t112 + t113);
+  const double t115 = 0.0449 * t25;
+  const double t116 = (-0.1879) * t26;
+  const double t117 =
+      (-t68 * 0.25 * t69 * t43 - 2.71205 * t2 - 0.23745 * t0 + t115 + t74 * 0.125 * t37 + t116);
+  const double t118 = t25 * (-0.2090281052825221);
+  const double t119 = t26 * 0.4650337029259214;
+  const double t120 = t0 * 2.982;
+  const double t121 = (t118 + t119 + t120);
+  const double t122 = t25 * (-0.4650337029259214);
+  const double t123 = t26 * (-0.2090281052825221);
+  const double t124 = (t122 + t113 + t123);
+  const double t125 = t12 * t8 * (-0.5726);
+  const double t126 = (t10 + t125 + t11 + 0.5726 * t13 * t109 * t4);
+  const double t127 = (-t2 * 0.12 + 1.4 * t0);
+  const double t128 = (t48 + t49 + 0.128925 * t46 * t81);
+  const double t129 = (2.71205 * t0 - t25 * 0.1879 - 0.0449 * t26 + t42 * t68 * 0.25 * t69 -
+                       0.23745 * t2 - 0.125 * t78 * t37);
+  const double t130 = (1.0 / (t6));
+  const double t131 = (-1.2074 + t10 + t11);
+  const double t132 = (t9 * t130 * t4 + t12 * t130 * t131);
+  const double t133 =
+      (20.765148133333334 * t9 * t130 * t4 + t12 * 20.765148133333334 * t130 * t131);
+  const double t134 = t25 * (-0.3592);
+  const double t135 = (-1.8996) * t0;
+  const double t136 = 1.5032 * t26;
+  const double t137 = (2.159600000000001 * t2 + t70 + t134 + t135 + t75 + t136);
   const double t138 =
-      (-1.0798000000000005 * t0 - t2 * 0.9498 + t32 * 0.1796 + t31 * 0.7516 + t49 * t43);
-  const double t139 = t31 * 1.5032;
-  const double t140 = 0.3592 * t32;
-  const double t141 = t2 * (-1.8996);
-  const double t142 = (t139 + t140 + t70 + t72 - 2.159600000000001 * t0 + t141);
-  const double t143 = (t133 * t137 * t134 * 2.5 + t137 * 2.5 * t138 * t142);
-  const double t144 = (-0.12 * t0 - t2 * 1.4);
-  const double t145 = (t29 + t77 - 0.128925 * t51 * t74);
-  const double t146 = 0.5726 * t12 * t8;
-  const double t147 = (-0.5726 * t13 * t105 * t4 + t146);
-  const double t148 = (t57 * t49 * t73 * t43 * 8.0 + t57 * t48 * t69 * t43 * 8.0);
-  const double t149 = t31 * (-0.22);
-  const double t150 = 0.45 * t32;
-  const double t151 = (t149 + t150 + t116);
-  const double t152 =
-      (12.021927866666665 * t9 * t126 * t4 + t12 * 12.021927866666665 * t126 * t127);
-  const double t153 = (-0.5726 * t13 * t105 * t5 + 0.5726 * t8 * t9);
-  const double t154 = 2.0 * t61 * t62 * t49;
-  const double t155 = 1.8996 * t0;
-  const double t156 = t67 * t43 * (-1.0);
-  const double t157 = (t154 + t155 + 21.6964 * t2 + t130 + t132 + t156);
-  const double t158 = t43 * t87 * (-1.0);
-  const double t159 = t84 * 2.0 * t62 * t49;
-  const double t160 = (t158 + t130 + t132 + t159);
-  const double t161 = (t149 + t150);
-  const double t162 = (t118 + t119);
-  const double t163 = (t114 + t115);
-  const double t164 = (t85 + t130 + t88 + t132);
-  const double t165 = t32 * (-0.3592);
-  const double t166 = t31 * (-1.5032);
-  const double t167 = (t165 + t166 + t91 + t92);
-  const double t168 = (-t137 * t134 * t164 + t137 * t138 * t167);
-  const double t169 = (t139 + t71 * t43 + t140 - 21.6964 * t0 + t2 * 1.8996 - t70);
-  const double t170 = (t139 + t140 + t91 + t92);
-  const double t171 = (t107 + t108);
-  const double t172 =
-      (t157 * 1.171875 * t160 - t124 * t94 * 24.49575 * t52 + 950.0 * t151 * t161 +
-       t145 * t51 * t94 * 24.49575 + 300.0 + ((t162 * t120 + t117 * t163)) * u[4] -
-       t143 * 0.5 * t168 + t169 * t170 * 1.171875 - 0.5 * t94 * t148 + 950.0 * t171 * t110);
-  const double t173 = (-t137 * 2.5 * t138 * t167 + t137 * t134 * 2.5 * t164);
-  const double t174 = (t94 * t94);
-  const double t175 = (t57 * t48 * t89 * t43 * 8.0 - t57 * t49 * t43 * t93 * 8.0);
-  const double t176 = (-t84 * 0.25 * t62 * t49 + 0.125 * t43 * t87 + t111 + t112);
-  const double t177 = cos(u[5]);
-  const double t178 = sin(u[5]);
-  const double t179 = (x[2] * x[2]);
-  const double t180 = pow(t6, (-2.5));
-  const double t181 = (t13 * t13);
-  const double t182 = t2 * (-0.1216);
-  const double t183 = (-0.6894) * t0;
-  const double t184 = (t182 + t183);
-  const double t185 = ((t12 * t12) + (t9 * t9) + t4 * t184 + t12 * t5);
-  const double t186 = t31 * 0.3592;
-  const double t187 = t32 * (-1.5032);
-  const double t188 = t61 * t62 * t71 * 8.0;
-  const double t189 = t31 * 0.3758;
-  const double t190 = 0.0898 * t32;
-  const double t191 = (t189 + t75 + t190 - t35);
-  const double t192 = (t60 * t33 + t40 + t39 * t191 + (t60 * t60));
-  const double t193 = t48 * t62 * 8.0 * t192;
-  const double t194 = (t61 * t61);
-  const double t195 = pow(t42, (-2.5));
-  const double t196 = (1.0 / (t42 * t42 * t42));
-  const double t197 = (-t44 * t192 * t65 + t41 * 2.0 * t45 * t192 + 4.0 * t45 * t194 -
-                       t41 * 8.0 * t194 * t65 + t44 * 4.0 * t196 * t194);
-  const double t198 = pow(t46, (-1.5));
-  const double t199 = (t66 * t66);
-  const double t200 =
-      ((-32.0 * t62 * t33 * t194 + 16.0 * t33 * t43 * t192 + t41 * 24.0 * t33 * t194 * t195 -
-        t39 * t41 * 16.0 * t61 * t62 + t39 * 32.0 * t61 * t43 + t41 * t60 * t43 * 8.0 -
-        t64 * t66 * t60 * 8.0 + t39 * t64 * t197 * 4.0 - t41 * t62 * t33 * 8.0 * t192 -
-        16.0 * t47 * t191 + t39 * t198 * t199)) *
-      t43;
-  const double t201 = t31 * 1.4368;
-  const double t202 = (-7.5984) * t0;
-  const double t203 = t32 * (-6.0128);
-  const double t204 = t48 * (-24.0) * t194 * t195;
-  const double t205 = t84 * 4.0 * t62 * t71;
-  const double t206 = t33 * t83;
-  const double t207 = (t189 + t190);
-  const double t208 = t39 * t207;
-  const double t209 = (t206 + t60 * t83 + t39 * t82 + t208);
-  const double t210 = (-16.0) * t47 * t207;
-  const double t211 = (-t209 * t44 * t65 + t84 * t61 * 4.0 * t45 + t84 * t44 * t61 * 4.0 * t196 -
-                       t41 * t84 * t61 * 8.0 * t65 + t209 * t41 * 2.0 * t45);
-  const double t212 = t41 * t43 * t83 * 8.0;
-  const double t213 = ((-t209 * t41 * t62 * t33 * 8.0 + t210 + t41 * t84 * t61 * 24.0 * t33 * t195 +
-                        t39 * t84 * 16.0 * t43 + t209 * 16.0 * t33 * t43 - t39 * t198 * t66 * t86 +
-                        t39 * t64 * 4.0 * t211 + t212 - t41 * t61 * t62 * t82 * 8.0 +
-                        16.0 * t61 * t82 * t43 + t64 * t60 * 4.0 * t86 - t64 * t66 * 4.0 * t83 -
-                        t84 * 32.0 * t61 * t62 * t33 - t39 * t41 * t84 * t62 * 8.0)) *
-                      t43;
-  const double t214 = t48 * (-24.0) * t84 * t61 * t195;
-  const double t215 = t61 * 4.0 * t62 * t90;
-  const double t216 = t48 * t209 * t62 * 8.0;
-  const double t217 = (t205 + t213 + t214 + t215 + t201 + t203 + t216);
-  const double t218 = t31 * (-1.4368);
-  const double t219 = (t84 * t84);
-  const double t220 = (t206 + (t82 * t82) + t208 + (t83 * t83));
-  const double t221 = (t86 * t86);
-  const double t222 = (-4.0 * t45 * t219 + t41 * 8.0 * t65 * t219 - t44 * 4.0 * t196 * t219 +
-                       t44 * t220 * t65 - t41 * t220 * 2.0 * t45);
-  const double t223 =
-      (-32.0 * t62 * t33 * t219 + t210 - t41 * t220 * t62 * t33 * 8.0 + t84 * 32.0 * t82 * t43 +
-       t39 * t198 * t221 + 16.0 * t220 * t33 * t43 + t212 - t39 * t64 * t222 * 4.0 +
-       t41 * 24.0 * t33 * t195 * t219 + t64 * t86 * t83 * 8.0 - t41 * t84 * 16.0 * t62 * t82);
-  const double t224 = t32 * 6.0128;
-  const double t225 =
-      (x[2] * ((((t188 + t193 + t200 - 86.7856 * t2 + t201 + t202 + t203 + t204)) * x[2] +
-                t217 * x[3])) +
-       x[3] * ((-((-t84 * t62 * 8.0 * t90 + t218 - t43 * t223 + t224 - t48 * t220 * t62 * 8.0 +
-                   t48 * 24.0 * t195 * t219)) *
+      (-0.9498 * t0 + 0.7516 * t26 + t2 * 1.0798000000000005 - t25 * 0.1796 + t42 * t37);
+  const double t139 = (t29 + t30 - 0.5 * t43 * t37 + t31 + t32);
+  const double t140 = ((t138 * t138) + (t139 * t139) * 4.0);
+  const double t141 = (1.0 / (t140));
+  const double t142 =
+      (-1.0798000000000005 * t0 - t2 * 0.9498 + t26 * 0.1796 + t25 * 0.7516 + t43 * t37);
+  const double t143 = t25 * 1.5032;
+  const double t144 = 0.3592 * t26;
+  const double t145 = t2 * (-1.8996);
+  const double t146 = (t143 + t144 + t77 + t79 - 2.159600000000001 * t0 + t145);
+  const double t147 = (t137 * t141 * t138 * 2.5 + t141 * 2.5 * t142 * t146);
+  const double t148 = (-0.12 * t0 - t2 * 1.4);
+  const double t149 = (t23 + t82 - 0.128925 * t45 * t81);
+  const double t150 = 0.5726 * t12 * t8;
+  const double t151 = (-0.5726 * t13 * t109 * t4 + t150);
+  const double t152 = (t64 * t43 * t80 * t37 * 8.0 + t64 * t42 * t76 * t37 * 8.0);
+  const double t153 = t25 * (-0.22);
+  const double t154 = 0.45 * t26;
+  const double t155 = (t153 + t154 + t120);
+  const double t156 =
+      (12.021927866666665 * t9 * t130 * t4 + t12 * 12.021927866666665 * t130 * t131);
+  const double t157 = (-0.5726 * t13 * t109 * t5 + 0.5726 * t8 * t9);
+  const double t158 = 2.0 * t68 * t69 * t43;
+  const double t159 = 1.8996 * t0;
+  const double t160 = t74 * t37 * (-1.0);
+  const double t161 = (t158 + t159 + 21.6964 * t2 + t134 + t136 + t160);
+  const double t162 = t37 * t90 * (-1.0);
+  const double t163 = t87 * 2.0 * t69 * t43;
+  const double t164 = (t162 + t134 + t136 + t163);
+  const double t165 = (t153 + t154);
+  const double t166 = (t122 + t123);
+  const double t167 = (t118 + t119);
+  const double t168 = (t88 + t134 + t91 + t136);
+  const double t169 = t26 * (-0.3592);
+  const double t170 = t25 * (-1.5032);
+  const double t171 = (t169 + t170 + t94 + t95);
+  const double t172 = (-t141 * t138 * t168 + t141 * t142 * t171);
+  const double t173 = (t143 + t78 * t37 + t144 - 21.6964 * t0 + t2 * 1.8996 - t77);
+  const double t174 = (t143 + t144 + t94 + t95);
+  const double t175 = (t111 + t112);
+  const double t176 =
+      (t161 * 1.171875 * t164 - t128 * t97 * 24.49575 * t46 + 950.0 * t155 * t165 +
+       t149 * t45 * t97 * 24.49575 + 300.0 + ((t166 * t124 + t121 * t167)) * u[4] -
+       t147 * 0.5 * t172 + t173 * t174 * 1.171875 - 0.5 * t97 * t152 + 950.0 * t175 * t114);
+  const double t177 = (-t141 * 2.5 * t142 * t171 + t141 * t138 * 2.5 * t168);
+  const double t178 = (t97 * t97);
+  const double t179 = (t64 * t42 * t92 * t37 * 8.0 - t64 * t43 * t37 * t96 * 8.0);
+  const double t180 = (-t87 * 0.25 * t69 * t43 + 0.125 * t37 * t90 + t115 + t116);
+  const double t181 = cos(u[5]);
+  const double t182 = sin(u[5]);
+  const double t183 = (x[2] * x[2]);
+  const double t184 = pow(t6, (-2.5));
+  const double t185 = (t13 * t13);
+  const double t186 = t2 * (-0.1216);
+  const double t187 = (-0.6894) * t0;
+  const double t188 = (t186 + t187);
+  const double t189 = ((t12 * t12) + (t9 * t9) + t4 * t188 + t12 * t5);
+  const double t190 = t25 * 0.3592;
+  const double t191 = t26 * (-1.5032);
+  const double t192 = t68 * t69 * t78 * 8.0;
+  const double t193 = t25 * 0.3758;
+  const double t194 = 0.0898 * t26;
+  const double t195 = (t193 + t48 + t194 - t29);
+  const double t196 = (t67 * t27 + t34 + t33 * t195 + (t67 * t67));
+  const double t197 = t42 * t69 * 8.0 * t196;
+  const double t198 = (t68 * t68);
+  const double t199 = pow(t36, (-2.5));
+  const double t200 = (1.0 / (t36 * t36 * t36));
+  const double t201 = (-t38 * t196 * t72 + t35 * 2.0 * t39 * t196 + 4.0 * t39 * t198 -
+                       t35 * 8.0 * t198 * t72 + t38 * 4.0 * t200 * t198);
+  const double t202 = pow(t40, (-1.5));
+  const double t203 = (t73 * t73);
+  const double t204 =
+      ((-32.0 * t69 * t27 * t198 + 16.0 * t27 * t37 * t196 + t35 * 24.0 * t27 * t198 * t199 -
+        t33 * t35 * 16.0 * t68 * t69 + t33 * 32.0 * t68 * t37 + t35 * t67 * t37 * 8.0 -
+        t71 * t73 * t67 * 8.0 + t33 * t71 * t201 * 4.0 - t35 * t69 * t27 * 8.0 * t196 -
+        16.0 * t41 * t195 + t33 * t202 * t203)) *
+      t37;
+  const double t205 = t25 * 1.4368;
+  const double t206 = (-7.5984) * t0;
+  const double t207 = t26 * (-6.0128);
+  const double t208 = t42 * (-24.0) * t198 * t199;
+  const double t209 = t87 * 4.0 * t69 * t78;
+  const double t210 = t27 * t86;
+  const double t211 = (t193 + t194);
+  const double t212 = t33 * t211;
+  const double t213 = (t210 + t67 * t86 + t33 * t85 + t212);
+  const double t214 = (-16.0) * t41 * t211;
+  const double t215 = (-t213 * t38 * t72 + t87 * t68 * 4.0 * t39 + t87 * t38 * t68 * 4.0 * t200 -
+                       t35 * t87 * t68 * 8.0 * t72 + t213 * t35 * 2.0 * t39);
+  const double t216 = t35 * t37 * t86 * 8.0;
+  const double t217 = ((-t213 * t35 * t69 * t27 * 8.0 + t214 + t35 * t87 * t68 * 24.0 * t27 * t199 +
+                        t33 * t87 * 16.0 * t37 + t213 * 16.0 * t27 * t37 - t33 * t202 * t73 * t89 +
+                        t33 * t71 * 4.0 * t215 + t216 - t35 * t68 * t69 * t85 * 8.0 +
+                        16.0 * t68 * t85 * t37 + t71 * t67 * 4.0 * t89 - t71 * t73 * 4.0 * t86 -
+                        t87 * 32.0 * t68 * t69 * t27 - t33 * t35 * t87 * t69 * 8.0)) *
+                      t37;
+  const double t218 = t42 * (-24.0) * t87 * t68 * t199;
+  const double t219 = t68 * 4.0 * t69 * t93;
+  const double t220 = t42 * t213 * t69 * 8.0;
+  const double t221 = (t209 + t217 + t218 + t219 + t205 + t207 + t220);
+  const double t222 = t25 * (-1.4368);
+  const double t223 = (t87 * t87);
+  const double t224 = (t210 + (t85 * t85) + t212 + (t86 * t86));
+  const double t225 = (t89 * t89);
+  const double t226 = (-4.0 * t39 * t223 + t35 * 8.0 * t72 * t223 - t38 * 4.0 * t200 * t223 +
+                       t38 * t224 * t72 - t35 * t224 * 2.0 * t39);
+  const double t227 =
+      (-32.0 * t69 * t27 * t223 + t214 - t35 * t224 * t69 * t27 * 8.0 + t87 * 32.0 * t85 * t37 +
+       t33 * t202 * t225 + 16.0 * t224 * t27 * t37 + t216 - t33 * t71 * t226 * 4.0 +
+       t35 * 24.0 * t27 * t199 * t223 + t71 * t89 * t86 * 8.0 - t35 * t87 * 16.0 * t69 * t85);
+  const double t228 = t26 * 6.0128;
+  const double t229 =
+      (x[2] * ((((t192 + t197 + t204 - 86.7856 * t2 + t205 + t206 + t207 + t208)) * x[2] +
+                t221 * x[3])) +
+       x[3] * ((-((-t87 * t69 * 8.0 * t93 + t222 - t37 * t227 + t228 - t42 * t224 * t69 * 8.0 +
+                   t42 * 24.0 * t199 * t223)) *
                     x[3] +
-                t217 * x[2])));
-  const double t226 = t162 * x[3];
-  const double t227 = (x[3] * ((t226 + t162 * x[2])) + ((x[2] * t120 + t226)) * x[2]);
-  const double t228 = t31 * 0.2090281052825221;
-  const double t229 = (-0.4650337029259214) * t32;
-  const double t230 = (t228 + t229);
-  const double t231 = t230 * x[3];
-  const double t232 = (-2.982) * t0;
-  const double t233 =
-      (x[3] * ((t230 * x[2] + t231)) + ((((t232 + t228 + t229)) * x[2] + t231)) * x[2]);
-  const double t234 = x[3] * t171;
-  const double t235 = (x[2] * ((x[2] * t110 + t234)) + ((x[2] * t171 + t234)) * x[3]);
-  const double t236 = (t7 - 1.1452);
-  const double t237 = (1e-06 + (t236 * t236));
-  const double t238 = (t7 - 1.8457);
-  const double t239 = (1e-06 + (t238 * t238));
-  const double t240 = (t96 - 2.2439);
+                t221 * x[2])));
+  const double t230 = t166 * x[3];
+  const double t231 = (x[3] * ((t230 + t166 * x[2])) + ((x[2] * t124 + t230)) * x[2]);
+  const double t232 = t25 * 0.2090281052825221;
+  const double t233 = (-0.4650337029259214) * t26;
+  const double t234 = (t232 + t233);
+  const double t235 = t234 * x[3];
+  const double t236 = (-2.982) * t0;
+  const double t237 =
+      (x[3] * ((t234 * x[2] + t235)) + ((((t236 + t232 + t233)) * x[2] + t235)) * x[2]);
+  const double t238 = x[3] * t175;
+  const double t239 = (x[2] * ((x[2] * t114 + t238)) + ((x[2] * t175 + t238)) * x[3]);
+  const double t240 = (t7 - 1.1452);
   const double t241 = (1e-06 + (t240 * t240));
-  const double t242 = (-2.6928 + t96);
-  const double t243 = ((t242 * t242) + 1e-06);
-  const double t244 =
-      (4e+08 * t96 - 987340000.0 - x[7] * 0.012164246754699676 - sqrt(t241) * 2e+08 -
-       ((t95 * 2e+06 * x[3] * t81 + t79 * 2e+06 * x[2] * t81)) *
-           ((t240 * (1.0 / sqrt(t241)) - 2.0 - (1.0 / sqrt(t243)) * t242)) +
-       2e+08 * sqrt(t243) + 0.002111150263212339 * x[9]);
-  const double t245 = (1.0 / (t6 * t6));
-  const double t246 = (-t245 * t12 * 2.0 * t13 * t127 + t12 * t9 * t126 + t12 * t126 * t4 +
-                       t12 * t126 * t184 + t126 * t184 * t127 - t245 * t9 * 2.0 * t13 * t4);
-  const double t247 = t31 * 0.22;
-  const double t248 = (-0.45) * t32;
-  const double t249 = (t247 + t248);
-  const double t250 = x[3] * t249;
-  const double t251 =
-      (x[3] * ((x[2] * t249 + t250)) + ((t250 + ((t247 + t232 + t248)) * x[2])) * x[2]);
-  const double t252 = t67 * t61 * t62 * 8.0;
-  const double t253 =
-      (t39 * t41 * 24.0 * t194 * t195 - t198 * t199 * t33 - t39 * 32.0 * t62 * t194 +
-       t39 * 16.0 * t43 * t192 - t41 * 16.0 * t60 * t61 * t62 - t39 * t41 * t62 * 8.0 * t192 -
-       t64 * t197 * 4.0 * t33 + t39 * t64 * t66 * 8.0 + 16.0 * t60 * t47 + 32.0 * t60 * t61 * t43 +
-       t41 * t43 * 8.0 * t191);
-  const double t254 = t253 * t43 * (-1.0);
-  const double t255 = t31 * (-6.0128);
-  const double t256 = (-24.0) * t49 * t194 * t195;
-  const double t257 = (-1.4368) * t32;
-  const double t258 = t2 * (-7.5984);
-  const double t259 = t62 * t49 * 8.0 * t192;
-  const double t260 = t209 * t62 * t49 * 8.0;
-  const double t261 = (-24.0) * t84 * t61 * t49 * t195;
-  const double t262 = t67 * t84 * 4.0 * t62;
-  const double t263 = 16.0 * t47 * t83;
-  const double t264 = t41 * t207 * t43 * 8.0;
-  const double t265 =
-      ((-t64 * 4.0 * t211 * t33 + t39 * t41 * t84 * t61 * 24.0 * t195 -
-        t39 * t84 * 32.0 * t61 * t62 + t84 * 16.0 * t60 * t43 - t41 * t84 * t60 * t62 * 8.0 +
-        t39 * t209 * 16.0 * t43 + t64 * t66 * 4.0 * t82 + 16.0 * t61 * t43 * t83 + t263 -
-        t39 * t64 * 4.0 * t86 - t41 * t61 * t62 * t83 * 8.0 - t39 * t209 * t41 * t62 * 8.0 +
-        t198 * t66 * t33 * t86 + t264)) *
-      t43 * (-1.0);
-  const double t266 = t61 * 4.0 * t62 * t87;
-  const double t267 = (t260 + t261 + t262 + t265 + t255 + t257 + t266);
-  const double t268 = t220 * t62 * t49 * 8.0;
-  const double t269 = t84 * t62 * 8.0 * t87;
-  const double t270 = ((t84 * 32.0 * t43 * t83 - t39 * 32.0 * t62 * t219 - t198 * t33 * t221 -
-                        t39 * t41 * t220 * t62 * 8.0 + t39 * 16.0 * t220 * t43 -
-                        t64 * t82 * t86 * 8.0 + t39 * t41 * 24.0 * t195 * t219 + t263 +
-                        t64 * t222 * 4.0 * t33 - t41 * t84 * 16.0 * t62 * t83 + t264)) *
-                      t43 * (-1.0);
-  const double t271 = (-24.0) * t49 * t195 * t219;
-  const double t272 =
-      (((x[2] * ((t252 + 86.7856 * t0 + t254 + t255 + t256 + t257 + t258 + t259)) + t267 * x[3])) *
+  const double t242 = (t7 - 1.8457);
+  const double t243 = (1e-06 + (t242 * t242));
+  const double t244 = (t52 - 2.2439);
+  const double t245 = (1e-06 + (t244 * t244));
+  const double t246 = (-2.6928 + t52);
+  const double t247 = ((t246 * t246) + 1e-06);
+  const double t248 =
+      (4e+08 * t52 - 987340000.0 - x[7] * 0.012164246754699676 - sqrt(t245) * 2e+08 -
+       ((t98 * 2e+06 * x[3] * t84 + t83 * 2e+06 * x[2] * t84)) *
+           ((t244 * (1.0 / sqrt(t245)) - 2.0 - (1.0 / sqrt(t247)) * t246)) +
+       2e+08 * sqrt(t247) + 0.002111150263212339 * x[9]);
+  const double t249 = (1.0 / (t6 * t6));
+  const double t250 = (-t249 * t12 * 2.0 * t13 * t131 + t12 * t9 * t130 + t12 * t130 * t4 +
+                       t12 * t130 * t188 + t130 * t188 * t131 - t249 * t9 * 2.0 * t13 * t4);
+  const double t251 = t25 * 0.22;
+  const double t252 = (-0.45) * t26;
+  const double t253 = (t251 + t252);
+  const double t254 = x[3] * t253;
+  const double t255 =
+      (x[3] * ((x[2] * t253 + t254)) + ((t254 + ((t251 + t236 + t252)) * x[2])) * x[2]);
+  const double t256 = t74 * t68 * t69 * 8.0;
+  const double t257 =
+      (t33 * t35 * 24.0 * t198 * t199 - t202 * t203 * t27 - t33 * 32.0 * t69 * t198 +
+       t33 * 16.0 * t37 * t196 - t35 * 16.0 * t67 * t68 * t69 - t33 * t35 * t69 * 8.0 * t196 -
+       t71 * t201 * 4.0 * t27 + t33 * t71 * t73 * 8.0 + 16.0 * t67 * t41 + 32.0 * t67 * t68 * t37 +
+       t35 * t37 * 8.0 * t195);
+  const double t258 = t257 * t37 * (-1.0);
+  const double t259 = t25 * (-6.0128);
+  const double t260 = (-24.0) * t43 * t198 * t199;
+  const double t261 = (-1.4368) * t26;
+  const double t262 = t2 * (-7.5984);
+  const double t263 = t69 * t43 * 8.0 * t196;
+  const double t264 = t213 * t69 * t43 * 8.0;
+  const double t265 = (-24.0) * t87 * t68 * t43 * t199;
+  const double t266 = t74 * t87 * 4.0 * t69;
+  const double t267 = 16.0 * t41 * t86;
+  const double t268 = t35 * t211 * t37 * 8.0;
+  const double t269 =
+      ((-t71 * 4.0 * t215 * t27 + t33 * t35 * t87 * t68 * 24.0 * t199 -
+        t33 * t87 * 32.0 * t68 * t69 + t87 * 16.0 * t67 * t37 - t35 * t87 * t67 * t69 * 8.0 +
+        t33 * t213 * 16.0 * t37 + t71 * t73 * 4.0 * t85 + 16.0 * t68 * t37 * t86 + t267 -
+        t33 * t71 * 4.0 * t89 - t35 * t68 * t69 * t86 * 8.0 - t33 * t213 * t35 * t69 * 8.0 +
+        t202 * t73 * t27 * t89 + t268)) *
+      t37 * (-1.0);
+  const double t270 = t68 * 4.0 * t69 * t90;
+  const double t271 = (t264 + t265 + t266 + t269 + t259 + t261 + t270);
+  const double t272 = t224 * t69 * t43 * 8.0;
+  const double t273 = t87 * t69 * 8.0 * t90;
+  const double t274 = ((t87 * 32.0 * t37 * t86 - t33 * 32.0 * t69 * t223 - t202 * t27 * t225 -
+                        t33 * t35 * t224 * t69 * 8.0 + t33 * 16.0 * t224 * t37 -
+                        t71 * t85 * t89 * 8.0 + t33 * t35 * 24.0 * t199 * t223 + t267 +
+                        t71 * t226 * 4.0 * t27 - t35 * t87 * 16.0 * t69 * t86 + t268)) *
+                      t37 * (-1.0);
+  const double t275 = (-24.0) * t43 * t199 * t223;
+  const double t276 =
+      (((x[2] * ((t256 + 86.7856 * t0 + t258 + t259 + t260 + t261 + t262 + t263)) + t271 * x[3])) *
            x[2] +
-       ((x[3] * ((t268 + t255 + t269 + t257 + t270 + t271)) + t267 * x[2])) * x[3]);
-  const double t273 = (-2.159600000000001 * t2 + t186 + t154 + t155 + t187 + t156);
-  const double t274 = t137 * ((t205 + t218 + t213 + t214 + t215 + t224 + t216)) * t138;
-  const double t275 = t31 * 6.0128;
-  const double t276 = t32 * 1.4368;
-  const double t277 = t137 * t134 * ((t260 + t261 + t262 + t265 + t275 + t276 + t266)) * (-1.0);
-  const double t278 = (t133 * t138 - t134 * t142);
-  const double t279 = (1.0 / (t136 * t136));
-  const double t280 = (t134 * t167 + t164 * t138);
-  const double t281 = (t186 + t158 + t187 + t159);
-  const double t282 = t48 * (-24.0) * t195 * t219;
-  const double t283 = t48 * t220 * t62 * 8.0;
-  const double t284 = t84 * t62 * 8.0 * t90;
-  const double t285 = t43 * t223;
-  const double t286 =
-      (((((-t137 * 2.0 * t164 * t142 + t137 * 2.0 * t273 * t167 + t274 + t277 +
-           t278 * t279 * 4.0 * t138 * t167 - t134 * t278 * t279 * 4.0 * t164)) *
+       ((x[3] * ((t272 + t259 + t273 + t261 + t274 + t275)) + t271 * x[2])) * x[3]);
+  const double t277 = (-2.159600000000001 * t2 + t190 + t158 + t159 + t191 + t160);
+  const double t278 = t141 * ((t209 + t222 + t217 + t218 + t219 + t228 + t220)) * t142;
+  const double t279 = t25 * 6.0128;
+  const double t280 = t26 * 1.4368;
+  const double t281 = t141 * t138 * ((t264 + t265 + t266 + t269 + t279 + t280 + t270)) * (-1.0);
+  const double t282 = (t137 * t142 - t138 * t146);
+  const double t283 = (1.0 / (t140 * t140));
+  const double t284 = (t138 * t171 + t168 * t142);
+  const double t285 = (t190 + t162 + t191 + t163);
+  const double t286 = t42 * (-24.0) * t199 * t223;
+  const double t287 = t42 * t224 * t69 * 8.0;
+  const double t288 = t87 * t69 * 8.0 * t93;
+  const double t289 = t37 * t227;
+  const double t290 =
+      (((((-t141 * 2.0 * t168 * t146 + t141 * 2.0 * t277 * t171 + t278 + t281 +
+           t282 * t283 * 4.0 * t142 * t171 - t138 * t282 * t283 * 4.0 * t168)) *
              x[3] -
-         x[2] * ((t133 * t137 * 2.0 * t142 + t137 * 2.0 * t273 * t142 -
-                  t137 * t138 *
-                      ((t218 + t188 + t193 + t200 + t224 + t202 + t2 * 8.638400000000004 + t204)) +
-                  t137 * t134 *
-                      ((t252 + t254 + t256 + t275 + t258 + t276 - 8.638400000000004 * t0 + t259)) +
-                  t133 * t134 * t278 * t279 * 4.0 + t278 * t279 * 4.0 * t138 * t142)))) *
+         x[2] * ((t137 * t141 * 2.0 * t146 + t141 * 2.0 * t277 * t146 -
+                  t141 * t142 *
+                      ((t222 + t192 + t197 + t204 + t228 + t206 + t2 * 8.638400000000004 + t208)) +
+                  t141 * t138 *
+                      ((t256 + t258 + t260 + t279 + t262 + t280 - 8.638400000000004 * t0 + t263)) +
+                  t137 * t138 * t282 * t283 * 4.0 + t282 * t283 * 4.0 * t142 * t146)))) *
            x[2] +
-       ((x[3] * ((t137 * 2.0 * t164 * t167 -
-                  t137 * t134 * ((t268 + t269 + t275 + t276 + t270 + t271)) -
-                  t280 * t134 * t279 * 4.0 * t164 + t137 * 2.0 * t281 * t167 +
-                  t137 * ((t282 + t218 + t283 + t284 + t285 + t224)) * t138 +
-                  t280 * t279 * 4.0 * t138 * t167)) +
-         x[2] * ((-t280 * t133 * t134 * t279 * 4.0 + t133 * t137 * 2.0 * t167 -
-                  t137 * 2.0 * t281 * t142 + t274 - t280 * t279 * 4.0 * t138 * t142 + t277)))) *
+       ((x[3] * ((t141 * 2.0 * t168 * t171 -
+                  t141 * t138 * ((t272 + t273 + t279 + t280 + t274 + t275)) -
+                  t284 * t138 * t283 * 4.0 * t168 + t141 * 2.0 * t285 * t171 +
+                  t141 * ((t286 + t222 + t287 + t288 + t289 + t228)) * t142 +
+                  t284 * t283 * 4.0 * t142 * t171)) +
+         x[2] * ((-t284 * t137 * t138 * t283 * 4.0 + t137 * t141 * 2.0 * t171 -
+                  t141 * 2.0 * t285 * t146 + t278 - t284 * t283 * 4.0 * t142 * t146 + t281)))) *
            x[3]);
-  const double t287 = t57 * ((t205 + t213 + t214 + t215 + t216)) * t49 * t43;
-  const double t288 = (1.0 / (t56 * t56));
-  const double t289 =
-      (-t48 * t45 * t90 + t84 * 2.0 * t54 * t65 + t84 * 2.0 * t55 * t65 - t45 * t49 * t87);
-  const double t290 = t57 * t48 * ((t260 + t261 + t262 + t265 + t266)) * t43 * (-1.0);
-  const double t291 =
-      (t287 + t48 * t69 * 4.0 * t43 * t288 * t289 + t57 * 2.0 * t73 * t43 * t87 +
-       t57 * 2.0 * t69 * t43 * t90 + 4.0 * t49 * t73 * t43 * t288 * t289 -
-       t57 * t84 * 4.0 * t62 * t49 * t73 + t290 - t57 * t48 * t84 * t69 * 4.0 * t62);
-  const double t292 =
-      (-t57 * t48 * ((t268 + t269 + t270 + t271)) * t43 - 4.0 * t49 * t43 * t93 * t288 * t289 -
-       t57 * 2.0 * t43 * t93 * t87 + t48 * 4.0 * t89 * t43 * t288 * t289 +
-       t57 * 2.0 * t89 * t43 * t90 - t57 * t48 * t84 * 4.0 * t62 * t89 +
-       t57 * t49 * t43 * ((t282 + t283 + t284 + t285)) + t57 * t84 * 4.0 * t62 * t49 * t93);
+  const double t291 = t64 * ((t209 + t217 + t218 + t219 + t220)) * t43 * t37;
+  const double t292 = (1.0 / (t63 * t63));
   const double t293 =
-      (-t67 * t45 * t49 + 2.0 * t61 * t55 * t65 + 2.0 * t61 * t54 * t65 - t48 * t45 * t71);
-  const double t294 =
-      (t57 * 2.0 * t69 * t71 * t43 +
-       t57 * t48 * t43 * ((24.0 * t49 * t194 * t195 + t253 * t43 - t259 - t252)) -
-       t57 * t48 * t69 * t61 * 4.0 * t62 - t57 * t61 * 4.0 * t62 * t49 * t73 +
-       t57 * t67 * 2.0 * t73 * t43 + t48 * t69 * 4.0 * t293 * t43 * t288 +
-       t57 * ((t188 + t193 + t200 + t204)) * t49 * t43 + 4.0 * t293 * t49 * t73 * t43 * t288);
+      (-t42 * t39 * t93 + t87 * 2.0 * t61 * t72 + t87 * 2.0 * t62 * t72 - t39 * t43 * t90);
+  const double t294 = t64 * t42 * ((t264 + t265 + t266 + t269 + t270)) * t37 * (-1.0);
   const double t295 =
-      (t48 * 4.0 * t293 * t89 * t43 * t288 + t287 - t57 * t48 * t61 * 4.0 * t62 * t89 -
-       t57 * t67 * 2.0 * t43 * t93 + t57 * 2.0 * t71 * t89 * t43 -
-       4.0 * t293 * t49 * t43 * t93 * t288 + t290 + t57 * t61 * 4.0 * t62 * t49 * t93);
-  const double t296 = (x[3] * ((x[2] * t291 + t292 * x[3])) + ((x[2] * t294 + t295 * x[3])) * x[2]);
-  const double t297 = 0.0644625 * t94 * t52 * t74;
-  const double t298 = (t74 * t74);
+      (t291 + t42 * t76 * 4.0 * t37 * t292 * t293 + t64 * 2.0 * t80 * t37 * t90 +
+       t64 * 2.0 * t76 * t37 * t93 + 4.0 * t43 * t80 * t37 * t292 * t293 -
+       t64 * t87 * 4.0 * t69 * t43 * t80 + t294 - t64 * t42 * t87 * t76 * 4.0 * t69);
+  const double t296 =
+      (-t64 * t42 * ((t272 + t273 + t274 + t275)) * t37 - 4.0 * t43 * t37 * t96 * t292 * t293 -
+       t64 * 2.0 * t37 * t96 * t90 + t42 * 4.0 * t92 * t37 * t292 * t293 +
+       t64 * 2.0 * t92 * t37 * t93 - t64 * t42 * t87 * 4.0 * t69 * t92 +
+       t64 * t43 * t37 * ((t286 + t287 + t288 + t289)) + t64 * t87 * 4.0 * t69 * t43 * t96);
+  const double t297 =
+      (-t74 * t39 * t43 + 2.0 * t68 * t62 * t72 + 2.0 * t68 * t61 * t72 - t42 * t39 * t78);
+  const double t298 =
+      (t64 * 2.0 * t76 * t78 * t37 +
+       t64 * t42 * t37 * ((24.0 * t43 * t198 * t199 + t257 * t37 - t263 - t256)) -
+       t64 * t42 * t76 * t68 * 4.0 * t69 - t64 * t68 * 4.0 * t69 * t43 * t80 +
+       t64 * t74 * 2.0 * t80 * t37 + t42 * t76 * 4.0 * t297 * t37 * t292 +
+       t64 * ((t192 + t197 + t204 + t208)) * t43 * t37 + 4.0 * t297 * t43 * t80 * t37 * t292);
   const double t299 =
-      (((x[2] * ((t297 - 0.03223125 * t51 * t291)) +
-         ((-0.0644625 * t174 * t52 - 0.03223125 * t292 * t51)) * x[3])) *
+      (t42 * 4.0 * t297 * t92 * t37 * t292 + t291 - t64 * t42 * t68 * 4.0 * t69 * t92 -
+       t64 * t74 * 2.0 * t37 * t96 + t64 * 2.0 * t78 * t92 * t37 -
+       4.0 * t297 * t43 * t37 * t96 * t292 + t294 + t64 * t68 * 4.0 * t69 * t43 * t96);
+  const double t300 = (x[3] * ((x[2] * t295 + t296 * x[3])) + ((x[2] * t298 + t299 * x[3])) * x[2]);
+  const double t301 = 0.0644625 * t97 * t46 * t81;
+  const double t302 = (t81 * t81);
+  const double t303 =
+      (((x[2] * ((t301 - 0.03223125 * t45 * t295)) +
+         ((-0.0644625 * t178 * t46 - 0.03223125 * t296 * t45)) * x[3])) *
            x[3] +
-       ((x[3] * ((t297 - 0.03223125 * t295 * t51)) +
-         x[2] * ((-0.0644625 * t298 * t52 - 0.03223125 * t51 * t294 - t76 + t38)))) *
+       ((x[3] * ((t301 - 0.03223125 * t299 * t45)) +
+         x[2] * ((-0.0644625 * t302 * t46 - 0.03223125 * t45 * t298 - t49 + t32)))) *
            x[2]);
-  const double t300 = 0.0644625 * t51 * t94 * t74;
-  const double t301 = (x[3] * ((((t300 + 0.03223125 * t52 * t291)) * x[2] +
-                                ((-0.0644625 * t174 * t51 + 0.03223125 * t292 * t52)) * x[3])) +
-                       ((((t300 + 0.03223125 * t295 * t52)) * x[3] +
-                         ((t29 + t77 - 0.0644625 * t298 * t51 + 0.03223125 * t52 * t294)) * x[2])) *
+  const double t304 = 0.0644625 * t45 * t97 * t81;
+  const double t305 = (x[3] * ((((t304 + 0.03223125 * t46 * t295)) * x[2] +
+                                ((-0.0644625 * t178 * t45 + 0.03223125 * t296 * t46)) * x[3])) +
+                       ((((t304 + 0.03223125 * t299 * t46)) * x[3] +
+                         ((t23 + t82 - 0.0644625 * t302 * t45 + 0.03223125 * t46 * t298)) * x[2])) *
                            x[2]);
   xdot[0] = x[2];
   xdot[1] = x[3];
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
-  xdot[6] = ((-t8 * 0.02454369260617026 * x[2] * t13 - 3.666666666666667e-09 * x[6] +
-              t15 * 1.496910398367498e-06 * pow((4e+10 + t17), (-0.25)) * t16 -
-              1.496910398367498e-06 * t18 * pow((4e+10 + (t19 * t19)), (-0.25)) * t19 +
-              sqrt((t17 + 1e+10)) * 1.8333333333333334e-09 -
-              1.8333333333333334e-09 * sqrt(((t20 * t20) + 1e+10)) + 0.04253333333333333)) *
-            1.2e+09 / (((t7 * 0.02454369260617026 - 0.02610743677258618)));
-  xdot[7] = ((-3.666666666666667e-09 * x[7] +
-              1.496910398367498e-06 * t22 * t23 * pow((4e+10 + t24), (-0.25)) +
-              sqrt((1e+10 + t24)) * 1.8333333333333334e-09 -
-              sqrt(((t25 * t25) + 1e+10)) * 1.8333333333333334e-09 -
-              t26 * 1.496910398367498e-06 * pow((4e+10 + (t27 * t27)), (-0.25)) * t27 -
-              0.006082123377349838 * t79 * x[2] * t81 - 0.006082123377349838 * t95 * x[3] * t81 +
-              0.04253333333333333)) *
-            1.2e+09 / (((0.006082123377349838 * t96 - 0.011647676646435302)));
-  xdot[8] = 1.2e+09 *
-            ((t8 * x[2] * t13 * 0.016846790604875265 -
-              pow((4e+10 + t98), (-0.25)) * 1.496910398367498e-06 * t18 * t97 -
-              3.666666666666667e-09 * x[8] - sqrt(((t99 * t99) + 1e+10)) * 1.8333333333333334e-09 +
-              t15 * pow((4e+10 + (t100 * t100)), (-0.25)) * 1.496910398367498e-06 * t100 +
-              sqrt((t98 + 1e+10)) * 1.8333333333333334e-09 + 0.04253333333333333)) /
-            (((-t7 * 0.016846790604875265 + 0.033094121419418275)));
-  xdot[9] = 1.2e+09 *
-            ((-3.666666666666667e-09 * x[9] -
-              t26 * 1.496910398367498e-06 * pow((4e+10 + t102), (-0.25)) * t101 +
-              t79 * 0.0010555751316061695 * x[2] * t81 -
-              1.8333333333333334e-09 * sqrt((1e+10 + (t103 * t103))) +
-              sqrt((1e+10 + t102)) * 1.8333333333333334e-09 + 0.04253333333333333 +
-              t95 * 0.0010555751316061695 * x[3] * t81 -
-              t104 * 1.496910398367498e-06 * t22 * pow(((t104 * t104) + 4e+10), (-0.25)))) /
-            (((-t96 * 0.0010555751316061695 + 0.004842452714389094)));
-  mass[0] = (110.0 * (t106 * t106) + 950.0 * (t110 * t110) + (t113 * t113) * 75.0 + 1400.0 +
-             (((t117 * t117) + (t120 * t120))) * u[4] + 110.0 * (t122 * t122) +
-             (t123 * t123) * 1350.0 + 190.0 * (t124 * t124) + (t125 * t125) * 75.0 + t128 * t129 +
-             t143 * ((t133 * t137 * t134 + t137 * t138 * t142)) * 0.5 + (t144 * t144) * 1350.0 +
-             190.0 * (t145 * t145) + 190.0 * (t147 * t147) + 0.5 * t74 * t148 +
-             950.0 * (t151 * t151) + t128 * t152 + 190.0 * (t153 * t153));
-  mass[1] = t172;
-  mass[2] = t172;
-  mass[3] = (-0.5 * t168 * t173 + (t170 * t170) * 1.171875 + 950.0 * (t171 * t171) + 300.0 +
-             950.0 * (t161 * t161) + 3.1581145687500007 * (t52 * t52) * t174 - 0.5 * t94 * t175 +
-             u[4] * (((t162 * t162) + (t163 * t163))) + 3.1581145687500007 * (t51 * t51) * t174 +
-             (t176 * t176) * 75.0);
+  xdot[6] = 1.2e+09 *
+            ((-t8 * 0.02454369260617026 * x[2] * t13 - 3.666666666666667e-09 * x[6] +
+              7.48455199183749e-07 * t15 * t17 * pow((4e+10 + 0.25 * (t15 * t15)), (-0.25)) +
+              t18 * 1.496910398367498e-06 * pow((4e+10 + t20), (-0.25)) * t19 +
+              sqrt((t20 + 1e+10)) * 1.8333333333333334e-09 -
+              1.8333333333333334e-09 * sqrt(((t21 * t21) + 1e+10)) + 0.04253333333333333)) /
+            (((t7 * 0.02454369260617026 - 0.02610743677258618)));
+  xdot[7] = 1.2e+09 *
+            ((-3.666666666666667e-09 * x[7] -
+              t54 * 7.48455199183749e-07 * t56 * pow((4e+10 + 0.25 * (t54 * t54)), (-0.25)) +
+              1.496910398367498e-06 * t57 * t58 * pow((4e+10 + t59), (-0.25)) +
+              sqrt((1e+10 + t59)) * 1.8333333333333334e-09 -
+              sqrt(((t60 * t60) + 1e+10)) * 1.8333333333333334e-09 -
+              0.006082123377349838 * t83 * x[2] * t84 - 0.006082123377349838 * t98 * x[3] * t84 +
+              0.04253333333333333)) /
+            (((0.006082123377349838 * t52 - 0.011647676646435302)));
+  xdot[8] =
+      ((t8 * x[2] * t13 * 0.016846790604875265 -
+        pow((4e+10 + t100), (-0.25)) * 1.496910398367498e-06 * t17 * t99 -
+        3.666666666666667e-09 * x[8] - sqrt(((t101 * t101) + 1e+10)) * 1.8333333333333334e-09 +
+        pow((4e+10 + 0.25 * (t103 * t103)), (-0.25)) * t18 * 7.48455199183749e-07 * t103 +
+        sqrt((t100 + 1e+10)) * 1.8333333333333334e-09 + 0.04253333333333333)) *
+      1.2e+09 / (((-t7 * 0.016846790604875265 + 0.033094121419418275)));
+  xdot[9] = ((-3.666666666666667e-09 * x[9] -
+              t56 * 1.496910398367498e-06 * pow((4e+10 + t105), (-0.25)) * t104 +
+              t83 * 0.0010555751316061695 * x[2] * t84 -
+              1.8333333333333334e-09 * sqrt((1e+10 + (t106 * t106))) -
+              7.48455199183749e-07 * t108 * t57 * pow(((t108 * t108) * 0.25 + 4e+10), (-0.25)) +
+              sqrt((1e+10 + t105)) * 1.8333333333333334e-09 + 0.04253333333333333 +
+              t98 * 0.0010555751316061695 * x[3] * t84)) *
+            1.2e+09 / (((-t52 * 0.0010555751316061695 + 0.004842452714389094)));
+  mass[0] = (110.0 * (t110 * t110) + 950.0 * (t114 * t114) + (t117 * t117) * 75.0 + 1400.0 +
+             (((t121 * t121) + (t124 * t124))) * u[4] + 110.0 * (t126 * t126) +
+             (t127 * t127) * 1350.0 + 190.0 * (t128 * t128) + (t129 * t129) * 75.0 + t132 * t133 +
+             t147 * ((t137 * t141 * t138 + t141 * t142 * t146)) * 0.5 + (t148 * t148) * 1350.0 +
+             190.0 * (t149 * t149) + 190.0 * (t151 * t151) + 0.5 * t81 * t152 +
+             950.0 * (t155 * t155) + t132 * t156 + 190.0 * (t157 * t157));
+  mass[1] = t176;
+  mass[2] = t176;
+  mass[3] = (-0.5 * t172 * t177 + (t174 * t174) * 1.171875 + 950.0 * (t175 * t175) + 300.0 +
+             950.0 * (t165 * t165) + 3.1581145687500007 * (t46 * t46) * t178 - 0.5 * t97 * t179 +
+             u[4] * (((t166 * t166) + (t167 * t167))) + 3.1581145687500007 * (t45 * t45) * t178 +
+             (t180 * t180) * 75.0);
   acceleration[0] =
-      (((-t117 * t177 * 9.80665 - t178 * 9.80665 * t120)) * u[4] -
-       t153 * t177 * 1863.2634999999998 - t151 * t177 * 9316.3175 - 1500.0 * x[2] -
-       t178 * 1863.2634999999998 * t147 -
-       t153 * 190.0 * t179 *
-           ((t180 * 1.7178 * t181 * t5 - t9 * t13 * t105 * 1.1452 - t185 * 0.5726 * t105 * t5 +
-             t146)) -
-       91.93734375 * t178 * ((t186 + t63 + t131 + t68 + t187 - 21.6964 * t2)) +
-       t169 * t225 * 0.29296875 - u[4] * ((t117 * t227 + t233 * t120)) - 950.0 * t235 * t151 -
-       13238.977499999999 * t123 * t177 - t124 * t177 * 1863.2634999999998 +
+      (((-t121 * t181 * 9.80665 - t182 * 9.80665 * t124)) * u[4] -
+       t157 * t181 * 1863.2634999999998 - t155 * t181 * 9316.3175 - 1500.0 * x[2] -
+       t182 * 1863.2634999999998 * t151 -
+       t157 * 190.0 * t183 *
+           ((t184 * 1.7178 * t185 * t5 - t9 * t13 * t109 * 1.1452 - t189 * 0.5726 * t109 * t5 +
+             t150)) -
+       91.93734375 * t182 * ((t190 + t70 + t135 + t75 + t191 - 21.6964 * t2)) +
+       t173 * t229 * 0.29296875 - u[4] * ((t121 * t231 + t237 * t124)) - 950.0 * t239 * t155 -
+       13238.977499999999 * t127 * t181 - t128 * t181 * 1863.2634999999998 +
        t8 *
            ((598180000.0 +
-             t8 * ((t236 * (1.0 / sqrt(t237)) - 2.0 - (1.0 / sqrt(t239)) * t238)) * 2e+06 * x[2] *
+             t8 * ((t240 * (1.0 / sqrt(t241)) - 2.0 - (1.0 / sqrt(t243)) * t242)) * 2e+06 * x[2] *
                  t13 -
-             x[8] * 0.016846790604875265 - sqrt(t239) * 2e+08 + 0.02454369260617026 * x[6] -
-             t7 * 4e+08 + 2e+08 * sqrt(t237))) *
+             x[8] * 0.016846790604875265 - sqrt(t243) * 2e+08 + 0.02454369260617026 * x[6] -
+             t7 * 4e+08 + 2e+08 * sqrt(t241))) *
            t13 -
-       t79 * t244 * 0.5 * t81 -
-       ((-t180 * 1.7178 * t181 * t5 + t10 + t121 + t9 * t13 * t105 * 1.1452 + t11 +
-         t185 * 0.5726 * t105 * t5)) *
-           t179 * 110.0 * t106 -
-       t178 * 13238.977499999999 * t144 -
-       91.93734375 * t177 * ((t70 + t72 + t165 + t166 + 21.6964 * t0 + t141)) - t246 * t179 * t152 -
-       t179 * 110.0 *
-           ((t182 + t12 * t13 * t105 * 1.1452 + t185 * 0.5726 * t105 * t4 - 0.5726 * t8 * t184 +
-             t183 - t180 * 1.7178 * t4 * t181)) *
-           t122 -
-       t251 * 950.0 * t110 - t272 * t157 * 0.29296875 + u[2] -
-       t179 * ((-1.4 * t0 + t2 * 0.12)) * 1350.0 * t144 - 0.125 * t286 * t143 -
-       t106 * t177 * 1078.7314999999999 - t145 * t178 * 1863.2634999999998 -
-       t178 * t110 * 9316.3175 -
-       190.0 * t179 *
-           ((t180 * 1.7178 * t4 * t181 + 0.5726 * t8 * t184 - t12 * t13 * t105 * 1.1452 -
-             t185 * 0.5726 * t105 * t4)) *
-           t147 -
-       t178 * t122 * 1078.7314999999999 - t179 * t123 * 1350.0 * t144 - 0.125 * t296 * t148 -
-       t145 * 190.0 * t299 - t246 * t179 * t129 - 190.0 * t124 * t301);
-  acceleration[1] = (-600.0 * x[3] - t177 * t161 * 9316.3175 + 91.93734375 * t170 * t177 -
-                     t178 * t171 * 9316.3175 + t225 * t170 * 0.29296875 - 0.125 * t286 * t173 -
-                     ((t162 * t233 + t163 * t227)) * u[4] - t95 * t244 * 0.5 * t81 -
-                     t272 * 0.29296875 * t160 - t251 * 950.0 * t171 - t51 * t94 * t299 * 24.49575 -
-                     0.125 * t296 * t175 - 91.93734375 * t178 * ((t186 + t85 + t88 + t187)) + u[3] +
-                     ((-t163 * t177 * 9.80665 - t178 * t162 * 9.80665)) * u[4] -
-                     t178 * t51 * t94 * 240.2212467375 - 950.0 * t235 * t161 +
-                     t177 * t94 * 240.2212467375 * t52 + t94 * 24.49575 * t52 * t301);
+       t83 * t248 * 0.5 * t84 -
+       ((-t184 * 1.7178 * t185 * t5 + t10 + t125 + t9 * t13 * t109 * 1.1452 + t11 +
+         t189 * 0.5726 * t109 * t5)) *
+           t183 * 110.0 * t110 -
+       t182 * 13238.977499999999 * t148 -
+       91.93734375 * t181 * ((t77 + t79 + t169 + t170 + 21.6964 * t0 + t145)) - t250 * t183 * t156 -
+       t183 * 110.0 *
+           ((t186 + t12 * t13 * t109 * 1.1452 + t189 * 0.5726 * t109 * t4 - 0.5726 * t8 * t188 +
+             t187 - t184 * 1.7178 * t4 * t185)) *
+           t126 -
+       t255 * 950.0 * t114 - t276 * t161 * 0.29296875 + u[2] -
+       t183 * ((-1.4 * t0 + t2 * 0.12)) * 1350.0 * t148 - 0.125 * t290 * t147 -
+       t110 * t181 * 1078.7314999999999 - t149 * t182 * 1863.2634999999998 -
+       t182 * t114 * 9316.3175 -
+       190.0 * t183 *
+           ((t184 * 1.7178 * t4 * t185 + 0.5726 * t8 * t188 - t12 * t13 * t109 * 1.1452 -
+             t189 * 0.5726 * t109 * t4)) *
+           t151 -
+       t182 * t126 * 1078.7314999999999 - t183 * t127 * 1350.0 * t148 - 0.125 * t300 * t152 -
+       t149 * 190.0 * t303 - t250 * t183 * t133 - 190.0 * t128 * t305);
+  acceleration[1] = (-600.0 * x[3] - t181 * t165 * 9316.3175 + 91.93734375 * t174 * t181 -
+                     t182 * t175 * 9316.3175 + t229 * t174 * 0.29296875 - 0.125 * t290 * t177 -
+                     ((t166 * t237 + t167 * t231)) * u[4] - t98 * t248 * 0.5 * t84 -
+                     t276 * 0.29296875 * t164 - t255 * 950.0 * t175 - t45 * t97 * t303 * 24.49575 -
+                     0.125 * t300 * t179 - 91.93734375 * t182 * ((t190 + t88 + t91 + t191)) + u[3] +
+                     ((-t167 * t181 * 9.80665 - t182 * t166 * 9.80665)) * u[4] -
+                     t182 * t45 * t97 * 240.2212467375 - 950.0 * t239 * t165 +
+                     t181 * t97 * 240.2212467375 * t46 + t97 * 24.49575 * t46 * t305);
   Factor(mass);
   Solve(mass, acceleration);
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
@@ -1211,855 +1216,867 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t6 = ((t4 * t4) + (t5 * t5));
   const double t7 = sqrt(t6);
   const double t8 = (t7 * 0.02454369260617026 - 0.02610743677258618);
-  const double t9 = (1.0 / (t8));
-  const double t10 = t2 * (-0.6894);
-  const double t11 = 0.1216 * t0;
-  const double t12 = (t10 + t11);
-  const double t13 = (t1 + t3);
-  const double t14 = t2 * (-0.1216);
-  const double t15 = (-0.6894) * t0;
-  const double t16 = (t14 + t15);
-  const double t17 = ((t12 * t12) + (t13 * t13) + t4 * t16 + t12 * t5);
-  const double t18 = (1.0 / sqrt(t6));
-  const double t19 = pow(t6, (-1.5));
-  const double t20 = (t13 * t5 + t12 * t4);
-  const double t21 = (t20 * t20);
-  const double t22 = ((x[4] * x[4]) + 1e-06);
-  const double t23 = sqrt(t22);
-  const double t24 = (-t23 + x[4]);
+  const double t9 = (1.0 / sqrt(t6));
+  const double t10 = (t1 + t3);
+  const double t11 = t2 * (-0.6894);
+  const double t12 = 0.1216 * t0;
+  const double t13 = (t11 + t12);
+  const double t14 = (t10 * t5 + t13 * t4);
+  const double t15 = (x[6] - u[6]);
+  const double t16 = ((t15 * t15) + 1e+08);
+  const double t17 = (-x[6] + u[6] + sqrt(t16));
+  const double t18 = ((x[4] * x[4]) + 1e-06);
+  const double t19 = sqrt(t18);
+  const double t20 = (x[4] + t19);
+  const double t21 = (t17 * t17);
+  const double t22 = (4e+10 + 0.25 * t21);
+  const double t23 = pow(t22, (-0.25));
+  const double t24 = (-t19 + x[4]);
   const double t25 = (x[6] - 2e+05);
   const double t26 = (t25 * t25);
   const double t27 = (4e+10 + t26);
   const double t28 = pow(t27, (-0.25));
-  const double t29 = (x[4] + t23);
-  const double t30 = (x[6] - u[6]);
-  const double t31 = (t30 * t30);
-  const double t32 = (4e+10 + t31);
-  const double t33 = pow(t32, (-0.25));
-  const double t34 = (t26 + 1e+10);
-  const double t35 = (-2.3e+07 + x[6]);
-  const double t36 = ((t35 * t35) + 1e+10);
-  const double t37 = (1.0 / sqrt(t22)) * x[4];
-  const double t38 = (1.0 + t37);
-  const double t39 = (t37 - 1.0);
-  const double t40 = 2.0 * x[6];
-  const double t41 = (-4e+05 + t40);
-  const double t42 = 0.4749 * t0;
-  const double t43 = (-0.4749) * t0;
-  const double t44 = (x[0] + x[1]);
-  const double t45 = sin(t44);
-  const double t46 = cos(t44);
-  const double t47 = (t43 + t2 * 0.5399000000000003 - t45 * 0.0898 + 0.3758 * t46);
-  const double t48 = (t47 * t47);
-  const double t49 = 0.5399000000000003 * t0;
-  const double t50 = (-0.0898) * t46;
-  const double t51 = t45 * (-0.3758);
-  const double t52 = 0.4749 * t2;
-  const double t53 = (t49 + t50 + t51 + t52);
-  const double t54 = (t53 * t53);
-  const double t55 = (-0.09333387000000004 + t48 + t54);
-  const double t56 = (t48 + t54);
-  const double t57 = (1.0 / sqrt(t56));
-  const double t58 = (t55 * t55);
-  const double t59 = (1.0 / (t56));
-  const double t60 = (-t58 * 0.25 * t59 + 0.26594649000000004);
-  const double t61 = sqrt(t60);
-  const double t62 = (-t55 * t47 * t57 + t53 * t61 * 2.0);
-  const double t63 = (t61 * 2.0 * t47 + t53 * t55 * t57);
-  const double t64 = atan2(t62 * t57 * (-0.5), 0.5 * t63 * t57);
-  const double t65 = sin(t64);
-  const double t66 = cos(t64);
-  const double t67 = (t42 + 0.0904 - 1.0001 * t65 + t2 * 2.4421 - 2e-04 * t66);
-  const double t68 = (-0.4749) * t2;
-  const double t69 = 2.4421 * t0;
-  const double t70 = (t68 - 0.6968 + t69 + 2e-04 * t65 - 1.0001 * t66);
-  const double t71 = ((t67 * t67) + (t70 * t70));
-  const double t72 = sqrt(t71);
-  const double t73 = (0.006082123377349838 * t72 - 0.011647676646435302);
-  const double t74 = (1.0 / (t73));
-  const double t75 = (t62 * t62);
-  const double t76 = (t63 * t63);
-  const double t77 = (t75 * t59 + t59 * t76);
-  const double t78 = (1.0 / (t77));
-  const double t79 = t46 * (-0.3758);
-  const double t80 = t45 * 0.0898;
-  const double t81 = (t42 - t2 * 0.5399000000000003 + t79 + t80);
-  const double t82 = (t53 * t81 + t53 * t47);
-  const double t83 = pow(t56, (-1.5));
-  const double t84 = t82 * t83 * (-2.0) * t63;
-  const double t85 = (1.0 / sqrt(t60));
-  const double t86 = (1.0 / (t56 * t56));
-  const double t87 = (t58 * t82 * t86 - t55 * 2.0 * t82 * t59);
-  const double t88 = (t53 * t82 * 4.0 * t57 - t53 * t55 * 2.0 * t82 * t83 + t55 * t81 * 2.0 * t57 +
-                      t53 * t61 * 4.0 + t85 * t87 * t47);
-  const double t89 = t88 * t57;
-  const double t90 = (t84 + t89);
-  const double t91 = t62 * 2.0 * t82 * t83;
-  const double t92 = (t55 * 2.0 * t82 * t83 * t47 - t53 * t55 * 2.0 * t57 - t82 * 4.0 * t47 * t57 +
-                      t81 * t61 * 4.0 + t53 * t85 * t87);
-  const double t93 = t92 * t57 * (-1.0);
-  const double t94 = (t91 + t93);
-  const double t95 = (t78 * t62 * t90 * t57 + t78 * t63 * t94 * t57);
-  const double t96 = (-0.50005 * t66 * t95 + t68 + 1e-04 * t65 * t95 + t69);
-  const double t97 = t2 * (-2.4421);
-  const double t98 = (t43 + 1e-04 * t66 * t95 + t97 + 0.50005 * t65 * t95);
-  const double t99 = (t67 * t96 + t98 * t70);
-  const double t100 = (t50 + t51);
-  const double t101 = (t79 + t80);
-  const double t102 = (t100 * t47 + t53 * t101);
-  const double t103 = t102 * t83 * (-2.0) * t63;
-  const double t104 = (t55 * t102 * 2.0 * t59 - t102 * t58 * t86);
-  const double t105 = (-t53 * t55 * t102 * 2.0 * t83 + t61 * 4.0 * t100 + t55 * 2.0 * t57 * t101 +
-                       t53 * t102 * 4.0 * t57 - t85 * t47 * t104);
-  const double t106 = t57 * t105;
-  const double t107 = (t103 + t106);
-  const double t108 = (t61 * 4.0 * t101 - t102 * 4.0 * t47 * t57 - t53 * t85 * t104 -
-                       t55 * 2.0 * t100 * t57 + t55 * t102 * 2.0 * t83 * t47);
-  const double t109 = t57 * t108;
-  const double t110 = t62 * t102 * t83 * (-2.0);
-  const double t111 = (t109 + t110);
-  const double t112 = (-t78 * t62 * t107 * t57 + t78 * t63 * t57 * t111);
-  const double t113 = (-0.50005 * t65 * t112 - 1e-04 * t112 * t66);
-  const double t114 = (-1e-04 * t65 * t112 + 0.50005 * t112 * t66);
-  const double t115 = (t113 * t70 + t114 * t67);
-  const double t116 = pow(t71, (-1.5));
-  const double t117 = (t99 * t99);
-  const double t118 = (t82 * t82);
-  const double t119 = pow(t56, (-2.5));
-  const double t120 = 24.0 * t63 * t118 * t119;
-  const double t121 = pow(t60, (-1.5));
-  const double t122 = (t87 * t87);
-  const double t123 = t45 * 0.3758;
-  const double t124 = 0.0898 * t46;
-  const double t125 = (t123 + t68 + t124 - t49);
-  const double t126 = (t81 * t47 + t54 + t53 * t125 + (t81 * t81));
-  const double t127 = (1.0 / (t56 * t56 * t56));
-  const double t128 = (-t58 * t126 * t86 + t55 * 2.0 * t59 * t126 + 4.0 * t59 * t118 -
-                       t55 * 8.0 * t118 * t86 + t58 * 4.0 * t127 * t118);
-  const double t129 =
-      (t53 * t55 * 24.0 * t118 * t119 - t121 * t122 * t47 - t53 * 32.0 * t83 * t118 +
-       t53 * 16.0 * t57 * t126 - t55 * 16.0 * t81 * t82 * t83 - t53 * t55 * t83 * 8.0 * t126 -
-       t85 * t128 * 4.0 * t47 + t53 * t85 * t87 * 8.0 + 16.0 * t81 * t61 + 32.0 * t81 * t82 * t57 +
-       t55 * t57 * 8.0 * t125);
-  const double t130 = t129 * t57;
-  const double t131 = (-8.0) * t83 * t63 * t126;
-  const double t132 = t88 * t82 * (-8.0) * t83;
-  const double t133 = (t120 + t130 + t131 + t132);
-  const double t134 =
-      (-t88 * t59 * t63 + 2.0 * t82 * t76 * t86 + 2.0 * t82 * t75 * t86 - t62 * t59 * t92);
-  const double t135 = (1.0 / (t77 * t77));
-  const double t136 = t82 * t83 * t92 * 8.0;
-  const double t137 = t62 * t83 * 8.0 * t126;
-  const double t138 =
-      ((-32.0 * t83 * t47 * t118 + 16.0 * t47 * t57 * t126 + t55 * 24.0 * t47 * t118 * t119 -
-        t53 * t55 * 16.0 * t82 * t83 + t53 * 32.0 * t82 * t57 + t55 * t81 * t57 * 8.0 -
-        t85 * t87 * t81 * 8.0 + t53 * t85 * t128 * 4.0 - t55 * t83 * t47 * 8.0 * t126 -
-        16.0 * t61 * t125 + t53 * t121 * t122)) *
-      t57;
-  const double t139 = t62 * (-24.0) * t118 * t119;
-  const double t140 = (t136 + t137 + t138 + t139);
-  const double t141 = (t78 * 2.0 * t90 * t92 * t57 + t78 * t62 * t57 * t133 -
-                       t78 * t62 * t90 * t82 * 4.0 * t83 - t78 * t82 * 4.0 * t83 * t63 * t94 +
-                       t78 * t88 * 2.0 * t94 * t57 + t62 * t90 * 4.0 * t134 * t57 * t135 +
-                       t78 * t140 * t63 * t57 + 4.0 * t134 * t63 * t94 * t57 * t135);
-  const double t142 = (t95 * t95);
-  const double t143 = (-2.4421) * t0;
-  const double t144 = ((t96 * t96) +
-                       t67 * ((2.5e-05 * t65 * t141 + t43 + t97 + t142 * t66 * 5e-05 +
-                               t142 * t65 * 0.250025 - t66 * 0.1250125 * t141)) +
-                       ((2.5e-05 * t66 * t141 + t142 * 0.250025 * t66 + t65 * 0.1250125 * t141 -
-                         t142 * t65 * 5e-05 + t143 + t52)) *
-                           t70 +
-                       (t98 * t98));
-  const double t145 = (1.0 / sqrt(t71));
-  const double t146 = t114 * t96;
-  const double t147 = t98 * t113;
-  const double t148 = (-0.250025) * t112 * t66 * t95;
-  const double t149 = t102 * 4.0 * t83 * t92;
-  const double t150 = t47 * t101;
-  const double t151 = (t123 + t124);
-  const double t152 = t53 * t151;
-  const double t153 = (t150 + t81 * t101 + t53 * t100 + t152);
-  const double t154 = (-16.0) * t61 * t151;
-  const double t155 = (-t153 * t58 * t86 + t102 * t82 * 4.0 * t59 + t102 * t58 * t82 * 4.0 * t127 -
-                       t55 * t102 * t82 * 8.0 * t86 + t153 * t55 * 2.0 * t59);
-  const double t156 = t55 * t57 * t101 * 8.0;
-  const double t157 =
-      ((-t153 * t55 * t83 * t47 * 8.0 + t154 + t55 * t102 * t82 * 24.0 * t47 * t119 +
-        t53 * t102 * 16.0 * t57 + t153 * 16.0 * t47 * t57 - t53 * t121 * t87 * t104 +
-        t53 * t85 * 4.0 * t155 + t156 - t55 * t82 * t83 * t100 * 8.0 + 16.0 * t82 * t100 * t57 +
-        t85 * t81 * 4.0 * t104 - t85 * t87 * 4.0 * t101 - t102 * 32.0 * t82 * t83 * t47 -
-        t53 * t55 * t102 * t83 * 8.0)) *
-      t57;
-  const double t158 = t62 * (-24.0) * t102 * t82 * t119;
-  const double t159 = t82 * 4.0 * t83 * t108;
-  const double t160 = t62 * t153 * t83 * 8.0;
-  const double t161 = (t149 + t157 + t158 + t159 + t160);
-  const double t162 = t78 * t161 * t63 * t57;
-  const double t163 = t153 * t83 * t63 * 8.0;
-  const double t164 = (-24.0) * t102 * t82 * t63 * t119;
-  const double t165 = t88 * t102 * 4.0 * t83;
-  const double t166 = 16.0 * t61 * t101;
-  const double t167 = t55 * t151 * t57 * 8.0;
-  const double t168 =
-      (-t85 * 4.0 * t155 * t47 + t53 * t55 * t102 * t82 * 24.0 * t119 -
-       t53 * t102 * 32.0 * t82 * t83 + t102 * 16.0 * t81 * t57 - t55 * t102 * t81 * t83 * 8.0 +
-       t53 * t153 * 16.0 * t57 + t85 * t87 * 4.0 * t100 + 16.0 * t82 * t57 * t101 + t166 -
-       t53 * t85 * 4.0 * t104 - t55 * t82 * t83 * t101 * 8.0 - t53 * t153 * t55 * t83 * 8.0 +
-       t121 * t87 * t47 * t104 + t167);
-  const double t169 = t168 * t57 * (-1.0);
-  const double t170 = t82 * 4.0 * t83 * t105;
-  const double t171 = (t163 + t164 + t165 + t169 + t170);
-  const double t172 = t78 * t62 * t171 * t57 * (-1.0);
-  const double t173 =
-      (t62 * 4.0 * t134 * t107 * t57 * t135 + t162 - t78 * t62 * t82 * 4.0 * t83 * t107 -
-       t78 * t88 * 2.0 * t57 * t111 + t78 * 2.0 * t92 * t107 * t57 -
-       4.0 * t134 * t63 * t57 * t111 * t135 + t172 + t78 * t82 * 4.0 * t83 * t63 * t111);
-  const double t174 = t65 * t112 * t95 * 5e-05;
-  const double t175 = t112 * t66 * t95 * (-5e-05);
-  const double t176 = (-0.250025) * t65 * t112 * t95;
-  const double t177 =
-      (t146 + t147 + ((t148 + 2.5e-05 * t173 * t66 + t173 * t65 * 0.1250125 + t174)) * t70 +
-       t67 * ((t175 - t173 * t66 * 0.1250125 + t176 + 2.5e-05 * t173 * t65)));
-  const double t178 = ((x[5] * x[5]) + 1e-06);
-  const double t179 = sqrt(t178);
-  const double t180 = (-t179 + x[5]);
-  const double t181 = (x[7] - 2e+05);
-  const double t182 = (t181 * t181);
-  const double t183 = (4e+10 + t182);
-  const double t184 = pow(t183, (-0.25));
-  const double t185 = (1e+10 + t182);
-  const double t186 = (-2.3e+07 + x[7]);
-  const double t187 = ((t186 * t186) + 1e+10);
-  const double t188 = (t179 + x[5]);
-  const double t189 = (x[7] - u[7]);
-  const double t190 = (t189 * t189);
-  const double t191 = (4e+10 + t190);
-  const double t192 = pow(t191, (-0.25));
-  const double t193 =
-      (-3.666666666666667e-09 * x[7] + 1.496910398367498e-06 * t180 * t181 * t184 +
-       sqrt(t185) * 1.8333333333333334e-09 - sqrt(t187) * 1.8333333333333334e-09 -
-       t188 * 1.496910398367498e-06 * t192 * t189 - 0.006082123377349838 * t99 * x[2] * t145 -
-       0.006082123377349838 * t115 * x[3] * t145 + 0.04253333333333333);
-  const double t194 = (1.0 / (t73 * t73));
-  const double t195 =
-      (-t62 * t59 * t108 + t102 * 2.0 * t75 * t86 + t102 * 2.0 * t76 * t86 - t59 * t63 * t105);
-  const double t196 =
-      (t162 + t62 * t90 * 4.0 * t57 * t135 * t195 + t78 * 2.0 * t94 * t57 * t105 +
-       t78 * 2.0 * t90 * t57 * t108 + 4.0 * t63 * t94 * t57 * t135 * t195 -
-       t78 * t102 * 4.0 * t83 * t63 * t94 + t172 - t78 * t62 * t102 * t90 * 4.0 * t83);
-  const double t197 =
-      (t67 * ((t175 + 2.5e-05 * t65 * t196 + t176 - t66 * 0.1250125 * t196)) + t146 + t147 +
-       ((t148 + 2.5e-05 * t66 * t196 + t65 * 0.1250125 * t196 + t174)) * t70);
-  const double t198 = (t115 * t115);
-  const double t199 = (t150 + (t100 * t100) + t152 + (t101 * t101));
-  const double t200 = t199 * t83 * t63 * 8.0;
-  const double t201 = t102 * t83 * 8.0 * t105;
-  const double t202 = (t102 * t102);
-  const double t203 = (t104 * t104);
-  const double t204 = (-4.0 * t59 * t202 + t55 * 8.0 * t86 * t202 - t58 * 4.0 * t127 * t202 +
-                       t58 * t199 * t86 - t55 * t199 * 2.0 * t59);
-  const double t205 = (t102 * 32.0 * t57 * t101 - t53 * 32.0 * t83 * t202 - t121 * t47 * t203 -
-                       t53 * t55 * t199 * t83 * 8.0 + t53 * 16.0 * t199 * t57 -
-                       t85 * t100 * t104 * 8.0 + t53 * t55 * 24.0 * t119 * t202 + t166 +
-                       t85 * t204 * 4.0 * t47 - t55 * t102 * 16.0 * t83 * t101 + t167);
-  const double t206 = t205 * t57 * (-1.0);
-  const double t207 = (-24.0) * t63 * t119 * t202;
-  const double t208 = (t200 + t201 + t206 + t207);
-  const double t209 = t62 * (-24.0) * t119 * t202;
-  const double t210 = t62 * t199 * t83 * 8.0;
-  const double t211 = t102 * t83 * 8.0 * t108;
-  const double t212 =
-      (-32.0 * t83 * t47 * t202 + t154 - t55 * t199 * t83 * t47 * 8.0 + t102 * 32.0 * t100 * t57 +
-       t53 * t121 * t203 + 16.0 * t199 * t47 * t57 + t156 - t53 * t85 * t204 * 4.0 +
-       t55 * 24.0 * t47 * t119 * t202 + t85 * t104 * t101 * 8.0 - t55 * t102 * 16.0 * t83 * t100);
-  const double t213 = t57 * t212;
-  const double t214 = (t209 + t210 + t211 + t213);
-  const double t215 = (-t78 * t62 * t208 * t57 - 4.0 * t63 * t57 * t111 * t135 * t195 -
-                       t78 * 2.0 * t57 * t111 * t105 + t62 * 4.0 * t107 * t57 * t135 * t195 +
-                       t78 * 2.0 * t107 * t57 * t108 - t78 * t62 * t102 * 4.0 * t83 * t107 +
-                       t78 * t63 * t57 * t214 + t78 * t102 * 4.0 * t83 * t63 * t111);
-  const double t216 = (t112 * t112);
-  const double t217 = ((t113 * t113) +
-                       ((t215 * 2.5e-05 * t66 - t216 * t65 * 5e-05 + t215 * t65 * 0.1250125 +
-                         t216 * 0.250025 * t66)) *
-                           t70 +
-                       (t114 * t114) +
-                       t67 * ((t216 * t66 * 5e-05 - t215 * t66 * 0.1250125 + t216 * t65 * 0.250025 +
-                               t215 * 2.5e-05 * t65)));
-  const double t218 = (1.0 / sqrt(t178)) * x[5];
-  const double t219 = (t218 - 1.0);
-  const double t220 = (t218 + 1.0);
-  const double t221 = 2.0 * x[7];
-  const double t222 = (-4e+05 + t221);
-  const double t223 = (x[8] - 2e+05);
-  const double t224 = (t223 * t223);
-  const double t225 = (4e+10 + t224);
-  const double t226 = pow(t225, (-0.25));
-  const double t227 = (-2.3e+07 + x[8]);
-  const double t228 = ((t227 * t227) + 1e+10);
-  const double t229 = (x[8] - u[6]);
+  const double t29 = (t26 + 1e+10);
+  const double t30 = (-2.3e+07 + x[6]);
+  const double t31 = ((t30 * t30) + 1e+10);
+  const double t32 = (1.0 / (t8));
+  const double t33 = t2 * (-0.1216);
+  const double t34 = (-0.6894) * t0;
+  const double t35 = (t33 + t34);
+  const double t36 = ((t13 * t13) + (t10 * t10) + t4 * t35 + t13 * t5);
+  const double t37 = pow(t6, (-1.5));
+  const double t38 = (t14 * t14);
+  const double t39 = (1.0 / sqrt(t18)) * x[4];
+  const double t40 = (1.0 + t39);
+  const double t41 = (t39 - 1.0);
+  const double t42 = ((1.0 / sqrt(t16)) * t15 - 1.0);
+  const double t43 = 2.0 * x[6];
+  const double t44 = (-4e+05 + t43);
+  const double t45 = 0.4749 * t0;
+  const double t46 = (-0.4749) * t0;
+  const double t47 = (x[0] + x[1]);
+  const double t48 = sin(t47);
+  const double t49 = cos(t47);
+  const double t50 = (t46 + t2 * 0.5399000000000003 - t48 * 0.0898 + 0.3758 * t49);
+  const double t51 = (t50 * t50);
+  const double t52 = 0.5399000000000003 * t0;
+  const double t53 = (-0.0898) * t49;
+  const double t54 = t48 * (-0.3758);
+  const double t55 = 0.4749 * t2;
+  const double t56 = (t52 + t53 + t54 + t55);
+  const double t57 = (t56 * t56);
+  const double t58 = (-0.09333387000000004 + t51 + t57);
+  const double t59 = (t51 + t57);
+  const double t60 = (1.0 / sqrt(t59));
+  const double t61 = (t58 * t58);
+  const double t62 = (1.0 / (t59));
+  const double t63 = (-t61 * 0.25 * t62 + 0.26594649000000004);
+  const double t64 = sqrt(t63);
+  const double t65 = (-t58 * t50 * t60 + t56 * t64 * 2.0);
+  const double t66 = (t64 * 2.0 * t50 + t56 * t58 * t60);
+  const double t67 = atan2(t65 * t60 * (-0.5), 0.5 * t66 * t60);
+  const double t68 = sin(t67);
+  const double t69 = cos(t67);
+  const double t70 = (t45 + 0.0904 - 1.0001 * t68 + t2 * 2.4421 - 2e-04 * t69);
+  const double t71 = (-0.4749) * t2;
+  const double t72 = 2.4421 * t0;
+  const double t73 = (t71 - 0.6968 + t72 + 2e-04 * t68 - 1.0001 * t69);
+  const double t74 = ((t70 * t70) + (t73 * t73));
+  const double t75 = sqrt(t74);
+  const double t76 = (0.006082123377349838 * t75 - 0.011647676646435302);
+  const double t77 = (1.0 / (t76));
+  const double t78 = (t65 * t65);
+  const double t79 = (t66 * t66);
+  const double t80 = (t78 * t62 + t62 * t79);
+  const double t81 = (1.0 / (t80));
+  const double t82 = t49 * (-0.3758);
+  const double t83 = t48 * 0.0898;
+  const double t84 = (t45 - t2 * 0.5399000000000003 + t82 + t83);
+  const double t85 = (t56 * t84 + t56 * t50);
+  const double t86 = pow(t59, (-1.5));
+  const double t87 = t85 * t86 * (-2.0) * t66;
+  const double t88 = (1.0 / sqrt(t63));
+  const double t89 = (1.0 / (t59 * t59));
+  const double t90 = (t61 * t85 * t89 - t58 * 2.0 * t85 * t62);
+  const double t91 = (t56 * t85 * 4.0 * t60 - t56 * t58 * 2.0 * t85 * t86 + t58 * t84 * 2.0 * t60 +
+                      t56 * t64 * 4.0 + t88 * t90 * t50);
+  const double t92 = t91 * t60;
+  const double t93 = (t87 + t92);
+  const double t94 = t65 * 2.0 * t85 * t86;
+  const double t95 = (t58 * 2.0 * t85 * t86 * t50 - t56 * t58 * 2.0 * t60 - t85 * 4.0 * t50 * t60 +
+                      t84 * t64 * 4.0 + t56 * t88 * t90);
+  const double t96 = t95 * t60 * (-1.0);
+  const double t97 = (t94 + t96);
+  const double t98 = (t81 * t65 * t93 * t60 + t81 * t66 * t97 * t60);
+  const double t99 = (-0.50005 * t69 * t98 + t71 + 1e-04 * t68 * t98 + t72);
+  const double t100 = t2 * (-2.4421);
+  const double t101 = (t46 + 1e-04 * t69 * t98 + t100 + 0.50005 * t68 * t98);
+  const double t102 = (t70 * t99 + t101 * t73);
+  const double t103 = (t53 + t54);
+  const double t104 = (t82 + t83);
+  const double t105 = (t103 * t50 + t56 * t104);
+  const double t106 = t105 * t86 * (-2.0) * t66;
+  const double t107 = (t58 * t105 * 2.0 * t62 - t105 * t61 * t89);
+  const double t108 = (-t56 * t58 * t105 * 2.0 * t86 + t64 * 4.0 * t103 + t58 * 2.0 * t60 * t104 +
+                       t56 * t105 * 4.0 * t60 - t88 * t50 * t107);
+  const double t109 = t60 * t108;
+  const double t110 = (t106 + t109);
+  const double t111 = (t64 * 4.0 * t104 - t105 * 4.0 * t50 * t60 - t56 * t88 * t107 -
+                       t58 * 2.0 * t103 * t60 + t58 * t105 * 2.0 * t86 * t50);
+  const double t112 = t60 * t111;
+  const double t113 = t65 * t105 * t86 * (-2.0);
+  const double t114 = (t112 + t113);
+  const double t115 = (-t81 * t65 * t110 * t60 + t81 * t66 * t60 * t114);
+  const double t116 = (-0.50005 * t68 * t115 - 1e-04 * t115 * t69);
+  const double t117 = (-1e-04 * t68 * t115 + 0.50005 * t115 * t69);
+  const double t118 = (t116 * t73 + t117 * t70);
+  const double t119 = pow(t74, (-1.5));
+  const double t120 = (t102 * t102);
+  const double t121 = (t85 * t85);
+  const double t122 = pow(t59, (-2.5));
+  const double t123 = 24.0 * t66 * t121 * t122;
+  const double t124 = pow(t63, (-1.5));
+  const double t125 = (t90 * t90);
+  const double t126 = t48 * 0.3758;
+  const double t127 = 0.0898 * t49;
+  const double t128 = (t126 + t71 + t127 - t52);
+  const double t129 = (t84 * t50 + t57 + t56 * t128 + (t84 * t84));
+  const double t130 = (1.0 / (t59 * t59 * t59));
+  const double t131 = (-t61 * t129 * t89 + t58 * 2.0 * t62 * t129 + 4.0 * t62 * t121 -
+                       t58 * 8.0 * t121 * t89 + t61 * 4.0 * t130 * t121);
+  const double t132 =
+      (t56 * t58 * 24.0 * t121 * t122 - t124 * t125 * t50 - t56 * 32.0 * t86 * t121 +
+       t56 * 16.0 * t60 * t129 - t58 * 16.0 * t84 * t85 * t86 - t56 * t58 * t86 * 8.0 * t129 -
+       t88 * t131 * 4.0 * t50 + t56 * t88 * t90 * 8.0 + 16.0 * t84 * t64 + 32.0 * t84 * t85 * t60 +
+       t58 * t60 * 8.0 * t128);
+  const double t133 = t132 * t60;
+  const double t134 = (-8.0) * t86 * t66 * t129;
+  const double t135 = t91 * t85 * (-8.0) * t86;
+  const double t136 = (t123 + t133 + t134 + t135);
+  const double t137 =
+      (-t91 * t62 * t66 + 2.0 * t85 * t79 * t89 + 2.0 * t85 * t78 * t89 - t65 * t62 * t95);
+  const double t138 = (1.0 / (t80 * t80));
+  const double t139 = t85 * t86 * t95 * 8.0;
+  const double t140 = t65 * t86 * 8.0 * t129;
+  const double t141 =
+      ((-32.0 * t86 * t50 * t121 + 16.0 * t50 * t60 * t129 + t58 * 24.0 * t50 * t121 * t122 -
+        t56 * t58 * 16.0 * t85 * t86 + t56 * 32.0 * t85 * t60 + t58 * t84 * t60 * 8.0 -
+        t88 * t90 * t84 * 8.0 + t56 * t88 * t131 * 4.0 - t58 * t86 * t50 * 8.0 * t129 -
+        16.0 * t64 * t128 + t56 * t124 * t125)) *
+      t60;
+  const double t142 = t65 * (-24.0) * t121 * t122;
+  const double t143 = (t139 + t140 + t141 + t142);
+  const double t144 = (t81 * 2.0 * t93 * t95 * t60 + t81 * t65 * t60 * t136 -
+                       t81 * t65 * t93 * t85 * 4.0 * t86 - t81 * t85 * 4.0 * t86 * t66 * t97 +
+                       t81 * t91 * 2.0 * t97 * t60 + t65 * t93 * 4.0 * t137 * t60 * t138 +
+                       t81 * t143 * t66 * t60 + 4.0 * t137 * t66 * t97 * t60 * t138);
+  const double t145 = (t98 * t98);
+  const double t146 = (-2.4421) * t0;
+  const double t147 = ((t99 * t99) +
+                       t70 * ((2.5e-05 * t68 * t144 + t46 + t100 + t145 * t69 * 5e-05 +
+                               t145 * t68 * 0.250025 - t69 * 0.1250125 * t144)) +
+                       ((2.5e-05 * t69 * t144 + t145 * 0.250025 * t69 + t68 * 0.1250125 * t144 -
+                         t145 * t68 * 5e-05 + t146 + t55)) *
+                           t73 +
+                       (t101 * t101));
+  const double t148 = (1.0 / sqrt(t74));
+  const double t149 = t117 * t99;
+  const double t150 = t101 * t116;
+  const double t151 = (-0.250025) * t115 * t69 * t98;
+  const double t152 = t105 * 4.0 * t86 * t95;
+  const double t153 = t50 * t104;
+  const double t154 = (t126 + t127);
+  const double t155 = t56 * t154;
+  const double t156 = (t153 + t84 * t104 + t56 * t103 + t155);
+  const double t157 = (-16.0) * t64 * t154;
+  const double t158 = (-t156 * t61 * t89 + t105 * t85 * 4.0 * t62 + t105 * t61 * t85 * 4.0 * t130 -
+                       t58 * t105 * t85 * 8.0 * t89 + t156 * t58 * 2.0 * t62);
+  const double t159 = t58 * t60 * t104 * 8.0;
+  const double t160 =
+      ((-t156 * t58 * t86 * t50 * 8.0 + t157 + t58 * t105 * t85 * 24.0 * t50 * t122 +
+        t56 * t105 * 16.0 * t60 + t156 * 16.0 * t50 * t60 - t56 * t124 * t90 * t107 +
+        t56 * t88 * 4.0 * t158 + t159 - t58 * t85 * t86 * t103 * 8.0 + 16.0 * t85 * t103 * t60 +
+        t88 * t84 * 4.0 * t107 - t88 * t90 * 4.0 * t104 - t105 * 32.0 * t85 * t86 * t50 -
+        t56 * t58 * t105 * t86 * 8.0)) *
+      t60;
+  const double t161 = t65 * (-24.0) * t105 * t85 * t122;
+  const double t162 = t85 * 4.0 * t86 * t111;
+  const double t163 = t65 * t156 * t86 * 8.0;
+  const double t164 = (t152 + t160 + t161 + t162 + t163);
+  const double t165 = t81 * t164 * t66 * t60;
+  const double t166 = t156 * t86 * t66 * 8.0;
+  const double t167 = (-24.0) * t105 * t85 * t66 * t122;
+  const double t168 = t91 * t105 * 4.0 * t86;
+  const double t169 = 16.0 * t64 * t104;
+  const double t170 = t58 * t154 * t60 * 8.0;
+  const double t171 =
+      (-t88 * 4.0 * t158 * t50 + t56 * t58 * t105 * t85 * 24.0 * t122 -
+       t56 * t105 * 32.0 * t85 * t86 + t105 * 16.0 * t84 * t60 - t58 * t105 * t84 * t86 * 8.0 +
+       t56 * t156 * 16.0 * t60 + t88 * t90 * 4.0 * t103 + 16.0 * t85 * t60 * t104 + t169 -
+       t56 * t88 * 4.0 * t107 - t58 * t85 * t86 * t104 * 8.0 - t56 * t156 * t58 * t86 * 8.0 +
+       t124 * t90 * t50 * t107 + t170);
+  const double t172 = t171 * t60 * (-1.0);
+  const double t173 = t85 * 4.0 * t86 * t108;
+  const double t174 = (t166 + t167 + t168 + t172 + t173);
+  const double t175 = t81 * t65 * t174 * t60 * (-1.0);
+  const double t176 =
+      (t65 * 4.0 * t137 * t110 * t60 * t138 + t165 - t81 * t65 * t85 * 4.0 * t86 * t110 -
+       t81 * t91 * 2.0 * t60 * t114 + t81 * 2.0 * t95 * t110 * t60 -
+       4.0 * t137 * t66 * t60 * t114 * t138 + t175 + t81 * t85 * 4.0 * t86 * t66 * t114);
+  const double t177 = t68 * t115 * t98 * 5e-05;
+  const double t178 = t115 * t69 * t98 * (-5e-05);
+  const double t179 = (-0.250025) * t68 * t115 * t98;
+  const double t180 =
+      (t149 + t150 + ((t151 + 2.5e-05 * t176 * t69 + t176 * t68 * 0.1250125 + t177)) * t73 +
+       t70 * ((t178 - t176 * t69 * 0.1250125 + t179 + 2.5e-05 * t176 * t68)));
+  const double t181 = (x[7] - u[7]);
+  const double t182 = (1e+08 + (t181 * t181));
+  const double t183 = (x[7] - u[7] - sqrt(t182));
+  const double t184 = ((x[5] * x[5]) + 1e-06);
+  const double t185 = sqrt(t184);
+  const double t186 = (t185 + x[5]);
+  const double t187 = (t183 * t183);
+  const double t188 = (4e+10 + 0.25 * t187);
+  const double t189 = pow(t188, (-0.25));
+  const double t190 = (-t185 + x[5]);
+  const double t191 = (x[7] - 2e+05);
+  const double t192 = (t191 * t191);
+  const double t193 = (4e+10 + t192);
+  const double t194 = pow(t193, (-0.25));
+  const double t195 = (1e+10 + t192);
+  const double t196 = (-2.3e+07 + x[7]);
+  const double t197 = ((t196 * t196) + 1e+10);
+  const double t198 =
+      (-3.666666666666667e-09 * x[7] - t183 * 7.48455199183749e-07 * t186 * t189 +
+       1.496910398367498e-06 * t190 * t191 * t194 + sqrt(t195) * 1.8333333333333334e-09 -
+       sqrt(t197) * 1.8333333333333334e-09 - 0.006082123377349838 * t102 * x[2] * t148 -
+       0.006082123377349838 * t118 * x[3] * t148 + 0.04253333333333333);
+  const double t199 = (1.0 / (t76 * t76));
+  const double t200 =
+      (-t65 * t62 * t111 + t105 * 2.0 * t78 * t89 + t105 * 2.0 * t79 * t89 - t62 * t66 * t108);
+  const double t201 =
+      (t165 + t65 * t93 * 4.0 * t60 * t138 * t200 + t81 * 2.0 * t97 * t60 * t108 +
+       t81 * 2.0 * t93 * t60 * t111 + 4.0 * t66 * t97 * t60 * t138 * t200 -
+       t81 * t105 * 4.0 * t86 * t66 * t97 + t175 - t81 * t65 * t105 * t93 * 4.0 * t86);
+  const double t202 =
+      (t70 * ((t178 + 2.5e-05 * t68 * t201 + t179 - t69 * 0.1250125 * t201)) + t149 + t150 +
+       ((t151 + 2.5e-05 * t69 * t201 + t68 * 0.1250125 * t201 + t177)) * t73);
+  const double t203 = (t118 * t118);
+  const double t204 = (t153 + (t103 * t103) + t155 + (t104 * t104));
+  const double t205 = t204 * t86 * t66 * 8.0;
+  const double t206 = t105 * t86 * 8.0 * t108;
+  const double t207 = (t105 * t105);
+  const double t208 = (t107 * t107);
+  const double t209 = (-4.0 * t62 * t207 + t58 * 8.0 * t89 * t207 - t61 * 4.0 * t130 * t207 +
+                       t61 * t204 * t89 - t58 * t204 * 2.0 * t62);
+  const double t210 = (t105 * 32.0 * t60 * t104 - t56 * 32.0 * t86 * t207 - t124 * t50 * t208 -
+                       t56 * t58 * t204 * t86 * 8.0 + t56 * 16.0 * t204 * t60 -
+                       t88 * t103 * t107 * 8.0 + t56 * t58 * 24.0 * t122 * t207 + t169 +
+                       t88 * t209 * 4.0 * t50 - t58 * t105 * 16.0 * t86 * t104 + t170);
+  const double t211 = t210 * t60 * (-1.0);
+  const double t212 = (-24.0) * t66 * t122 * t207;
+  const double t213 = (t205 + t206 + t211 + t212);
+  const double t214 = t65 * (-24.0) * t122 * t207;
+  const double t215 = t65 * t204 * t86 * 8.0;
+  const double t216 = t105 * t86 * 8.0 * t111;
+  const double t217 =
+      (-32.0 * t86 * t50 * t207 + t157 - t58 * t204 * t86 * t50 * 8.0 + t105 * 32.0 * t103 * t60 +
+       t56 * t124 * t208 + 16.0 * t204 * t50 * t60 + t159 - t56 * t88 * t209 * 4.0 +
+       t58 * 24.0 * t50 * t122 * t207 + t88 * t107 * t104 * 8.0 - t58 * t105 * 16.0 * t86 * t103);
+  const double t218 = t60 * t217;
+  const double t219 = (t214 + t215 + t216 + t218);
+  const double t220 = (-t81 * t65 * t213 * t60 - 4.0 * t66 * t60 * t114 * t138 * t200 -
+                       t81 * 2.0 * t60 * t114 * t108 + t65 * 4.0 * t110 * t60 * t138 * t200 +
+                       t81 * 2.0 * t110 * t60 * t111 - t81 * t65 * t105 * 4.0 * t86 * t110 +
+                       t81 * t66 * t60 * t219 + t81 * t105 * 4.0 * t86 * t66 * t114);
+  const double t221 = (t115 * t115);
+  const double t222 = ((t116 * t116) +
+                       ((t220 * 2.5e-05 * t69 - t221 * t68 * 5e-05 + t220 * t68 * 0.1250125 +
+                         t221 * 0.250025 * t69)) *
+                           t73 +
+                       (t117 * t117) +
+                       t70 * ((t221 * t69 * 5e-05 - t220 * t69 * 0.1250125 + t221 * t68 * 0.250025 +
+                               t220 * 2.5e-05 * t68)));
+  const double t223 = (1.0 / sqrt(t184)) * x[5];
+  const double t224 = (t223 + 1.0);
+  const double t225 = (t223 - 1.0);
+  const double t226 = ((1.0 / sqrt(t182)) * t181 - 1.0);
+  const double t227 = 2.0 * x[7];
+  const double t228 = (-4e+05 + t227);
+  const double t229 = (x[8] - 2e+05);
   const double t230 = (t229 * t229);
   const double t231 = (4e+10 + t230);
   const double t232 = pow(t231, (-0.25));
-  const double t233 = (t224 + 1e+10);
-  const double t234 = (-t7 * 0.016846790604875265 + 0.033094121419418275);
-  const double t235 = (1.0 / (t234));
-  const double t236 = 2.0 * x[8];
-  const double t237 = (-4e+05 + t236);
-  const double t238 = (x[9] - 2e+05);
-  const double t239 = (t238 * t238);
-  const double t240 = (4e+10 + t239);
-  const double t241 = pow(t240, (-0.25));
-  const double t242 = (-2.3e+07 + x[9]);
-  const double t243 = (1e+10 + (t242 * t242));
-  const double t244 = (1e+10 + t239);
-  const double t245 = (-x[9] + u[7]);
-  const double t246 = (t245 * t245);
-  const double t247 = (t246 + 4e+10);
-  const double t248 = pow(t247, (-0.25));
-  const double t249 =
-      (-3.666666666666667e-09 * x[9] - t188 * 1.496910398367498e-06 * t241 * t238 +
-       t99 * 0.0010555751316061695 * x[2] * t145 - 1.8333333333333334e-09 * sqrt(t243) +
-       sqrt(t244) * 1.8333333333333334e-09 + 0.04253333333333333 +
-       t115 * 0.0010555751316061695 * x[3] * t145 - t245 * 1.496910398367498e-06 * t180 * t248);
-  const double t250 = (-t72 * 0.0010555751316061695 + 0.004842452714389094);
-  const double t251 = (1.0 / (t250 * t250));
-  const double t252 = (1.0 / (t250));
-  const double t253 = 2.0 * x[9];
-  const double t254 = (-4e+05 + t253);
-  const double t255 = (t1 + t3 - 0.5726 * t18 * t13 + 0.5726 * t20 * t19 * t5);
-  const double t256 = t45 * (-0.45);
-  const double t257 = (-0.22) * t46;
-  const double t258 = t2 * (-2.982);
-  const double t259 = (t256 + t257 + t258);
-  const double t260 = 0.0449 * t45;
-  const double t261 = (-0.1879) * t46;
-  const double t262 =
-      (-t82 * 0.25 * t83 * t63 - 2.71205 * t2 - 0.23745 * t0 + t260 + t88 * 0.125 * t57 + t261);
-  const double t263 = t45 * (-0.2090281052825221);
-  const double t264 = t46 * 0.4650337029259214;
-  const double t265 = t0 * 2.982;
-  const double t266 = (t263 + t264 + t265);
-  const double t267 = t45 * (-0.4650337029259214);
-  const double t268 = t46 * (-0.2090281052825221);
-  const double t269 = (t267 + t258 + t268);
-  const double t270 = t12 * t18 * (-0.5726);
-  const double t271 = (t10 + t270 + t11 + 0.5726 * t20 * t19 * t4);
-  const double t272 = (-t2 * 0.12 + 1.4 * t0);
-  const double t273 = (t68 + t69 + 0.128925 * t66 * t95);
-  const double t274 = (2.71205 * t0 - t45 * 0.1879 - 0.0449 * t46 + t62 * t82 * 0.25 * t83 -
-                       0.23745 * t2 - 0.125 * t92 * t57);
-  const double t275 = (1.0 / (t6));
-  const double t276 = (-1.2074 + t10 + t11);
-  const double t277 = (t13 * t275 * t4 + t12 * t275 * t276);
-  const double t278 =
-      (20.765148133333334 * t13 * t275 * t4 + t12 * 20.765148133333334 * t275 * t276);
-  const double t279 = t45 * (-0.3592);
-  const double t280 = (-1.8996) * t0;
-  const double t281 = 1.5032 * t46;
-  const double t282 = (2.159600000000001 * t2 + t84 + t279 + t280 + t89 + t281);
-  const double t283 =
-      (-0.9498 * t0 + 0.7516 * t46 + t2 * 1.0798000000000005 - t45 * 0.1796 + t62 * t57);
-  const double t284 = (t49 + t50 - 0.5 * t63 * t57 + t51 + t52);
-  const double t285 = ((t283 * t283) + (t284 * t284) * 4.0);
-  const double t286 = (1.0 / (t285));
-  const double t287 =
-      (-1.0798000000000005 * t0 - t2 * 0.9498 + t46 * 0.1796 + t45 * 0.7516 + t63 * t57);
-  const double t288 = t45 * 1.5032;
-  const double t289 = 0.3592 * t46;
-  const double t290 = t2 * (-1.8996);
-  const double t291 = (t288 + t289 + t91 + t93 - 2.159600000000001 * t0 + t290);
-  const double t292 = (t282 * t286 * t283 * 2.5 + t286 * 2.5 * t287 * t291);
-  const double t293 = (t282 * t286 * t283 + t286 * t287 * t291);
-  const double t294 = (-0.12 * t0 - t2 * 1.4);
-  const double t295 = (t43 + t97 - 0.128925 * t65 * t95);
-  const double t296 = 0.5726 * t12 * t18;
-  const double t297 = (-0.5726 * t20 * t19 * t4 + t296);
-  const double t298 = (t78 * t63 * t94 * t57 * 8.0 + t78 * t62 * t90 * t57 * 8.0);
-  const double t299 = t45 * (-0.22);
-  const double t300 = 0.45 * t46;
-  const double t301 = (t299 + t300 + t265);
-  const double t302 =
-      (12.021927866666665 * t13 * t275 * t4 + t12 * 12.021927866666665 * t275 * t276);
-  const double t303 = (-0.5726 * t20 * t19 * t5 + 0.5726 * t18 * t13);
-  const double t304 = 2.0 * t82 * t83 * t63;
-  const double t305 = 1.8996 * t0;
-  const double t306 = t88 * t57 * (-1.0);
-  const double t307 = (t304 + t305 + 21.6964 * t2 + t279 + t281 + t306);
-  const double t308 = t57 * t105 * (-1.0);
-  const double t309 = t102 * 2.0 * t83 * t63;
-  const double t310 = (t308 + t279 + t281 + t309);
-  const double t311 = (t299 + t300);
-  const double t312 = (t267 + t268);
-  const double t313 = (t263 + t264);
-  const double t314 = (t103 + t279 + t106 + t281);
-  const double t315 = t46 * (-0.3592);
-  const double t316 = t45 * (-1.5032);
-  const double t317 = (t315 + t316 + t109 + t110);
-  const double t318 = (-t286 * t283 * t314 + t286 * t287 * t317);
-  const double t319 = (t288 + t92 * t57 + t289 - 21.6964 * t0 + t2 * 1.8996 - t91);
-  const double t320 = (t288 + t289 + t109 + t110);
-  const double t321 = (t256 + t257);
-  const double t322 =
-      (t307 * 1.171875 * t310 - t273 * t112 * 24.49575 * t66 + 950.0 * t301 * t311 +
-       t295 * t65 * t112 * 24.49575 + 300.0 + ((t312 * t269 + t266 * t313)) * u[4] -
-       t292 * 0.5 * t318 + t319 * t320 * 1.171875 - 0.5 * t112 * t298 + 950.0 * t321 * t259);
-  const double t323 = (-t286 * 2.5 * t287 * t317 + t286 * t283 * 2.5 * t314);
-  const double t324 = (t66 * t66);
-  const double t325 = (t78 * t62 * t107 * t57 * 8.0 - t78 * t63 * t57 * t111 * 8.0);
-  const double t326 = (t65 * t65);
-  const double t327 = (-t102 * 0.25 * t83 * t63 + 0.125 * t57 * t105 + t260 + t261);
-  const double t328 = cos(u[5]);
-  const double t329 = sin(u[5]);
-  const double t330 = (x[2] * x[2]);
-  const double t331 = pow(t6, (-2.5));
-  const double t332 =
-      (t331 * 1.7178 * t21 * t5 - t13 * t20 * t19 * 1.1452 - t17 * 0.5726 * t19 * t5 + t296);
-  const double t333 = t45 * 0.3592;
-  const double t334 = t46 * (-1.5032);
-  const double t335 = t45 * 1.4368;
-  const double t336 = (-7.5984) * t0;
-  const double t337 = t46 * (-6.0128);
-  const double t338 = (t136 + t137 + t138 - 86.7856 * t2 + t335 + t336 + t337 + t139);
-  const double t339 = (t149 + t157 + t158 + t159 + t335 + t337 + t160);
-  const double t340 = (t338 * x[2] + t339 * x[3]);
-  const double t341 = t45 * (-1.4368);
-  const double t342 = t46 * 6.0128;
-  const double t343 =
-      ((-t211 + t341 - t213 + t342 - t210 + t62 * 24.0 * t119 * t202)) * x[3] * (-1.0);
-  const double t344 = (x[2] * t340 + x[3] * ((t343 + t339 * x[2])));
-  const double t345 = t312 * x[3];
-  const double t346 = (t345 + t312 * x[2]);
-  const double t347 = (x[2] * t269 + t345);
-  const double t348 = (x[3] * t346 + t347 * x[2]);
-  const double t349 = t45 * 0.2090281052825221;
-  const double t350 = (-0.4650337029259214) * t46;
-  const double t351 = (t349 + t350);
-  const double t352 = t351 * x[3];
-  const double t353 = (t351 * x[2] + t352);
-  const double t354 = (-2.982) * t0;
-  const double t355 = (t354 + t349 + t350);
-  const double t356 = (t355 * x[2] + t352);
-  const double t357 = (x[3] * t353 + t356 * x[2]);
-  const double t358 = x[3] * t321;
-  const double t359 = (x[2] * t259 + t358);
-  const double t360 = (x[2] * t321 + t358);
-  const double t361 = (x[2] * t359 + t360 * x[3]);
-  const double t362 = (t7 - 1.1452);
-  const double t363 = (t362 * t362);
-  const double t364 = (1e-06 + t363);
-  const double t365 = (1.0 / sqrt(t364));
-  const double t366 = (t7 - 1.8457);
-  const double t367 = (t366 * t366);
-  const double t368 = (1e-06 + t367);
-  const double t369 = (1.0 / sqrt(t368));
-  const double t370 = (t362 * t365 - 2.0 - t369 * t366);
-  const double t371 =
-      (598180000.0 + t18 * t370 * 2e+06 * x[2] * t20 - x[8] * 0.016846790604875265 -
-       sqrt(t368) * 2e+08 + 0.02454369260617026 * x[6] - t7 * 4e+08 + 2e+08 * sqrt(t364));
-  const double t372 = (t72 - 2.2439);
-  const double t373 = (t372 * t372);
-  const double t374 = (1e-06 + t373);
-  const double t375 = (t115 * 2e+06 * x[3] * t145 + t99 * 2e+06 * x[2] * t145);
-  const double t376 = (1.0 / sqrt(t374));
-  const double t377 = (-2.6928 + t72);
-  const double t378 = (t377 * t377);
-  const double t379 = (t378 + 1e-06);
-  const double t380 = (1.0 / sqrt(t379));
-  const double t381 = (t372 * t376 - 2.0 - t380 * t377);
-  const double t382 =
-      (4e+08 * t72 - 987340000.0 - x[7] * 0.012164246754699676 - sqrt(t374) * 2e+08 - t375 * t381 +
-       2e+08 * sqrt(t379) + 0.002111150263212339 * x[9]);
-  const double t383 = (-t331 * 1.7178 * t21 * t5 + t10 + t270 + t13 * t20 * t19 * 1.1452 + t11 +
-                       t17 * 0.5726 * t19 * t5);
-  const double t384 = (1.0 / (t6 * t6));
-  const double t385 = (-t384 * t12 * 2.0 * t20 * t276 + t12 * t13 * t275 + t12 * t275 * t4 +
-                       t12 * t275 * t16 + t275 * t16 * t276 - t384 * t13 * 2.0 * t20 * t4);
-  const double t386 = (t14 + t12 * t20 * t19 * 1.1452 + t17 * 0.5726 * t19 * t4 -
-                       0.5726 * t18 * t16 + t15 - t331 * 1.7178 * t4 * t21);
-  const double t387 = t45 * 0.22;
-  const double t388 = (-0.45) * t46;
-  const double t389 = (t387 + t388);
-  const double t390 = x[3] * t389;
-  const double t391 = (x[2] * t389 + t390);
-  const double t392 = (t387 + t354 + t388);
-  const double t393 = (t390 + t392 * x[2]);
-  const double t394 = (x[3] * t391 + t393 * x[2]);
-  const double t395 = t88 * t82 * t83 * 8.0;
-  const double t396 = t129 * t57 * (-1.0);
-  const double t397 = t45 * (-6.0128);
-  const double t398 = (-24.0) * t63 * t118 * t119;
-  const double t399 = (-1.4368) * t46;
-  const double t400 = t2 * (-7.5984);
-  const double t401 = t83 * t63 * 8.0 * t126;
-  const double t402 = (t395 + 86.7856 * t0 + t396 + t397 + t398 + t399 + t400 + t401);
-  const double t403 = (t163 + t164 + t165 + t169 + t397 + t399 + t170);
-  const double t404 = (x[2] * t402 + t403 * x[3]);
-  const double t405 = (t200 + t397 + t201 + t399 + t206 + t207);
-  const double t406 = (x[3] * t405 + t403 * x[2]);
-  const double t407 = (t404 * x[2] + t406 * x[3]);
-  const double t408 = (-1.4 * t0 + t2 * 0.12);
-  const double t409 = (-2.159600000000001 * t2 + t333 + t304 + t305 + t334 + t306);
-  const double t410 = (t149 + t341 + t157 + t158 + t159 + t342 + t160);
-  const double t411 = t286 * t410 * t287;
-  const double t412 = t45 * 6.0128;
-  const double t413 = t46 * 1.4368;
-  const double t414 = (t163 + t164 + t165 + t169 + t412 + t413 + t170);
-  const double t415 = t286 * t283 * t414 * (-1.0);
-  const double t416 = (t282 * t287 - t283 * t291);
-  const double t417 = (1.0 / (t285 * t285));
-  const double t418 = (-t286 * 2.0 * t314 * t291 + t286 * 2.0 * t409 * t317 + t411 + t415 +
-                       t416 * t417 * 4.0 * t287 * t317 - t283 * t416 * t417 * 4.0 * t314);
-  const double t419 = t418 * x[3];
-  const double t420 = (t341 + t136 + t137 + t138 + t342 + t336 + t2 * 8.638400000000004 + t139);
-  const double t421 = (t395 + t396 + t398 + t412 + t400 + t413 - 8.638400000000004 * t0 + t401);
-  const double t422 =
-      (t282 * t286 * 2.0 * t291 + t286 * 2.0 * t409 * t291 - t286 * t287 * t420 +
-       t286 * t283 * t421 + t282 * t283 * t416 * t417 * 4.0 + t416 * t417 * 4.0 * t287 * t291);
-  const double t423 = (t200 + t201 + t412 + t413 + t206 + t207);
-  const double t424 = (t283 * t317 + t314 * t287);
-  const double t425 = (t333 + t308 + t334 + t309);
-  const double t426 = (t209 + t341 + t210 + t211 + t213 + t342);
-  const double t427 =
-      (t286 * 2.0 * t314 * t317 - t286 * t283 * t423 - t424 * t283 * t417 * 4.0 * t314 +
-       t286 * 2.0 * t425 * t317 + t286 * t426 * t287 + t424 * t417 * 4.0 * t287 * t317);
-  const double t428 = (-t424 * t282 * t283 * t417 * 4.0 + t282 * t286 * 2.0 * t317 -
-                       t286 * 2.0 * t425 * t291 + t411 - t424 * t417 * 4.0 * t287 * t291 + t415);
-  const double t429 = x[2] * t428;
-  const double t430 = (((t419 - x[2] * t422)) * x[2] + ((x[3] * t427 + t429)) * x[3]);
-  const double t431 = (t331 * 1.7178 * t4 * t21 + 0.5726 * t18 * t16 - t12 * t20 * t19 * 1.1452 -
-                       t17 * 0.5726 * t19 * t4);
-  const double t432 = x[2] * t196;
-  const double t433 = t173 * x[3];
-  const double t434 = (x[3] * ((t432 + t215 * x[3])) + ((x[2] * t141 + t433)) * x[2]);
-  const double t435 = 0.0644625 * t112 * t66 * t95;
-  const double t436 = (t435 - 0.03223125 * t65 * t196);
-  const double t437 = x[2] * t436;
-  const double t438 = (-0.0644625 * t216 * t66 - 0.03223125 * t215 * t65);
-  const double t439 = (t435 - 0.03223125 * t173 * t65);
-  const double t440 = x[3] * t439;
-  const double t441 = (-0.0644625 * t142 * t66 - 0.03223125 * t65 * t141 + t143 + t52);
-  const double t442 = (((t437 + t438 * x[3])) * x[3] + ((t440 + x[2] * t441)) * x[2]);
-  const double t443 = 0.0644625 * t65 * t112 * t95;
-  const double t444 = (t443 + 0.03223125 * t66 * t196);
-  const double t445 = t444 * x[2];
-  const double t446 = (-0.0644625 * t216 * t65 + 0.03223125 * t215 * t66);
-  const double t447 = (t443 + 0.03223125 * t173 * t66);
-  const double t448 = t447 * x[3];
-  const double t449 = (t43 + t97 - 0.0644625 * t142 * t65 + 0.03223125 * t66 * t141);
-  const double t450 = (x[3] * ((t445 + t446 * x[3])) + ((t448 + t449 * x[2])) * x[2]);
-  const double t451 = pow(t379, (-1.5));
-  const double t452 = pow(t374, (-1.5));
-  const double t453 = (t99 * 2e+08 * t380 * t145 * t377 - t99 * t372 * 2e+08 * t376 * t145 -
-                       t381 * ((2e+06 * t144 * x[2] * t145 + t177 * 2e+06 * x[3] * t145 -
-                                t99 * t115 * 2e+06 * x[3] * t116 - t117 * 2e+06 * x[2] * t116)) +
-                       ((-t99 * t378 * t145 * t451 + t99 * t380 * t145 - t99 * t376 * t145 +
-                         t99 * t452 * t373 * t145)) *
-                           t375 +
-                       t99 * 4e+08 * t145);
-  const double t454 = t329 * t389 * (-9316.3175);
-  const double t455 = t403 * t329 * 22.9843359375;
-  const double t456 = (-22.9843359375) * t339 * t328;
-  const double t457 = t328 * t321 * (-9316.3175);
-  const double t458 = u[4] * ((-t312 * t328 * 9.80665 - t329 * t351 * 9.80665));
-  const double t459 = (4e+08 * t115 * t145 + t115 * 2e+08 * t380 * t145 * t377 -
-                       ((-t198 * 2e+06 * x[3] * t116 + 2e+06 * x[2] * t145 * t197 +
-                         t217 * 2e+06 * x[3] * t145 - t99 * t115 * 2e+06 * x[2] * t116)) *
-                           t381 -
-                       t115 * t372 * 2e+08 * t376 * t145 +
-                       ((t115 * t452 * t373 * t145 - t378 * t115 * t145 * t451 +
-                         t115 * t380 * t145 - t115 * t376 * t145)) *
-                           t375);
-  const double t460 = t99 * t115 * t382 * 0.5 * t116;
-  const double t461 = (x[3] * t436 + t440 + 2.0 * x[2] * t441);
-  const double t462 = (t419 + x[3] * t428 - 2.0 * x[2] * t422);
-  const double t463 = (t444 * x[3] + t448 + t449 * 2.0 * x[2]);
-  const double t464 = (1.0 / (t71));
-  const double t465 = (x[3] * t196 + 2.0 * x[2] * t141 + t433);
-  const double t466 = (t432 + t215 * 2.0 * x[3] + t173 * x[2]);
-  const double t467 = (t445 + t447 * x[2] + 2.0 * t446 * x[3]);
-  const double t468 = t99 * t115 * 1e+06 * t381 * t464;
-  const double t469 = (t418 * x[2] + t429 + 2.0 * x[3] * t427);
-  const double t470 = (t437 + x[2] * t439 + t438 * 2.0 * x[3]);
-  const double t471 = (t209 + t210 + t211 + t213 + t335 + t337);
-  const double t472 = (2.0 * t339 * x[2] + t343 + t471 * x[3]);
-  const double t473 = (t134 * t63 * t94 * t57 * 8.0 * t135 + t78 * 2.0 * t140 * t63 * t57 -
-                       t78 * t82 * t83 * t63 * t94 * 8.0 + t78 * t62 * 2.0 * t57 * t133 +
-                       t62 * t90 * t134 * t57 * 8.0 * t135 - t78 * t62 * t90 * t82 * t83 * 8.0 +
-                       t78 * t90 * 4.0 * t92 * t57 + t78 * t88 * 4.0 * t94 * t57);
-  const double t474 =
-      (-1.25 * t282 * t286 * t291 + t286 * 0.625 * t287 * t420 - t282 * t283 * t416 * 2.5 * t417 -
-       t416 * 2.5 * t417 * t287 * t291 - 1.25 * t286 * t409 * t291 - t286 * t283 * t421 * 0.625);
-  const double t475 = 950.0 * t389 * t259;
-  const double t476 =
-      (t168 * t57 - t163 + t102 * t82 * 24.0 * t63 * t119 - t165 + t412 + t413 - t170);
-  const double t477 = 950.0 * t301 * t321;
-  const double t478 = t266 * t312;
-  const double t479 = t351 * t269;
-  const double t480 =
-      (t295 * 12.247875 * t112 * t66 * t95 + t273 * 12.247875 * t65 * t112 * t95 -
-       t320 * t338 * 0.29296875 + t418 * 0.125 * t292 - t319 * t339 * 0.29296875 + t475 -
-       0.5 * t318 * t474 - t307 * 0.29296875 * t476 - t295 * t173 * t65 * 6.1239375 +
-       0.125 * t173 * t298 + t65 * t112 * 24.49575 * t441 + t477 + 950.0 * t259 * t311 -
-       0.5 * t112 * t473 -
-       ((t120 - 86.7856 * t0 + t130 + t131 + t412 + t2 * 7.5984 + t413 + t132)) * 0.29296875 *
-           t310 +
-       u[4] * ((t478 + t313 * t269 + t479 + t355 * t312)) - t449 * t112 * 24.49575 * t66 +
-       950.0 * t392 * t321 + t273 * t173 * 6.1239375 * t66);
-  const double t481 = t78 * t161 * 2.0 * t63 * t57;
-  const double t482 = t78 * t62 * t171 * (-2.0) * t57;
-  const double t483 = 1900.0 * t389 * t321;
-  const double t484 = t312 * t351;
-  const double t485 = t313 * t312;
-  const double t486 = ((t484 + t485)) * 2.0 * u[4];
-  const double t487 = (-0.625) * t286 * t283 * t414;
-  const double t488 = t286 * t410 * 0.625 * t287;
-  const double t489 = 1900.0 * t321 * t311;
-  const double t490 =
-      (t78 * t90 * 4.0 * t57 * t108 + t481 + t482 + t63 * t94 * t57 * 8.0 * t135 * t195 -
-       t78 * t62 * t102 * t90 * t83 * 8.0 - t78 * t102 * t83 * t63 * t94 * 8.0 +
-       t62 * t90 * t57 * 8.0 * t135 * t195 + t78 * 4.0 * t94 * t57 * t105);
-  const double t491 = (t487 - t424 * t282 * t283 * 2.5 * t417 - 1.25 * t286 * t425 * t291 -
-                       t424 * 2.5 * t417 * t287 * t291 + 1.25 * t282 * t286 * t317 + t488);
+  const double t233 = (-2.3e+07 + x[8]);
+  const double t234 = ((t233 * t233) + 1e+10);
+  const double t235 = (x[8] - u[6]);
+  const double t236 = ((t235 * t235) + 1e+08);
+  const double t237 = (-sqrt(t236) + x[8] - u[6]);
+  const double t238 = (t237 * t237);
+  const double t239 = (4e+10 + 0.25 * t238);
+  const double t240 = pow(t239, (-0.25));
+  const double t241 = (t230 + 1e+10);
+  const double t242 = (-t7 * 0.016846790604875265 + 0.033094121419418275);
+  const double t243 = (1.0 / (t242));
+  const double t244 = 2.0 * x[8];
+  const double t245 = (-4e+05 + t244);
+  const double t246 = ((1.0 / sqrt(t236)) * t235 - 1.0);
+  const double t247 = (x[9] - 2e+05);
+  const double t248 = (t247 * t247);
+  const double t249 = (4e+10 + t248);
+  const double t250 = pow(t249, (-0.25));
+  const double t251 = (-2.3e+07 + x[9]);
+  const double t252 = (1e+10 + (t251 * t251));
+  const double t253 = (-x[9] + u[7]);
+  const double t254 = ((t253 * t253) + 1e+08);
+  const double t255 = (-x[9] + u[7] + sqrt(t254));
+  const double t256 = (t255 * t255);
+  const double t257 = (t256 * 0.25 + 4e+10);
+  const double t258 = pow(t257, (-0.25));
+  const double t259 = (1e+10 + t248);
+  const double t260 =
+      (-3.666666666666667e-09 * x[9] - t186 * 1.496910398367498e-06 * t250 * t247 +
+       t102 * 0.0010555751316061695 * x[2] * t148 - 1.8333333333333334e-09 * sqrt(t252) -
+       7.48455199183749e-07 * t255 * t190 * t258 + sqrt(t259) * 1.8333333333333334e-09 +
+       0.04253333333333333 + t118 * 0.0010555751316061695 * x[3] * t148);
+  const double t261 = (-t75 * 0.0010555751316061695 + 0.004842452714389094);
+  const double t262 = (1.0 / (t261 * t261));
+  const double t263 = (1.0 / (t261));
+  const double t264 = (t253 * (1.0 / sqrt(t254)) + 1.0);
+  const double t265 = 2.0 * x[9];
+  const double t266 = (-4e+05 + t265);
+  const double t267 = (t1 + t3 - 0.5726 * t9 * t10 + 0.5726 * t14 * t37 * t5);
+  const double t268 = t48 * (-0.45);
+  const double t269 = (-0.22) * t49;
+  const double t270 = t2 * (-2.982);
+  const double t271 = (t268 + t269 + t270);
+  const double t272 = 0.0449 * t48;
+  const double t273 = (-0.1879) * t49;
+  const double t274 =
+      (-t85 * 0.25 * t86 * t66 - 2.71205 * t2 - 0.23745 * t0 + t272 + t91 * 0.125 * t60 + t273);
+  const double t275 = t48 * (-0.2090281052825221);
+  const double t276 = t49 * 0.4650337029259214;
+  const double t277 = t0 * 2.982;
+  const double t278 = (t275 + t276 + t277);
+  const double t279 = t48 * (-0.4650337029259214);
+  const double t280 = t49 * (-0.2090281052825221);
+  const double t281 = (t279 + t270 + t280);
+  const double t282 = t13 * t9 * (-0.5726);
+  const double t283 = (t11 + t282 + t12 + 0.5726 * t14 * t37 * t4);
+  const double t284 = (-t2 * 0.12 + 1.4 * t0);
+  const double t285 = (t71 + t72 + 0.128925 * t69 * t98);
+  const double t286 = (2.71205 * t0 - t48 * 0.1879 - 0.0449 * t49 + t65 * t85 * 0.25 * t86 -
+                       0.23745 * t2 - 0.125 * t95 * t60);
+  const double t287 = (1.0 / (t6));
+  const double t288 = (-1.2074 + t11 + t12);
+  const double t289 = (t10 * t287 * t4 + t13 * t287 * t288);
+  const double t290 =
+      (20.765148133333334 * t10 * t287 * t4 + t13 * 20.765148133333334 * t287 * t288);
+  const double t291 = t48 * (-0.3592);
+  const double t292 = (-1.8996) * t0;
+  const double t293 = 1.5032 * t49;
+  const double t294 = (2.159600000000001 * t2 + t87 + t291 + t292 + t92 + t293);
+  const double t295 =
+      (-0.9498 * t0 + 0.7516 * t49 + t2 * 1.0798000000000005 - t48 * 0.1796 + t65 * t60);
+  const double t296 = (t52 + t53 - 0.5 * t66 * t60 + t54 + t55);
+  const double t297 = ((t295 * t295) + (t296 * t296) * 4.0);
+  const double t298 = (1.0 / (t297));
+  const double t299 =
+      (-1.0798000000000005 * t0 - t2 * 0.9498 + t49 * 0.1796 + t48 * 0.7516 + t66 * t60);
+  const double t300 = t48 * 1.5032;
+  const double t301 = 0.3592 * t49;
+  const double t302 = t2 * (-1.8996);
+  const double t303 = (t300 + t301 + t94 + t96 - 2.159600000000001 * t0 + t302);
+  const double t304 = (t294 * t298 * t295 * 2.5 + t298 * 2.5 * t299 * t303);
+  const double t305 = (t294 * t298 * t295 + t298 * t299 * t303);
+  const double t306 = (-0.12 * t0 - t2 * 1.4);
+  const double t307 = (t46 + t100 - 0.128925 * t68 * t98);
+  const double t308 = 0.5726 * t13 * t9;
+  const double t309 = (-0.5726 * t14 * t37 * t4 + t308);
+  const double t310 = (t81 * t66 * t97 * t60 * 8.0 + t81 * t65 * t93 * t60 * 8.0);
+  const double t311 = t48 * (-0.22);
+  const double t312 = 0.45 * t49;
+  const double t313 = (t311 + t312 + t277);
+  const double t314 =
+      (12.021927866666665 * t10 * t287 * t4 + t13 * 12.021927866666665 * t287 * t288);
+  const double t315 = (-0.5726 * t14 * t37 * t5 + 0.5726 * t9 * t10);
+  const double t316 = 2.0 * t85 * t86 * t66;
+  const double t317 = 1.8996 * t0;
+  const double t318 = t91 * t60 * (-1.0);
+  const double t319 = (t316 + t317 + 21.6964 * t2 + t291 + t293 + t318);
+  const double t320 = t60 * t108 * (-1.0);
+  const double t321 = t105 * 2.0 * t86 * t66;
+  const double t322 = (t320 + t291 + t293 + t321);
+  const double t323 = (t311 + t312);
+  const double t324 = (t279 + t280);
+  const double t325 = (t275 + t276);
+  const double t326 = (t106 + t291 + t109 + t293);
+  const double t327 = t49 * (-0.3592);
+  const double t328 = t48 * (-1.5032);
+  const double t329 = (t327 + t328 + t112 + t113);
+  const double t330 = (-t298 * t295 * t326 + t298 * t299 * t329);
+  const double t331 = (t300 + t95 * t60 + t301 - 21.6964 * t0 + t2 * 1.8996 - t94);
+  const double t332 = (t300 + t301 + t112 + t113);
+  const double t333 = (t268 + t269);
+  const double t334 =
+      (t319 * 1.171875 * t322 - t285 * t115 * 24.49575 * t69 + 950.0 * t313 * t323 +
+       t307 * t68 * t115 * 24.49575 + 300.0 + ((t324 * t281 + t278 * t325)) * u[4] -
+       t304 * 0.5 * t330 + t331 * t332 * 1.171875 - 0.5 * t115 * t310 + 950.0 * t333 * t271);
+  const double t335 = (-t298 * 2.5 * t299 * t329 + t298 * t295 * 2.5 * t326);
+  const double t336 = (t69 * t69);
+  const double t337 = (t81 * t65 * t110 * t60 * 8.0 - t81 * t66 * t60 * t114 * 8.0);
+  const double t338 = (t68 * t68);
+  const double t339 = (-t105 * 0.25 * t86 * t66 + 0.125 * t60 * t108 + t272 + t273);
+  const double t340 = cos(u[5]);
+  const double t341 = sin(u[5]);
+  const double t342 = (x[2] * x[2]);
+  const double t343 = pow(t6, (-2.5));
+  const double t344 =
+      (t343 * 1.7178 * t38 * t5 - t10 * t14 * t37 * 1.1452 - t36 * 0.5726 * t37 * t5 + t308);
+  const double t345 = t48 * 0.3592;
+  const double t346 = t49 * (-1.5032);
+  const double t347 = t48 * 1.4368;
+  const double t348 = (-7.5984) * t0;
+  const double t349 = t49 * (-6.0128);
+  const double t350 = (t139 + t140 + t141 - 86.7856 * t2 + t347 + t348 + t349 + t142);
+  const double t351 = (t152 + t160 + t161 + t162 + t347 + t349 + t163);
+  const double t352 = (t350 * x[2] + t351 * x[3]);
+  const double t353 = t48 * (-1.4368);
+  const double t354 = t49 * 6.0128;
+  const double t355 =
+      ((-t216 + t353 - t218 + t354 - t215 + t65 * 24.0 * t122 * t207)) * x[3] * (-1.0);
+  const double t356 = (x[2] * t352 + x[3] * ((t355 + t351 * x[2])));
+  const double t357 = t324 * x[3];
+  const double t358 = (t357 + t324 * x[2]);
+  const double t359 = (x[2] * t281 + t357);
+  const double t360 = (x[3] * t358 + t359 * x[2]);
+  const double t361 = t48 * 0.2090281052825221;
+  const double t362 = (-0.4650337029259214) * t49;
+  const double t363 = (t361 + t362);
+  const double t364 = t363 * x[3];
+  const double t365 = (t363 * x[2] + t364);
+  const double t366 = (-2.982) * t0;
+  const double t367 = (t366 + t361 + t362);
+  const double t368 = (t367 * x[2] + t364);
+  const double t369 = (x[3] * t365 + t368 * x[2]);
+  const double t370 = x[3] * t333;
+  const double t371 = (x[2] * t271 + t370);
+  const double t372 = (x[2] * t333 + t370);
+  const double t373 = (x[2] * t371 + t372 * x[3]);
+  const double t374 = (t7 - 1.1452);
+  const double t375 = (t374 * t374);
+  const double t376 = (1e-06 + t375);
+  const double t377 = (1.0 / sqrt(t376));
+  const double t378 = (t7 - 1.8457);
+  const double t379 = (t378 * t378);
+  const double t380 = (1e-06 + t379);
+  const double t381 = (1.0 / sqrt(t380));
+  const double t382 = (t374 * t377 - 2.0 - t381 * t378);
+  const double t383 =
+      (598180000.0 + t9 * t382 * 2e+06 * x[2] * t14 - x[8] * 0.016846790604875265 -
+       sqrt(t380) * 2e+08 + 0.02454369260617026 * x[6] - t7 * 4e+08 + 2e+08 * sqrt(t376));
+  const double t384 = (t75 - 2.2439);
+  const double t385 = (t384 * t384);
+  const double t386 = (1e-06 + t385);
+  const double t387 = (t118 * 2e+06 * x[3] * t148 + t102 * 2e+06 * x[2] * t148);
+  const double t388 = (1.0 / sqrt(t386));
+  const double t389 = (-2.6928 + t75);
+  const double t390 = (t389 * t389);
+  const double t391 = (t390 + 1e-06);
+  const double t392 = (1.0 / sqrt(t391));
+  const double t393 = (t384 * t388 - 2.0 - t392 * t389);
+  const double t394 =
+      (4e+08 * t75 - 987340000.0 - x[7] * 0.012164246754699676 - sqrt(t386) * 2e+08 - t387 * t393 +
+       2e+08 * sqrt(t391) + 0.002111150263212339 * x[9]);
+  const double t395 = (-t343 * 1.7178 * t38 * t5 + t11 + t282 + t10 * t14 * t37 * 1.1452 + t12 +
+                       t36 * 0.5726 * t37 * t5);
+  const double t396 = (1.0 / (t6 * t6));
+  const double t397 = (-t396 * t13 * 2.0 * t14 * t288 + t13 * t10 * t287 + t13 * t287 * t4 +
+                       t13 * t287 * t35 + t287 * t35 * t288 - t396 * t10 * 2.0 * t14 * t4);
+  const double t398 = (t33 + t13 * t14 * t37 * 1.1452 + t36 * 0.5726 * t37 * t4 -
+                       0.5726 * t9 * t35 + t34 - t343 * 1.7178 * t4 * t38);
+  const double t399 = t48 * 0.22;
+  const double t400 = (-0.45) * t49;
+  const double t401 = (t399 + t400);
+  const double t402 = x[3] * t401;
+  const double t403 = (x[2] * t401 + t402);
+  const double t404 = (t399 + t366 + t400);
+  const double t405 = (t402 + t404 * x[2]);
+  const double t406 = (x[3] * t403 + t405 * x[2]);
+  const double t407 = t91 * t85 * t86 * 8.0;
+  const double t408 = t132 * t60 * (-1.0);
+  const double t409 = t48 * (-6.0128);
+  const double t410 = (-24.0) * t66 * t121 * t122;
+  const double t411 = (-1.4368) * t49;
+  const double t412 = t2 * (-7.5984);
+  const double t413 = t86 * t66 * 8.0 * t129;
+  const double t414 = (t407 + 86.7856 * t0 + t408 + t409 + t410 + t411 + t412 + t413);
+  const double t415 = (t166 + t167 + t168 + t172 + t409 + t411 + t173);
+  const double t416 = (x[2] * t414 + t415 * x[3]);
+  const double t417 = (t205 + t409 + t206 + t411 + t211 + t212);
+  const double t418 = (x[3] * t417 + t415 * x[2]);
+  const double t419 = (t416 * x[2] + t418 * x[3]);
+  const double t420 = (-1.4 * t0 + t2 * 0.12);
+  const double t421 = (-2.159600000000001 * t2 + t345 + t316 + t317 + t346 + t318);
+  const double t422 = (t152 + t353 + t160 + t161 + t162 + t354 + t163);
+  const double t423 = t298 * t422 * t299;
+  const double t424 = t48 * 6.0128;
+  const double t425 = t49 * 1.4368;
+  const double t426 = (t166 + t167 + t168 + t172 + t424 + t425 + t173);
+  const double t427 = t298 * t295 * t426 * (-1.0);
+  const double t428 = (t294 * t299 - t295 * t303);
+  const double t429 = (1.0 / (t297 * t297));
+  const double t430 = (-t298 * 2.0 * t326 * t303 + t298 * 2.0 * t421 * t329 + t423 + t427 +
+                       t428 * t429 * 4.0 * t299 * t329 - t295 * t428 * t429 * 4.0 * t326);
+  const double t431 = t430 * x[3];
+  const double t432 = (t353 + t139 + t140 + t141 + t354 + t348 + t2 * 8.638400000000004 + t142);
+  const double t433 = (t407 + t408 + t410 + t424 + t412 + t425 - 8.638400000000004 * t0 + t413);
+  const double t434 =
+      (t294 * t298 * 2.0 * t303 + t298 * 2.0 * t421 * t303 - t298 * t299 * t432 +
+       t298 * t295 * t433 + t294 * t295 * t428 * t429 * 4.0 + t428 * t429 * 4.0 * t299 * t303);
+  const double t435 = (t205 + t206 + t424 + t425 + t211 + t212);
+  const double t436 = (t295 * t329 + t326 * t299);
+  const double t437 = (t345 + t320 + t346 + t321);
+  const double t438 = (t214 + t353 + t215 + t216 + t218 + t354);
+  const double t439 =
+      (t298 * 2.0 * t326 * t329 - t298 * t295 * t435 - t436 * t295 * t429 * 4.0 * t326 +
+       t298 * 2.0 * t437 * t329 + t298 * t438 * t299 + t436 * t429 * 4.0 * t299 * t329);
+  const double t440 = (-t436 * t294 * t295 * t429 * 4.0 + t294 * t298 * 2.0 * t329 -
+                       t298 * 2.0 * t437 * t303 + t423 - t436 * t429 * 4.0 * t299 * t303 + t427);
+  const double t441 = x[2] * t440;
+  const double t442 = (((t431 - x[2] * t434)) * x[2] + ((x[3] * t439 + t441)) * x[3]);
+  const double t443 = (t343 * 1.7178 * t4 * t38 + 0.5726 * t9 * t35 - t13 * t14 * t37 * 1.1452 -
+                       t36 * 0.5726 * t37 * t4);
+  const double t444 = x[2] * t201;
+  const double t445 = t176 * x[3];
+  const double t446 = (x[3] * ((t444 + t220 * x[3])) + ((x[2] * t144 + t445)) * x[2]);
+  const double t447 = 0.0644625 * t115 * t69 * t98;
+  const double t448 = (t447 - 0.03223125 * t68 * t201);
+  const double t449 = x[2] * t448;
+  const double t450 = (-0.0644625 * t221 * t69 - 0.03223125 * t220 * t68);
+  const double t451 = (t447 - 0.03223125 * t176 * t68);
+  const double t452 = x[3] * t451;
+  const double t453 = (-0.0644625 * t145 * t69 - 0.03223125 * t68 * t144 + t146 + t55);
+  const double t454 = (((t449 + t450 * x[3])) * x[3] + ((t452 + x[2] * t453)) * x[2]);
+  const double t455 = 0.0644625 * t68 * t115 * t98;
+  const double t456 = (t455 + 0.03223125 * t69 * t201);
+  const double t457 = t456 * x[2];
+  const double t458 = (-0.0644625 * t221 * t68 + 0.03223125 * t220 * t69);
+  const double t459 = (t455 + 0.03223125 * t176 * t69);
+  const double t460 = t459 * x[3];
+  const double t461 = (t46 + t100 - 0.0644625 * t145 * t68 + 0.03223125 * t69 * t144);
+  const double t462 = (x[3] * ((t457 + t458 * x[3])) + ((t460 + t461 * x[2])) * x[2]);
+  const double t463 = pow(t391, (-1.5));
+  const double t464 = pow(t386, (-1.5));
+  const double t465 = (t102 * 2e+08 * t392 * t148 * t389 - t102 * t384 * 2e+08 * t388 * t148 -
+                       t393 * ((2e+06 * t147 * x[2] * t148 + t180 * 2e+06 * x[3] * t148 -
+                                t102 * t118 * 2e+06 * x[3] * t119 - t120 * 2e+06 * x[2] * t119)) +
+                       ((-t102 * t390 * t148 * t463 + t102 * t392 * t148 - t102 * t388 * t148 +
+                         t102 * t464 * t385 * t148)) *
+                           t387 +
+                       t102 * 4e+08 * t148);
+  const double t466 = t341 * t401 * (-9316.3175);
+  const double t467 = t415 * t341 * 22.9843359375;
+  const double t468 = (-22.9843359375) * t351 * t340;
+  const double t469 = t340 * t333 * (-9316.3175);
+  const double t470 = u[4] * ((-t324 * t340 * 9.80665 - t341 * t363 * 9.80665));
+  const double t471 = (4e+08 * t118 * t148 + t118 * 2e+08 * t392 * t148 * t389 -
+                       ((-t203 * 2e+06 * x[3] * t119 + 2e+06 * x[2] * t148 * t202 +
+                         t222 * 2e+06 * x[3] * t148 - t102 * t118 * 2e+06 * x[2] * t119)) *
+                           t393 -
+                       t118 * t384 * 2e+08 * t388 * t148 +
+                       ((t118 * t464 * t385 * t148 - t390 * t118 * t148 * t463 +
+                         t118 * t392 * t148 - t118 * t388 * t148)) *
+                           t387);
+  const double t472 = t102 * t118 * t394 * 0.5 * t119;
+  const double t473 = (x[3] * t448 + t452 + 2.0 * x[2] * t453);
+  const double t474 = (t431 + x[3] * t440 - 2.0 * x[2] * t434);
+  const double t475 = (t456 * x[3] + t460 + t461 * 2.0 * x[2]);
+  const double t476 = (1.0 / (t74));
+  const double t477 = (x[3] * t201 + 2.0 * x[2] * t144 + t445);
+  const double t478 = (t444 + t220 * 2.0 * x[3] + t176 * x[2]);
+  const double t479 = (t457 + t459 * x[2] + 2.0 * t458 * x[3]);
+  const double t480 = t102 * t118 * 1e+06 * t393 * t476;
+  const double t481 = (t430 * x[2] + t441 + 2.0 * x[3] * t439);
+  const double t482 = (t449 + x[2] * t451 + t450 * 2.0 * x[3]);
+  const double t483 = (t214 + t215 + t216 + t218 + t347 + t349);
+  const double t484 = (2.0 * t351 * x[2] + t355 + t483 * x[3]);
+  const double t485 = (t137 * t66 * t97 * t60 * 8.0 * t138 + t81 * 2.0 * t143 * t66 * t60 -
+                       t81 * t85 * t86 * t66 * t97 * 8.0 + t81 * t65 * 2.0 * t60 * t136 +
+                       t65 * t93 * t137 * t60 * 8.0 * t138 - t81 * t65 * t93 * t85 * t86 * 8.0 +
+                       t81 * t93 * 4.0 * t95 * t60 + t81 * t91 * 4.0 * t97 * t60);
+  const double t486 =
+      (-1.25 * t294 * t298 * t303 + t298 * 0.625 * t299 * t432 - t294 * t295 * t428 * 2.5 * t429 -
+       t428 * 2.5 * t429 * t299 * t303 - 1.25 * t298 * t421 * t303 - t298 * t295 * t433 * 0.625);
+  const double t487 = 950.0 * t401 * t271;
+  const double t488 =
+      (t171 * t60 - t166 + t105 * t85 * 24.0 * t66 * t122 - t168 + t424 + t425 - t173);
+  const double t489 = 950.0 * t313 * t333;
+  const double t490 = t278 * t324;
+  const double t491 = t363 * t281;
   const double t492 =
-      (-t444 * t112 * 24.49575 * t66 - 0.29296875 * t476 * t310 + 950.0 * t389 * t321 -
-       t491 * 0.5 * t318 + t475 - t320 * t339 * 0.29296875 + t65 * t112 * t436 * 24.49575 + t477 -
-       t295 * t215 * t65 * 6.1239375 + u[4] * ((t478 + t479 + t484 + t485)) -
-       t471 * t319 * 0.29296875 + t215 * t273 * 6.1239375 * t66 + 0.125 * t292 * t427 -
-       t295 * 12.247875 * t216 * t66 + t215 * 0.125 * t298 - t273 * 12.247875 * t216 * t65 +
-       950.0 * t321 * t311 -
-       ((-t200 + t205 * t57 - t201 + t412 + t413 + 24.0 * t63 * t119 * t202)) * t307 * 0.29296875 -
-       t490 * 0.5 * t112);
+      (t307 * 12.247875 * t115 * t69 * t98 + t285 * 12.247875 * t68 * t115 * t98 -
+       t332 * t350 * 0.29296875 + t430 * 0.125 * t304 - t331 * t351 * 0.29296875 + t487 -
+       0.5 * t330 * t486 - t319 * 0.29296875 * t488 - t307 * t176 * t68 * 6.1239375 +
+       0.125 * t176 * t310 + t68 * t115 * 24.49575 * t453 + t489 + 950.0 * t271 * t323 -
+       0.5 * t115 * t485 -
+       ((t123 - 86.7856 * t0 + t133 + t134 + t424 + t2 * 7.5984 + t425 + t135)) * 0.29296875 *
+           t322 +
+       u[4] * ((t490 + t325 * t281 + t491 + t367 * t324)) - t461 * t115 * 24.49575 * t69 +
+       950.0 * t404 * t333 + t285 * t176 * 6.1239375 * t69);
+  const double t493 = t81 * t164 * 2.0 * t66 * t60;
+  const double t494 = t81 * t65 * t174 * (-2.0) * t60;
+  const double t495 = 1900.0 * t401 * t333;
+  const double t496 = t324 * t363;
+  const double t497 = t325 * t324;
+  const double t498 = ((t496 + t497)) * 2.0 * u[4];
+  const double t499 = (-0.625) * t298 * t295 * t426;
+  const double t500 = t298 * t422 * 0.625 * t299;
+  const double t501 = 1900.0 * t333 * t323;
+  const double t502 =
+      (t81 * t93 * 4.0 * t60 * t111 + t493 + t494 + t66 * t97 * t60 * 8.0 * t138 * t200 -
+       t81 * t65 * t105 * t93 * t86 * 8.0 - t81 * t105 * t86 * t66 * t97 * 8.0 +
+       t65 * t93 * t60 * 8.0 * t138 * t200 + t81 * 4.0 * t97 * t60 * t108);
+  const double t503 = (t499 - t436 * t294 * t295 * 2.5 * t429 - 1.25 * t298 * t437 * t303 -
+                       t436 * 2.5 * t429 * t299 * t303 + 1.25 * t294 * t298 * t329 + t500);
+  const double t504 =
+      (-t456 * t115 * 24.49575 * t69 - 0.29296875 * t488 * t322 + 950.0 * t401 * t333 -
+       t503 * 0.5 * t330 + t487 - t332 * t351 * 0.29296875 + t68 * t115 * t448 * 24.49575 + t489 -
+       t307 * t220 * t68 * 6.1239375 + u[4] * ((t490 + t491 + t496 + t497)) -
+       t483 * t331 * 0.29296875 + t220 * t285 * 6.1239375 * t69 + 0.125 * t304 * t439 -
+       t307 * 12.247875 * t221 * t69 + t220 * 0.125 * t310 - t285 * 12.247875 * t221 * t68 +
+       950.0 * t333 * t323 -
+       ((-t205 + t210 * t60 - t206 + t424 + t425 + 24.0 * t66 * t122 * t207)) * t319 * 0.29296875 -
+       t502 * 0.5 * t115);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
-      (t9 * 1.2e+09 *
-           ((-t17 * t18 * 0.02454369260617026 * x[2] + 0.02454369260617026 * x[2] * t19 * t21)) -
-       t18 *
-           ((-t18 * 0.02454369260617026 * x[2] * t20 - 3.666666666666667e-09 * x[6] +
-             t24 * 1.496910398367498e-06 * t28 * t25 - 1.496910398367498e-06 * t29 * t33 * t30 +
-             sqrt(t34) * 1.8333333333333334e-09 - 1.8333333333333334e-09 * sqrt(t36) +
+      (-t9 * 29452431.12740431 *
+           ((-t9 * 0.02454369260617026 * x[2] * t14 - 3.666666666666667e-09 * x[6] +
+             7.48455199183749e-07 * t17 * t20 * t23 + t24 * 1.496910398367498e-06 * t28 * t25 +
+             sqrt(t29) * 1.8333333333333334e-09 - 1.8333333333333334e-09 * sqrt(t31) +
              0.04253333333333333)) *
-           29452431.12740431 * t20 / (t8 * t8));
-  jacobian[62] = t9 * t18 * (-29452431.12740431) * t20;
+           t14 / (t8 * t8) +
+       t32 * 1.2e+09 *
+           ((-t36 * t9 * 0.02454369260617026 * x[2] + 0.02454369260617026 * x[2] * t37 * t38)));
+  jacobian[62] = t32 * t9 * (-29452431.12740431) * t14;
   jacobian[64] =
-      ((-1.496910398367498e-06 * t33 * t30 * t38 - 1.496910398367498e-06 * t39 * t28 * t25)) * t9 *
-      1.2e+09;
+      t32 * 1.2e+09 *
+      ((7.48455199183749e-07 * t17 * t40 * t23 - 1.496910398367498e-06 * t41 * t28 * t25));
   jacobian[66] =
-      t9 * 1.2e+09 *
-      ((-1.496910398367498e-06 * t29 * t33 -
-        9.166666666666667e-10 * (1.0 / sqrt(t36)) * ((-4.6e+07 + t40)) +
-        t41 * 9.166666666666667e-10 * (1.0 / sqrt(t34)) + t24 * 1.496910398367498e-06 * t28 -
-        3.666666666666667e-09 - t41 * pow(t27, (-1.25)) * t24 * 3.742275995918745e-07 * t25 +
-        pow(t32, (-1.25)) * t31 * 7.48455199183749e-07 * t29));
+      t32 * 1.2e+09 *
+      ((-t42 * pow(t22, (-1.25)) * t20 * 9.355689989796862e-08 * t21 -
+        9.166666666666667e-10 * (1.0 / sqrt(t31)) * ((-4.6e+07 + t43)) +
+        t44 * 9.166666666666667e-10 * (1.0 / sqrt(t29)) + t24 * 1.496910398367498e-06 * t28 +
+        t42 * 7.48455199183749e-07 * t20 * t23 - 3.666666666666667e-09 -
+        t44 * pow(t27, (-1.25)) * t24 * 3.742275995918745e-07 * t25));
   jacobian[70] =
-      (1.2e+09 * t74 *
-           ((0.006082123377349838 * t99 * t115 * x[3] * t116 +
-             0.006082123377349838 * t117 * x[2] * t116 - 0.006082123377349838 * t144 * x[2] * t145 -
-             0.006082123377349838 * t177 * x[3] * t145)) -
-       t99 * t193 * t194 * t145 * 7298548.052819805);
+      (1.2e+09 * t77 *
+           ((0.006082123377349838 * t102 * t118 * x[3] * t119 +
+             0.006082123377349838 * t120 * x[2] * t119 - 0.006082123377349838 * t147 * x[2] * t148 -
+             0.006082123377349838 * t180 * x[3] * t148)) -
+       t102 * t198 * t199 * t148 * 7298548.052819805);
   jacobian[71] =
-      (-t193 * t115 * t194 * t145 * 7298548.052819805 +
-       1.2e+09 * t74 *
-           ((0.006082123377349838 * t99 * t115 * x[2] * t116 -
-             0.006082123377349838 * x[2] * t145 * t197 + 0.006082123377349838 * t198 * x[3] * t116 -
-             0.006082123377349838 * t217 * x[3] * t145)));
-  jacobian[72] = t99 * t74 * t145 * (-7298548.052819805);
-  jacobian[73] = t115 * t74 * t145 * (-7298548.052819805);
+      (-t118 * t198 * t199 * t148 * 7298548.052819805 +
+       1.2e+09 * t77 *
+           ((0.006082123377349838 * t102 * t118 * x[2] * t119 -
+             0.006082123377349838 * x[2] * t148 * t202 + 0.006082123377349838 * t203 * x[3] * t119 -
+             0.006082123377349838 * t222 * x[3] * t148)));
+  jacobian[72] = t102 * t77 * t148 * (-7298548.052819805);
+  jacobian[73] = t118 * t77 * t148 * (-7298548.052819805);
   jacobian[75] =
-      ((-1.496910398367498e-06 * t219 * t181 * t184 - t220 * 1.496910398367498e-06 * t192 * t189)) *
-      1.2e+09 * t74;
+      ((-t224 * t183 * 7.48455199183749e-07 * t189 - 1.496910398367498e-06 * t225 * t191 * t194)) *
+      1.2e+09 * t77;
   jacobian[77] =
-      1.2e+09 * t74 *
-      (((1.0 / sqrt(t185)) * t222 * 9.166666666666667e-10 + 1.496910398367498e-06 * t180 * t184 -
-        9.166666666666667e-10 * (1.0 / sqrt(t187)) * ((-4.6e+07 + t221)) +
-        pow(t191, (-1.25)) * 7.48455199183749e-07 * t188 * t190 - 3.666666666666667e-09 -
-        t188 * 1.496910398367498e-06 * t192 -
-        t222 * 3.742275995918745e-07 * pow(t183, (-1.25)) * t180 * t181));
+      ((t226 * 7.48455199183749e-07 * t186 * t189 +
+        (1.0 / sqrt(t195)) * t228 * 9.166666666666667e-10 + 1.496910398367498e-06 * t190 * t194 -
+        9.166666666666667e-10 * (1.0 / sqrt(t197)) * ((-4.6e+07 + t227)) -
+        t226 * pow(t188, (-1.25)) * t186 * t187 * 9.355689989796862e-08 - 3.666666666666667e-09 -
+        t228 * 3.742275995918745e-07 * pow(t193, (-1.25)) * t190 * t191)) *
+      1.2e+09 * t77;
   jacobian[80] =
-      (t18 *
-           ((t18 * x[2] * t20 * 0.016846790604875265 - t226 * 1.496910398367498e-06 * t29 * t223 -
-             3.666666666666667e-09 * x[8] - sqrt(t228) * 1.8333333333333334e-09 +
-             t24 * t232 * 1.496910398367498e-06 * t229 + sqrt(t233) * 1.8333333333333334e-09 +
-             0.04253333333333333)) *
-           t20 * 20216148.725850318 / (t234 * t234) +
-       t235 * 1.2e+09 *
-           ((t17 * t18 * x[2] * 0.016846790604875265 - x[2] * t19 * 0.016846790604875265 * t21)));
-  jacobian[82] = t18 * t235 * t20 * 20216148.725850318;
+      (((t9 * x[2] * t14 * 0.016846790604875265 - t232 * 1.496910398367498e-06 * t20 * t229 -
+         3.666666666666667e-09 * x[8] - sqrt(t234) * 1.8333333333333334e-09 +
+         t240 * t24 * 7.48455199183749e-07 * t237 + sqrt(t241) * 1.8333333333333334e-09 +
+         0.04253333333333333)) *
+           t9 * t14 * 20216148.725850318 / (t242 * t242) +
+       t243 * 1.2e+09 *
+           ((t36 * t9 * x[2] * 0.016846790604875265 - x[2] * t37 * 0.016846790604875265 * t38)));
+  jacobian[82] = t9 * t243 * t14 * 20216148.725850318;
   jacobian[84] =
-      t235 * 1.2e+09 *
-      ((-t232 * 1.496910398367498e-06 * t39 * t229 - t226 * 1.496910398367498e-06 * t38 * t223));
-  jacobian[88] =
-      t235 *
-      ((t237 * 3.742275995918745e-07 * t29 * t223 * pow(t225, (-1.25)) +
-        t237 * 9.166666666666667e-10 * (1.0 / sqrt(t233)) + t24 * t232 * 1.496910398367498e-06 -
-        t226 * 1.496910398367498e-06 * t29 - 3.666666666666667e-09 -
-        9.166666666666667e-10 * (1.0 / sqrt(t228)) * ((-4.6e+07 + t236)) -
-        t24 * t230 * 7.48455199183749e-07 * pow(t231, (-1.25)))) *
-      1.2e+09;
+      ((-t240 * 7.48455199183749e-07 * t41 * t237 - t232 * 1.496910398367498e-06 * t40 * t229)) *
+      t243 * 1.2e+09;
+  jacobian[88] = ((t245 * 3.742275995918745e-07 * t20 * t229 * pow(t231, (-1.25)) +
+                   t245 * 9.166666666666667e-10 * (1.0 / sqrt(t241)) +
+                   t24 * t246 * pow(t239, (-1.25)) * 9.355689989796862e-08 * t238 -
+                   t232 * 1.496910398367498e-06 * t20 - 3.666666666666667e-09 -
+                   9.166666666666667e-10 * (1.0 / sqrt(t234)) * ((-4.6e+07 + t244)) -
+                   t240 * t24 * 7.48455199183749e-07 * t246)) *
+                 t243 * 1.2e+09;
   jacobian[90] =
-      (t99 * t249 * 1266690.1579274035 * t251 * t145 +
-       ((t177 * 0.0010555751316061695 * x[3] * t145 -
-         t99 * t115 * 0.0010555751316061695 * x[3] * t116 +
-         0.0010555751316061695 * t144 * x[2] * t145 - t117 * 0.0010555751316061695 * x[2] * t116)) *
-           1.2e+09 * t252);
+      (t102 * t260 * 1266690.1579274035 * t262 * t148 +
+       ((t180 * 0.0010555751316061695 * x[3] * t148 -
+         t102 * t118 * 0.0010555751316061695 * x[3] * t119 +
+         0.0010555751316061695 * t147 * x[2] * t148 - t120 * 0.0010555751316061695 * x[2] * t119)) *
+           1.2e+09 * t263);
   jacobian[91] =
-      (t115 * t249 * 1266690.1579274035 * t251 * t145 +
-       ((0.0010555751316061695 * x[2] * t145 * t197 - t198 * 0.0010555751316061695 * x[3] * t116 -
-         t99 * t115 * 0.0010555751316061695 * x[2] * t116 +
-         t217 * 0.0010555751316061695 * x[3] * t145)) *
-           1.2e+09 * t252);
-  jacobian[92] = t99 * 1266690.1579274035 * t145 * t252;
-  jacobian[93] = t115 * 1266690.1579274035 * t145 * t252;
+      (t260 * t118 * 1266690.1579274035 * t262 * t148 +
+       ((0.0010555751316061695 * x[2] * t148 * t202 - t203 * 0.0010555751316061695 * x[3] * t119 -
+         t102 * t118 * 0.0010555751316061695 * x[2] * t119 +
+         t222 * 0.0010555751316061695 * x[3] * t148)) *
+           1.2e+09 * t263);
+  jacobian[92] = t102 * 1266690.1579274035 * t148 * t263;
+  jacobian[93] = t118 * 1266690.1579274035 * t148 * t263;
   jacobian[95] =
-      ((-t220 * 1.496910398367498e-06 * t241 * t238 + t245 * 1.496910398367498e-06 * t248 * t219)) *
-      1.2e+09 * t252;
-  jacobian[99] = ((-t188 * 1.496910398367498e-06 * t241 + 1.496910398367498e-06 * t180 * t248 -
-                   t246 * 7.48455199183749e-07 * pow(t247, (-1.25)) * t180 -
-                   9.166666666666667e-10 * (1.0 / sqrt(t243)) * ((-4.6e+07 + t253)) -
-                   3.666666666666667e-09 + t254 * 9.166666666666667e-10 * (1.0 / sqrt(t244)) +
-                   t254 * t188 * 3.742275995918745e-07 * pow(t240, (-1.25)) * t238)) *
-                 1.2e+09 * t252;
+      1.2e+09 *
+      ((-t224 * 1.496910398367498e-06 * t250 * t247 + 7.48455199183749e-07 * t255 * t258 * t225)) *
+      t263;
+  jacobian[99] =
+      ((-t186 * 1.496910398367498e-06 * t250 + t264 * 7.48455199183749e-07 * t190 * t258 -
+        9.166666666666667e-10 * (1.0 / sqrt(t252)) * ((-4.6e+07 + t265)) - 3.666666666666667e-09 -
+        t256 * t264 * pow(t257, (-1.25)) * 9.355689989796862e-08 * t190 +
+        t266 * 9.166666666666667e-10 * (1.0 / sqrt(t259)) +
+        t266 * t186 * 3.742275995918745e-07 * pow(t249, (-1.25)) * t247)) *
+      1.2e+09 * t263;
   mass[0] =
-      (110.0 * (t255 * t255) + 950.0 * (t259 * t259) + (t262 * t262) * 75.0 + 1400.0 +
-       (((t266 * t266) + (t269 * t269))) * u[4] + 110.0 * (t271 * t271) + (t272 * t272) * 1350.0 +
-       190.0 * (t273 * t273) + (t274 * t274) * 75.0 + t277 * t278 + t292 * t293 * 0.5 +
-       (t294 * t294) * 1350.0 + 190.0 * (t295 * t295) + 190.0 * (t297 * t297) + 0.5 * t95 * t298 +
-       950.0 * (t301 * t301) + t277 * t302 + 190.0 * (t303 * t303));
-  mass[1] = t322;
-  mass[2] = t322;
-  mass[3] = (-0.5 * t318 * t323 + (t320 * t320) * 1.171875 + 950.0 * (t321 * t321) + 300.0 +
-             950.0 * (t311 * t311) + 3.1581145687500007 * t324 * t216 - 0.5 * t112 * t325 +
-             u[4] * (((t312 * t312) + (t313 * t313))) + 3.1581145687500007 * t326 * t216 +
-             (t327 * t327) * 75.0);
+      (110.0 * (t267 * t267) + 950.0 * (t271 * t271) + (t274 * t274) * 75.0 + 1400.0 +
+       (((t278 * t278) + (t281 * t281))) * u[4] + 110.0 * (t283 * t283) + (t284 * t284) * 1350.0 +
+       190.0 * (t285 * t285) + (t286 * t286) * 75.0 + t289 * t290 + t304 * t305 * 0.5 +
+       (t306 * t306) * 1350.0 + 190.0 * (t307 * t307) + 190.0 * (t309 * t309) + 0.5 * t98 * t310 +
+       950.0 * (t313 * t313) + t289 * t314 + 190.0 * (t315 * t315));
+  mass[1] = t334;
+  mass[2] = t334;
+  mass[3] = (-0.5 * t330 * t335 + (t332 * t332) * 1.171875 + 950.0 * (t333 * t333) + 300.0 +
+             950.0 * (t323 * t323) + 3.1581145687500007 * t336 * t221 - 0.5 * t115 * t337 +
+             u[4] * (((t324 * t324) + (t325 * t325))) + 3.1581145687500007 * t338 * t221 +
+             (t339 * t339) * 75.0);
   acceleration[0] =
-      (((-t266 * t328 * 9.80665 - t329 * 9.80665 * t269)) * u[4] -
-       t303 * t328 * 1863.2634999999998 - t301 * t328 * 9316.3175 - 1500.0 * x[2] -
-       t329 * 1863.2634999999998 * t297 - t303 * 190.0 * t330 * t332 -
-       91.93734375 * t329 * ((t333 + t84 + t280 + t89 + t334 - 21.6964 * t2)) +
-       t319 * t344 * 0.29296875 - u[4] * ((t266 * t348 + t357 * t269)) - 950.0 * t361 * t301 -
-       13238.977499999999 * t272 * t328 - t273 * t328 * 1863.2634999999998 + t18 * t371 * t20 -
-       t99 * t382 * 0.5 * t145 - t383 * t330 * 110.0 * t255 - t329 * 13238.977499999999 * t294 -
-       91.93734375 * t328 * ((t91 + t93 + t315 + t316 + 21.6964 * t0 + t290)) - t385 * t330 * t302 -
-       t330 * 110.0 * t386 * t271 - t394 * 950.0 * t259 - t407 * t307 * 0.29296875 + u[2] -
-       t330 * t408 * 1350.0 * t294 - 0.125 * t430 * t292 - t255 * t328 * 1078.7314999999999 -
-       t295 * t329 * 1863.2634999999998 - t329 * t259 * 9316.3175 - 190.0 * t330 * t431 * t297 -
-       t329 * t271 * 1078.7314999999999 - t330 * t272 * 1350.0 * t294 - 0.125 * t434 * t298 -
-       t295 * 190.0 * t442 - t385 * t330 * t278 - 190.0 * t273 * t450);
-  acceleration[1] = (-600.0 * x[3] - t328 * t311 * 9316.3175 + 91.93734375 * t320 * t328 -
-                     t329 * t321 * 9316.3175 + t344 * t320 * 0.29296875 - 0.125 * t430 * t323 -
-                     ((t312 * t357 + t313 * t348)) * u[4] - t115 * t382 * 0.5 * t145 -
-                     t407 * 0.29296875 * t310 - t394 * 950.0 * t321 - t65 * t112 * t442 * 24.49575 -
-                     0.125 * t434 * t325 - 91.93734375 * t329 * ((t333 + t103 + t106 + t334)) +
-                     u[3] + ((-t313 * t328 * 9.80665 - t329 * t312 * 9.80665)) * u[4] -
-                     t329 * t65 * t112 * 240.2212467375 - 950.0 * t361 * t311 +
-                     t328 * t112 * 240.2212467375 * t66 + t112 * 24.49575 * t66 * t450);
+      (((-t278 * t340 * 9.80665 - t341 * 9.80665 * t281)) * u[4] -
+       t315 * t340 * 1863.2634999999998 - t313 * t340 * 9316.3175 - 1500.0 * x[2] -
+       t341 * 1863.2634999999998 * t309 - t315 * 190.0 * t342 * t344 -
+       91.93734375 * t341 * ((t345 + t87 + t292 + t92 + t346 - 21.6964 * t2)) +
+       t331 * t356 * 0.29296875 - u[4] * ((t278 * t360 + t369 * t281)) - 950.0 * t373 * t313 -
+       13238.977499999999 * t284 * t340 - t285 * t340 * 1863.2634999999998 + t9 * t383 * t14 -
+       t102 * t394 * 0.5 * t148 - t395 * t342 * 110.0 * t267 - t341 * 13238.977499999999 * t306 -
+       91.93734375 * t340 * ((t94 + t96 + t327 + t328 + 21.6964 * t0 + t302)) - t397 * t342 * t314 -
+       t342 * 110.0 * t398 * t283 - t406 * 950.0 * t271 - t419 * t319 * 0.29296875 + u[2] -
+       t342 * t420 * 1350.0 * t306 - 0.125 * t442 * t304 - t267 * t340 * 1078.7314999999999 -
+       t307 * t341 * 1863.2634999999998 - t341 * t271 * 9316.3175 - 190.0 * t342 * t443 * t309 -
+       t341 * t283 * 1078.7314999999999 - t342 * t284 * 1350.0 * t306 - 0.125 * t446 * t310 -
+       t307 * 190.0 * t454 - t397 * t342 * t290 - 190.0 * t285 * t462);
+  acceleration[1] = (-600.0 * x[3] - t340 * t323 * 9316.3175 + 91.93734375 * t332 * t340 -
+                     t341 * t333 * 9316.3175 + t356 * t332 * 0.29296875 - 0.125 * t442 * t335 -
+                     ((t324 * t369 + t325 * t360)) * u[4] - t118 * t394 * 0.5 * t148 -
+                     t419 * 0.29296875 * t322 - t406 * 950.0 * t333 - t68 * t115 * t454 * 24.49575 -
+                     0.125 * t446 * t337 - 91.93734375 * t341 * ((t345 + t106 + t109 + t346)) +
+                     u[3] + ((-t325 * t340 * 9.80665 - t341 * t324 * 9.80665)) * u[4] -
+                     t341 * t68 * t115 * 240.2212467375 - 950.0 * t373 * t323 +
+                     t340 * t115 * 240.2212467375 * t69 + t115 * 24.49575 * t69 * t462);
   d_force[0] =
-      (t17 * t18 * t371 - t328 * t259 * 9316.3175 + t117 * t382 * 0.5 * t116 - t371 * t19 * t21 -
-       t329 * 1863.2634999999998 * t431 - t329 * t386 * 1078.7314999999999 +
-       t329 * 22.9843359375 * t402 - t338 * t328 * 22.9843359375 -
-       t329 * 1863.2634999999998 * t441 +
-       u[4] * ((-t328 * 9.80665 * t269 - t355 * t329 * 9.80665)) - t392 * t329 * 9316.3175 +
-       t18 *
-           ((-4e+08 * t18 * t20 + t362 * t18 * 2e+08 * t20 * t365 -
-             t18 * 2e+06 * x[2] * t20 *
-                 ((-t18 * t367 * pow(t368, (-1.5)) * t20 + t18 * t369 * t20 +
-                   t18 * t363 * pow(t364, (-1.5)) * t20 - t18 * t20 * t365)) +
-             t17 * t18 * t370 * 2e+06 * x[2] - t370 * 2e+06 * x[2] * t19 * t21 -
-             t18 * 2e+08 * t369 * t20 * t366)) *
-           t20 -
-       t328 * 1863.2634999999998 * t332 - t382 * t144 * 0.5 * t145 -
-       13238.977499999999 * t328 * t294 - t383 * t328 * 1078.7314999999999 -
-       t408 * t329 * 13238.977499999999 - t449 * t328 * 1863.2634999999998 -
-       t99 * t453 * 0.5 * t145);
+      (t36 * t9 * t383 - t340 * t271 * 9316.3175 + t120 * t394 * 0.5 * t119 - t383 * t37 * t38 -
+       t341 * 1863.2634999999998 * t443 - t341 * t398 * 1078.7314999999999 +
+       t341 * 22.9843359375 * t414 - t350 * t340 * 22.9843359375 -
+       t341 * 1863.2634999999998 * t453 +
+       u[4] * ((-t340 * 9.80665 * t281 - t367 * t341 * 9.80665)) - t404 * t341 * 9316.3175 +
+       t9 *
+           ((-4e+08 * t9 * t14 + t374 * t9 * 2e+08 * t14 * t377 -
+             t9 * 2e+06 * x[2] * t14 *
+                 ((-t9 * t379 * pow(t380, (-1.5)) * t14 + t9 * t381 * t14 +
+                   t9 * t375 * pow(t376, (-1.5)) * t14 - t9 * t14 * t377)) +
+             t36 * t9 * t382 * 2e+06 * x[2] - t382 * 2e+06 * x[2] * t37 * t38 -
+             t9 * 2e+08 * t381 * t14 * t378)) *
+           t14 -
+       t340 * 1863.2634999999998 * t344 - t394 * t147 * 0.5 * t148 -
+       13238.977499999999 * t340 * t306 - t395 * t340 * 1078.7314999999999 -
+       t420 * t341 * 13238.977499999999 - t461 * t340 * 1863.2634999999998 -
+       t102 * t465 * 0.5 * t148);
   d_force[1] =
-      (t454 + t455 + t456 + t457 - t382 * 0.5 * t145 * t197 + t458 - t99 * t459 * 0.5 * t145 -
-       t329 * 1863.2634999999998 * t436 + t460 - t444 * t328 * 1863.2634999999998);
+      (t466 + t467 + t468 + t469 - t394 * 0.5 * t148 * t202 + t470 - t102 * t471 * 0.5 * t148 -
+       t341 * 1863.2634999999998 * t448 + t472 - t456 * t340 * 1863.2634999999998);
   d_force[2] =
-      (-t303 * 380.0 * x[2] * t332 - 0.5859375 * t404 * t307 - t295 * 190.0 * t461 -
-       t386 * 220.0 * x[2] * t271 - 2.0 * ((t356 * t269 + t347 * t266)) * u[4] -
-       t301 * 1900.0 * t359 - t462 * 0.125 * t292 - 190.0 * t463 * t273 +
-       t117 * 1e+06 * t381 * t464 + 0.5859375 * t319 * t340 - 0.125 * t465 * t298 -
-       t408 * x[2] * 2700.0 * t294 + t370 * 2e+06 * t275 * t21 - t383 * 220.0 * t255 * x[2] -
-       t272 * x[2] * 2700.0 * t294 - 380.0 * x[2] * t431 * t297 - t385 * t302 * 2.0 * x[2] -
-       1500.0 - t393 * 1900.0 * t259 - t385 * 2.0 * x[2] * t278);
+      (-t315 * 380.0 * x[2] * t344 - 0.5859375 * t416 * t319 - t307 * 190.0 * t473 -
+       t398 * 220.0 * x[2] * t283 - 2.0 * ((t368 * t281 + t359 * t278)) * u[4] -
+       t313 * 1900.0 * t371 - t474 * 0.125 * t304 - 190.0 * t475 * t285 +
+       t120 * 1e+06 * t393 * t476 + 0.5859375 * t331 * t352 - 0.125 * t477 * t310 -
+       t420 * x[2] * 2700.0 * t306 + t382 * 2e+06 * t287 * t38 - t395 * 220.0 * t267 * x[2] -
+       t284 * x[2] * 2700.0 * t306 - 380.0 * x[2] * t443 * t309 - t397 * t314 * 2.0 * x[2] -
+       1500.0 - t405 * 1900.0 * t271 - t397 * 2.0 * x[2] * t290);
   d_force[3] =
-      (-1900.0 * t391 * t259 - t360 * t301 * 1900.0 - 2.0 * ((t266 * t346 + t353 * t269)) * u[4] -
-       0.125 * t466 * t298 - 190.0 * t467 * t273 + t468 - 0.125 * t292 * t469 -
-       t295 * 190.0 * t470 + t472 * t319 * 0.29296875 - 0.5859375 * t406 * t307);
-  d_force[6] = t18 * 0.02454369260617026 * t20;
-  d_force[7] = 0.006082123377349838 * t99 * t145;
-  d_force[8] = t18 * t20 * (-0.016846790604875265);
-  d_force[9] = t99 * t145 * (-0.0010555751316061695);
-  d_force[10] = (t454 + t329 * 60.055311684375 * t173 * t65 + t455 + t456 -
-                 120.11062336875 * t329 * t112 * t66 * t95 - t177 * t382 * 0.5 * t145 + t457 -
-                 60.055311684375 * t173 * t328 * t66 + t458 - t115 * t453 * 0.5 * t145 -
-                 120.11062336875 * t328 * t65 * t112 * t95 + t460);
-  d_force[11] = (120.11062336875 * t328 * t216 * t65 + t454 + t198 * t382 * 0.5 * t116 + t457 -
-                 t115 * t459 * 0.5 * t145 + t329 * 22.9843359375 * t405 - t217 * t382 * 0.5 * t145 -
-                 t471 * t328 * 22.9843359375 + 120.11062336875 * t329 * t216 * t66 + t458 +
-                 t215 * t329 * 60.055311684375 * t65 - t215 * 60.055311684375 * t328 * t66);
+      (-1900.0 * t403 * t271 - t372 * t313 * 1900.0 - 2.0 * ((t278 * t358 + t365 * t281)) * u[4] -
+       0.125 * t478 * t310 - 190.0 * t479 * t285 + t480 - 0.125 * t304 * t481 -
+       t307 * 190.0 * t482 + t484 * t331 * 0.29296875 - 0.5859375 * t418 * t319);
+  d_force[6] = t9 * 0.02454369260617026 * t14;
+  d_force[7] = 0.006082123377349838 * t102 * t148;
+  d_force[8] = t9 * t14 * (-0.016846790604875265);
+  d_force[9] = t102 * t148 * (-0.0010555751316061695);
+  d_force[10] = (t466 + t341 * 60.055311684375 * t176 * t68 + t467 + t468 -
+                 120.11062336875 * t341 * t115 * t69 * t98 - t180 * t394 * 0.5 * t148 + t469 -
+                 60.055311684375 * t176 * t340 * t69 + t470 - t118 * t465 * 0.5 * t148 -
+                 120.11062336875 * t340 * t68 * t115 * t98 + t472);
+  d_force[11] = (120.11062336875 * t340 * t221 * t68 + t466 + t203 * t394 * 0.5 * t119 + t469 -
+                 t118 * t471 * 0.5 * t148 + t341 * 22.9843359375 * t417 - t222 * t394 * 0.5 * t148 -
+                 t483 * t340 * 22.9843359375 + 120.11062336875 * t341 * t221 * t69 + t470 +
+                 t220 * t341 * 60.055311684375 * t68 - t220 * 60.055311684375 * t340 * t69);
   d_force[12] =
-      (-2.0 * ((t356 * t312 + t347 * t313)) * u[4] - 0.125 * t465 * t325 + 0.5859375 * t320 * t340 -
-       1900.0 * t359 * t311 + t468 + t463 * t112 * 24.49575 * t66 - 0.5859375 * t404 * t310 -
-       t462 * 0.125 * t323 - t393 * 1900.0 * t321 - t65 * t112 * 24.49575 * t461);
+      (-2.0 * ((t368 * t324 + t359 * t325)) * u[4] - 0.125 * t477 * t337 + 0.5859375 * t332 * t352 -
+       1900.0 * t371 * t323 + t480 + t475 * t115 * 24.49575 * t69 - 0.5859375 * t416 * t322 -
+       t474 * 0.125 * t335 - t405 * 1900.0 * t333 - t68 * t115 * 24.49575 * t473);
   d_force[13] =
-      (-0.5859375 * t406 * t310 - t470 * t65 * t112 * 24.49575 -
-       ((t312 * t353 + t313 * t346)) * 2.0 * u[4] - t360 * 1900.0 * t311 +
-       t467 * t112 * 24.49575 * t66 - 0.125 * t469 * t323 - 0.125 * t466 * t325 +
-       t472 * t320 * 0.29296875 - 1900.0 * t391 * t321 - 600.0 + t198 * 1e+06 * t381 * t464);
-  d_force[17] = 0.006082123377349838 * t115 * t145;
-  d_force[19] = t115 * t145 * (-0.0010555751316061695);
+      (-0.5859375 * t418 * t322 - t482 * t68 * t115 * 24.49575 -
+       ((t324 * t365 + t325 * t358)) * 2.0 * u[4] - t372 * 1900.0 * t323 +
+       t479 * t115 * 24.49575 * t69 - 0.125 * t481 * t335 - 0.125 * t478 * t337 +
+       t484 * t332 * 0.29296875 - 1900.0 * t403 * t333 - 600.0 + t203 * 1e+06 * t393 * t476);
+  d_force[17] = 0.006082123377349838 * t118 * t148;
+  d_force[19] = t118 * t148 * (-0.0010555751316061695);
   d_mass[0] =
-      (t385 * t278 + t392 * 1900.0 * t259 + 380.0 * t431 * t297 + t301 * 1900.0 * t259 +
-       t295 * 380.0 * t441 +
-       t277 *
-           ((t12 * 12.021927866666665 * t275 * t16 + t12 * 12.021927866666665 * t275 * t4 +
-             12.021927866666665 * t275 * t16 * t276 - t384 * t12 * t20 * t276 * 24.04385573333333 +
-             t12 * 12.021927866666665 * t13 * t275 - t384 * t13 * t20 * t4 * 24.04385573333333)) +
-       t449 * 380.0 * t273 + t408 * 2700.0 * t294 + t386 * 220.0 * t271 +
-       t277 *
-           ((t12 * 20.765148133333334 * t13 * t275 + t12 * 20.765148133333334 * t275 * t4 +
-             t12 * 20.765148133333334 * t275 * t16 - t384 * t12 * 41.53029626666667 * t20 * t276 -
-             t384 * t13 * 41.53029626666667 * t20 * t4 + 20.765148133333334 * t275 * t16 * t276)) +
-       t303 * 380.0 * t332 - 0.5859375 * t319 * t338 + 2.0 * ((t355 * t269 + t266 * t269)) * u[4] +
-       t385 * t302 + 0.5859375 * t307 * t402 + t383 * 220.0 * t255 - 0.125 * t292 * t422 +
-       0.5 * t95 * t473 + 0.125 * t141 * t298 + t293 * 0.5 * t474 + t272 * 2700.0 * t294);
-  d_mass[1] = t480;
-  d_mass[2] = t480;
-  d_mass[3] = (-((-t134 * t63 * t57 * t111 * 8.0 * t135 + t78 * 4.0 * t92 * t107 * t57 + t481 -
-                  t78 * t62 * t82 * t83 * t107 * 8.0 + t62 * t134 * t107 * t57 * 8.0 * t135 + t482 +
-                  t78 * t82 * t83 * t63 * t111 * 8.0 - t78 * t88 * 4.0 * t57 * t111)) *
-                   0.5 * t112 +
-               t483 + 0.125 * t173 * t325 + t486 -
-               ((t487 - 1.25 * t286 * t314 * t291 + t488 + 1.25 * t286 * t409 * t317 +
-                 t416 * 2.5 * t417 * t287 * t317 - t283 * t416 * 2.5 * t417 * t314)) *
-                   0.5 * t318 -
-               0.5859375 * t320 * t339 + t418 * 0.125 * t323 + t489 -
-               t324 * 1.5790572843750004 * t173 * t112 - 1.5790572843750004 * t326 * t173 * t112 +
-               0.5859375 * t403 * t310);
-  d_mass[4] = (380.0 * t273 * t444 + 0.125 * t196 * t298 + t301 * 1900.0 * t321 +
-               ((t478 + t479)) * 2.0 * u[4] - 0.5859375 * t319 * t339 + 1900.0 * t389 * t259 +
-               0.5859375 * t403 * t307 + t295 * 380.0 * t436 + 0.125 * t292 * t428 +
-               t490 * 0.5 * t95 + t491 * t293 * 0.5);
-  d_mass[5] = t492;
-  d_mass[6] = t492;
-  d_mass[7] = (t483 + t486 + 0.125 * t427 * t323 -
-               ((t62 * t107 * t57 * 8.0 * t135 * t195 - t78 * t62 * 2.0 * t208 * t57 +
-                 t78 * 2.0 * t63 * t57 * t214 - t78 * 4.0 * t57 * t111 * t105 +
-                 t78 * 4.0 * t107 * t57 * t108 - t78 * t62 * t102 * t83 * t107 * 8.0 +
-                 t78 * t102 * t83 * t63 * t111 * 8.0 - t63 * t57 * t111 * 8.0 * t135 * t195)) *
-                   0.5 * t112 +
-               t489 - 0.5859375 * t471 * t320 + t215 * 0.125 * t325 -
-               0.5 * t318 *
-                   ((1.25 * t286 * t425 * t317 + 1.25 * t286 * t314 * t317 -
-                     t424 * t283 * 2.5 * t417 * t314 + t424 * 2.5 * t417 * t287 * t317 -
-                     t286 * t283 * t423 * 0.625 + t286 * 0.625 * t426 * t287)) -
-               t215 * 1.5790572843750004 * t326 * t112 + 0.5859375 * t405 * t310 -
-               t215 * t324 * 1.5790572843750004 * t112);
+      (t397 * t290 + t404 * 1900.0 * t271 + 380.0 * t443 * t309 + t313 * 1900.0 * t271 +
+       t307 * 380.0 * t453 +
+       t289 *
+           ((t13 * 12.021927866666665 * t287 * t35 + t13 * 12.021927866666665 * t287 * t4 +
+             12.021927866666665 * t287 * t35 * t288 - t396 * t13 * t14 * t288 * 24.04385573333333 +
+             t13 * 12.021927866666665 * t10 * t287 - t396 * t10 * t14 * t4 * 24.04385573333333)) +
+       t461 * 380.0 * t285 + t420 * 2700.0 * t306 + t398 * 220.0 * t283 +
+       t289 *
+           ((t13 * 20.765148133333334 * t10 * t287 + t13 * 20.765148133333334 * t287 * t4 +
+             t13 * 20.765148133333334 * t287 * t35 - t396 * t13 * 41.53029626666667 * t14 * t288 -
+             t396 * t10 * 41.53029626666667 * t14 * t4 + 20.765148133333334 * t287 * t35 * t288)) +
+       t315 * 380.0 * t344 - 0.5859375 * t331 * t350 + 2.0 * ((t367 * t281 + t278 * t281)) * u[4] +
+       t397 * t314 + 0.5859375 * t319 * t414 + t395 * 220.0 * t267 - 0.125 * t304 * t434 +
+       0.5 * t98 * t485 + 0.125 * t144 * t310 + t305 * 0.5 * t486 + t284 * 2700.0 * t306);
+  d_mass[1] = t492;
+  d_mass[2] = t492;
+  d_mass[3] = (-((-t137 * t66 * t60 * t114 * 8.0 * t138 + t81 * 4.0 * t95 * t110 * t60 + t493 -
+                  t81 * t65 * t85 * t86 * t110 * 8.0 + t65 * t137 * t110 * t60 * 8.0 * t138 + t494 +
+                  t81 * t85 * t86 * t66 * t114 * 8.0 - t81 * t91 * 4.0 * t60 * t114)) *
+                   0.5 * t115 +
+               t495 + 0.125 * t176 * t337 + t498 -
+               ((t499 - 1.25 * t298 * t326 * t303 + t500 + 1.25 * t298 * t421 * t329 +
+                 t428 * 2.5 * t429 * t299 * t329 - t295 * t428 * 2.5 * t429 * t326)) *
+                   0.5 * t330 -
+               0.5859375 * t332 * t351 + t430 * 0.125 * t335 + t501 -
+               t336 * 1.5790572843750004 * t176 * t115 - 1.5790572843750004 * t338 * t176 * t115 +
+               0.5859375 * t415 * t322);
+  d_mass[4] = (380.0 * t285 * t456 + 0.125 * t201 * t310 + t313 * 1900.0 * t333 +
+               ((t490 + t491)) * 2.0 * u[4] - 0.5859375 * t331 * t351 + 1900.0 * t401 * t271 +
+               0.5859375 * t415 * t319 + t307 * 380.0 * t448 + 0.125 * t304 * t440 +
+               t502 * 0.5 * t98 + t503 * t305 * 0.5);
+  d_mass[5] = t504;
+  d_mass[6] = t504;
+  d_mass[7] = (t495 + t498 + 0.125 * t439 * t335 -
+               ((t65 * t110 * t60 * 8.0 * t138 * t200 - t81 * t65 * 2.0 * t213 * t60 +
+                 t81 * 2.0 * t66 * t60 * t219 - t81 * 4.0 * t60 * t114 * t108 +
+                 t81 * 4.0 * t110 * t60 * t111 - t81 * t65 * t105 * t86 * t110 * 8.0 +
+                 t81 * t105 * t86 * t66 * t114 * 8.0 - t66 * t60 * t114 * 8.0 * t138 * t200)) *
+                   0.5 * t115 +
+               t501 - 0.5859375 * t483 * t332 + t220 * 0.125 * t337 -
+               0.5 * t330 *
+                   ((1.25 * t298 * t437 * t329 + 1.25 * t298 * t326 * t329 -
+                     t436 * t295 * 2.5 * t429 * t326 + t436 * 2.5 * t429 * t299 * t329 -
+                     t298 * t295 * t435 * 0.625 + t298 * 0.625 * t438 * t299)) -
+               t220 * 1.5790572843750004 * t338 * t115 + 0.5859375 * t417 * t322 -
+               t220 * t336 * 1.5790572843750004 * t115);
   // -dh/dq by central differences (see codegen/symbolic_model.cc).
   for (int c = 0; c < kNumJoints; ++c) {
     double shifted[kNumStates];

@@ -333,486 +333,491 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   const double t11 = 0.1216 * t0;
   const double t12 = (t10 + t11);
   const double t13 = (t9 * t5 + t12 * t4);
-  const double t14 = sqrt(((x[4] * x[4]) + 1e-06));
-  const double t15 = (-t14 + x[4]);
-  const double t16 = (x[6] - 2e+05);
-  const double t17 = (t16 * t16);
-  const double t18 = (x[4] + t14);
-  const double t19 = (x[6] - u[6]);
-  const double t20 = (-2.3e+07 + x[6]);
-  const double t21 = (x[0] + x[1]);
-  const double t22 = cos(t21);
-  const double t23 = 0.5 * t22;
-  const double t24 = t2 * 0.5499999999999998;
-  const double t25 = sin(t21);
-  const double t26 = t25 * (-0.1);
-  const double t27 = (t23 + t24 + t26);
-  const double t28 = t25 * (-0.5);
-  const double t29 = t22 * (-0.1);
-  const double t30 = t0 * 0.5499999999999998;
-  const double t31 = (t28 + t29 + t30);
-  const double t32 = (t31 * t31);
-  const double t33 = (t27 * t27);
-  const double t34 = (-0.06250000000000006 + t32 + t33);
-  const double t35 = (t32 + t33);
-  const double t36 = (1.0 / sqrt(t35));
-  const double t37 = (t34 * t34);
-  const double t38 = (1.0 / (t35));
-  const double t39 = (0.36 - t37 * 0.25 * t38);
-  const double t40 = sqrt(t39);
-  const double t41 = (t27 * t34 * t36 + t31 * t40 * 2.0);
-  const double t42 = (t28 + t29);
-  const double t43 = t25 * 0.1;
-  const double t44 = t22 * (-0.5);
-  const double t45 = (t43 + t44);
-  const double t46 = pow(t35, (-1.5));
-  const double t47 = (t31 * t45 + t27 * t42);
-  const double t48 = (1.0 / sqrt(t39));
-  const double t49 = (1.0 / (t35 * t35));
-  const double t50 = (t34 * 2.0 * t38 * t47 - t49 * t37 * t47);
-  const double t51 = (t42 * t40 * 4.0 - t45 * t34 * 2.0 * t36 + t31 * t34 * 2.0 * t46 * t47 -
-                      t31 * 4.0 * t36 * t47 - t27 * t48 * t50);
-  const double t52 = t36 * t51;
-  const double t53 = (-t31 * t34 * t36 + t27 * t40 * 2.0);
-  const double t54 = t53 * t46 * (-2.0) * t47;
-  const double t55 = (t52 + t54);
-  const double t56 = (t41 * t41);
-  const double t57 = (t53 * t53);
-  const double t58 = (t56 * t38 + t57 * t38);
-  const double t59 = (1.0 / (t58));
-  const double t60 = t41 * 2.0 * t46 * t47;
-  const double t61 = (t27 * t34 * 2.0 * t46 * t47 - t27 * 4.0 * t36 * t47 - t45 * t40 * 4.0 -
-                      t42 * t34 * 2.0 * t36 + t31 * t48 * t50);
-  const double t62 = t36 * t61;
-  const double t63 = (t60 + t62);
-  const double t64 = (t41 * t55 * t36 * t59 + t53 * t63 * t36 * t59);
-  const double t65 = atan2(t41 * 0.5 * t36, t53 * t36 * (-0.5));
-  const double t66 = cos(t65);
-  const double t67 = 2.4314 * t0;
-  const double t68 = (-0.55 * t66 + t67 - 0.1);
-  const double t69 = sin(t65);
-  const double t70 = (-t69 * 0.55 + t2 * 2.4314 + 0.5);
-  const double t71 = (t64 * t68 * t69 * 0.55 - t70 * t64 * 0.55 * t66);
-  const double t72 = ((t70 * t70) + (t68 * t68));
-  const double t73 = (1.0 / sqrt(t72));
-  const double t74 = (-2.1e+07 + x[7]);
-  const double t75 = sqrt(((x[5] * x[5]) + 1e-06));
-  const double t76 = (-t75 + x[5]);
-  const double t77 = (x[7] - 2e+05);
-  const double t78 = (t77 * t77);
-  const double t79 = (t75 + x[5]);
-  const double t80 = (x[7] - u[7]);
-  const double t81 = (t43 + t44 - t24);
-  const double t82 = (t31 * t81 + t31 * t27);
-  const double t83 = t41 * 2.0 * t46 * t82;
-  const double t84 = (-t34 * 2.0 * t38 * t82 + t49 * t37 * t82);
-  const double t85 = (-t27 * t34 * 2.0 * t46 * t82 + t31 * t34 * 2.0 * t36 + t27 * 4.0 * t36 * t82 +
-                      t31 * t48 * t84 + t40 * 4.0 * t81);
-  const double t86 = t36 * (-1.0) * t85;
-  const double t87 = (t83 + t86);
-  const double t88 = t53 * 2.0 * t46 * t82;
-  const double t89 = (t27 * t48 * t84 + t31 * t40 * 4.0 + t31 * t34 * 2.0 * t46 * t82 -
-                      t34 * 2.0 * t36 * t81 - t31 * 4.0 * t36 * t82);
-  const double t90 = t89 * t36 * (-1.0);
-  const double t91 = (t88 + t90);
-  const double t92 = (t87 * t53 * t36 * t59 - t91 * t41 * t36 * t59);
-  const double t93 = t2 * (-2.4314);
-  const double t94 = (t70 * ((t67 - 0.275 * t92 * t66)) + ((t93 + 0.275 * t92 * t69)) * t68);
-  const double t95 = sqrt(t72);
-  const double t96 = (x[8] - 2e+05);
-  const double t97 = (t96 * t96);
-  const double t98 = (-2.3e+07 + x[8]);
-  const double t99 = (x[8] - u[6]);
-  const double t100 = (x[9] - 2e+05);
-  const double t101 = (t100 * t100);
-  const double t102 = (-2.1e+07 + x[9]);
-  const double t103 = (-x[9] + u[7]);
-  const double t104 = (t87 * t53 * t36 * 8.0 * t59 - t91 * t41 * t36 * 8.0 * t59);
-  const double t105 = (-t92 * t69 * 0.15 + t93);
-  const double t106 = (t28 + t29 + t53 * 0.5 * t36 + t30);
-  const double t107 = (t23 - t41 * 0.5 * t36 + t24 + t26);
-  const double t108 = ((t106 * t106) + (t107 * t107));
-  const double t109 = (1.0 / (t108));
-  const double t110 = (-1.0999999999999996 * t0 + t25 + 0.2 * t22 - t53 * t36);
-  const double t111 = t25 * 2.0;
-  const double t112 = 0.4 * t22;
-  const double t113 = t41 * t46 * (-2.0) * t82;
-  const double t114 = t36 * t85;
-  const double t115 = (t111 + t112 - 2.1999999999999993 * t0 + t113 + t114);
-  const double t116 = t25 * (-0.2);
-  const double t117 = (-t41 * t36 + t116 + t2 * 1.0999999999999996 + t22);
-  const double t118 = t25 * (-0.4);
-  const double t119 = 2.0 * t22;
-  const double t120 = (t118 + t2 * 2.1999999999999993 + t88 + t119 + t90);
-  const double t121 = (t109 * 0.625 * t110 * t115 + t117 * t109 * t120 * 0.625);
-  const double t122 = pow(t6, (-1.5));
-  const double t123 = (t1 + t3 - 0.5726 * t8 * t9 + 0.5726 * t13 * t122 * t5);
-  const double t124 = (-0.15 * t0 - 1.39 * t2);
-  const double t125 = t12 * t8 * (-0.5726);
-  const double t126 = (t10 + t125 + t11 + 0.5726 * t13 * t122 * t4);
-  const double t127 = (-t2 * 0.15 + 1.39 * t0);
-  const double t128 = t25 * (-0.20276316964285715);
-  const double t129 = 0.4231954017857143 * t22;
-  const double t130 = 2.9814 * t0;
-  const double t131 = (t128 + t129 + t130);
-  const double t132 = t25 * (-0.4231954017857143);
-  const double t133 = (-0.20276316964285715) * t22;
-  const double t134 = (-2.9814) * t2;
+  const double t14 = (x[6] - u[6]);
+  const double t15 = (-x[6] + u[6] + sqrt(((t14 * t14) + 1e+08)));
+  const double t16 = sqrt(((x[4] * x[4]) + 1e-06));
+  const double t17 = (x[4] + t16);
+  const double t18 = (-t16 + x[4]);
+  const double t19 = (x[6] - 2e+05);
+  const double t20 = (t19 * t19);
+  const double t21 = (-2.3e+07 + x[6]);
+  const double t22 = (x[0] + x[1]);
+  const double t23 = cos(t22);
+  const double t24 = 0.5 * t23;
+  const double t25 = t2 * 0.5499999999999998;
+  const double t26 = sin(t22);
+  const double t27 = t26 * (-0.1);
+  const double t28 = (t24 + t25 + t27);
+  const double t29 = t26 * (-0.5);
+  const double t30 = t23 * (-0.1);
+  const double t31 = t0 * 0.5499999999999998;
+  const double t32 = (t29 + t30 + t31);
+  const double t33 = (t32 * t32);
+  const double t34 = (t28 * t28);
+  const double t35 = (-0.06250000000000006 + t33 + t34);
+  const double t36 = (t33 + t34);
+  const double t37 = (1.0 / sqrt(t36));
+  const double t38 = (t35 * t35);
+  const double t39 = (1.0 / (t36));
+  const double t40 = (0.36 - t38 * 0.25 * t39);
+  const double t41 = sqrt(t40);
+  const double t42 = (t28 * t35 * t37 + t32 * t41 * 2.0);
+  const double t43 = (t29 + t30);
+  const double t44 = t26 * 0.1;
+  const double t45 = t23 * (-0.5);
+  const double t46 = (t44 + t45);
+  const double t47 = pow(t36, (-1.5));
+  const double t48 = (t32 * t46 + t28 * t43);
+  const double t49 = (1.0 / sqrt(t40));
+  const double t50 = (1.0 / (t36 * t36));
+  const double t51 = (t35 * 2.0 * t39 * t48 - t50 * t38 * t48);
+  const double t52 = (t43 * t41 * 4.0 - t46 * t35 * 2.0 * t37 + t32 * t35 * 2.0 * t47 * t48 -
+                      t32 * 4.0 * t37 * t48 - t28 * t49 * t51);
+  const double t53 = t37 * t52;
+  const double t54 = (-t32 * t35 * t37 + t28 * t41 * 2.0);
+  const double t55 = t54 * t47 * (-2.0) * t48;
+  const double t56 = (t53 + t55);
+  const double t57 = (t42 * t42);
+  const double t58 = (t54 * t54);
+  const double t59 = (t57 * t39 + t58 * t39);
+  const double t60 = (1.0 / (t59));
+  const double t61 = t42 * 2.0 * t47 * t48;
+  const double t62 = (t28 * t35 * 2.0 * t47 * t48 - t28 * 4.0 * t37 * t48 - t46 * t41 * 4.0 -
+                      t43 * t35 * 2.0 * t37 + t32 * t49 * t51);
+  const double t63 = t37 * t62;
+  const double t64 = (t61 + t63);
+  const double t65 = (t42 * t56 * t37 * t60 + t54 * t64 * t37 * t60);
+  const double t66 = atan2(t42 * 0.5 * t37, t54 * t37 * (-0.5));
+  const double t67 = cos(t66);
+  const double t68 = 2.4314 * t0;
+  const double t69 = (-0.55 * t67 + t68 - 0.1);
+  const double t70 = sin(t66);
+  const double t71 = (-t70 * 0.55 + t2 * 2.4314 + 0.5);
+  const double t72 = (t65 * t69 * t70 * 0.55 - t71 * t65 * 0.55 * t67);
+  const double t73 = ((t71 * t71) + (t69 * t69));
+  const double t74 = (1.0 / sqrt(t73));
+  const double t75 = (x[7] - u[7]);
+  const double t76 = (x[7] - u[7] - sqrt((1e+08 + (t75 * t75))));
+  const double t77 = sqrt(((x[5] * x[5]) + 1e-06));
+  const double t78 = (t77 + x[5]);
+  const double t79 = (-2.1e+07 + x[7]);
+  const double t80 = (-t77 + x[5]);
+  const double t81 = (x[7] - 2e+05);
+  const double t82 = (t81 * t81);
+  const double t83 = (t44 + t45 - t25);
+  const double t84 = (t32 * t83 + t32 * t28);
+  const double t85 = t42 * 2.0 * t47 * t84;
+  const double t86 = (-t35 * 2.0 * t39 * t84 + t50 * t38 * t84);
+  const double t87 = (-t28 * t35 * 2.0 * t47 * t84 + t32 * t35 * 2.0 * t37 + t28 * 4.0 * t37 * t84 +
+                      t32 * t49 * t86 + t41 * 4.0 * t83);
+  const double t88 = t37 * (-1.0) * t87;
+  const double t89 = (t85 + t88);
+  const double t90 = t54 * 2.0 * t47 * t84;
+  const double t91 = (t28 * t49 * t86 + t32 * t41 * 4.0 + t32 * t35 * 2.0 * t47 * t84 -
+                      t35 * 2.0 * t37 * t83 - t32 * 4.0 * t37 * t84);
+  const double t92 = t91 * t37 * (-1.0);
+  const double t93 = (t90 + t92);
+  const double t94 = (t89 * t54 * t37 * t60 - t93 * t42 * t37 * t60);
+  const double t95 = t2 * (-2.4314);
+  const double t96 = (t71 * ((t68 - 0.275 * t94 * t67)) + ((t95 + 0.275 * t94 * t70)) * t69);
+  const double t97 = sqrt(t73);
+  const double t98 = (x[8] - 2e+05);
+  const double t99 = (t98 * t98);
+  const double t100 = (-2.3e+07 + x[8]);
+  const double t101 = (x[8] - u[6]);
+  const double t102 = (-sqrt(((t101 * t101) + 1e+08)) + x[8] - u[6]);
+  const double t103 = (x[9] - 2e+05);
+  const double t104 = (t103 * t103);
+  const double t105 = (-2.1e+07 + x[9]);
+  const double t106 = (-x[9] + u[7]);
+  const double t107 = (-x[9] + u[7] + sqrt(((t106 * t106) + 1e+08)));
+  const double t108 = (t89 * t54 * t37 * 8.0 * t60 - t93 * t42 * t37 * 8.0 * t60);
+  const double t109 = (-t94 * t70 * 0.15 + t95);
+  const double t110 = (t29 + t30 + t54 * 0.5 * t37 + t31);
+  const double t111 = (t24 - t42 * 0.5 * t37 + t25 + t27);
+  const double t112 = ((t110 * t110) + (t111 * t111));
+  const double t113 = (1.0 / (t112));
+  const double t114 = (-1.0999999999999996 * t0 + t26 + 0.2 * t23 - t54 * t37);
+  const double t115 = t26 * 2.0;
+  const double t116 = 0.4 * t23;
+  const double t117 = t42 * t47 * (-2.0) * t84;
+  const double t118 = t37 * t87;
+  const double t119 = (t115 + t116 - 2.1999999999999993 * t0 + t117 + t118);
+  const double t120 = t26 * (-0.2);
+  const double t121 = (-t42 * t37 + t120 + t2 * 1.0999999999999996 + t23);
+  const double t122 = t26 * (-0.4);
+  const double t123 = 2.0 * t23;
+  const double t124 = (t122 + t2 * 2.1999999999999993 + t90 + t123 + t92);
+  const double t125 = (t113 * 0.625 * t114 * t119 + t121 * t113 * t124 * 0.625);
+  const double t126 = pow(t6, (-1.5));
+  const double t127 = (t1 + t3 - 0.5726 * t8 * t9 + 0.5726 * t13 * t126 * t5);
+  const double t128 = (-0.15 * t0 - 1.39 * t2);
+  const double t129 = t12 * t8 * (-0.5726);
+  const double t130 = (t10 + t129 + t11 + 0.5726 * t13 * t126 * t4);
+  const double t131 = (-t2 * 0.15 + 1.39 * t0);
+  const double t132 = t26 * (-0.20276316964285715);
+  const double t133 = 0.4231954017857143 * t23;
+  const double t134 = 2.9814 * t0;
   const double t135 = (t132 + t133 + t134);
-  const double t136 = 0.42 * t22;
-  const double t137 = (t116 + t130 + t136);
-  const double t138 = t25 * (-0.42);
-  const double t139 = t22 * (-0.2);
-  const double t140 = (t138 + t139 + t134);
-  const double t141 = (1.0 / (t6));
-  const double t142 = (-1.2074 + t10 + t11);
-  const double t143 = (t9 * t141 * t4 + t12 * t141 * t142);
-  const double t144 =
-      (20.765148133333334 * t9 * t141 * t4 + t12 * 20.765148133333334 * t141 * t142);
-  const double t145 = (t92 * 0.15 * t66 + t67);
-  const double t146 = 0.5726 * t12 * t8;
-  const double t147 = (-0.5726 * t13 * t122 * t4 + t146);
+  const double t136 = t26 * (-0.4231954017857143);
+  const double t137 = (-0.20276316964285715) * t23;
+  const double t138 = (-2.9814) * t2;
+  const double t139 = (t136 + t137 + t138);
+  const double t140 = 0.42 * t23;
+  const double t141 = (t120 + t134 + t140);
+  const double t142 = t26 * (-0.42);
+  const double t143 = t23 * (-0.2);
+  const double t144 = (t142 + t143 + t138);
+  const double t145 = (1.0 / (t6));
+  const double t146 = (-1.2074 + t10 + t11);
+  const double t147 = (t9 * t145 * t4 + t12 * t145 * t146);
   const double t148 =
-      (-t25 * 0.25 - 0.05 * t22 - t41 * 0.25 * t46 * t82 + 0.125 * t36 * t85 + t0 * 2.7064);
-  const double t149 = t25 * 0.05;
-  const double t150 = (-0.25) * t22;
-  const double t151 = (t149 + t150 + t53 * 0.25 * t46 * t82 - t89 * 0.125 * t36 - t2 * 2.7064);
+      (20.765148133333334 * t9 * t145 * t4 + t12 * 20.765148133333334 * t145 * t146);
+  const double t149 = (t94 * 0.15 * t67 + t68);
+  const double t150 = 0.5726 * t12 * t8;
+  const double t151 = (-0.5726 * t13 * t126 * t4 + t150);
   const double t152 =
-      (12.021927866666665 * t9 * t141 * t4 + t12 * 12.021927866666665 * t141 * t142);
-  const double t153 = (-0.5726 * t13 * t122 * t5 + 0.5726 * t8 * t9);
-  const double t154 = (t116 + t136);
-  const double t155 = (t118 + t52 + t54 + t119);
-  const double t156 = t53 * t46 * (-2.0) * t82;
-  const double t157 = t89 * t36;
-  const double t158 = (t118 + t156 + t119 + t157 + t2 * 21.6512);
-  const double t159 = (t83 + t111 + t112 + t86 - 21.6512 * t0);
-  const double t160 = (t60 + t111 + t112 + t62);
-  const double t161 = (t132 + t133);
-  const double t162 = (t128 + t129);
-  const double t163 = t25 * (-2.0);
-  const double t164 = t22 * (-0.4);
-  const double t165 = (t60 + t163 + t164 + t62);
-  const double t166 = t36 * t51 * (-1.0);
-  const double t167 = t53 * 2.0 * t46 * t47;
-  const double t168 = (t166 + t118 + t167 + t119);
-  const double t169 = (t109 * t165 * t110 - t117 * t109 * t168);
-  const double t170 = (t138 + t139);
-  const double t171 =
-      (t154 * 900.0 * t137 + t155 * 1.171875 * t158 + 28.5 * t64 * t66 * t145 + 280.0 +
-       t64 * t104 * 0.5 - t105 * 28.5 * t64 * t69 + t159 * t160 * 1.171875 +
-       u[4] * ((t161 * t135 + t131 * t162)) - 0.125 * t169 * t121 + 900.0 * t140 * t170);
-  const double t172 = (t41 * t55 * t36 * 8.0 * t59 + t53 * t63 * t36 * 8.0 * t59);
-  const double t173 = (t64 * t64);
-  const double t174 = (t149 + t150 - 0.125 * t36 * t51 + t53 * 0.25 * t46 * t47);
-  const double t175 = (-t109 * t165 * 0.625 * t110 + t117 * t109 * t168 * 0.625);
-  const double t176 = cos(u[5]);
-  const double t177 = t45 * t27;
-  const double t178 = 0.1 * t22;
-  const double t179 = t25 * 0.5;
-  const double t180 = (t178 + t179);
-  const double t181 = t31 * t180;
-  const double t182 = (t177 + t45 * t81 + t31 * t42 + t181);
-  const double t183 = t53 * t46 * 8.0 * t182;
-  const double t184 = 4.0 * t46 * t51 * t82;
-  const double t185 = (1.0 / (t35 * t35 * t35));
-  const double t186 = (t34 * 2.0 * t38 * t182 - t34 * t49 * 8.0 * t47 * t82 - t49 * t37 * t182 +
-                       4.0 * t38 * t47 * t82 + t185 * t37 * 4.0 * t47 * t82);
-  const double t187 = t45 * (-16.0) * t40;
-  const double t188 = pow(t39, (-1.5));
-  const double t189 = pow(t35, (-2.5));
-  const double t190 = t34 * t180 * t36 * 8.0;
-  const double t191 =
-      t36 *
-      ((t27 * t186 * t48 * 4.0 + t187 - t42 * t48 * 4.0 * t84 - t45 * t34 * t46 * 8.0 * t82 -
-        t188 * t27 * t50 * t84 + t31 * t34 * t189 * 24.0 * t47 * t82 + t31 * 16.0 * t36 * t182 -
-        t31 * 32.0 * t46 * t47 * t82 + t45 * 16.0 * t36 * t82 + 16.0 * t36 * t81 * t47 -
-        t34 * t46 * t81 * 8.0 * t47 + t31 * t48 * 4.0 * t50 + t190 - t31 * t34 * t46 * 8.0 * t182));
-  const double t192 = t53 * (-24.0) * t189 * t47 * t82;
-  const double t193 = t89 * 4.0 * t46 * t47;
-  const double t194 = t41 * t36 * ((t183 + t184 + t191 + t192 + t193)) * (-1.0) * t59;
+      (-t26 * 0.25 - 0.05 * t23 - t42 * 0.25 * t47 * t84 + 0.125 * t37 * t87 + t0 * 2.7064);
+  const double t153 = t26 * 0.05;
+  const double t154 = (-0.25) * t23;
+  const double t155 = (t153 + t154 + t54 * 0.25 * t47 * t84 - t91 * 0.125 * t37 - t2 * 2.7064);
+  const double t156 =
+      (12.021927866666665 * t9 * t145 * t4 + t12 * 12.021927866666665 * t145 * t146);
+  const double t157 = (-0.5726 * t13 * t126 * t5 + 0.5726 * t8 * t9);
+  const double t158 = (t120 + t140);
+  const double t159 = (t122 + t53 + t55 + t123);
+  const double t160 = t54 * t47 * (-2.0) * t84;
+  const double t161 = t91 * t37;
+  const double t162 = (t122 + t160 + t123 + t161 + t2 * 21.6512);
+  const double t163 = (t85 + t115 + t116 + t88 - 21.6512 * t0);
+  const double t164 = (t61 + t115 + t116 + t63);
+  const double t165 = (t136 + t137);
+  const double t166 = (t132 + t133);
+  const double t167 = t26 * (-2.0);
+  const double t168 = t23 * (-0.4);
+  const double t169 = (t61 + t167 + t168 + t63);
+  const double t170 = t37 * t52 * (-1.0);
+  const double t171 = t54 * 2.0 * t47 * t48;
+  const double t172 = (t170 + t122 + t171 + t123);
+  const double t173 = (t113 * t169 * t114 - t121 * t113 * t172);
+  const double t174 = (t142 + t143);
+  const double t175 =
+      (t158 * 900.0 * t141 + t159 * 1.171875 * t162 + 28.5 * t65 * t67 * t149 + 280.0 +
+       t65 * t108 * 0.5 - t109 * 28.5 * t65 * t70 + t163 * t164 * 1.171875 +
+       u[4] * ((t165 * t139 + t135 * t166)) - 0.125 * t173 * t125 + 900.0 * t144 * t174);
+  const double t176 = (t42 * t56 * t37 * 8.0 * t60 + t54 * t64 * t37 * 8.0 * t60);
+  const double t177 = (t65 * t65);
+  const double t178 = (t153 + t154 - 0.125 * t37 * t52 + t54 * 0.25 * t47 * t48);
+  const double t179 = (-t113 * t169 * 0.625 * t114 + t121 * t113 * t172 * 0.625);
+  const double t180 = cos(u[5]);
+  const double t181 = t46 * t28;
+  const double t182 = 0.1 * t23;
+  const double t183 = t26 * 0.5;
+  const double t184 = (t182 + t183);
+  const double t185 = t32 * t184;
+  const double t186 = (t181 + t46 * t83 + t32 * t43 + t185);
+  const double t187 = t54 * t47 * 8.0 * t186;
+  const double t188 = 4.0 * t47 * t52 * t84;
+  const double t189 = (1.0 / (t36 * t36 * t36));
+  const double t190 = (t35 * 2.0 * t39 * t186 - t35 * t50 * 8.0 * t48 * t84 - t50 * t38 * t186 +
+                       4.0 * t39 * t48 * t84 + t189 * t38 * 4.0 * t48 * t84);
+  const double t191 = t46 * (-16.0) * t41;
+  const double t192 = pow(t40, (-1.5));
+  const double t193 = pow(t36, (-2.5));
+  const double t194 = t35 * t184 * t37 * 8.0;
   const double t195 =
-      (t45 * t48 * 4.0 * t84 - t31 * t186 * t48 * 4.0 + t31 * 16.0 * t36 * t47 + 16.0 * t40 * t180 -
-       t42 * t34 * t46 * 8.0 * t82 - t27 * 32.0 * t46 * t47 * t82 + t27 * 16.0 * t36 * t182 -
-       t48 * 4.0 * t50 * t81 + t45 * t34 * t36 * 8.0 + t31 * t188 * t50 * t84 +
-       t42 * 16.0 * t36 * t82 - t27 * t34 * t46 * 8.0 * t182 - t31 * t34 * t46 * 8.0 * t47 +
-       t27 * t34 * t189 * 24.0 * t47 * t82);
-  const double t196 = t36 * t195 * (-1.0);
-  const double t197 = (-24.0) * t41 * t189 * t47 * t82;
-  const double t198 = t41 * t46 * 8.0 * t182;
-  const double t199 = t46 * (-4.0) * t61 * t82;
-  const double t200 = 4.0 * t46 * t85 * t47;
-  const double t201 = t53 * ((t196 + t197 + t198 + t199 + t200)) * t36 * t59;
-  const double t202 = (1.0 / (t58 * t58));
-  const double t203 =
-      (t41 * t38 * t85 + t89 * t53 * t38 - t57 * t49 * 2.0 * t82 - t56 * t49 * 2.0 * t82);
-  const double t204 =
-      (-t41 * t55 * 4.0 * t46 * t82 * t59 + t194 + t201 - t53 * t202 * t203 * 4.0 * t63 * t36 +
-       t55 * 2.0 * t36 * t85 * t59 - t53 * 4.0 * t63 * t46 * t82 * t59 -
-       t202 * t41 * t55 * t203 * 4.0 * t36 + t89 * 2.0 * t63 * t36 * t59);
-  const double t205 = (t178 - t30 + t179);
-  const double t206 = (t27 * t81 + (t81 * t81) + t32 + t31 * t205);
-  const double t207 = (t82 * t82);
-  const double t208 = (-t34 * 2.0 * t206 * t38 + t34 * t49 * t207 * 8.0 + t49 * t37 * t206 -
-                       t185 * t37 * 4.0 * t207 - 4.0 * t207 * t38);
-  const double t209 = (t84 * t84);
-  const double t210 =
-      (-16.0 * t40 * t81 + t34 * t205 * t36 * 8.0 + t31 * 16.0 * t206 * t36 +
-       t31 * t34 * t189 * 24.0 * t207 - t208 * t27 * t48 * 4.0 - t31 * 32.0 * t207 * t46 -
-       t34 * 16.0 * t46 * t81 * t82 + 32.0 * t36 * t81 * t82 + t188 * t27 * t209 -
-       t31 * t34 * t206 * t46 * 8.0 - t31 * t48 * 8.0 * t84);
-  const double t211 = t46 * 8.0 * t85 * t82;
-  const double t212 = t41 * t206 * t46 * 8.0;
-  const double t213 =
-      ((t48 * t81 * 8.0 * t84 + t34 * t36 * t81 * 8.0 - t27 * t34 * t206 * t46 * 8.0 +
-        t27 * 16.0 * t206 * t36 + 16.0 * t205 * t40 + t27 * t34 * t189 * 24.0 * t207 -
-        t31 * t188 * t209 + t31 * 32.0 * t36 * t82 - t31 * t34 * 16.0 * t46 * t82 +
-        t31 * t208 * t48 * 4.0 - t27 * 32.0 * t207 * t46)) *
-      t36 * (-1.0);
-  const double t214 = (-24.0) * t41 * t189 * t207;
-  const double t215 = (t91 * t41 * 4.0 * t46 * t82 * t59 - t87 * t53 * t202 * t203 * 4.0 * t36 +
-                       t91 * t202 * t41 * t203 * 4.0 * t36 - t91 * 2.0 * t36 * t85 * t59 -
-                       t87 * t53 * 4.0 * t46 * t82 * t59 + t87 * t89 * 2.0 * t36 * t59 -
-                       t41 *
-                           ((t89 * t46 * 8.0 * t82 + t53 * t206 * t46 * 8.0 + t210 * t36 -
-                             t53 * t189 * 24.0 * t207)) *
-                           t36 * t59 +
-                       t53 * t36 * ((t211 + t212 + t213 + t214)) * t59);
-  const double t216 =
-      (t53 * t38 * t51 - t41 * t38 * t61 - t57 * t49 * 2.0 * t47 - t56 * t49 * 2.0 * t47);
-  const double t217 = (t47 * t47);
-  const double t218 = (-24.0) * t41 * t189 * t217;
-  const double t219 = (t177 + (t45 * t45) + t181 + (t42 * t42));
-  const double t220 = t219 * t41 * t46 * 8.0;
-  const double t221 = (-t219 * t49 * t37 + t185 * t37 * 4.0 * t217 + t219 * t34 * 2.0 * t38 +
-                       4.0 * t38 * t217 - t34 * t49 * 8.0 * t217);
-  const double t222 = (t50 * t50);
-  const double t223 =
-      (t45 * t48 * t50 * 8.0 + t27 * t219 * t34 * t46 * 8.0 + t42 * t34 * 16.0 * t46 * t47 -
-       t27 * t219 * 16.0 * t36 - t42 * 32.0 * t36 * t47 + t31 * t48 * 4.0 * t221 +
-       t27 * 32.0 * t46 * t217 - 16.0 * t40 * t180 - t27 * t34 * t189 * 24.0 * t217 -
-       t45 * t34 * t36 * 8.0 + t31 * t188 * t222);
-  const double t224 = t223 * t36;
-  const double t225 = (-8.0) * t46 * t61 * t47;
-  const double t226 = t53 * t219 * (-8.0) * t46;
+      t37 *
+      ((t28 * t190 * t49 * 4.0 + t191 - t43 * t49 * 4.0 * t86 - t46 * t35 * t47 * 8.0 * t84 -
+        t192 * t28 * t51 * t86 + t32 * t35 * t193 * 24.0 * t48 * t84 + t32 * 16.0 * t37 * t186 -
+        t32 * 32.0 * t47 * t48 * t84 + t46 * 16.0 * t37 * t84 + 16.0 * t37 * t83 * t48 -
+        t35 * t47 * t83 * 8.0 * t48 + t32 * t49 * 4.0 * t51 + t194 - t32 * t35 * t47 * 8.0 * t186));
+  const double t196 = t54 * (-24.0) * t193 * t48 * t84;
+  const double t197 = t91 * 4.0 * t47 * t48;
+  const double t198 = t42 * t37 * ((t187 + t188 + t195 + t196 + t197)) * (-1.0) * t60;
+  const double t199 =
+      (t46 * t49 * 4.0 * t86 - t32 * t190 * t49 * 4.0 + t32 * 16.0 * t37 * t48 + 16.0 * t41 * t184 -
+       t43 * t35 * t47 * 8.0 * t84 - t28 * 32.0 * t47 * t48 * t84 + t28 * 16.0 * t37 * t186 -
+       t49 * 4.0 * t51 * t83 + t46 * t35 * t37 * 8.0 + t32 * t192 * t51 * t86 +
+       t43 * 16.0 * t37 * t84 - t28 * t35 * t47 * 8.0 * t186 - t32 * t35 * t47 * 8.0 * t48 +
+       t28 * t35 * t193 * 24.0 * t48 * t84);
+  const double t200 = t37 * t199 * (-1.0);
+  const double t201 = (-24.0) * t42 * t193 * t48 * t84;
+  const double t202 = t42 * t47 * 8.0 * t186;
+  const double t203 = t47 * (-4.0) * t62 * t84;
+  const double t204 = 4.0 * t47 * t87 * t48;
+  const double t205 = t54 * ((t200 + t201 + t202 + t203 + t204)) * t37 * t60;
+  const double t206 = (1.0 / (t59 * t59));
+  const double t207 =
+      (t42 * t39 * t87 + t91 * t54 * t39 - t58 * t50 * 2.0 * t84 - t57 * t50 * 2.0 * t84);
+  const double t208 =
+      (-t42 * t56 * 4.0 * t47 * t84 * t60 + t198 + t205 - t54 * t206 * t207 * 4.0 * t64 * t37 +
+       t56 * 2.0 * t37 * t87 * t60 - t54 * 4.0 * t64 * t47 * t84 * t60 -
+       t206 * t42 * t56 * t207 * 4.0 * t37 + t91 * 2.0 * t64 * t37 * t60);
+  const double t209 = (t182 - t31 + t183);
+  const double t210 = (t28 * t83 + (t83 * t83) + t33 + t32 * t209);
+  const double t211 = (t84 * t84);
+  const double t212 = (-t35 * 2.0 * t210 * t39 + t35 * t50 * t211 * 8.0 + t50 * t38 * t210 -
+                       t189 * t38 * 4.0 * t211 - 4.0 * t211 * t39);
+  const double t213 = (t86 * t86);
+  const double t214 =
+      (-16.0 * t41 * t83 + t35 * t209 * t37 * 8.0 + t32 * 16.0 * t210 * t37 +
+       t32 * t35 * t193 * 24.0 * t211 - t212 * t28 * t49 * 4.0 - t32 * 32.0 * t211 * t47 -
+       t35 * 16.0 * t47 * t83 * t84 + 32.0 * t37 * t83 * t84 + t192 * t28 * t213 -
+       t32 * t35 * t210 * t47 * 8.0 - t32 * t49 * 8.0 * t86);
+  const double t215 = t47 * 8.0 * t87 * t84;
+  const double t216 = t42 * t210 * t47 * 8.0;
+  const double t217 =
+      ((t49 * t83 * 8.0 * t86 + t35 * t37 * t83 * 8.0 - t28 * t35 * t210 * t47 * 8.0 +
+        t28 * 16.0 * t210 * t37 + 16.0 * t209 * t41 + t28 * t35 * t193 * 24.0 * t211 -
+        t32 * t192 * t213 + t32 * 32.0 * t37 * t84 - t32 * t35 * 16.0 * t47 * t84 +
+        t32 * t212 * t49 * 4.0 - t28 * 32.0 * t211 * t47)) *
+      t37 * (-1.0);
+  const double t218 = (-24.0) * t42 * t193 * t211;
+  const double t219 = (t93 * t42 * 4.0 * t47 * t84 * t60 - t89 * t54 * t206 * t207 * 4.0 * t37 +
+                       t93 * t206 * t42 * t207 * 4.0 * t37 - t93 * 2.0 * t37 * t87 * t60 -
+                       t89 * t54 * 4.0 * t47 * t84 * t60 + t89 * t91 * 2.0 * t37 * t60 -
+                       t42 *
+                           ((t91 * t47 * 8.0 * t84 + t54 * t210 * t47 * 8.0 + t214 * t37 -
+                             t54 * t193 * 24.0 * t211)) *
+                           t37 * t60 +
+                       t54 * t37 * ((t215 + t216 + t217 + t218)) * t60);
+  const double t220 =
+      (t54 * t39 * t52 - t42 * t39 * t62 - t58 * t50 * 2.0 * t48 - t57 * t50 * 2.0 * t48);
+  const double t221 = (t48 * t48);
+  const double t222 = (-24.0) * t42 * t193 * t221;
+  const double t223 = (t181 + (t46 * t46) + t185 + (t43 * t43));
+  const double t224 = t223 * t42 * t47 * 8.0;
+  const double t225 = (-t223 * t50 * t38 + t189 * t38 * 4.0 * t221 + t223 * t35 * 2.0 * t39 +
+                       4.0 * t39 * t221 - t35 * t50 * 8.0 * t221);
+  const double t226 = (t51 * t51);
   const double t227 =
-      ((t45 * 32.0 * t36 * t47 + t31 * t219 * 16.0 * t36 + t187 + t188 * t222 * t27 +
-        t42 * t48 * t50 * 8.0 + t31 * t34 * t189 * 24.0 * t217 + t190 + t27 * t48 * 4.0 * t221 -
-        t45 * t34 * 16.0 * t46 * t47 - t31 * t219 * t34 * t46 * 8.0 - t31 * 32.0 * t46 * t217)) *
-      t36 * (-1.0);
-  const double t228 = t53 * t189 * 24.0 * t217;
-  const double t229 = (-8.0) * t46 * t51 * t47;
-  const double t230 =
-      (-t202 * t41 * t55 * 4.0 * t216 * t36 + 2.0 * t63 * t36 * t51 * t59 +
-       t53 * ((t218 + t220 + t224 + t225)) * t36 * t59 - t53 * 4.0 * t63 * t46 * t47 * t59 +
-       t41 * t36 * ((t226 + t227 + t228 + t229)) * t59 - t55 * 2.0 * t36 * t61 * t59 -
-       t41 * t55 * 4.0 * t46 * t47 * t59 - t53 * t202 * 4.0 * t216 * t63 * t36);
+      (t46 * t49 * t51 * 8.0 + t28 * t223 * t35 * t47 * 8.0 + t43 * t35 * 16.0 * t47 * t48 -
+       t28 * t223 * 16.0 * t37 - t43 * 32.0 * t37 * t48 + t32 * t49 * 4.0 * t225 +
+       t28 * 32.0 * t47 * t221 - 16.0 * t41 * t184 - t28 * t35 * t193 * 24.0 * t221 -
+       t46 * t35 * t37 * 8.0 + t32 * t192 * t226);
+  const double t228 = t227 * t37;
+  const double t229 = (-8.0) * t47 * t62 * t48;
+  const double t230 = t54 * t223 * (-8.0) * t47;
   const double t231 =
-      (t91 * t41 * 4.0 * t46 * t47 * t59 + t91 * 2.0 * t36 * t61 * t59 + t194 + t201 +
-       t91 * t202 * t41 * 4.0 * t216 * t36 - t87 * t53 * t202 * 4.0 * t216 * t36 -
-       t87 * t53 * 4.0 * t46 * t47 * t59 + t87 * 2.0 * t36 * t51 * t59);
-  const double t232 = (((t204 * x[3] + x[2] * t215)) * x[2] + ((t230 * x[3] + t231 * x[2])) * x[3]);
-  const double t233 = (t92 * t92);
-  const double t234 = (-0.075) * t92 * t64 * t66;
-  const double t235 = (((x[2] * ((-t67 - t69 * t215 * 0.0375 - 0.075 * t66 * t233)) +
-                         ((t234 - t204 * t69 * 0.0375)) * x[3])) *
+      ((t46 * 32.0 * t37 * t48 + t32 * t223 * 16.0 * t37 + t191 + t192 * t226 * t28 +
+        t43 * t49 * t51 * 8.0 + t32 * t35 * t193 * 24.0 * t221 + t194 + t28 * t49 * 4.0 * t225 -
+        t46 * t35 * 16.0 * t47 * t48 - t32 * t223 * t35 * t47 * 8.0 - t32 * 32.0 * t47 * t221)) *
+      t37 * (-1.0);
+  const double t232 = t54 * t193 * 24.0 * t221;
+  const double t233 = (-8.0) * t47 * t52 * t48;
+  const double t234 =
+      (-t206 * t42 * t56 * 4.0 * t220 * t37 + 2.0 * t64 * t37 * t52 * t60 +
+       t54 * ((t222 + t224 + t228 + t229)) * t37 * t60 - t54 * 4.0 * t64 * t47 * t48 * t60 +
+       t42 * t37 * ((t230 + t231 + t232 + t233)) * t60 - t56 * 2.0 * t37 * t62 * t60 -
+       t42 * t56 * 4.0 * t47 * t48 * t60 - t54 * t206 * 4.0 * t220 * t64 * t37);
+  const double t235 =
+      (t93 * t42 * 4.0 * t47 * t48 * t60 + t93 * 2.0 * t37 * t62 * t60 + t198 + t205 +
+       t93 * t206 * t42 * 4.0 * t220 * t37 - t89 * t54 * t206 * 4.0 * t220 * t37 -
+       t89 * t54 * 4.0 * t47 * t48 * t60 + t89 * 2.0 * t37 * t52 * t60);
+  const double t236 = (((t208 * x[3] + x[2] * t219)) * x[2] + ((t234 * x[3] + t235 * x[2])) * x[3]);
+  const double t237 = (t94 * t94);
+  const double t238 = (-0.075) * t94 * t65 * t67;
+  const double t239 = (((x[2] * ((-t68 - t70 * t219 * 0.0375 - 0.075 * t67 * t237)) +
+                         ((t238 - t208 * t70 * 0.0375)) * x[3])) *
                            x[2] +
-                       ((((t234 - t69 * t231 * 0.0375)) * x[2] +
-                         ((-0.075 * t66 * t173 - t230 * t69 * 0.0375)) * x[3])) *
+                       ((((t238 - t70 * t235 * 0.0375)) * x[2] +
+                         ((-0.075 * t67 * t177 - t234 * t70 * 0.0375)) * x[3])) *
                            x[3]);
-  const double t236 = sin(u[5]);
-  const double t237 = t161 * x[3];
-  const double t238 = (x[3] * ((t237 + t161 * x[2])) + ((x[2] * t135 + t237)) * x[2]);
-  const double t239 = t25 * 0.20276316964285715;
-  const double t240 = t22 * (-0.4231954017857143);
-  const double t241 = (t239 + t240);
-  const double t242 = x[3] * t241;
-  const double t243 = (-2.9814) * t0;
-  const double t244 =
-      (((t242 + x[2] * t241)) * x[3] + ((t242 + ((t243 + t239 + t240)) * x[2])) * x[2]);
-  const double t245 = (x[2] * x[2]);
-  const double t246 = pow(t6, (-2.5));
-  const double t247 = (t13 * t13);
-  const double t248 = t2 * (-0.1216);
-  const double t249 = (-0.6894) * t0;
-  const double t250 = (t248 + t249);
-  const double t251 = ((t12 * t12) + (t9 * t9) + t4 * t250 + t12 * t5);
-  const double t252 = x[3] * t170;
-  const double t253 = (((t140 * x[2] + t252)) * x[2] + ((t252 + x[2] * t170)) * x[3]);
-  const double t254 = t22 * 8.0;
-  const double t255 = t25 * (-1.6);
-  const double t256 = (t196 + t197 + t198 + t199 + t254 + t255 + t200);
-  const double t257 =
-      (((x[3] * ((t218 + t220 + t254 + t255 + t224 + t225)) + t256 * x[2])) * x[3] +
-       ((x[2] * ((t211 + t212 + t213 + t254 + t255 + t214 + 86.6048 * t2)) + t256 * x[3])) * x[2]);
-  const double t258 = t25 * (-8.0);
-  const double t259 = t22 * (-1.6);
-  const double t260 = t25 * 8.0;
-  const double t261 = 1.6 * t22;
-  const double t262 = (t183 + t260 + t184 + t191 + t261 + t192 + t193);
-  const double t263 = t53 * t189 * 24.0 * t207;
-  const double t264 = t89 * (-8.0) * t46 * t82;
-  const double t265 = t210 * t36 * (-1.0);
-  const double t266 = t53 * t206 * (-8.0) * t46;
-  const double t267 =
-      (-((x[3] * ((t226 + t227 + t258 + t259 + t228 + t229)) - t262 * x[2])) * x[3] +
-       ((-x[2] * ((t263 + t264 + 86.6048 * t0 + t258 + t265 + t259 + t266)) + t262 * x[3])) * x[2]);
-  const double t268 = (-0.075) * t92 * t64 * t69;
-  const double t269 = (((((t66 * t215 * 0.0375 - 0.075 * t69 * t233 + t93)) * x[2] +
-                         x[3] * ((t268 + t204 * t66 * 0.0375)))) *
+  const double t240 = sin(u[5]);
+  const double t241 = t165 * x[3];
+  const double t242 = (x[3] * ((t241 + t165 * x[2])) + ((x[2] * t139 + t241)) * x[2]);
+  const double t243 = t26 * 0.20276316964285715;
+  const double t244 = t23 * (-0.4231954017857143);
+  const double t245 = (t243 + t244);
+  const double t246 = x[3] * t245;
+  const double t247 = (-2.9814) * t0;
+  const double t248 =
+      (((t246 + x[2] * t245)) * x[3] + ((t246 + ((t247 + t243 + t244)) * x[2])) * x[2]);
+  const double t249 = (x[2] * x[2]);
+  const double t250 = pow(t6, (-2.5));
+  const double t251 = (t13 * t13);
+  const double t252 = t2 * (-0.1216);
+  const double t253 = (-0.6894) * t0;
+  const double t254 = (t252 + t253);
+  const double t255 = ((t12 * t12) + (t9 * t9) + t4 * t254 + t12 * t5);
+  const double t256 = x[3] * t174;
+  const double t257 = (((t144 * x[2] + t256)) * x[2] + ((t256 + x[2] * t174)) * x[3]);
+  const double t258 = t23 * 8.0;
+  const double t259 = t26 * (-1.6);
+  const double t260 = (t200 + t201 + t202 + t203 + t258 + t259 + t204);
+  const double t261 =
+      (((x[3] * ((t222 + t224 + t258 + t259 + t228 + t229)) + t260 * x[2])) * x[3] +
+       ((x[2] * ((t215 + t216 + t217 + t258 + t259 + t218 + 86.6048 * t2)) + t260 * x[3])) * x[2]);
+  const double t262 = t26 * (-8.0);
+  const double t263 = t23 * (-1.6);
+  const double t264 = t26 * 8.0;
+  const double t265 = 1.6 * t23;
+  const double t266 = (t187 + t264 + t188 + t195 + t265 + t196 + t197);
+  const double t267 = t54 * t193 * 24.0 * t211;
+  const double t268 = t91 * (-8.0) * t47 * t84;
+  const double t269 = t214 * t37 * (-1.0);
+  const double t270 = t54 * t210 * (-8.0) * t47;
+  const double t271 =
+      (-((x[3] * ((t230 + t231 + t262 + t263 + t232 + t233)) - t266 * x[2])) * x[3] +
+       ((-x[2] * ((t267 + t268 + 86.6048 * t0 + t262 + t269 + t263 + t270)) + t266 * x[3])) * x[2]);
+  const double t272 = (-0.075) * t94 * t65 * t70;
+  const double t273 = (((((t67 * t219 * 0.0375 - 0.075 * t70 * t237 + t95)) * x[2] +
+                         x[3] * ((t272 + t208 * t67 * 0.0375)))) *
                            x[2] +
-                       ((((t230 * t66 * 0.0375 - 0.075 * t69 * t173)) * x[3] +
-                         ((t231 * t66 * 0.0375 + t268)) * x[2])) *
+                       ((((t234 * t67 * 0.0375 - 0.075 * t70 * t177)) * x[3] +
+                         ((t235 * t67 * 0.0375 + t272)) * x[2])) *
                            x[3]);
-  const double t270 = (t95 - 2.6718);
-  const double t271 = (1e-06 + (t270 * t270));
-  const double t272 = (t95 - 2.2443);
-  const double t273 = ((t272 * t272) + 1e-06);
-  const double t274 = (t95 * 8e+08 + 4e+08 * sqrt(t271) +
-                       ((2.0 + t270 * (1.0 / sqrt(t271)) - t272 * (1.0 / sqrt(t273)))) *
-                           ((4e+06 * x[2] * t94 * t73 + t71 * 2e+06 * x[3] * t73)) -
+  const double t274 = (t97 - 2.6718);
+  const double t275 = (1e-06 + (t274 * t274));
+  const double t276 = (t97 - 2.2443);
+  const double t277 = ((t276 * t276) + 1e-06);
+  const double t278 = (t97 * 8e+08 + 4e+08 * sqrt(t275) +
+                       ((2.0 + t274 * (1.0 / sqrt(t275)) - t276 * (1.0 / sqrt(t277)))) *
+                           ((4e+06 * x[2] * t96 * t74 + t72 * 2e+06 * x[3] * t74)) -
                        1966440000.0 + x[9] * 0.011388273369263005 - 0.02269800692218626 * x[7] -
-                       4e+08 * sqrt(t273));
-  const double t275 = (1.0 / (t6 * t6));
-  const double t276 = (-t275 * t12 * 2.0 * t13 * t142 + t12 * t9 * t141 + t12 * t141 * t4 +
-                       t12 * t141 * t250 + t141 * t250 * t142 - t275 * t9 * 2.0 * t13 * t4);
-  const double t277 = (-2.0) * t22;
-  const double t278 = t25 * 0.4;
-  const double t279 = t25 * 0.2;
-  const double t280 = (-0.42) * t22;
-  const double t281 = (t279 + t280);
-  const double t282 = x[3] * t281;
-  const double t283 =
-      (((t282 + x[2] * t281)) * x[3] + ((t282 + x[2] * ((t243 + t279 + t280)))) * x[2]);
-  const double t284 = (t52 + t277 + t54 + t278);
-  const double t285 = (t183 + t184 + t191 + t258 + t259 + t192 + t193);
-  const double t286 = (1.0 / (t108 * t108));
-  const double t287 = (t279 - t22 + t41 * t36 - t2 * 1.0999999999999996);
-  const double t288 = (t165 * t287 - t168 * t110);
-  const double t289 = t25 * 1.6;
-  const double t290 = (-8.0) * t22;
-  const double t291 = (t120 * t110 + t287 * t115);
-  const double t292 = (t156 - t2 * 2.1999999999999993 + t277 + t278 + t157);
-  const double t293 =
-      (((((-t109 * t284 * 2.0 * t115 + t117 * t285 * t109 + t117 * t120 * t286 * t288 +
-           t286 * t288 * t110 * t115 -
-           t109 * ((t196 + t197 + t198 + t289 + t199 + t290 + t200)) * t110 +
-           t109 * t165 * t120 * 2.0)) *
+                       4e+08 * sqrt(t277));
+  const double t279 = (1.0 / (t6 * t6));
+  const double t280 = (-t279 * t12 * 2.0 * t13 * t146 + t12 * t9 * t145 + t12 * t145 * t4 +
+                       t12 * t145 * t254 + t145 * t254 * t146 - t279 * t9 * 2.0 * t13 * t4);
+  const double t281 = (-2.0) * t23;
+  const double t282 = t26 * 0.4;
+  const double t283 = t26 * 0.2;
+  const double t284 = (-0.42) * t23;
+  const double t285 = (t283 + t284);
+  const double t286 = x[3] * t285;
+  const double t287 =
+      (((t286 + x[2] * t285)) * x[3] + ((t286 + x[2] * ((t247 + t283 + t284)))) * x[2]);
+  const double t288 = (t53 + t281 + t55 + t282);
+  const double t289 = (t187 + t188 + t195 + t262 + t263 + t196 + t197);
+  const double t290 = (1.0 / (t112 * t112));
+  const double t291 = (t283 - t23 + t42 * t37 - t2 * 1.0999999999999996);
+  const double t292 = (t169 * t291 - t172 * t114);
+  const double t293 = t26 * 1.6;
+  const double t294 = (-8.0) * t23;
+  const double t295 = (t124 * t114 + t291 * t119);
+  const double t296 = (t160 - t2 * 2.1999999999999993 + t281 + t282 + t161);
+  const double t297 =
+      (((((-t113 * t288 * 2.0 * t119 + t121 * t289 * t113 + t121 * t124 * t290 * t292 +
+           t290 * t292 * t114 * t119 -
+           t113 * ((t200 + t201 + t202 + t293 + t203 + t294 + t204)) * t114 +
+           t113 * t169 * t124 * 2.0)) *
              x[2] +
-         ((t109 *
-               ((-t224 + t46 * 8.0 * t61 * t47 + t41 * t189 * 24.0 * t217 - t220 + t254 + t255)) *
-               t110 +
-           t109 * t284 * t165 * 2.0 + t117 * t168 * t286 * t288 + t109 * t168 * t165 * 2.0 -
-           t165 * t286 * t288 * t110 - t117 * t109 * ((t226 + t227 + t260 + t261 + t228 + t229)))) *
+         ((t113 *
+               ((-t228 + t47 * 8.0 * t62 * t48 + t42 * t193 * 24.0 * t221 - t224 + t258 + t259)) *
+               t114 +
+           t113 * t288 * t169 * 2.0 + t121 * t172 * t290 * t292 + t113 * t172 * t169 * 2.0 -
+           t169 * t290 * t292 * t114 - t121 * t113 * ((t230 + t231 + t264 + t265 + t232 + t233)))) *
              x[3])) *
            x[3] -
-       ((((((t263 + t264 - 8.799999999999997 * t0 + t260 + t261 + t265 + t266)) * t117 * t109 +
-           t291 * t286 * t110 * t115 +
-           t109 * t110 * ((t211 - t2 * 8.799999999999997 + t212 + t213 + t289 + t290 + t214)) +
-           t117 * t120 * t291 * t286 + t109 * 2.0 * t115 * t292 + t109 * t120 * 2.0 * t115)) *
+       ((((((t267 + t268 - 8.799999999999997 * t0 + t264 + t265 + t269 + t270)) * t121 * t113 +
+           t295 * t290 * t114 * t119 +
+           t113 * t114 * ((t215 - t2 * 8.799999999999997 + t216 + t217 + t293 + t294 + t218)) +
+           t121 * t124 * t295 * t290 + t113 * 2.0 * t119 * t296 + t113 * t124 * 2.0 * t119)) *
              x[2] +
-         ((-t117 * t285 * t109 - t109 * t165 * 2.0 * t292 - t165 * t291 * t286 * t110 +
-           t109 * t168 * 2.0 * t115 -
-           t109 * t110 *
-               ((-t200 + t36 * t195 + t41 * t189 * 24.0 * t47 * t82 - t198 + t254 +
-                 4.0 * t46 * t61 * t82 + t255)) +
-           t117 * t168 * t291 * t286)) *
+         ((-t121 * t289 * t113 - t113 * t169 * 2.0 * t296 - t169 * t295 * t290 * t114 +
+           t113 * t172 * 2.0 * t119 -
+           t113 * t114 *
+               ((-t204 + t37 * t199 + t42 * t193 * 24.0 * t48 * t84 - t202 + t258 +
+                 4.0 * t47 * t62 * t84 + t259)) +
+           t121 * t172 * t295 * t290)) *
              x[3])) *
            x[2]);
-  const double t294 = (t7 - 1.8458);
-  const double t295 = (1e-06 + (t294 * t294));
-  const double t296 = (t7 - 1.1452);
-  const double t297 = (1e-06 + (t296 * t296));
+  const double t298 = (t7 - 1.8458);
+  const double t299 = (1e-06 + (t298 * t298));
+  const double t300 = (t7 - 1.1452);
+  const double t301 = (1e-06 + (t300 * t300));
   xdot[0] = x[2];
   xdot[1] = x[3];
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
-  xdot[6] = ((-t8 * 0.02454369260617026 * x[2] * t13 - 3.666666666666667e-09 * x[6] +
-              t15 * 1.496910398367498e-06 * pow((4e+10 + t17), (-0.25)) * t16 -
-              1.496910398367498e-06 * t18 * pow((4e+10 + (t19 * t19)), (-0.25)) * t19 +
-              sqrt((t17 + 1e+10)) * 1.8333333333333334e-09 -
-              1.8333333333333334e-09 * sqrt(((t20 * t20) + 1e+10)) + 0.04253333333333333)) *
-            1.2e+09 / (((t7 * 0.02454369260617026 - 0.02610743677258618)));
-  xdot[7] = 1.2e+09 *
-            ((-3.666666666666667e-09 * x[7] + 0.03886666666666667 -
-              t71 * 0.005674501730546565 * x[3] * t73 -
-              1.8333333333333334e-09 * sqrt((1e+10 + (t74 * t74))) +
-              1.496910398367498e-06 * t76 * t77 * pow((4e+10 + t78), (-0.25)) +
-              sqrt((1e+10 + t78)) * 1.8333333333333334e-09 -
-              t79 * 1.496910398367498e-06 * pow((4e+10 + (t80 * t80)), (-0.25)) * t80 -
-              x[2] * 0.01134900346109313 * t94 * t73)) /
-            (((-0.023470568467731313 + t95 * 0.01134900346109313)));
-  xdot[8] = 1.2e+09 *
-            ((t8 * x[2] * t13 * 0.016846790604875265 -
-              pow((4e+10 + t97), (-0.25)) * 1.496910398367498e-06 * t18 * t96 -
-              3.666666666666667e-09 * x[8] - sqrt(((t98 * t98) + 1e+10)) * 1.8333333333333334e-09 +
-              t15 * pow((4e+10 + (t99 * t99)), (-0.25)) * 1.496910398367498e-06 * t99 +
-              sqrt((t97 + 1e+10)) * 1.8333333333333334e-09 + 0.04253333333333333)) /
-            (((-t7 * 0.016846790604875265 + 0.033095806098478765)));
-  xdot[9] =
+  xdot[6] = 1.2e+09 *
+            ((-t8 * 0.02454369260617026 * x[2] * t13 - 3.666666666666667e-09 * x[6] +
+              7.48455199183749e-07 * t15 * t17 * pow((4e+10 + 0.25 * (t15 * t15)), (-0.25)) +
+              t18 * 1.496910398367498e-06 * pow((4e+10 + t20), (-0.25)) * t19 +
+              sqrt((t20 + 1e+10)) * 1.8333333333333334e-09 -
+              1.8333333333333334e-09 * sqrt(((t21 * t21) + 1e+10)) + 0.04253333333333333)) /
+            (((t7 * 0.02454369260617026 - 0.02610743677258618)));
+  xdot[7] =
       1.2e+09 *
-      ((-3.666666666666667e-09 * x[9] + 0.03886666666666667 -
-        t79 * 1.496910398367498e-06 * pow((4e+10 + t101), (-0.25)) * t100 +
-        0.002847068342315751 * t71 * x[3] * t73 -
-        1.8333333333333334e-09 * sqrt((1e+10 + (t102 * t102))) +
-        x[2] * t94 * t73 * 0.005694136684631502 + sqrt((1e+10 + t101)) * 1.8333333333333334e-09 -
-        t103 * 1.496910398367498e-06 * t76 * pow(((t103 * t103) + 4e+10), (-0.25)))) /
-      (((-t95 * 0.005694136684631502 + 0.017213594393998447)));
-  mass[0] = (t92 * t104 * 0.5 + 190.0 * (t105 * t105) +
-             0.125 * ((t109 * t110 * t115 + t117 * t109 * t120)) * t121 + 110.0 * (t123 * t123) +
-             1600.0 * (t124 * t124) + 110.0 * (t126 * t126) + 1600.0 * (t127 * t127) +
-             u[4] * (((t131 * t131) + (t135 * t135))) + 1580.0 + 900.0 * (t137 * t137) +
-             900.0 * (t140 * t140) + t143 * t144 + (t145 * t145) * 190.0 + 190.0 * (t147 * t147) +
-             75.0 * (t148 * t148) + (t151 * t151) * 75.0 + t143 * t152 + 190.0 * (t153 * t153));
-  mass[1] = t171;
-  mass[2] = t171;
-  mass[3] = ((t160 * t160) * 1.171875 + t64 * 0.5 * t172 + (t66 * t66) * 4.2749999999999995 * t173 +
-             280.0 + (t174 * t174) * 75.0 + (t69 * t69) * 4.2749999999999995 * t173 -
-             0.125 * t169 * t175 + u[4] * (((t162 * t162) + (t161 * t161))) +
-             (t154 * t154) * 900.0 + 900.0 * (t170 * t170));
+      ((-3.666666666666667e-09 * x[7] + 0.03886666666666667 -
+        t72 * 0.005674501730546565 * x[3] * t74 -
+        t76 * 7.48455199183749e-07 * t78 * pow((4e+10 + 0.25 * (t76 * t76)), (-0.25)) -
+        1.8333333333333334e-09 * sqrt((1e+10 + (t79 * t79))) +
+        1.496910398367498e-06 * t80 * t81 * pow((4e+10 + t82), (-0.25)) +
+        sqrt((1e+10 + t82)) * 1.8333333333333334e-09 - x[2] * 0.01134900346109313 * t96 * t74)) /
+      (((-0.023470568467731313 + t97 * 0.01134900346109313)));
+  xdot[8] =
+      ((t8 * x[2] * t13 * 0.016846790604875265 -
+        pow((4e+10 + t99), (-0.25)) * 1.496910398367498e-06 * t17 * t98 -
+        3.666666666666667e-09 * x[8] - sqrt(((t100 * t100) + 1e+10)) * 1.8333333333333334e-09 +
+        pow((4e+10 + 0.25 * (t102 * t102)), (-0.25)) * t18 * 7.48455199183749e-07 * t102 +
+        sqrt((t99 + 1e+10)) * 1.8333333333333334e-09 + 0.04253333333333333)) *
+      1.2e+09 / (((-t7 * 0.016846790604875265 + 0.033095806098478765)));
+  xdot[9] = 1.2e+09 *
+            ((-3.666666666666667e-09 * x[9] + 0.03886666666666667 -
+              t78 * 1.496910398367498e-06 * pow((4e+10 + t104), (-0.25)) * t103 +
+              0.002847068342315751 * t72 * x[3] * t74 -
+              1.8333333333333334e-09 * sqrt((1e+10 + (t105 * t105))) +
+              x[2] * t96 * t74 * 0.005694136684631502 -
+              7.48455199183749e-07 * t107 * t80 * pow(((t107 * t107) * 0.25 + 4e+10), (-0.25)) +
+              sqrt((1e+10 + t104)) * 1.8333333333333334e-09)) /
+            (((-t97 * 0.005694136684631502 + 0.017213594393998447)));
+  mass[0] = (t94 * t108 * 0.5 + 190.0 * (t109 * t109) +
+             0.125 * ((t113 * t114 * t119 + t121 * t113 * t124)) * t125 + 110.0 * (t127 * t127) +
+             1600.0 * (t128 * t128) + 110.0 * (t130 * t130) + 1600.0 * (t131 * t131) +
+             u[4] * (((t135 * t135) + (t139 * t139))) + 1580.0 + 900.0 * (t141 * t141) +
+             900.0 * (t144 * t144) + t147 * t148 + (t149 * t149) * 190.0 + 190.0 * (t151 * t151) +
+             75.0 * (t152 * t152) + (t155 * t155) * 75.0 + t147 * t156 + 190.0 * (t157 * t157));
+  mass[1] = t175;
+  mass[2] = t175;
+  mass[3] = ((t164 * t164) * 1.171875 + t65 * 0.5 * t176 + (t67 * t67) * 4.2749999999999995 * t177 +
+             280.0 + (t178 * t178) * 75.0 + (t70 * t70) * 4.2749999999999995 * t177 -
+             0.125 * t173 * t179 + u[4] * (((t166 * t166) + (t165 * t165))) +
+             (t158 * t158) * 900.0 + 900.0 * (t174 * t174));
   acceleration[0] =
-      (-91.93734375 * ((t163 + t164 + 21.6512 * t0 + t113 + t114)) * t176 - t232 * 0.125 * t104 -
-       t153 * t176 * 1863.2634999999998 - 190.0 * t235 * t105 - 1500.0 * x[2] -
-       t236 * t124 * 15690.64 - ((t131 * t238 + t244 * t135)) * u[4] -
-       t236 * 1863.2634999999998 * t147 -
-       t153 * 190.0 * t245 *
-           ((t246 * 1.7178 * t247 * t5 - t9 * t13 * t122 * 1.1452 - t251 * 0.5726 * t122 * t5 +
-             t146)) -
-       900.0 * t137 * t253 - t159 * t257 * 0.29296875 - 8825.984999999999 * t176 * t137 +
-       t267 * 0.29296875 * t158 - 190.0 * t269 * t145 - 0.5 * t274 * t94 * t73 -
-       ((-t246 * 1.7178 * t247 * t5 + t10 + t125 + t9 * t13 * t122 * 1.1452 + t11 +
-         t251 * 0.5726 * t122 * t5)) *
-           t245 * 110.0 * t123 -
-       t276 * t245 * t152 -
-       t245 * 110.0 *
-           ((t248 + t12 * t13 * t122 * 1.1452 + t251 * 0.5726 * t122 * t4 - 0.5726 * t8 * t250 +
-             t249 - t246 * 1.7178 * t4 * t247)) *
-           t126 -
-       91.93734375 * t236 * ((t277 + t88 + t278 - t2 * 21.6512 + t90)) +
-       u[4] * ((-t236 * t135 * 9.80665 - t131 * t176 * 9.80665)) + u[2] - t127 * 15690.64 * t176 -
-       t105 * t236 * 1863.2634999999998 - t176 * 1863.2634999999998 * t145 - 900.0 * t283 * t140 -
-       t123 * t176 * 1078.7314999999999 - 1600.0 * t245 * t124 * ((t2 * 0.15 - 1.39 * t0)) -
-       190.0 * t245 *
-           ((t246 * 1.7178 * t4 * t247 + 0.5726 * t8 * t250 - t12 * t13 * t122 * 1.1452 -
-             t251 * 0.5726 * t122 * t4)) *
-           t147 -
-       t236 * t126 * 1078.7314999999999 - 1600.0 * t127 * t245 * t124 - t121 * 0.03125 * t293 -
-       t236 * 8825.984999999999 * t140 +
+      (-91.93734375 * ((t167 + t168 + 21.6512 * t0 + t117 + t118)) * t180 - t236 * 0.125 * t108 -
+       t157 * t180 * 1863.2634999999998 - 190.0 * t239 * t109 - 1500.0 * x[2] -
+       t240 * t128 * 15690.64 - ((t135 * t242 + t248 * t139)) * u[4] -
+       t240 * 1863.2634999999998 * t151 -
+       t157 * 190.0 * t249 *
+           ((t250 * 1.7178 * t251 * t5 - t9 * t13 * t126 * 1.1452 - t255 * 0.5726 * t126 * t5 +
+             t150)) -
+       900.0 * t141 * t257 - t163 * t261 * 0.29296875 - 8825.984999999999 * t180 * t141 +
+       t271 * 0.29296875 * t162 - 190.0 * t273 * t149 - 0.5 * t278 * t96 * t74 -
+       ((-t250 * 1.7178 * t251 * t5 + t10 + t129 + t9 * t13 * t126 * 1.1452 + t11 +
+         t255 * 0.5726 * t126 * t5)) *
+           t249 * 110.0 * t127 -
+       t280 * t249 * t156 -
+       t249 * 110.0 *
+           ((t252 + t12 * t13 * t126 * 1.1452 + t255 * 0.5726 * t126 * t4 - 0.5726 * t8 * t254 +
+             t253 - t250 * 1.7178 * t4 * t251)) *
+           t130 -
+       91.93734375 * t240 * ((t281 + t90 + t282 - t2 * 21.6512 + t92)) +
+       u[4] * ((-t240 * t139 * 9.80665 - t135 * t180 * 9.80665)) + u[2] - t131 * 15690.64 * t180 -
+       t109 * t240 * 1863.2634999999998 - t180 * 1863.2634999999998 * t149 - 900.0 * t287 * t144 -
+       t127 * t180 * 1078.7314999999999 - 1600.0 * t249 * t128 * ((t2 * 0.15 - 1.39 * t0)) -
+       190.0 * t249 *
+           ((t250 * 1.7178 * t4 * t251 + 0.5726 * t8 * t254 - t12 * t13 * t126 * 1.1452 -
+             t255 * 0.5726 * t126 * t4)) *
+           t151 -
+       t240 * t130 * 1078.7314999999999 - 1600.0 * t131 * t249 * t128 - t125 * 0.03125 * t297 -
+       t240 * 8825.984999999999 * t144 +
        t8 * t13 *
-           ((598200000.0 - sqrt(t295) * 2e+08 - x[8] * 0.016846790604875265 +
+           ((598200000.0 - sqrt(t299) * 2e+08 - x[8] * 0.016846790604875265 +
              0.02454369260617026 * x[6] -
              t8 * 2e+06 * x[2] * t13 *
-                 (((1.0 / sqrt(t295)) * t294 + 2.0 - t296 * (1.0 / sqrt(t297)))) -
-             t7 * 4e+08 + 2e+08 * sqrt(t297))) -
-       t276 * t245 * t144);
+                 (((1.0 / sqrt(t299)) * t298 + 2.0 - t300 * (1.0 / sqrt(t301)))) -
+             t7 * 4e+08 + 2e+08 * sqrt(t301))) -
+       t280 * t249 * t148);
   acceleration[1] =
-      (-600.0 * x[3] - t64 * t176 * t66 * 279.48952499999996 - 900.0 * t283 * t170 +
-       t235 * 28.5 * t64 * t69 - ((t166 + t277 + t278 + t167)) * 91.93734375 * t236 -
-       t154 * 900.0 * t253 - t232 * 0.125 * t172 + t155 * t267 * 0.29296875 -
-       28.5 * t64 * t269 * t66 + ((-t176 * 9.80665 * t162 - t161 * t236 * 9.80665)) * u[4] -
-       t236 * 8825.984999999999 * t170 - t257 * t160 * 0.29296875 +
-       t236 * t64 * t69 * 279.48952499999996 + 91.93734375 * t176 * t160 + u[3] -
-       t71 * 0.25 * t274 * t73 - ((t238 * t162 + t161 * t244)) * u[4] -
-       t154 * 8825.984999999999 * t176 - t175 * 0.03125 * t293);
+      (-600.0 * x[3] - t65 * t180 * t67 * 279.48952499999996 - 900.0 * t287 * t174 +
+       t239 * 28.5 * t65 * t70 - ((t170 + t281 + t282 + t171)) * 91.93734375 * t240 -
+       t158 * 900.0 * t257 - t236 * 0.125 * t176 + t159 * t271 * 0.29296875 -
+       28.5 * t65 * t273 * t67 + ((-t180 * 9.80665 * t166 - t165 * t240 * 9.80665)) * u[4] -
+       t240 * 8825.984999999999 * t174 - t261 * t164 * 0.29296875 +
+       t240 * t65 * t70 * 279.48952499999996 + 91.93734375 * t180 * t164 + u[3] -
+       t72 * 0.25 * t278 * t74 - ((t242 * t166 + t165 * t248)) * u[4] -
+       t158 * 8825.984999999999 * t180 - t179 * 0.03125 * t297);
   Factor(mass);
   Solve(mass, acceleration);
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
@@ -1202,840 +1207,850 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t6 = ((t4 * t4) + (t5 * t5));
   const double t7 = sqrt(t6);
   const double t8 = (t7 * 0.02454369260617026 - 0.02610743677258618);
-  const double t9 = (1.0 / (t8));
-  const double t10 = t2 * (-0.6894);
-  const double t11 = 0.1216 * t0;
-  const double t12 = (t10 + t11);
-  const double t13 = (t1 + t3);
-  const double t14 = t2 * (-0.1216);
-  const double t15 = (-0.6894) * t0;
-  const double t16 = (t14 + t15);
-  const double t17 = ((t12 * t12) + (t13 * t13) + t4 * t16 + t12 * t5);
-  const double t18 = (1.0 / sqrt(t6));
-  const double t19 = pow(t6, (-1.5));
-  const double t20 = (t13 * t5 + t12 * t4);
-  const double t21 = (t20 * t20);
-  const double t22 = ((x[4] * x[4]) + 1e-06);
-  const double t23 = sqrt(t22);
-  const double t24 = (-t23 + x[4]);
+  const double t9 = (1.0 / sqrt(t6));
+  const double t10 = (t1 + t3);
+  const double t11 = t2 * (-0.6894);
+  const double t12 = 0.1216 * t0;
+  const double t13 = (t11 + t12);
+  const double t14 = (t10 * t5 + t13 * t4);
+  const double t15 = (x[6] - u[6]);
+  const double t16 = ((t15 * t15) + 1e+08);
+  const double t17 = (-x[6] + u[6] + sqrt(t16));
+  const double t18 = ((x[4] * x[4]) + 1e-06);
+  const double t19 = sqrt(t18);
+  const double t20 = (x[4] + t19);
+  const double t21 = (t17 * t17);
+  const double t22 = (4e+10 + 0.25 * t21);
+  const double t23 = pow(t22, (-0.25));
+  const double t24 = (-t19 + x[4]);
   const double t25 = (x[6] - 2e+05);
   const double t26 = (t25 * t25);
   const double t27 = (4e+10 + t26);
   const double t28 = pow(t27, (-0.25));
-  const double t29 = (x[4] + t23);
-  const double t30 = (x[6] - u[6]);
-  const double t31 = (t30 * t30);
-  const double t32 = (4e+10 + t31);
-  const double t33 = pow(t32, (-0.25));
-  const double t34 = (t26 + 1e+10);
-  const double t35 = (-2.3e+07 + x[6]);
-  const double t36 = ((t35 * t35) + 1e+10);
-  const double t37 = (1.0 / sqrt(t22)) * x[4];
-  const double t38 = (1.0 + t37);
-  const double t39 = (t37 - 1.0);
-  const double t40 = 2.0 * x[6];
-  const double t41 = (-4e+05 + t40);
-  const double t42 = (x[0] + x[1]);
-  const double t43 = cos(t42);
-  const double t44 = 0.5 * t43;
-  const double t45 = t2 * 0.5499999999999998;
-  const double t46 = sin(t42);
-  const double t47 = t46 * (-0.1);
-  const double t48 = (t44 + t45 + t47);
-  const double t49 = t46 * (-0.5);
-  const double t50 = t43 * (-0.1);
-  const double t51 = t0 * 0.5499999999999998;
-  const double t52 = (t49 + t50 + t51);
-  const double t53 = (t52 * t52);
-  const double t54 = (t48 * t48);
-  const double t55 = (-0.06250000000000006 + t53 + t54);
-  const double t56 = (t53 + t54);
-  const double t57 = (1.0 / sqrt(t56));
-  const double t58 = (t55 * t55);
-  const double t59 = (1.0 / (t56));
-  const double t60 = (0.36 - t58 * 0.25 * t59);
-  const double t61 = sqrt(t60);
-  const double t62 = (t48 * t55 * t57 + t52 * t61 * 2.0);
-  const double t63 = (-t52 * t55 * t57 + t48 * t61 * 2.0);
-  const double t64 = atan2(t62 * 0.5 * t57, t63 * t57 * (-0.5));
-  const double t65 = sin(t64);
-  const double t66 = (-t65 * 0.55 + t2 * 2.4314 + 0.5);
-  const double t67 = cos(t64);
-  const double t68 = 2.4314 * t0;
-  const double t69 = (-0.55 * t67 + t68 - 0.1);
-  const double t70 = ((t66 * t66) + (t69 * t69));
-  const double t71 = sqrt(t70);
-  const double t72 = (-0.023470568467731313 + t71 * 0.01134900346109313);
-  const double t73 = (1.0 / (t72));
-  const double t74 = (1.0 / sqrt(t70));
-  const double t75 = t2 * (-2.4314);
-  const double t76 = pow(t56, (-1.5));
-  const double t77 = t46 * 0.1;
-  const double t78 = t43 * (-0.5);
-  const double t79 = (t77 + t78 - t45);
-  const double t80 = (t52 * t79 + t52 * t48);
-  const double t81 = t62 * 2.0 * t76 * t80;
-  const double t82 = (1.0 / sqrt(t60));
-  const double t83 = (1.0 / (t56 * t56));
-  const double t84 = (-t55 * 2.0 * t59 * t80 + t83 * t58 * t80);
-  const double t85 = (-t48 * t55 * 2.0 * t76 * t80 + t52 * t55 * 2.0 * t57 + t48 * 4.0 * t57 * t80 +
-                      t52 * t82 * t84 + t61 * 4.0 * t79);
-  const double t86 = t57 * (-1.0) * t85;
-  const double t87 = (t81 + t86);
-  const double t88 = (t62 * t62);
-  const double t89 = (t63 * t63);
-  const double t90 = (t88 * t59 + t89 * t59);
-  const double t91 = (1.0 / (t90));
-  const double t92 = t63 * 2.0 * t76 * t80;
-  const double t93 = (t48 * t82 * t84 + t52 * t61 * 4.0 + t52 * t55 * 2.0 * t76 * t80 -
-                      t55 * 2.0 * t57 * t79 - t52 * 4.0 * t57 * t80);
-  const double t94 = t93 * t57 * (-1.0);
-  const double t95 = (t92 + t94);
-  const double t96 = (t87 * t63 * t57 * t91 - t95 * t62 * t57 * t91);
-  const double t97 = (t75 + 0.275 * t96 * t65);
-  const double t98 = (t68 - 0.275 * t96 * t67);
-  const double t99 = (-2.4314) * t0;
-  const double t100 = (1.0 / (t90 * t90));
-  const double t101 =
-      (t62 * t59 * t85 + t93 * t63 * t59 - t89 * t83 * 2.0 * t80 - t88 * t83 * 2.0 * t80);
-  const double t102 = t93 * t76 * 8.0 * t80;
-  const double t103 = 0.1 * t43;
-  const double t104 = t46 * 0.5;
-  const double t105 = (t103 - t51 + t104);
-  const double t106 = (t48 * t79 + (t79 * t79) + t53 + t52 * t105);
-  const double t107 = t63 * t106 * t76 * 8.0;
-  const double t108 = pow(t56, (-2.5));
-  const double t109 = (t80 * t80);
-  const double t110 = (1.0 / (t56 * t56 * t56));
-  const double t111 = (-t55 * 2.0 * t106 * t59 + t55 * t83 * t109 * 8.0 + t83 * t58 * t106 -
-                       t110 * t58 * 4.0 * t109 - 4.0 * t109 * t59);
-  const double t112 = pow(t60, (-1.5));
-  const double t113 = (t84 * t84);
-  const double t114 =
-      (-16.0 * t61 * t79 + t55 * t105 * t57 * 8.0 + t52 * 16.0 * t106 * t57 +
-       t52 * t55 * t108 * 24.0 * t109 - t111 * t48 * t82 * 4.0 - t52 * 32.0 * t109 * t76 -
-       t55 * 16.0 * t76 * t79 * t80 + 32.0 * t57 * t79 * t80 + t112 * t48 * t113 -
-       t52 * t55 * t106 * t76 * 8.0 - t52 * t82 * 8.0 * t84);
-  const double t115 = t114 * t57;
-  const double t116 = t63 * (-24.0) * t108 * t109;
-  const double t117 = (t102 + t107 + t115 + t116);
-  const double t118 = t76 * 8.0 * t85 * t80;
-  const double t119 = t62 * t106 * t76 * 8.0;
-  const double t120 =
-      ((t82 * t79 * 8.0 * t84 + t55 * t57 * t79 * 8.0 - t48 * t55 * t106 * t76 * 8.0 +
-        t48 * 16.0 * t106 * t57 + 16.0 * t105 * t61 + t48 * t55 * t108 * 24.0 * t109 -
-        t52 * t112 * t113 + t52 * 32.0 * t57 * t80 - t52 * t55 * 16.0 * t76 * t80 +
-        t52 * t111 * t82 * 4.0 - t48 * 32.0 * t109 * t76)) *
-      t57 * (-1.0);
-  const double t121 = (-24.0) * t62 * t108 * t109;
-  const double t122 = (t118 + t119 + t120 + t121);
-  const double t123 = (t95 * t62 * 4.0 * t76 * t80 * t91 - t87 * t63 * t100 * t101 * 4.0 * t57 +
-                       t95 * t100 * t62 * t101 * 4.0 * t57 - t95 * 2.0 * t57 * t85 * t91 -
-                       t87 * t63 * 4.0 * t76 * t80 * t91 + t87 * t93 * 2.0 * t57 * t91 -
-                       t62 * t117 * t57 * t91 + t63 * t57 * t122 * t91);
-  const double t124 = (t96 * t96);
-  const double t125 =
-      ((t97 * t97) + (t98 * t98) + ((t99 + t65 * 0.06875 * t123 + t67 * 0.1375 * t124)) * t69 +
-       t66 * ((t75 - 0.06875 * t67 * t123 + t65 * 0.1375 * t124)));
-  const double t126 = (t49 + t50);
-  const double t127 = (t77 + t78);
-  const double t128 = (t52 * t127 + t48 * t126);
-  const double t129 = (t55 * 2.0 * t59 * t128 - t83 * t58 * t128);
-  const double t130 = (t126 * t61 * 4.0 - t127 * t55 * 2.0 * t57 + t52 * t55 * 2.0 * t76 * t128 -
-                       t52 * 4.0 * t57 * t128 - t48 * t82 * t129);
-  const double t131 = t57 * t130;
-  const double t132 = t63 * t76 * (-2.0) * t128;
-  const double t133 = (t131 + t132);
-  const double t134 = t62 * 2.0 * t76 * t128;
-  const double t135 = (t48 * t55 * 2.0 * t76 * t128 - t48 * 4.0 * t57 * t128 - t127 * t61 * 4.0 -
-                       t126 * t55 * 2.0 * t57 + t52 * t82 * t129);
-  const double t136 = t57 * t135;
-  const double t137 = (t134 + t136);
-  const double t138 = (t62 * t133 * t57 * t91 + t63 * t137 * t57 * t91);
-  const double t139 = t127 * t48;
-  const double t140 = (t103 + t104);
-  const double t141 = t52 * t140;
-  const double t142 = (t139 + t127 * t79 + t52 * t126 + t141);
-  const double t143 = t63 * t76 * 8.0 * t142;
-  const double t144 = 4.0 * t76 * t130 * t80;
-  const double t145 = (t55 * 2.0 * t59 * t142 - t55 * t83 * 8.0 * t128 * t80 - t83 * t58 * t142 +
-                       4.0 * t59 * t128 * t80 + t110 * t58 * 4.0 * t128 * t80);
-  const double t146 = t127 * (-16.0) * t61;
-  const double t147 = t55 * t140 * t57 * 8.0;
-  const double t148 = t57 * ((t48 * t145 * t82 * 4.0 + t146 - t126 * t82 * 4.0 * t84 -
-                              t127 * t55 * t76 * 8.0 * t80 - t112 * t48 * t129 * t84 +
-                              t52 * t55 * t108 * 24.0 * t128 * t80 + t52 * 16.0 * t57 * t142 -
-                              t52 * 32.0 * t76 * t128 * t80 + t127 * 16.0 * t57 * t80 +
-                              16.0 * t57 * t79 * t128 - t55 * t76 * t79 * 8.0 * t128 +
-                              t52 * t82 * 4.0 * t129 + t147 - t52 * t55 * t76 * 8.0 * t142));
-  const double t149 = t63 * (-24.0) * t108 * t128 * t80;
-  const double t150 = t93 * 4.0 * t76 * t128;
-  const double t151 = (t143 + t144 + t148 + t149 + t150);
-  const double t152 = t62 * t57 * t151 * (-1.0) * t91;
-  const double t153 =
-      (t127 * t82 * 4.0 * t84 - t52 * t145 * t82 * 4.0 + t52 * 16.0 * t57 * t128 +
-       16.0 * t61 * t140 - t126 * t55 * t76 * 8.0 * t80 - t48 * 32.0 * t76 * t128 * t80 +
-       t48 * 16.0 * t57 * t142 - t82 * 4.0 * t129 * t79 + t127 * t55 * t57 * 8.0 +
-       t52 * t112 * t129 * t84 + t126 * 16.0 * t57 * t80 - t48 * t55 * t76 * 8.0 * t142 -
-       t52 * t55 * t76 * 8.0 * t128 + t48 * t55 * t108 * 24.0 * t128 * t80);
-  const double t154 = t57 * t153 * (-1.0);
-  const double t155 = (-24.0) * t62 * t108 * t128 * t80;
-  const double t156 = t62 * t76 * 8.0 * t142;
-  const double t157 = t76 * (-4.0) * t135 * t80;
-  const double t158 = 4.0 * t76 * t85 * t128;
-  const double t159 = (t154 + t155 + t156 + t157 + t158);
-  const double t160 = t63 * t159 * t57 * t91;
-  const double t161 =
-      (-t62 * t133 * 4.0 * t76 * t80 * t91 + t152 + t160 - t63 * t100 * t101 * 4.0 * t137 * t57 +
-       t133 * 2.0 * t57 * t85 * t91 - t63 * 4.0 * t137 * t76 * t80 * t91 -
-       t100 * t62 * t133 * t101 * 4.0 * t57 + t93 * 2.0 * t137 * t57 * t91);
-  const double t162 =
-      (t97 * t138 * t65 * 0.55 - t98 * t138 * 0.55 * t67 - t66 * t161 * t67 * 0.1375 +
-       t66 * 0.275 * t96 * t138 * t65 + 0.275 * t96 * t138 * t69 * t67 + t161 * t69 * t65 * 0.1375);
-  const double t163 = (t138 * t69 * t65 * 0.55 - t66 * t138 * 0.55 * t67);
-  const double t164 = (t66 * t98 + t97 * t69);
-  const double t165 = pow(t70, (-1.5));
-  const double t166 = (t164 * t164);
-  const double t167 = (-2.1e+07 + x[7]);
-  const double t168 = (1e+10 + (t167 * t167));
-  const double t169 = ((x[5] * x[5]) + 1e-06);
-  const double t170 = sqrt(t169);
-  const double t171 = (-t170 + x[5]);
-  const double t172 = (x[7] - 2e+05);
-  const double t173 = (t172 * t172);
-  const double t174 = (4e+10 + t173);
-  const double t175 = pow(t174, (-0.25));
-  const double t176 = (1e+10 + t173);
-  const double t177 = (t170 + x[5]);
-  const double t178 = (x[7] - u[7]);
-  const double t179 = (t178 * t178);
-  const double t180 = (4e+10 + t179);
-  const double t181 = pow(t180, (-0.25));
-  const double t182 =
+  const double t29 = (t26 + 1e+10);
+  const double t30 = (-2.3e+07 + x[6]);
+  const double t31 = ((t30 * t30) + 1e+10);
+  const double t32 = (1.0 / (t8));
+  const double t33 = t2 * (-0.1216);
+  const double t34 = (-0.6894) * t0;
+  const double t35 = (t33 + t34);
+  const double t36 = ((t13 * t13) + (t10 * t10) + t4 * t35 + t13 * t5);
+  const double t37 = pow(t6, (-1.5));
+  const double t38 = (t14 * t14);
+  const double t39 = (1.0 / sqrt(t18)) * x[4];
+  const double t40 = (1.0 + t39);
+  const double t41 = (t39 - 1.0);
+  const double t42 = ((1.0 / sqrt(t16)) * t15 - 1.0);
+  const double t43 = 2.0 * x[6];
+  const double t44 = (-4e+05 + t43);
+  const double t45 = (x[0] + x[1]);
+  const double t46 = cos(t45);
+  const double t47 = 0.5 * t46;
+  const double t48 = t2 * 0.5499999999999998;
+  const double t49 = sin(t45);
+  const double t50 = t49 * (-0.1);
+  const double t51 = (t47 + t48 + t50);
+  const double t52 = t49 * (-0.5);
+  const double t53 = t46 * (-0.1);
+  const double t54 = t0 * 0.5499999999999998;
+  const double t55 = (t52 + t53 + t54);
+  const double t56 = (t55 * t55);
+  const double t57 = (t51 * t51);
+  const double t58 = (-0.06250000000000006 + t56 + t57);
+  const double t59 = (t56 + t57);
+  const double t60 = (1.0 / sqrt(t59));
+  const double t61 = (t58 * t58);
+  const double t62 = (1.0 / (t59));
+  const double t63 = (0.36 - t61 * 0.25 * t62);
+  const double t64 = sqrt(t63);
+  const double t65 = (t51 * t58 * t60 + t55 * t64 * 2.0);
+  const double t66 = (-t55 * t58 * t60 + t51 * t64 * 2.0);
+  const double t67 = atan2(t65 * 0.5 * t60, t66 * t60 * (-0.5));
+  const double t68 = sin(t67);
+  const double t69 = (-t68 * 0.55 + t2 * 2.4314 + 0.5);
+  const double t70 = cos(t67);
+  const double t71 = 2.4314 * t0;
+  const double t72 = (-0.55 * t70 + t71 - 0.1);
+  const double t73 = ((t69 * t69) + (t72 * t72));
+  const double t74 = sqrt(t73);
+  const double t75 = (-0.023470568467731313 + t74 * 0.01134900346109313);
+  const double t76 = (1.0 / (t75));
+  const double t77 = (1.0 / sqrt(t73));
+  const double t78 = t2 * (-2.4314);
+  const double t79 = pow(t59, (-1.5));
+  const double t80 = t49 * 0.1;
+  const double t81 = t46 * (-0.5);
+  const double t82 = (t80 + t81 - t48);
+  const double t83 = (t55 * t82 + t55 * t51);
+  const double t84 = t65 * 2.0 * t79 * t83;
+  const double t85 = (1.0 / sqrt(t63));
+  const double t86 = (1.0 / (t59 * t59));
+  const double t87 = (-t58 * 2.0 * t62 * t83 + t86 * t61 * t83);
+  const double t88 = (-t51 * t58 * 2.0 * t79 * t83 + t55 * t58 * 2.0 * t60 + t51 * 4.0 * t60 * t83 +
+                      t55 * t85 * t87 + t64 * 4.0 * t82);
+  const double t89 = t60 * (-1.0) * t88;
+  const double t90 = (t84 + t89);
+  const double t91 = (t65 * t65);
+  const double t92 = (t66 * t66);
+  const double t93 = (t91 * t62 + t92 * t62);
+  const double t94 = (1.0 / (t93));
+  const double t95 = t66 * 2.0 * t79 * t83;
+  const double t96 = (t51 * t85 * t87 + t55 * t64 * 4.0 + t55 * t58 * 2.0 * t79 * t83 -
+                      t58 * 2.0 * t60 * t82 - t55 * 4.0 * t60 * t83);
+  const double t97 = t96 * t60 * (-1.0);
+  const double t98 = (t95 + t97);
+  const double t99 = (t90 * t66 * t60 * t94 - t98 * t65 * t60 * t94);
+  const double t100 = (t78 + 0.275 * t99 * t68);
+  const double t101 = (t71 - 0.275 * t99 * t70);
+  const double t102 = (-2.4314) * t0;
+  const double t103 = (1.0 / (t93 * t93));
+  const double t104 =
+      (t65 * t62 * t88 + t96 * t66 * t62 - t92 * t86 * 2.0 * t83 - t91 * t86 * 2.0 * t83);
+  const double t105 = t96 * t79 * 8.0 * t83;
+  const double t106 = 0.1 * t46;
+  const double t107 = t49 * 0.5;
+  const double t108 = (t106 - t54 + t107);
+  const double t109 = (t51 * t82 + (t82 * t82) + t56 + t55 * t108);
+  const double t110 = t66 * t109 * t79 * 8.0;
+  const double t111 = pow(t59, (-2.5));
+  const double t112 = (t83 * t83);
+  const double t113 = (1.0 / (t59 * t59 * t59));
+  const double t114 = (-t58 * 2.0 * t109 * t62 + t58 * t86 * t112 * 8.0 + t86 * t61 * t109 -
+                       t113 * t61 * 4.0 * t112 - 4.0 * t112 * t62);
+  const double t115 = pow(t63, (-1.5));
+  const double t116 = (t87 * t87);
+  const double t117 =
+      (-16.0 * t64 * t82 + t58 * t108 * t60 * 8.0 + t55 * 16.0 * t109 * t60 +
+       t55 * t58 * t111 * 24.0 * t112 - t114 * t51 * t85 * 4.0 - t55 * 32.0 * t112 * t79 -
+       t58 * 16.0 * t79 * t82 * t83 + 32.0 * t60 * t82 * t83 + t115 * t51 * t116 -
+       t55 * t58 * t109 * t79 * 8.0 - t55 * t85 * 8.0 * t87);
+  const double t118 = t117 * t60;
+  const double t119 = t66 * (-24.0) * t111 * t112;
+  const double t120 = (t105 + t110 + t118 + t119);
+  const double t121 = t79 * 8.0 * t88 * t83;
+  const double t122 = t65 * t109 * t79 * 8.0;
+  const double t123 =
+      ((t85 * t82 * 8.0 * t87 + t58 * t60 * t82 * 8.0 - t51 * t58 * t109 * t79 * 8.0 +
+        t51 * 16.0 * t109 * t60 + 16.0 * t108 * t64 + t51 * t58 * t111 * 24.0 * t112 -
+        t55 * t115 * t116 + t55 * 32.0 * t60 * t83 - t55 * t58 * 16.0 * t79 * t83 +
+        t55 * t114 * t85 * 4.0 - t51 * 32.0 * t112 * t79)) *
+      t60 * (-1.0);
+  const double t124 = (-24.0) * t65 * t111 * t112;
+  const double t125 = (t121 + t122 + t123 + t124);
+  const double t126 = (t98 * t65 * 4.0 * t79 * t83 * t94 - t90 * t66 * t103 * t104 * 4.0 * t60 +
+                       t98 * t103 * t65 * t104 * 4.0 * t60 - t98 * 2.0 * t60 * t88 * t94 -
+                       t90 * t66 * 4.0 * t79 * t83 * t94 + t90 * t96 * 2.0 * t60 * t94 -
+                       t65 * t120 * t60 * t94 + t66 * t60 * t125 * t94);
+  const double t127 = (t99 * t99);
+  const double t128 =
+      ((t100 * t100) + (t101 * t101) + ((t102 + t68 * 0.06875 * t126 + t70 * 0.1375 * t127)) * t72 +
+       t69 * ((t78 - 0.06875 * t70 * t126 + t68 * 0.1375 * t127)));
+  const double t129 = (t52 + t53);
+  const double t130 = (t80 + t81);
+  const double t131 = (t55 * t130 + t51 * t129);
+  const double t132 = (t58 * 2.0 * t62 * t131 - t86 * t61 * t131);
+  const double t133 = (t129 * t64 * 4.0 - t130 * t58 * 2.0 * t60 + t55 * t58 * 2.0 * t79 * t131 -
+                       t55 * 4.0 * t60 * t131 - t51 * t85 * t132);
+  const double t134 = t60 * t133;
+  const double t135 = t66 * t79 * (-2.0) * t131;
+  const double t136 = (t134 + t135);
+  const double t137 = t65 * 2.0 * t79 * t131;
+  const double t138 = (t51 * t58 * 2.0 * t79 * t131 - t51 * 4.0 * t60 * t131 - t130 * t64 * 4.0 -
+                       t129 * t58 * 2.0 * t60 + t55 * t85 * t132);
+  const double t139 = t60 * t138;
+  const double t140 = (t137 + t139);
+  const double t141 = (t65 * t136 * t60 * t94 + t66 * t140 * t60 * t94);
+  const double t142 = t130 * t51;
+  const double t143 = (t106 + t107);
+  const double t144 = t55 * t143;
+  const double t145 = (t142 + t130 * t82 + t55 * t129 + t144);
+  const double t146 = t66 * t79 * 8.0 * t145;
+  const double t147 = 4.0 * t79 * t133 * t83;
+  const double t148 = (t58 * 2.0 * t62 * t145 - t58 * t86 * 8.0 * t131 * t83 - t86 * t61 * t145 +
+                       4.0 * t62 * t131 * t83 + t113 * t61 * 4.0 * t131 * t83);
+  const double t149 = t130 * (-16.0) * t64;
+  const double t150 = t58 * t143 * t60 * 8.0;
+  const double t151 = t60 * ((t51 * t148 * t85 * 4.0 + t149 - t129 * t85 * 4.0 * t87 -
+                              t130 * t58 * t79 * 8.0 * t83 - t115 * t51 * t132 * t87 +
+                              t55 * t58 * t111 * 24.0 * t131 * t83 + t55 * 16.0 * t60 * t145 -
+                              t55 * 32.0 * t79 * t131 * t83 + t130 * 16.0 * t60 * t83 +
+                              16.0 * t60 * t82 * t131 - t58 * t79 * t82 * 8.0 * t131 +
+                              t55 * t85 * 4.0 * t132 + t150 - t55 * t58 * t79 * 8.0 * t145));
+  const double t152 = t66 * (-24.0) * t111 * t131 * t83;
+  const double t153 = t96 * 4.0 * t79 * t131;
+  const double t154 = (t146 + t147 + t151 + t152 + t153);
+  const double t155 = t65 * t60 * t154 * (-1.0) * t94;
+  const double t156 =
+      (t130 * t85 * 4.0 * t87 - t55 * t148 * t85 * 4.0 + t55 * 16.0 * t60 * t131 +
+       16.0 * t64 * t143 - t129 * t58 * t79 * 8.0 * t83 - t51 * 32.0 * t79 * t131 * t83 +
+       t51 * 16.0 * t60 * t145 - t85 * 4.0 * t132 * t82 + t130 * t58 * t60 * 8.0 +
+       t55 * t115 * t132 * t87 + t129 * 16.0 * t60 * t83 - t51 * t58 * t79 * 8.0 * t145 -
+       t55 * t58 * t79 * 8.0 * t131 + t51 * t58 * t111 * 24.0 * t131 * t83);
+  const double t157 = t60 * t156 * (-1.0);
+  const double t158 = (-24.0) * t65 * t111 * t131 * t83;
+  const double t159 = t65 * t79 * 8.0 * t145;
+  const double t160 = t79 * (-4.0) * t138 * t83;
+  const double t161 = 4.0 * t79 * t88 * t131;
+  const double t162 = (t157 + t158 + t159 + t160 + t161);
+  const double t163 = t66 * t162 * t60 * t94;
+  const double t164 =
+      (-t65 * t136 * 4.0 * t79 * t83 * t94 + t155 + t163 - t66 * t103 * t104 * 4.0 * t140 * t60 +
+       t136 * 2.0 * t60 * t88 * t94 - t66 * 4.0 * t140 * t79 * t83 * t94 -
+       t103 * t65 * t136 * t104 * 4.0 * t60 + t96 * 2.0 * t140 * t60 * t94);
+  const double t165 =
+      (t100 * t141 * t68 * 0.55 - t101 * t141 * 0.55 * t70 - t69 * t164 * t70 * 0.1375 +
+       t69 * 0.275 * t99 * t141 * t68 + 0.275 * t99 * t141 * t72 * t70 + t164 * t72 * t68 * 0.1375);
+  const double t166 = (t141 * t72 * t68 * 0.55 - t69 * t141 * 0.55 * t70);
+  const double t167 = (t69 * t101 + t100 * t72);
+  const double t168 = pow(t73, (-1.5));
+  const double t169 = (t167 * t167);
+  const double t170 = (x[7] - u[7]);
+  const double t171 = (1e+08 + (t170 * t170));
+  const double t172 = (x[7] - u[7] - sqrt(t171));
+  const double t173 = ((x[5] * x[5]) + 1e-06);
+  const double t174 = sqrt(t173);
+  const double t175 = (t174 + x[5]);
+  const double t176 = (t172 * t172);
+  const double t177 = (4e+10 + 0.25 * t176);
+  const double t178 = pow(t177, (-0.25));
+  const double t179 = (-2.1e+07 + x[7]);
+  const double t180 = (1e+10 + (t179 * t179));
+  const double t181 = (-t174 + x[5]);
+  const double t182 = (x[7] - 2e+05);
+  const double t183 = (t182 * t182);
+  const double t184 = (4e+10 + t183);
+  const double t185 = pow(t184, (-0.25));
+  const double t186 = (1e+10 + t183);
+  const double t187 =
       (-3.666666666666667e-09 * x[7] + 0.03886666666666667 -
-       t163 * 0.005674501730546565 * x[3] * t74 - 1.8333333333333334e-09 * sqrt(t168) +
-       1.496910398367498e-06 * t171 * t172 * t175 + sqrt(t176) * 1.8333333333333334e-09 -
-       t177 * 1.496910398367498e-06 * t181 * t178 - x[2] * 0.01134900346109313 * t164 * t74);
-  const double t183 = (1.0 / (t72 * t72));
-  const double t184 =
-      (t63 * t59 * t130 - t62 * t59 * t135 - t89 * t83 * 2.0 * t128 - t88 * t83 * 2.0 * t128);
-  const double t185 = (t128 * t128);
-  const double t186 = (-24.0) * t62 * t108 * t185;
-  const double t187 = (t139 + (t127 * t127) + t141 + (t126 * t126));
-  const double t188 = t187 * t62 * t76 * 8.0;
-  const double t189 = (-t187 * t83 * t58 + t110 * t58 * 4.0 * t185 + t187 * t55 * 2.0 * t59 +
-                       4.0 * t59 * t185 - t55 * t83 * 8.0 * t185);
-  const double t190 = (t129 * t129);
-  const double t191 =
-      (t127 * t82 * t129 * 8.0 + t48 * t187 * t55 * t76 * 8.0 + t126 * t55 * 16.0 * t76 * t128 -
-       t48 * t187 * 16.0 * t57 - t126 * 32.0 * t57 * t128 + t52 * t82 * 4.0 * t189 +
-       t48 * 32.0 * t76 * t185 - 16.0 * t61 * t140 - t48 * t55 * t108 * 24.0 * t185 -
-       t127 * t55 * t57 * 8.0 + t52 * t112 * t190);
-  const double t192 = t191 * t57;
-  const double t193 = (-8.0) * t76 * t135 * t128;
-  const double t194 = (t186 + t188 + t192 + t193);
-  const double t195 = t63 * t187 * (-8.0) * t76;
+       t166 * 0.005674501730546565 * x[3] * t77 - t172 * 7.48455199183749e-07 * t175 * t178 -
+       1.8333333333333334e-09 * sqrt(t180) + 1.496910398367498e-06 * t181 * t182 * t185 +
+       sqrt(t186) * 1.8333333333333334e-09 - x[2] * 0.01134900346109313 * t167 * t77);
+  const double t188 = (1.0 / (t75 * t75));
+  const double t189 =
+      (t66 * t62 * t133 - t65 * t62 * t138 - t92 * t86 * 2.0 * t131 - t91 * t86 * 2.0 * t131);
+  const double t190 = (t131 * t131);
+  const double t191 = (-24.0) * t65 * t111 * t190;
+  const double t192 = (t142 + (t130 * t130) + t144 + (t129 * t129));
+  const double t193 = t192 * t65 * t79 * 8.0;
+  const double t194 = (-t192 * t86 * t61 + t113 * t61 * 4.0 * t190 + t192 * t58 * 2.0 * t62 +
+                       4.0 * t62 * t190 - t58 * t86 * 8.0 * t190);
+  const double t195 = (t132 * t132);
   const double t196 =
-      (t127 * 32.0 * t57 * t128 + t52 * t187 * 16.0 * t57 + t146 + t112 * t190 * t48 +
-       t126 * t82 * t129 * 8.0 + t52 * t55 * t108 * 24.0 * t185 + t147 + t48 * t82 * 4.0 * t189 -
-       t127 * t55 * 16.0 * t76 * t128 - t52 * t187 * t55 * t76 * 8.0 - t52 * 32.0 * t76 * t185);
-  const double t197 = t196 * t57 * (-1.0);
-  const double t198 = t63 * t108 * 24.0 * t185;
-  const double t199 = (-8.0) * t76 * t130 * t128;
-  const double t200 = (t195 + t197 + t198 + t199);
-  const double t201 = (-t100 * t62 * t133 * 4.0 * t184 * t57 + 2.0 * t137 * t57 * t130 * t91 +
-                       t63 * t194 * t57 * t91 - t63 * 4.0 * t137 * t76 * t128 * t91 +
-                       t62 * t57 * t200 * t91 - t133 * 2.0 * t57 * t135 * t91 -
-                       t62 * t133 * 4.0 * t76 * t128 * t91 - t63 * t100 * 4.0 * t184 * t137 * t57);
-  const double t202 = (t138 * t138);
-  const double t203 = (t67 * t67);
-  const double t204 = (t65 * t65);
-  const double t205 = (-t66 * t201 * t67 * 0.1375 + t66 * 0.275 * t65 * t202 +
-                       0.275 * t69 * t67 * t202 + t201 * t69 * t65 * 0.1375 +
-                       0.15125000000000002 * t203 * t202 + t204 * 0.15125000000000002 * t202);
-  const double t206 =
-      (t95 * t62 * 4.0 * t76 * t128 * t91 + t95 * 2.0 * t57 * t135 * t91 + t152 + t160 +
-       t95 * t100 * t62 * 4.0 * t184 * t57 - t87 * t63 * t100 * 4.0 * t184 * t57 -
-       t87 * t63 * 4.0 * t76 * t128 * t91 + t87 * 2.0 * t57 * t130 * t91);
-  const double t207 =
-      (t69 * ((t65 * t206 * 0.06875 + t96 * t138 * t67 * 0.1375)) + t97 * 0.275 * t138 * t65 +
-       t66 * ((t96 * t138 * t65 * 0.1375 - t206 * 0.06875 * t67)) - 0.275 * t98 * t138 * t67);
-  const double t208 = (t163 * t163);
-  const double t209 = (1.0 / sqrt(t169)) * x[5];
-  const double t210 = (t209 - 1.0);
-  const double t211 = (t209 + 1.0);
-  const double t212 = 2.0 * x[7];
-  const double t213 = (-4e+05 + t212);
-  const double t214 = (-t7 * 0.016846790604875265 + 0.033095806098478765);
-  const double t215 = (1.0 / (t214));
-  const double t216 = (x[8] - 2e+05);
-  const double t217 = (t216 * t216);
-  const double t218 = (4e+10 + t217);
-  const double t219 = pow(t218, (-0.25));
-  const double t220 = (-2.3e+07 + x[8]);
-  const double t221 = ((t220 * t220) + 1e+10);
-  const double t222 = (x[8] - u[6]);
+      (t130 * t85 * t132 * 8.0 + t51 * t192 * t58 * t79 * 8.0 + t129 * t58 * 16.0 * t79 * t131 -
+       t51 * t192 * 16.0 * t60 - t129 * 32.0 * t60 * t131 + t55 * t85 * 4.0 * t194 +
+       t51 * 32.0 * t79 * t190 - 16.0 * t64 * t143 - t51 * t58 * t111 * 24.0 * t190 -
+       t130 * t58 * t60 * 8.0 + t55 * t115 * t195);
+  const double t197 = t196 * t60;
+  const double t198 = (-8.0) * t79 * t138 * t131;
+  const double t199 = (t191 + t193 + t197 + t198);
+  const double t200 = t66 * t192 * (-8.0) * t79;
+  const double t201 =
+      (t130 * 32.0 * t60 * t131 + t55 * t192 * 16.0 * t60 + t149 + t115 * t195 * t51 +
+       t129 * t85 * t132 * 8.0 + t55 * t58 * t111 * 24.0 * t190 + t150 + t51 * t85 * 4.0 * t194 -
+       t130 * t58 * 16.0 * t79 * t131 - t55 * t192 * t58 * t79 * 8.0 - t55 * 32.0 * t79 * t190);
+  const double t202 = t201 * t60 * (-1.0);
+  const double t203 = t66 * t111 * 24.0 * t190;
+  const double t204 = (-8.0) * t79 * t133 * t131;
+  const double t205 = (t200 + t202 + t203 + t204);
+  const double t206 = (-t103 * t65 * t136 * 4.0 * t189 * t60 + 2.0 * t140 * t60 * t133 * t94 +
+                       t66 * t199 * t60 * t94 - t66 * 4.0 * t140 * t79 * t131 * t94 +
+                       t65 * t60 * t205 * t94 - t136 * 2.0 * t60 * t138 * t94 -
+                       t65 * t136 * 4.0 * t79 * t131 * t94 - t66 * t103 * 4.0 * t189 * t140 * t60);
+  const double t207 = (t141 * t141);
+  const double t208 = (t70 * t70);
+  const double t209 = (t68 * t68);
+  const double t210 = (-t69 * t206 * t70 * 0.1375 + t69 * 0.275 * t68 * t207 +
+                       0.275 * t72 * t70 * t207 + t206 * t72 * t68 * 0.1375 +
+                       0.15125000000000002 * t208 * t207 + t209 * 0.15125000000000002 * t207);
+  const double t211 =
+      (t98 * t65 * 4.0 * t79 * t131 * t94 + t98 * 2.0 * t60 * t138 * t94 + t155 + t163 +
+       t98 * t103 * t65 * 4.0 * t189 * t60 - t90 * t66 * t103 * 4.0 * t189 * t60 -
+       t90 * t66 * 4.0 * t79 * t131 * t94 + t90 * 2.0 * t60 * t133 * t94);
+  const double t212 =
+      (t72 * ((t68 * t211 * 0.06875 + t99 * t141 * t70 * 0.1375)) + t100 * 0.275 * t141 * t68 +
+       t69 * ((t99 * t141 * t68 * 0.1375 - t211 * 0.06875 * t70)) - 0.275 * t101 * t141 * t70);
+  const double t213 = (t166 * t166);
+  const double t214 = (1.0 / sqrt(t173)) * x[5];
+  const double t215 = (t214 + 1.0);
+  const double t216 = (t214 - 1.0);
+  const double t217 = ((1.0 / sqrt(t171)) * t170 - 1.0);
+  const double t218 = 2.0 * x[7];
+  const double t219 = (-4e+05 + t218);
+  const double t220 = (-t7 * 0.016846790604875265 + 0.033095806098478765);
+  const double t221 = (1.0 / (t220));
+  const double t222 = (x[8] - 2e+05);
   const double t223 = (t222 * t222);
   const double t224 = (4e+10 + t223);
   const double t225 = pow(t224, (-0.25));
-  const double t226 = (t217 + 1e+10);
-  const double t227 = 2.0 * x[8];
-  const double t228 = (-4e+05 + t227);
-  const double t229 = (-t71 * 0.005694136684631502 + 0.017213594393998447);
-  const double t230 = (1.0 / (t229));
-  const double t231 = (x[9] - 2e+05);
-  const double t232 = (t231 * t231);
-  const double t233 = (4e+10 + t232);
-  const double t234 = pow(t233, (-0.25));
-  const double t235 = (-2.1e+07 + x[9]);
-  const double t236 = (1e+10 + (t235 * t235));
-  const double t237 = (1e+10 + t232);
-  const double t238 = (-x[9] + u[7]);
-  const double t239 = (t238 * t238);
-  const double t240 = (t239 + 4e+10);
-  const double t241 = pow(t240, (-0.25));
-  const double t242 =
+  const double t226 = (-2.3e+07 + x[8]);
+  const double t227 = ((t226 * t226) + 1e+10);
+  const double t228 = (x[8] - u[6]);
+  const double t229 = ((t228 * t228) + 1e+08);
+  const double t230 = (-sqrt(t229) + x[8] - u[6]);
+  const double t231 = (t230 * t230);
+  const double t232 = (4e+10 + 0.25 * t231);
+  const double t233 = pow(t232, (-0.25));
+  const double t234 = (t223 + 1e+10);
+  const double t235 = 2.0 * x[8];
+  const double t236 = (-4e+05 + t235);
+  const double t237 = ((1.0 / sqrt(t229)) * t228 - 1.0);
+  const double t238 = (-t74 * 0.005694136684631502 + 0.017213594393998447);
+  const double t239 = (1.0 / (t238 * t238));
+  const double t240 = (x[9] - 2e+05);
+  const double t241 = (t240 * t240);
+  const double t242 = (4e+10 + t241);
+  const double t243 = pow(t242, (-0.25));
+  const double t244 = (-2.1e+07 + x[9]);
+  const double t245 = (1e+10 + (t244 * t244));
+  const double t246 = (-x[9] + u[7]);
+  const double t247 = ((t246 * t246) + 1e+08);
+  const double t248 = (-x[9] + u[7] + sqrt(t247));
+  const double t249 = (t248 * t248);
+  const double t250 = (t249 * 0.25 + 4e+10);
+  const double t251 = pow(t250, (-0.25));
+  const double t252 = (1e+10 + t241);
+  const double t253 =
       (-3.666666666666667e-09 * x[9] + 0.03886666666666667 -
-       t177 * 1.496910398367498e-06 * t234 * t231 + 0.002847068342315751 * t163 * x[3] * t74 -
-       1.8333333333333334e-09 * sqrt(t236) + x[2] * t164 * t74 * 0.005694136684631502 +
-       sqrt(t237) * 1.8333333333333334e-09 - t238 * 1.496910398367498e-06 * t171 * t241);
-  const double t243 = (1.0 / (t229 * t229));
-  const double t244 = 2.0 * x[9];
-  const double t245 = (-4e+05 + t244);
-  const double t246 = (t87 * t63 * t57 * 8.0 * t91 - t95 * t62 * t57 * 8.0 * t91);
-  const double t247 = (-t96 * t65 * 0.15 + t75);
-  const double t248 = (t49 + t50 + t63 * 0.5 * t57 + t51);
-  const double t249 = (t44 - t62 * 0.5 * t57 + t45 + t47);
-  const double t250 = ((t248 * t248) + (t249 * t249));
-  const double t251 = (1.0 / (t250));
-  const double t252 = (-1.0999999999999996 * t0 + t46 + 0.2 * t43 - t63 * t57);
-  const double t253 = t46 * 2.0;
-  const double t254 = 0.4 * t43;
-  const double t255 = t62 * t76 * (-2.0) * t80;
-  const double t256 = t57 * t85;
-  const double t257 = (t253 + t254 - 2.1999999999999993 * t0 + t255 + t256);
-  const double t258 = t46 * (-0.2);
-  const double t259 = (-t62 * t57 + t258 + t2 * 1.0999999999999996 + t43);
-  const double t260 = t46 * (-0.4);
-  const double t261 = 2.0 * t43;
-  const double t262 = (t260 + t2 * 2.1999999999999993 + t92 + t261 + t94);
-  const double t263 = (t251 * t252 * t257 + t259 * t251 * t262);
-  const double t264 = (t251 * 0.625 * t252 * t257 + t259 * t251 * t262 * 0.625);
-  const double t265 = (t1 + t3 - 0.5726 * t18 * t13 + 0.5726 * t20 * t19 * t5);
-  const double t266 = (-0.15 * t0 - 1.39 * t2);
-  const double t267 = t12 * t18 * (-0.5726);
-  const double t268 = (t10 + t267 + t11 + 0.5726 * t20 * t19 * t4);
-  const double t269 = (-t2 * 0.15 + 1.39 * t0);
-  const double t270 = t46 * (-0.20276316964285715);
-  const double t271 = 0.4231954017857143 * t43;
-  const double t272 = 2.9814 * t0;
-  const double t273 = (t270 + t271 + t272);
-  const double t274 = t46 * (-0.4231954017857143);
-  const double t275 = (-0.20276316964285715) * t43;
-  const double t276 = (-2.9814) * t2;
-  const double t277 = (t274 + t275 + t276);
-  const double t278 = 0.42 * t43;
-  const double t279 = (t258 + t272 + t278);
-  const double t280 = t46 * (-0.42);
-  const double t281 = t43 * (-0.2);
-  const double t282 = (t280 + t281 + t276);
-  const double t283 = (1.0 / (t6));
-  const double t284 = (-1.2074 + t10 + t11);
-  const double t285 = (t13 * t283 * t4 + t12 * t283 * t284);
-  const double t286 =
-      (20.765148133333334 * t13 * t283 * t4 + t12 * 20.765148133333334 * t283 * t284);
-  const double t287 = (t96 * 0.15 * t67 + t68);
-  const double t288 = 0.5726 * t12 * t18;
-  const double t289 = (-0.5726 * t20 * t19 * t4 + t288);
-  const double t290 =
-      (-t46 * 0.25 - 0.05 * t43 - t62 * 0.25 * t76 * t80 + 0.125 * t57 * t85 + t0 * 2.7064);
-  const double t291 = t46 * 0.05;
-  const double t292 = (-0.25) * t43;
-  const double t293 = (t291 + t292 + t63 * 0.25 * t76 * t80 - t93 * 0.125 * t57 - t2 * 2.7064);
-  const double t294 =
-      (12.021927866666665 * t13 * t283 * t4 + t12 * 12.021927866666665 * t283 * t284);
-  const double t295 = (-0.5726 * t20 * t19 * t5 + 0.5726 * t18 * t13);
-  const double t296 = (t258 + t278);
-  const double t297 = (t260 + t131 + t132 + t261);
-  const double t298 = t63 * t76 * (-2.0) * t80;
-  const double t299 = t93 * t57;
-  const double t300 = (t260 + t298 + t261 + t299 + t2 * 21.6512);
-  const double t301 = (t81 + t253 + t254 + t86 - 21.6512 * t0);
-  const double t302 = (t134 + t253 + t254 + t136);
-  const double t303 = (t274 + t275);
-  const double t304 = (t270 + t271);
-  const double t305 = t46 * (-2.0);
-  const double t306 = t43 * (-0.4);
-  const double t307 = (t134 + t305 + t306 + t136);
-  const double t308 = t57 * t130 * (-1.0);
-  const double t309 = t63 * 2.0 * t76 * t128;
-  const double t310 = (t308 + t260 + t309 + t261);
-  const double t311 = (t251 * t307 * t252 - t259 * t251 * t310);
-  const double t312 = (t280 + t281);
-  const double t313 =
-      (t296 * 900.0 * t279 + t297 * 1.171875 * t300 + 28.5 * t138 * t67 * t287 + 280.0 +
-       t138 * t246 * 0.5 - t247 * 28.5 * t138 * t65 + t301 * t302 * 1.171875 +
-       u[4] * ((t303 * t277 + t273 * t304)) - 0.125 * t311 * t264 + 900.0 * t282 * t312);
-  const double t314 = (t62 * t133 * t57 * 8.0 * t91 + t63 * t137 * t57 * 8.0 * t91);
-  const double t315 = (t291 + t292 - 0.125 * t57 * t130 + t63 * 0.25 * t76 * t128);
-  const double t316 = (-t251 * t307 * 0.625 * t252 + t259 * t251 * t310 * 0.625);
-  const double t317 = cos(u[5]);
-  const double t318 = t161 * x[3];
-  const double t319 = t206 * x[2];
-  const double t320 = (((t318 + x[2] * t123)) * x[2] + ((t201 * x[3] + t319)) * x[3]);
-  const double t321 = (t99 - t65 * t123 * 0.0375 - 0.075 * t67 * t124);
-  const double t322 = (-0.075) * t96 * t138 * t67;
-  const double t323 = (t322 - t161 * t65 * 0.0375);
-  const double t324 = t323 * x[3];
-  const double t325 = (t322 - t65 * t206 * 0.0375);
-  const double t326 = t325 * x[2];
-  const double t327 = (-0.075 * t67 * t202 - t201 * t65 * 0.0375);
-  const double t328 = (((x[2] * t321 + t324)) * x[2] + ((t326 + t327 * x[3])) * x[3]);
-  const double t329 = sin(u[5]);
-  const double t330 = t303 * x[3];
-  const double t331 = (t330 + t303 * x[2]);
-  const double t332 = (x[2] * t277 + t330);
-  const double t333 = (x[3] * t331 + t332 * x[2]);
-  const double t334 = t46 * 0.20276316964285715;
-  const double t335 = t43 * (-0.4231954017857143);
-  const double t336 = (t334 + t335);
-  const double t337 = x[3] * t336;
-  const double t338 = (t337 + x[2] * t336);
-  const double t339 = (-2.9814) * t0;
-  const double t340 = (t339 + t334 + t335);
-  const double t341 = (t337 + t340 * x[2]);
-  const double t342 = (t338 * x[3] + t341 * x[2]);
-  const double t343 = (x[2] * x[2]);
-  const double t344 = pow(t6, (-2.5));
-  const double t345 =
-      (t344 * 1.7178 * t21 * t5 - t13 * t20 * t19 * 1.1452 - t17 * 0.5726 * t19 * t5 + t288);
-  const double t346 = x[3] * t312;
-  const double t347 = (t282 * x[2] + t346);
-  const double t348 = (t346 + x[2] * t312);
-  const double t349 = (t347 * x[2] + t348 * x[3]);
-  const double t350 = t43 * 8.0;
-  const double t351 = t46 * (-1.6);
-  const double t352 = (t154 + t155 + t156 + t157 + t350 + t351 + t158);
-  const double t353 = (x[3] * ((t186 + t188 + t350 + t351 + t192 + t193)) + t352 * x[2]);
-  const double t354 = (t118 + t119 + t120 + t350 + t351 + t121 + 86.6048 * t2);
-  const double t355 = (x[2] * t354 + t352 * x[3]);
-  const double t356 = (t353 * x[3] + t355 * x[2]);
-  const double t357 = t46 * (-8.0);
-  const double t358 = t43 * (-1.6);
-  const double t359 = (t195 + t197 + t357 + t358 + t198 + t199);
-  const double t360 = t46 * 8.0;
-  const double t361 = 1.6 * t43;
-  const double t362 = (t143 + t360 + t144 + t148 + t361 + t149 + t150);
-  const double t363 = (x[3] * t359 - t362 * x[2]);
-  const double t364 = t63 * t108 * 24.0 * t109;
-  const double t365 = t93 * (-8.0) * t76 * t80;
-  const double t366 = t114 * t57 * (-1.0);
-  const double t367 = t63 * t106 * (-8.0) * t76;
-  const double t368 = (t364 + t365 + 86.6048 * t0 + t357 + t366 + t358 + t367);
-  const double t369 = x[2] * t368 * (-1.0);
-  const double t370 = (-t363 * x[3] + ((t369 + t362 * x[3])) * x[2]);
-  const double t371 = (t67 * t123 * 0.0375 - 0.075 * t65 * t124 + t75);
-  const double t372 = (-0.075) * t96 * t138 * t65;
-  const double t373 = (t372 + t161 * t67 * 0.0375);
-  const double t374 = x[3] * t373;
-  const double t375 = (t201 * t67 * 0.0375 - 0.075 * t65 * t202);
-  const double t376 = (t206 * t67 * 0.0375 + t372);
-  const double t377 = t376 * x[2];
-  const double t378 = (((t371 * x[2] + t374)) * x[2] + ((t375 * x[3] + t377)) * x[3]);
-  const double t379 = (t71 - 2.6718);
-  const double t380 = (t379 * t379);
-  const double t381 = (1e-06 + t380);
-  const double t382 = (1.0 / sqrt(t381));
-  const double t383 = (t71 - 2.2443);
-  const double t384 = (t383 * t383);
-  const double t385 = (t384 + 1e-06);
-  const double t386 = (1.0 / sqrt(t385));
-  const double t387 = (2.0 + t379 * t382 - t383 * t386);
-  const double t388 = (4e+06 * x[2] * t164 * t74 + t163 * 2e+06 * x[3] * t74);
-  const double t389 =
-      (t71 * 8e+08 + 4e+08 * sqrt(t381) + t387 * t388 - 1966440000.0 + x[9] * 0.011388273369263005 -
-       0.02269800692218626 * x[7] - 4e+08 * sqrt(t385));
-  const double t390 = (-t344 * 1.7178 * t21 * t5 + t10 + t267 + t13 * t20 * t19 * 1.1452 + t11 +
-                       t17 * 0.5726 * t19 * t5);
-  const double t391 = (1.0 / (t6 * t6));
-  const double t392 = (-t391 * t12 * 2.0 * t20 * t284 + t12 * t13 * t283 + t12 * t283 * t4 +
-                       t12 * t283 * t16 + t283 * t16 * t284 - t391 * t13 * 2.0 * t20 * t4);
-  const double t393 = (t14 + t12 * t20 * t19 * 1.1452 + t17 * 0.5726 * t19 * t4 -
-                       0.5726 * t18 * t16 + t15 - t344 * 1.7178 * t4 * t21);
-  const double t394 = (-2.0) * t43;
-  const double t395 = t46 * 0.4;
-  const double t396 = t46 * 0.2;
-  const double t397 = (-0.42) * t43;
-  const double t398 = (t396 + t397);
-  const double t399 = x[3] * t398;
-  const double t400 = (t399 + x[2] * t398);
-  const double t401 = (t339 + t396 + t397);
-  const double t402 = (t399 + x[2] * t401);
-  const double t403 = (t400 * x[3] + t402 * x[2]);
-  const double t404 = (t2 * 0.15 - 1.39 * t0);
-  const double t405 = (t344 * 1.7178 * t4 * t21 + 0.5726 * t18 * t16 - t12 * t20 * t19 * 1.1452 -
-                       t17 * 0.5726 * t19 * t4);
-  const double t406 = (t131 + t394 + t132 + t395);
-  const double t407 = (t143 + t144 + t148 + t357 + t358 + t149 + t150);
-  const double t408 = (1.0 / (t250 * t250));
-  const double t409 = (t396 - t43 + t62 * t57 - t2 * 1.0999999999999996);
-  const double t410 = (t307 * t409 - t310 * t252);
-  const double t411 = t46 * 1.6;
-  const double t412 = (-8.0) * t43;
-  const double t413 = (t154 + t155 + t156 + t411 + t157 + t412 + t158);
-  const double t414 = (-t251 * t406 * 2.0 * t257 + t259 * t407 * t251 + t259 * t262 * t408 * t410 +
-                       t408 * t410 * t252 * t257 - t251 * t413 * t252 + t251 * t307 * t262 * 2.0);
-  const double t415 = t414 * x[2];
-  const double t416 = t191 * t57 * (-1.0);
-  const double t417 = t76 * 8.0 * t135 * t128;
-  const double t418 = t62 * t108 * 24.0 * t185;
-  const double t419 = t187 * t62 * (-8.0) * t76;
-  const double t420 = (t416 + t417 + t418 + t419 + t350 + t351);
-  const double t421 = (t195 + t197 + t360 + t361 + t198 + t199);
-  const double t422 = (t251 * t420 * t252 + t251 * t406 * t307 * 2.0 + t259 * t310 * t408 * t410 +
-                       t251 * t310 * t307 * 2.0 - t307 * t408 * t410 * t252 - t259 * t251 * t421);
-  const double t423 = (t364 + t365 - 8.799999999999997 * t0 + t360 + t361 + t366 + t367);
-  const double t424 = (t262 * t252 + t409 * t257);
-  const double t425 = (t118 - t2 * 8.799999999999997 + t119 + t120 + t411 + t412 + t121);
-  const double t426 = (t298 - t2 * 2.1999999999999993 + t394 + t395 + t299);
-  const double t427 =
-      (t423 * t259 * t251 + t424 * t408 * t252 * t257 + t251 * t252 * t425 +
-       t259 * t262 * t424 * t408 + t251 * 2.0 * t257 * t426 + t251 * t262 * 2.0 * t257);
-  const double t428 = t76 * (-4.0) * t85 * t128;
-  const double t429 = t57 * t153;
-  const double t430 = t62 * t108 * 24.0 * t128 * t80;
-  const double t431 = t62 * (-8.0) * t76 * t142;
-  const double t432 = 4.0 * t76 * t135 * t80;
-  const double t433 = (t428 + t429 + t430 + t431 + t350 + t432 + t351);
-  const double t434 = (-t259 * t407 * t251 - t251 * t307 * 2.0 * t426 - t307 * t424 * t408 * t252 +
-                       t251 * t310 * 2.0 * t257 - t251 * t252 * t433 + t259 * t310 * t424 * t408);
-  const double t435 = (((t415 + t422 * x[3])) * x[3] - ((t427 * x[2] + t434 * x[3])) * x[2]);
-  const double t436 = (t7 - 1.8458);
-  const double t437 = (t436 * t436);
-  const double t438 = (1e-06 + t437);
-  const double t439 = (1.0 / sqrt(t438));
-  const double t440 = (t7 - 1.1452);
-  const double t441 = (t440 * t440);
-  const double t442 = (1e-06 + t441);
-  const double t443 = (1.0 / sqrt(t442));
-  const double t444 = (t439 * t436 + 2.0 - t440 * t443);
-  const double t445 =
-      (598200000.0 - sqrt(t438) * 2e+08 - x[8] * 0.016846790604875265 + 0.02454369260617026 * x[6] -
-       t18 * 2e+06 * x[2] * t20 * t444 - t7 * 4e+08 + 2e+08 * sqrt(t442));
-  const double t446 = pow(t385, (-1.5));
-  const double t447 = pow(t381, (-1.5));
-  const double t448 =
-      (((t382 * t164 * t74 - t386 * t164 * t74 + t384 * t446 * t164 * t74 -
-         t447 * t380 * t164 * t74)) *
-           t388 +
-       t387 * ((-t163 * 2e+06 * x[3] * t164 * t165 + t162 * 2e+06 * x[3] * t74 +
-                4e+06 * x[2] * t74 * t125 - t166 * 4e+06 * x[2] * t165)) -
-       t383 * 4e+08 * t386 * t164 * t74 + 8e+08 * t164 * t74 + t379 * 4e+08 * t382 * t164 * t74);
-  const double t449 = t329 * t398 * (-8825.984999999999);
-  const double t450 = ((-t329 * t336 * 9.80665 - t303 * t317 * 9.80665)) * u[4];
-  const double t451 = t163 * 0.25 * t389 * t164 * t165;
-  const double t452 = (t383 * 4e+08 * t386 * t163 * t74 -
-                       t388 * ((t384 * t446 * t163 * t74 - t447 * t163 * t380 * t74 -
-                                t386 * t163 * t74 + t382 * t163 * t74)) -
-                       t387 * 2.0 *
-                           ((4e+06 * t207 * x[2] * t74 - 1e+06 * x[3] * t165 * t208 -
-                             t163 * 2e+06 * x[2] * t164 * t165 + 2e+06 * x[3] * t74 * t205)) -
-                       t379 * 4e+08 * t382 * t163 * t74 - t163 * 8e+08 * t74);
-  const double t453 = t317 * t312 * (-8825.984999999999);
-  const double t454 = t329 * (-22.9843359375) * t362;
-  const double t455 = (t360 + t102 + t107 + t361 + t115 + t116 - 86.6048 * t0);
-  const double t456 = (2.0 * t362 * x[3] + t369 + t455 * x[2]);
-  const double t457 = (t318 + t206 * x[3] + 2.0 * x[2] * t123);
-  const double t458 = (t374 + t376 * x[3] + t371 * 2.0 * x[2]);
-  const double t459 = (t325 * x[3] + 2.0 * x[2] * t321 + t324);
-  const double t460 = (1.0 / (t70));
-  const double t461 = (t414 * x[3] - 2.0 * t427 * x[2] - t434 * x[3]);
-  const double t462 = (t161 * x[2] + t201 * 2.0 * x[3] + t319);
-  const double t463 = (t326 + t323 * x[2] + 2.0 * t327 * x[3]);
-  const double t464 = (x[2] * t373 + t377 + 2.0 * t375 * x[3]);
-  const double t465 = (t415 + 2.0 * t422 * x[3] - t434 * x[2]);
-  const double t466 = t387 * t163 * (-1e+06) * t164 * t460;
-  const double t467 = (t428 + t429 + t430 + t411 + t431 + t432 + t412);
-  const double t468 = (t416 + t417 + t411 + t418 + t419 + t412);
-  const double t469 = (-t259 * t262 * t424 * t408 * 0.15625 - t251 * 0.3125 * t257 * t426 -
-                       t423 * t259 * t251 * 0.15625 - t251 * t262 * 0.3125 * t257 -
-                       t251 * t252 * 0.15625 * t425 - t424 * t408 * t252 * 0.15625 * t257);
-  const double t470 = (-t87 * t63 * t100 * t101 * t57 * 8.0 + t95 * t100 * t62 * t101 * t57 * 8.0 +
-                       t63 * 2.0 * t57 * t122 * t91 - t95 * 4.0 * t57 * t85 * t91 +
-                       t95 * t62 * t76 * 8.0 * t80 * t91 - t62 * t117 * 2.0 * t57 * t91 -
-                       t87 * t63 * t76 * 8.0 * t80 * t91 + t87 * t93 * 4.0 * t57 * t91);
-  const double t471 = 900.0 * t279 * t312;
-  const double t472 = t273 * t303;
-  const double t473 = t336 * t277;
-  const double t474 = 900.0 * t282 * t398;
-  const double t475 =
-      (-t161 * t247 * t65 * 7.125 + t354 * t302 * 0.29296875 - t297 * t455 * 0.29296875 -
-       t469 * 0.125 * t311 + t470 * t138 * 0.5 + t161 * 0.125 * t246 + t471 + t296 * 900.0 * t282 -
-       t362 * 0.29296875 * t300 - t264 * t434 * 0.03125 - t96 * t138 * t65 * t287 * 14.25 -
-       t467 * t301 * 0.29296875 - 28.5 * t138 * t65 * t321 - t247 * t96 * t138 * t67 * 14.25 +
-       900.0 * t401 * t312 + t371 * 28.5 * t138 * t67 +
-       ((t472 + t277 * t304 + t303 * t340 + t473)) * u[4] + t161 * t67 * t287 * 7.125 + t474);
-  const double t476 = t63 * 2.0 * t159 * t57 * t91;
-  const double t477 = t62 * (-2.0) * t57 * t151 * t91;
-  const double t478 = t303 * t336;
-  const double t479 = t303 * t304;
-  const double t480 = ((t478 + t479)) * 2.0 * u[4];
-  const double t481 = t296 * 1800.0 * t312;
-  const double t482 = t259 * t407 * t251 * 0.15625;
-  const double t483 = 1800.0 * t312 * t398;
-  const double t484 =
-      (t95 * 4.0 * t57 * t135 * t91 + t476 + t477 + t95 * t100 * t62 * t184 * t57 * 8.0 +
-       t95 * t62 * t76 * 8.0 * t128 * t91 - t87 * t63 * t76 * 8.0 * t128 * t91 -
-       t87 * t63 * t100 * t184 * t57 * 8.0 + t87 * 4.0 * t57 * t130 * t91);
-  const double t485 = (t251 * t307 * t262 * 0.3125 - t251 * t413 * t252 * 0.15625 +
-                       t408 * t410 * t252 * 0.15625 * t257 + t482 +
-                       t259 * t262 * t408 * t410 * 0.15625 - t251 * t406 * 0.3125 * t257);
-  const double t486 =
-      (t201 * t67 * t287 * 7.125 + t201 * 0.125 * t246 + ((t472 + t478 + t479 + t473)) * u[4] -
-       t467 * t302 * 0.29296875 - 28.5 * t138 * t325 * t65 + t471 - t247 * t67 * 14.25 * t202 +
-       28.5 * t138 * t376 * t67 - 0.125 * t311 * t485 + 900.0 * t312 * t398 -
-       t297 * t362 * 0.29296875 - t65 * t287 * 14.25 * t202 - t301 * 0.29296875 * t468 +
-       t296 * 900.0 * t312 -
+       t175 * 1.496910398367498e-06 * t243 * t240 + 0.002847068342315751 * t166 * x[3] * t77 -
+       1.8333333333333334e-09 * sqrt(t245) + x[2] * t167 * t77 * 0.005694136684631502 -
+       7.48455199183749e-07 * t248 * t181 * t251 + sqrt(t252) * 1.8333333333333334e-09);
+  const double t254 = (1.0 / (t238));
+  const double t255 = 2.0 * x[9];
+  const double t256 = (t246 * (1.0 / sqrt(t247)) + 1.0);
+  const double t257 = (-4e+05 + t255);
+  const double t258 = (t90 * t66 * t60 * 8.0 * t94 - t98 * t65 * t60 * 8.0 * t94);
+  const double t259 = (-t99 * t68 * 0.15 + t78);
+  const double t260 = (t52 + t53 + t66 * 0.5 * t60 + t54);
+  const double t261 = (t47 - t65 * 0.5 * t60 + t48 + t50);
+  const double t262 = ((t260 * t260) + (t261 * t261));
+  const double t263 = (1.0 / (t262));
+  const double t264 = (-1.0999999999999996 * t0 + t49 + 0.2 * t46 - t66 * t60);
+  const double t265 = t49 * 2.0;
+  const double t266 = 0.4 * t46;
+  const double t267 = t65 * t79 * (-2.0) * t83;
+  const double t268 = t60 * t88;
+  const double t269 = (t265 + t266 - 2.1999999999999993 * t0 + t267 + t268);
+  const double t270 = t49 * (-0.2);
+  const double t271 = (-t65 * t60 + t270 + t2 * 1.0999999999999996 + t46);
+  const double t272 = t49 * (-0.4);
+  const double t273 = 2.0 * t46;
+  const double t274 = (t272 + t2 * 2.1999999999999993 + t95 + t273 + t97);
+  const double t275 = (t263 * t264 * t269 + t271 * t263 * t274);
+  const double t276 = (t263 * 0.625 * t264 * t269 + t271 * t263 * t274 * 0.625);
+  const double t277 = (t1 + t3 - 0.5726 * t9 * t10 + 0.5726 * t14 * t37 * t5);
+  const double t278 = (-0.15 * t0 - 1.39 * t2);
+  const double t279 = t13 * t9 * (-0.5726);
+  const double t280 = (t11 + t279 + t12 + 0.5726 * t14 * t37 * t4);
+  const double t281 = (-t2 * 0.15 + 1.39 * t0);
+  const double t282 = t49 * (-0.20276316964285715);
+  const double t283 = 0.4231954017857143 * t46;
+  const double t284 = 2.9814 * t0;
+  const double t285 = (t282 + t283 + t284);
+  const double t286 = t49 * (-0.4231954017857143);
+  const double t287 = (-0.20276316964285715) * t46;
+  const double t288 = (-2.9814) * t2;
+  const double t289 = (t286 + t287 + t288);
+  const double t290 = 0.42 * t46;
+  const double t291 = (t270 + t284 + t290);
+  const double t292 = t49 * (-0.42);
+  const double t293 = t46 * (-0.2);
+  const double t294 = (t292 + t293 + t288);
+  const double t295 = (1.0 / (t6));
+  const double t296 = (-1.2074 + t11 + t12);
+  const double t297 = (t10 * t295 * t4 + t13 * t295 * t296);
+  const double t298 =
+      (20.765148133333334 * t10 * t295 * t4 + t13 * 20.765148133333334 * t295 * t296);
+  const double t299 = (t99 * 0.15 * t70 + t71);
+  const double t300 = 0.5726 * t13 * t9;
+  const double t301 = (-0.5726 * t14 * t37 * t4 + t300);
+  const double t302 =
+      (-t49 * 0.25 - 0.05 * t46 - t65 * 0.25 * t79 * t83 + 0.125 * t60 * t88 + t0 * 2.7064);
+  const double t303 = t49 * 0.05;
+  const double t304 = (-0.25) * t46;
+  const double t305 = (t303 + t304 + t66 * 0.25 * t79 * t83 - t96 * 0.125 * t60 - t2 * 2.7064);
+  const double t306 =
+      (12.021927866666665 * t10 * t295 * t4 + t13 * 12.021927866666665 * t295 * t296);
+  const double t307 = (-0.5726 * t14 * t37 * t5 + 0.5726 * t9 * t10);
+  const double t308 = (t270 + t290);
+  const double t309 = (t272 + t134 + t135 + t273);
+  const double t310 = t66 * t79 * (-2.0) * t83;
+  const double t311 = t96 * t60;
+  const double t312 = (t272 + t310 + t273 + t311 + t2 * 21.6512);
+  const double t313 = (t84 + t265 + t266 + t89 - 21.6512 * t0);
+  const double t314 = (t137 + t265 + t266 + t139);
+  const double t315 = (t286 + t287);
+  const double t316 = (t282 + t283);
+  const double t317 = t49 * (-2.0);
+  const double t318 = t46 * (-0.4);
+  const double t319 = (t137 + t317 + t318 + t139);
+  const double t320 = t60 * t133 * (-1.0);
+  const double t321 = t66 * 2.0 * t79 * t131;
+  const double t322 = (t320 + t272 + t321 + t273);
+  const double t323 = (t263 * t319 * t264 - t271 * t263 * t322);
+  const double t324 = (t292 + t293);
+  const double t325 =
+      (t308 * 900.0 * t291 + t309 * 1.171875 * t312 + 28.5 * t141 * t70 * t299 + 280.0 +
+       t141 * t258 * 0.5 - t259 * 28.5 * t141 * t68 + t313 * t314 * 1.171875 +
+       u[4] * ((t315 * t289 + t285 * t316)) - 0.125 * t323 * t276 + 900.0 * t294 * t324);
+  const double t326 = (t65 * t136 * t60 * 8.0 * t94 + t66 * t140 * t60 * 8.0 * t94);
+  const double t327 = (t303 + t304 - 0.125 * t60 * t133 + t66 * 0.25 * t79 * t131);
+  const double t328 = (-t263 * t319 * 0.625 * t264 + t271 * t263 * t322 * 0.625);
+  const double t329 = cos(u[5]);
+  const double t330 = t164 * x[3];
+  const double t331 = t211 * x[2];
+  const double t332 = (((t330 + x[2] * t126)) * x[2] + ((t206 * x[3] + t331)) * x[3]);
+  const double t333 = (t102 - t68 * t126 * 0.0375 - 0.075 * t70 * t127);
+  const double t334 = (-0.075) * t99 * t141 * t70;
+  const double t335 = (t334 - t164 * t68 * 0.0375);
+  const double t336 = t335 * x[3];
+  const double t337 = (t334 - t68 * t211 * 0.0375);
+  const double t338 = t337 * x[2];
+  const double t339 = (-0.075 * t70 * t207 - t206 * t68 * 0.0375);
+  const double t340 = (((x[2] * t333 + t336)) * x[2] + ((t338 + t339 * x[3])) * x[3]);
+  const double t341 = sin(u[5]);
+  const double t342 = t315 * x[3];
+  const double t343 = (t342 + t315 * x[2]);
+  const double t344 = (x[2] * t289 + t342);
+  const double t345 = (x[3] * t343 + t344 * x[2]);
+  const double t346 = t49 * 0.20276316964285715;
+  const double t347 = t46 * (-0.4231954017857143);
+  const double t348 = (t346 + t347);
+  const double t349 = x[3] * t348;
+  const double t350 = (t349 + x[2] * t348);
+  const double t351 = (-2.9814) * t0;
+  const double t352 = (t351 + t346 + t347);
+  const double t353 = (t349 + t352 * x[2]);
+  const double t354 = (t350 * x[3] + t353 * x[2]);
+  const double t355 = (x[2] * x[2]);
+  const double t356 = pow(t6, (-2.5));
+  const double t357 =
+      (t356 * 1.7178 * t38 * t5 - t10 * t14 * t37 * 1.1452 - t36 * 0.5726 * t37 * t5 + t300);
+  const double t358 = x[3] * t324;
+  const double t359 = (t294 * x[2] + t358);
+  const double t360 = (t358 + x[2] * t324);
+  const double t361 = (t359 * x[2] + t360 * x[3]);
+  const double t362 = t46 * 8.0;
+  const double t363 = t49 * (-1.6);
+  const double t364 = (t157 + t158 + t159 + t160 + t362 + t363 + t161);
+  const double t365 = (x[3] * ((t191 + t193 + t362 + t363 + t197 + t198)) + t364 * x[2]);
+  const double t366 = (t121 + t122 + t123 + t362 + t363 + t124 + 86.6048 * t2);
+  const double t367 = (x[2] * t366 + t364 * x[3]);
+  const double t368 = (t365 * x[3] + t367 * x[2]);
+  const double t369 = t49 * (-8.0);
+  const double t370 = t46 * (-1.6);
+  const double t371 = (t200 + t202 + t369 + t370 + t203 + t204);
+  const double t372 = t49 * 8.0;
+  const double t373 = 1.6 * t46;
+  const double t374 = (t146 + t372 + t147 + t151 + t373 + t152 + t153);
+  const double t375 = (x[3] * t371 - t374 * x[2]);
+  const double t376 = t66 * t111 * 24.0 * t112;
+  const double t377 = t96 * (-8.0) * t79 * t83;
+  const double t378 = t117 * t60 * (-1.0);
+  const double t379 = t66 * t109 * (-8.0) * t79;
+  const double t380 = (t376 + t377 + 86.6048 * t0 + t369 + t378 + t370 + t379);
+  const double t381 = x[2] * t380 * (-1.0);
+  const double t382 = (-t375 * x[3] + ((t381 + t374 * x[3])) * x[2]);
+  const double t383 = (t70 * t126 * 0.0375 - 0.075 * t68 * t127 + t78);
+  const double t384 = (-0.075) * t99 * t141 * t68;
+  const double t385 = (t384 + t164 * t70 * 0.0375);
+  const double t386 = x[3] * t385;
+  const double t387 = (t206 * t70 * 0.0375 - 0.075 * t68 * t207);
+  const double t388 = (t211 * t70 * 0.0375 + t384);
+  const double t389 = t388 * x[2];
+  const double t390 = (((t383 * x[2] + t386)) * x[2] + ((t387 * x[3] + t389)) * x[3]);
+  const double t391 = (t74 - 2.6718);
+  const double t392 = (t391 * t391);
+  const double t393 = (1e-06 + t392);
+  const double t394 = (1.0 / sqrt(t393));
+  const double t395 = (t74 - 2.2443);
+  const double t396 = (t395 * t395);
+  const double t397 = (t396 + 1e-06);
+  const double t398 = (1.0 / sqrt(t397));
+  const double t399 = (2.0 + t391 * t394 - t395 * t398);
+  const double t400 = (4e+06 * x[2] * t167 * t77 + t166 * 2e+06 * x[3] * t77);
+  const double t401 =
+      (t74 * 8e+08 + 4e+08 * sqrt(t393) + t399 * t400 - 1966440000.0 + x[9] * 0.011388273369263005 -
+       0.02269800692218626 * x[7] - 4e+08 * sqrt(t397));
+  const double t402 = (-t356 * 1.7178 * t38 * t5 + t11 + t279 + t10 * t14 * t37 * 1.1452 + t12 +
+                       t36 * 0.5726 * t37 * t5);
+  const double t403 = (1.0 / (t6 * t6));
+  const double t404 = (-t403 * t13 * 2.0 * t14 * t296 + t13 * t10 * t295 + t13 * t295 * t4 +
+                       t13 * t295 * t35 + t295 * t35 * t296 - t403 * t10 * 2.0 * t14 * t4);
+  const double t405 = (t33 + t13 * t14 * t37 * 1.1452 + t36 * 0.5726 * t37 * t4 -
+                       0.5726 * t9 * t35 + t34 - t356 * 1.7178 * t4 * t38);
+  const double t406 = (-2.0) * t46;
+  const double t407 = t49 * 0.4;
+  const double t408 = t49 * 0.2;
+  const double t409 = (-0.42) * t46;
+  const double t410 = (t408 + t409);
+  const double t411 = x[3] * t410;
+  const double t412 = (t411 + x[2] * t410);
+  const double t413 = (t351 + t408 + t409);
+  const double t414 = (t411 + x[2] * t413);
+  const double t415 = (t412 * x[3] + t414 * x[2]);
+  const double t416 = (t2 * 0.15 - 1.39 * t0);
+  const double t417 = (t356 * 1.7178 * t4 * t38 + 0.5726 * t9 * t35 - t13 * t14 * t37 * 1.1452 -
+                       t36 * 0.5726 * t37 * t4);
+  const double t418 = (t134 + t406 + t135 + t407);
+  const double t419 = (t146 + t147 + t151 + t369 + t370 + t152 + t153);
+  const double t420 = (1.0 / (t262 * t262));
+  const double t421 = (t408 - t46 + t65 * t60 - t2 * 1.0999999999999996);
+  const double t422 = (t319 * t421 - t322 * t264);
+  const double t423 = t49 * 1.6;
+  const double t424 = (-8.0) * t46;
+  const double t425 = (t157 + t158 + t159 + t423 + t160 + t424 + t161);
+  const double t426 = (-t263 * t418 * 2.0 * t269 + t271 * t419 * t263 + t271 * t274 * t420 * t422 +
+                       t420 * t422 * t264 * t269 - t263 * t425 * t264 + t263 * t319 * t274 * 2.0);
+  const double t427 = t426 * x[2];
+  const double t428 = t196 * t60 * (-1.0);
+  const double t429 = t79 * 8.0 * t138 * t131;
+  const double t430 = t65 * t111 * 24.0 * t190;
+  const double t431 = t192 * t65 * (-8.0) * t79;
+  const double t432 = (t428 + t429 + t430 + t431 + t362 + t363);
+  const double t433 = (t200 + t202 + t372 + t373 + t203 + t204);
+  const double t434 = (t263 * t432 * t264 + t263 * t418 * t319 * 2.0 + t271 * t322 * t420 * t422 +
+                       t263 * t322 * t319 * 2.0 - t319 * t420 * t422 * t264 - t271 * t263 * t433);
+  const double t435 = (t376 + t377 - 8.799999999999997 * t0 + t372 + t373 + t378 + t379);
+  const double t436 = (t274 * t264 + t421 * t269);
+  const double t437 = (t121 - t2 * 8.799999999999997 + t122 + t123 + t423 + t424 + t124);
+  const double t438 = (t310 - t2 * 2.1999999999999993 + t406 + t407 + t311);
+  const double t439 =
+      (t435 * t271 * t263 + t436 * t420 * t264 * t269 + t263 * t264 * t437 +
+       t271 * t274 * t436 * t420 + t263 * 2.0 * t269 * t438 + t263 * t274 * 2.0 * t269);
+  const double t440 = t79 * (-4.0) * t88 * t131;
+  const double t441 = t60 * t156;
+  const double t442 = t65 * t111 * 24.0 * t131 * t83;
+  const double t443 = t65 * (-8.0) * t79 * t145;
+  const double t444 = 4.0 * t79 * t138 * t83;
+  const double t445 = (t440 + t441 + t442 + t443 + t362 + t444 + t363);
+  const double t446 = (-t271 * t419 * t263 - t263 * t319 * 2.0 * t438 - t319 * t436 * t420 * t264 +
+                       t263 * t322 * 2.0 * t269 - t263 * t264 * t445 + t271 * t322 * t436 * t420);
+  const double t447 = (((t427 + t434 * x[3])) * x[3] - ((t439 * x[2] + t446 * x[3])) * x[2]);
+  const double t448 = (t7 - 1.8458);
+  const double t449 = (t448 * t448);
+  const double t450 = (1e-06 + t449);
+  const double t451 = (1.0 / sqrt(t450));
+  const double t452 = (t7 - 1.1452);
+  const double t453 = (t452 * t452);
+  const double t454 = (1e-06 + t453);
+  const double t455 = (1.0 / sqrt(t454));
+  const double t456 = (t451 * t448 + 2.0 - t452 * t455);
+  const double t457 =
+      (598200000.0 - sqrt(t450) * 2e+08 - x[8] * 0.016846790604875265 + 0.02454369260617026 * x[6] -
+       t9 * 2e+06 * x[2] * t14 * t456 - t7 * 4e+08 + 2e+08 * sqrt(t454));
+  const double t458 = pow(t397, (-1.5));
+  const double t459 = pow(t393, (-1.5));
+  const double t460 =
+      (((t394 * t167 * t77 - t398 * t167 * t77 + t396 * t458 * t167 * t77 -
+         t459 * t392 * t167 * t77)) *
+           t400 +
+       t399 * ((-t166 * 2e+06 * x[3] * t167 * t168 + t165 * 2e+06 * x[3] * t77 +
+                4e+06 * x[2] * t77 * t128 - t169 * 4e+06 * x[2] * t168)) -
+       t395 * 4e+08 * t398 * t167 * t77 + 8e+08 * t167 * t77 + t391 * 4e+08 * t394 * t167 * t77);
+  const double t461 = t341 * t410 * (-8825.984999999999);
+  const double t462 = ((-t341 * t348 * 9.80665 - t315 * t329 * 9.80665)) * u[4];
+  const double t463 = t166 * 0.25 * t401 * t167 * t168;
+  const double t464 = (t395 * 4e+08 * t398 * t166 * t77 -
+                       t400 * ((t396 * t458 * t166 * t77 - t459 * t166 * t392 * t77 -
+                                t398 * t166 * t77 + t394 * t166 * t77)) -
+                       t399 * 2.0 *
+                           ((4e+06 * t212 * x[2] * t77 - 1e+06 * x[3] * t168 * t213 -
+                             t166 * 2e+06 * x[2] * t167 * t168 + 2e+06 * x[3] * t77 * t210)) -
+                       t391 * 4e+08 * t394 * t166 * t77 - t166 * 8e+08 * t77);
+  const double t465 = t329 * t324 * (-8825.984999999999);
+  const double t466 = t341 * (-22.9843359375) * t374;
+  const double t467 = (t372 + t105 + t110 + t373 + t118 + t119 - 86.6048 * t0);
+  const double t468 = (2.0 * t374 * x[3] + t381 + t467 * x[2]);
+  const double t469 = (t330 + t211 * x[3] + 2.0 * x[2] * t126);
+  const double t470 = (t386 + t388 * x[3] + t383 * 2.0 * x[2]);
+  const double t471 = (t337 * x[3] + 2.0 * x[2] * t333 + t336);
+  const double t472 = (1.0 / (t73));
+  const double t473 = (t426 * x[3] - 2.0 * t439 * x[2] - t446 * x[3]);
+  const double t474 = (t164 * x[2] + t206 * 2.0 * x[3] + t331);
+  const double t475 = (t338 + t335 * x[2] + 2.0 * t339 * x[3]);
+  const double t476 = (x[2] * t385 + t389 + 2.0 * t387 * x[3]);
+  const double t477 = (t427 + 2.0 * t434 * x[3] - t446 * x[2]);
+  const double t478 = t399 * t166 * (-1e+06) * t167 * t472;
+  const double t479 = (t440 + t441 + t442 + t423 + t443 + t444 + t424);
+  const double t480 = (t428 + t429 + t423 + t430 + t431 + t424);
+  const double t481 = (-t271 * t274 * t436 * t420 * 0.15625 - t263 * 0.3125 * t269 * t438 -
+                       t435 * t271 * t263 * 0.15625 - t263 * t274 * 0.3125 * t269 -
+                       t263 * t264 * 0.15625 * t437 - t436 * t420 * t264 * 0.15625 * t269);
+  const double t482 = (-t90 * t66 * t103 * t104 * t60 * 8.0 + t98 * t103 * t65 * t104 * t60 * 8.0 +
+                       t66 * 2.0 * t60 * t125 * t94 - t98 * 4.0 * t60 * t88 * t94 +
+                       t98 * t65 * t79 * 8.0 * t83 * t94 - t65 * t120 * 2.0 * t60 * t94 -
+                       t90 * t66 * t79 * 8.0 * t83 * t94 + t90 * t96 * 4.0 * t60 * t94);
+  const double t483 = 900.0 * t291 * t324;
+  const double t484 = t285 * t315;
+  const double t485 = t348 * t289;
+  const double t486 = 900.0 * t294 * t410;
+  const double t487 =
+      (-t164 * t259 * t68 * 7.125 + t366 * t314 * 0.29296875 - t309 * t467 * 0.29296875 -
+       t481 * 0.125 * t323 + t482 * t141 * 0.5 + t164 * 0.125 * t258 + t483 + t308 * 900.0 * t294 -
+       t374 * 0.29296875 * t312 - t276 * t446 * 0.03125 - t99 * t141 * t68 * t299 * 14.25 -
+       t479 * t313 * 0.29296875 - 28.5 * t141 * t68 * t333 - t259 * t99 * t141 * t70 * 14.25 +
+       900.0 * t413 * t324 + t383 * 28.5 * t141 * t70 +
+       ((t484 + t289 * t316 + t315 * t352 + t485)) * u[4] + t164 * t70 * t299 * 7.125 + t486);
+  const double t488 = t66 * 2.0 * t162 * t60 * t94;
+  const double t489 = t65 * (-2.0) * t60 * t154 * t94;
+  const double t490 = t315 * t348;
+  const double t491 = t315 * t316;
+  const double t492 = ((t490 + t491)) * 2.0 * u[4];
+  const double t493 = t308 * 1800.0 * t324;
+  const double t494 = t271 * t419 * t263 * 0.15625;
+  const double t495 = 1800.0 * t324 * t410;
+  const double t496 =
+      (t98 * 4.0 * t60 * t138 * t94 + t488 + t489 + t98 * t103 * t65 * t189 * t60 * 8.0 +
+       t98 * t65 * t79 * 8.0 * t131 * t94 - t90 * t66 * t79 * 8.0 * t131 * t94 -
+       t90 * t66 * t103 * t189 * t60 * 8.0 + t90 * 4.0 * t60 * t133 * t94);
+  const double t497 = (t263 * t319 * t274 * 0.3125 - t263 * t425 * t264 * 0.15625 +
+                       t420 * t422 * t264 * 0.15625 * t269 + t494 +
+                       t271 * t274 * t420 * t422 * 0.15625 - t263 * t418 * 0.3125 * t269);
+  const double t498 =
+      (t206 * t70 * t299 * 7.125 + t206 * 0.125 * t258 + ((t484 + t490 + t491 + t485)) * u[4] -
+       t479 * t314 * 0.29296875 - 28.5 * t141 * t337 * t68 + t483 - t259 * t70 * 14.25 * t207 +
+       28.5 * t141 * t388 * t70 - 0.125 * t323 * t497 + 900.0 * t324 * t410 -
+       t309 * t374 * 0.29296875 - t68 * t299 * 14.25 * t207 - t313 * 0.29296875 * t480 +
+       t308 * 900.0 * t324 -
        0.29296875 *
-           ((t360 - t198 + t361 + t196 * t57 + t63 * t187 * t76 * 8.0 + t76 * t130 * 8.0 * t128)) *
-           t300 +
-       t422 * t264 * 0.03125 + t474 - t201 * t247 * t65 * 7.125 + t138 * t484 * 0.5);
+           ((t372 - t203 + t373 + t201 * t60 + t66 * t192 * t79 * 8.0 + t79 * t133 * 8.0 * t131)) *
+           t312 +
+       t434 * t276 * 0.03125 + t486 - t206 * t259 * t68 * 7.125 + t141 * t496 * 0.5);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[44] = (-12.5);
   jacobian[55] = (-12.5);
   jacobian[60] =
-      (t9 * 1.2e+09 *
-           ((-t17 * t18 * 0.02454369260617026 * x[2] + 0.02454369260617026 * x[2] * t19 * t21)) -
-       t18 *
-           ((-t18 * 0.02454369260617026 * x[2] * t20 - 3.666666666666667e-09 * x[6] +
-             t24 * 1.496910398367498e-06 * t28 * t25 - 1.496910398367498e-06 * t29 * t33 * t30 +
-             sqrt(t34) * 1.8333333333333334e-09 - 1.8333333333333334e-09 * sqrt(t36) +
+      (-t9 * 29452431.12740431 *
+           ((-t9 * 0.02454369260617026 * x[2] * t14 - 3.666666666666667e-09 * x[6] +
+             7.48455199183749e-07 * t17 * t20 * t23 + t24 * 1.496910398367498e-06 * t28 * t25 +
+             sqrt(t29) * 1.8333333333333334e-09 - 1.8333333333333334e-09 * sqrt(t31) +
              0.04253333333333333)) *
-           29452431.12740431 * t20 / (t8 * t8));
-  jacobian[62] = t9 * t18 * (-29452431.12740431) * t20;
+           t14 / (t8 * t8) +
+       t32 * 1.2e+09 *
+           ((-t36 * t9 * 0.02454369260617026 * x[2] + 0.02454369260617026 * x[2] * t37 * t38)));
+  jacobian[62] = t32 * t9 * (-29452431.12740431) * t14;
   jacobian[64] =
-      ((-1.496910398367498e-06 * t33 * t30 * t38 - 1.496910398367498e-06 * t39 * t28 * t25)) * t9 *
-      1.2e+09;
+      t32 * 1.2e+09 *
+      ((7.48455199183749e-07 * t17 * t40 * t23 - 1.496910398367498e-06 * t41 * t28 * t25));
   jacobian[66] =
-      t9 * 1.2e+09 *
-      ((-1.496910398367498e-06 * t29 * t33 -
-        9.166666666666667e-10 * (1.0 / sqrt(t36)) * ((-4.6e+07 + t40)) +
-        t41 * 9.166666666666667e-10 * (1.0 / sqrt(t34)) + t24 * 1.496910398367498e-06 * t28 -
-        3.666666666666667e-09 - t41 * pow(t27, (-1.25)) * t24 * 3.742275995918745e-07 * t25 +
-        pow(t32, (-1.25)) * t31 * 7.48455199183749e-07 * t29));
+      t32 * 1.2e+09 *
+      ((-t42 * pow(t22, (-1.25)) * t20 * 9.355689989796862e-08 * t21 -
+        9.166666666666667e-10 * (1.0 / sqrt(t31)) * ((-4.6e+07 + t43)) +
+        t44 * 9.166666666666667e-10 * (1.0 / sqrt(t29)) + t24 * 1.496910398367498e-06 * t28 +
+        t42 * 7.48455199183749e-07 * t20 * t23 - 3.666666666666667e-09 -
+        t44 * pow(t27, (-1.25)) * t24 * 3.742275995918745e-07 * t25));
   jacobian[70] =
-      (1.2e+09 * t73 *
-           ((-x[2] * 0.01134900346109313 * t74 * t125 - t162 * 0.005674501730546565 * x[3] * t74 +
-             t163 * 0.005674501730546565 * x[3] * t164 * t165 +
-             t166 * x[2] * 0.01134900346109313 * t165)) -
-       t182 * t164 * 13618804.153311757 * t183 * t74);
+      (1.2e+09 * t76 *
+           ((-x[2] * 0.01134900346109313 * t77 * t128 - t165 * 0.005674501730546565 * x[3] * t77 +
+             t166 * 0.005674501730546565 * x[3] * t167 * t168 +
+             t169 * x[2] * 0.01134900346109313 * t168)) -
+       t187 * t167 * 13618804.153311757 * t188 * t77);
   jacobian[71] =
-      (1.2e+09 * t73 *
-           ((t163 * 0.005674501730546565 * x[2] * t164 * t165 -
-             0.005674501730546565 * x[3] * t74 * t205 - t207 * x[2] * 0.01134900346109313 * t74 +
-             x[3] * t165 * t208 * 0.0028372508652732826)) -
-       t163 * t182 * 6809402.076655879 * t183 * t74);
-  jacobian[72] = t73 * (-13618804.153311757) * t164 * t74;
-  jacobian[73] = (-6809402.076655879) * t163 * t73 * t74;
+      (1.2e+09 * t76 *
+           ((t166 * 0.005674501730546565 * x[2] * t167 * t168 -
+             0.005674501730546565 * x[3] * t77 * t210 - t212 * x[2] * 0.01134900346109313 * t77 +
+             x[3] * t168 * t213 * 0.0028372508652732826)) -
+       t166 * t187 * 6809402.076655879 * t188 * t77);
+  jacobian[72] = t76 * (-13618804.153311757) * t167 * t77;
+  jacobian[73] = (-6809402.076655879) * t166 * t76 * t77;
   jacobian[75] =
-      ((-1.496910398367498e-06 * t210 * t172 * t175 - t211 * 1.496910398367498e-06 * t181 * t178)) *
-      1.2e+09 * t73;
+      ((-t215 * t172 * 7.48455199183749e-07 * t178 - 1.496910398367498e-06 * t216 * t182 * t185)) *
+      1.2e+09 * t76;
   jacobian[77] =
       1.2e+09 *
-      (((1.0 / sqrt(t176)) * t213 * 9.166666666666667e-10 + 1.496910398367498e-06 * t171 * t175 +
-        pow(t180, (-1.25)) * 7.48455199183749e-07 * t177 * t179 -
-        9.166666666666667e-10 * (1.0 / sqrt(t168)) * ((t212 - 4.2e+07)) - 3.666666666666667e-09 -
-        t177 * 1.496910398367498e-06 * t181 -
-        t213 * 3.742275995918745e-07 * pow(t174, (-1.25)) * t171 * t172)) *
-      t73;
+      ((t217 * 7.48455199183749e-07 * t175 * t178 +
+        (1.0 / sqrt(t186)) * t219 * 9.166666666666667e-10 + 1.496910398367498e-06 * t181 * t185 -
+        t217 * pow(t177, (-1.25)) * t175 * t176 * 9.355689989796862e-08 -
+        9.166666666666667e-10 * (1.0 / sqrt(t180)) * ((t218 - 4.2e+07)) - 3.666666666666667e-09 -
+        t219 * 3.742275995918745e-07 * pow(t184, (-1.25)) * t181 * t182)) *
+      t76;
   jacobian[80] =
-      (1.2e+09 * t215 *
-           ((t17 * t18 * x[2] * 0.016846790604875265 - x[2] * t19 * 0.016846790604875265 * t21)) +
-       t18 *
-           ((t18 * x[2] * t20 * 0.016846790604875265 - t219 * 1.496910398367498e-06 * t29 * t216 -
-             3.666666666666667e-09 * x[8] - sqrt(t221) * 1.8333333333333334e-09 +
-             t24 * t225 * 1.496910398367498e-06 * t222 + sqrt(t226) * 1.8333333333333334e-09 +
-             0.04253333333333333)) *
-           t20 * 20216148.725850318 / (t214 * t214));
-  jacobian[82] = t18 * t20 * 20216148.725850318 * t215;
+      (1.2e+09 * t221 *
+           ((t36 * t9 * x[2] * 0.016846790604875265 - x[2] * t37 * 0.016846790604875265 * t38)) +
+       ((t9 * x[2] * t14 * 0.016846790604875265 - t225 * 1.496910398367498e-06 * t20 * t222 -
+         3.666666666666667e-09 * x[8] - sqrt(t227) * 1.8333333333333334e-09 +
+         t233 * t24 * 7.48455199183749e-07 * t230 + sqrt(t234) * 1.8333333333333334e-09 +
+         0.04253333333333333)) *
+           t9 * t14 * 20216148.725850318 / (t220 * t220));
+  jacobian[82] = t9 * t14 * 20216148.725850318 * t221;
   jacobian[84] =
-      1.2e+09 *
-      ((-t225 * 1.496910398367498e-06 * t39 * t222 - t219 * 1.496910398367498e-06 * t38 * t216)) *
-      t215;
-  jacobian[88] =
-      ((t228 * 3.742275995918745e-07 * t29 * t216 * pow(t218, (-1.25)) +
-        t228 * 9.166666666666667e-10 * (1.0 / sqrt(t226)) + t24 * t225 * 1.496910398367498e-06 -
-        t219 * 1.496910398367498e-06 * t29 - 3.666666666666667e-09 -
-        9.166666666666667e-10 * (1.0 / sqrt(t221)) * ((-4.6e+07 + t227)) -
-        t24 * t223 * 7.48455199183749e-07 * pow(t224, (-1.25)))) *
-      1.2e+09 * t215;
+      ((-t233 * 7.48455199183749e-07 * t41 * t230 - t225 * 1.496910398367498e-06 * t40 * t222)) *
+      1.2e+09 * t221;
+  jacobian[88] = ((t236 * 3.742275995918745e-07 * t20 * t222 * pow(t224, (-1.25)) +
+                   t236 * 9.166666666666667e-10 * (1.0 / sqrt(t234)) +
+                   t24 * t237 * pow(t232, (-1.25)) * 9.355689989796862e-08 * t231 -
+                   t225 * 1.496910398367498e-06 * t20 - 3.666666666666667e-09 -
+                   9.166666666666667e-10 * (1.0 / sqrt(t227)) * ((-4.6e+07 + t235)) -
+                   t233 * t24 * 7.48455199183749e-07 * t237)) *
+                 1.2e+09 * t221;
   jacobian[90] =
-      (1.2e+09 *
-           ((-0.002847068342315751 * t163 * x[3] * t164 * t165 +
-             0.002847068342315751 * t162 * x[3] * t74 - t166 * x[2] * t165 * 0.005694136684631502 +
-             x[2] * t74 * t125 * 0.005694136684631502)) *
-           t230 +
-       6832964.021557803 * t242 * t243 * t164 * t74);
+      (6832964.021557803 * t239 * t253 * t167 * t77 +
+       1.2e+09 *
+           ((-0.002847068342315751 * t166 * x[3] * t167 * t168 +
+             0.002847068342315751 * t165 * x[3] * t77 - t169 * x[2] * t168 * 0.005694136684631502 +
+             x[2] * t77 * t128 * 0.005694136684631502)) *
+           t254);
   jacobian[91] =
       (1.2e+09 *
-           ((-0.002847068342315751 * t163 * x[2] * t164 * t165 +
-             0.002847068342315751 * x[3] * t74 * t205 - 0.0014235341711578756 * x[3] * t165 * t208 +
-             t207 * x[2] * t74 * 0.005694136684631502)) *
-           t230 +
-       t163 * 3416482.0107789016 * t242 * t243 * t74);
-  jacobian[92] = 6832964.021557803 * t164 * t74 * t230;
-  jacobian[93] = t163 * 3416482.0107789016 * t74 * t230;
+           ((-0.002847068342315751 * t166 * x[2] * t167 * t168 +
+             0.002847068342315751 * x[3] * t77 * t210 - 0.0014235341711578756 * x[3] * t168 * t213 +
+             t212 * x[2] * t77 * 0.005694136684631502)) *
+           t254 +
+       t166 * 3416482.0107789016 * t239 * t253 * t77);
+  jacobian[92] = 6832964.021557803 * t167 * t77 * t254;
+  jacobian[93] = t166 * 3416482.0107789016 * t77 * t254;
   jacobian[95] =
-      ((-t211 * 1.496910398367498e-06 * t234 * t231 + t238 * 1.496910398367498e-06 * t241 * t210)) *
-      1.2e+09 * t230;
-  jacobian[99] = 1.2e+09 *
-                 ((-t177 * 1.496910398367498e-06 * t234 + 1.496910398367498e-06 * t171 * t241 -
-                   9.166666666666667e-10 * (1.0 / sqrt(t236)) * ((t244 - 4.2e+07)) -
-                   t239 * 7.48455199183749e-07 * pow(t240, (-1.25)) * t171 - 3.666666666666667e-09 +
-                   t245 * 9.166666666666667e-10 * (1.0 / sqrt(t237)) +
-                   t245 * t177 * 3.742275995918745e-07 * pow(t233, (-1.25)) * t231)) *
-                 t230;
+      1.2e+09 *
+      ((-t215 * 1.496910398367498e-06 * t243 * t240 + 7.48455199183749e-07 * t248 * t251 * t216)) *
+      t254;
+  jacobian[99] = ((-t175 * 1.496910398367498e-06 * t243 -
+                   9.166666666666667e-10 * (1.0 / sqrt(t245)) * ((t255 - 4.2e+07)) +
+                   t256 * 7.48455199183749e-07 * t181 * t251 - 3.666666666666667e-09 -
+                   t249 * t256 * pow(t250, (-1.25)) * 9.355689989796862e-08 * t181 +
+                   t257 * 9.166666666666667e-10 * (1.0 / sqrt(t252)) +
+                   t257 * t175 * 3.742275995918745e-07 * pow(t242, (-1.25)) * t240)) *
+                 1.2e+09 * t254;
   mass[0] =
-      (t96 * t246 * 0.5 + 190.0 * (t247 * t247) + 0.125 * t263 * t264 + 110.0 * (t265 * t265) +
-       1600.0 * (t266 * t266) + 110.0 * (t268 * t268) + 1600.0 * (t269 * t269) +
-       u[4] * (((t273 * t273) + (t277 * t277))) + 1580.0 + 900.0 * (t279 * t279) +
-       900.0 * (t282 * t282) + t285 * t286 + (t287 * t287) * 190.0 + 190.0 * (t289 * t289) +
-       75.0 * (t290 * t290) + (t293 * t293) * 75.0 + t285 * t294 + 190.0 * (t295 * t295));
-  mass[1] = t313;
-  mass[2] = t313;
+      (t99 * t258 * 0.5 + 190.0 * (t259 * t259) + 0.125 * t275 * t276 + 110.0 * (t277 * t277) +
+       1600.0 * (t278 * t278) + 110.0 * (t280 * t280) + 1600.0 * (t281 * t281) +
+       u[4] * (((t285 * t285) + (t289 * t289))) + 1580.0 + 900.0 * (t291 * t291) +
+       900.0 * (t294 * t294) + t297 * t298 + (t299 * t299) * 190.0 + 190.0 * (t301 * t301) +
+       75.0 * (t302 * t302) + (t305 * t305) * 75.0 + t297 * t306 + 190.0 * (t307 * t307));
+  mass[1] = t325;
+  mass[2] = t325;
   mass[3] =
-      ((t302 * t302) * 1.171875 + t138 * 0.5 * t314 + t203 * 4.2749999999999995 * t202 + 280.0 +
-       (t315 * t315) * 75.0 + t204 * 4.2749999999999995 * t202 - 0.125 * t311 * t316 +
-       u[4] * (((t304 * t304) + (t303 * t303))) + (t296 * t296) * 900.0 + 900.0 * (t312 * t312));
+      ((t314 * t314) * 1.171875 + t141 * 0.5 * t326 + t208 * 4.2749999999999995 * t207 + 280.0 +
+       (t327 * t327) * 75.0 + t209 * 4.2749999999999995 * t207 - 0.125 * t323 * t328 +
+       u[4] * (((t316 * t316) + (t315 * t315))) + (t308 * t308) * 900.0 + 900.0 * (t324 * t324));
   acceleration[0] =
-      (-91.93734375 * ((t305 + t306 + 21.6512 * t0 + t255 + t256)) * t317 - t320 * 0.125 * t246 -
-       t295 * t317 * 1863.2634999999998 - 190.0 * t328 * t247 - 1500.0 * x[2] -
-       t329 * t266 * 15690.64 - ((t273 * t333 + t342 * t277)) * u[4] -
-       t329 * 1863.2634999999998 * t289 - t295 * 190.0 * t343 * t345 - 900.0 * t279 * t349 -
-       t301 * t356 * 0.29296875 - 8825.984999999999 * t317 * t279 + t370 * 0.29296875 * t300 -
-       190.0 * t378 * t287 - 0.5 * t389 * t164 * t74 - t390 * t343 * 110.0 * t265 -
-       t392 * t343 * t294 - t343 * 110.0 * t393 * t268 -
-       91.93734375 * t329 * ((t394 + t92 + t395 - t2 * 21.6512 + t94)) +
-       u[4] * ((-t329 * t277 * 9.80665 - t273 * t317 * 9.80665)) + u[2] - t269 * 15690.64 * t317 -
-       t247 * t329 * 1863.2634999999998 - t317 * 1863.2634999999998 * t287 - 900.0 * t403 * t282 -
-       t265 * t317 * 1078.7314999999999 - 1600.0 * t343 * t266 * t404 - 190.0 * t343 * t405 * t289 -
-       t329 * t268 * 1078.7314999999999 - 1600.0 * t269 * t343 * t266 - t264 * 0.03125 * t435 -
-       t329 * 8825.984999999999 * t282 + t18 * t20 * t445 - t392 * t343 * t286);
+      (-91.93734375 * ((t317 + t318 + 21.6512 * t0 + t267 + t268)) * t329 - t332 * 0.125 * t258 -
+       t307 * t329 * 1863.2634999999998 - 190.0 * t340 * t259 - 1500.0 * x[2] -
+       t341 * t278 * 15690.64 - ((t285 * t345 + t354 * t289)) * u[4] -
+       t341 * 1863.2634999999998 * t301 - t307 * 190.0 * t355 * t357 - 900.0 * t291 * t361 -
+       t313 * t368 * 0.29296875 - 8825.984999999999 * t329 * t291 + t382 * 0.29296875 * t312 -
+       190.0 * t390 * t299 - 0.5 * t401 * t167 * t77 - t402 * t355 * 110.0 * t277 -
+       t404 * t355 * t306 - t355 * 110.0 * t405 * t280 -
+       91.93734375 * t341 * ((t406 + t95 + t407 - t2 * 21.6512 + t97)) +
+       u[4] * ((-t341 * t289 * 9.80665 - t285 * t329 * 9.80665)) + u[2] - t281 * 15690.64 * t329 -
+       t259 * t341 * 1863.2634999999998 - t329 * 1863.2634999999998 * t299 - 900.0 * t415 * t294 -
+       t277 * t329 * 1078.7314999999999 - 1600.0 * t355 * t278 * t416 - 190.0 * t355 * t417 * t301 -
+       t341 * t280 * 1078.7314999999999 - 1600.0 * t281 * t355 * t278 - t276 * 0.03125 * t447 -
+       t341 * 8825.984999999999 * t294 + t9 * t14 * t457 - t404 * t355 * t298);
   acceleration[1] =
-      (-600.0 * x[3] - t138 * t317 * t67 * 279.48952499999996 - 900.0 * t403 * t312 +
-       t328 * 28.5 * t138 * t65 - ((t308 + t394 + t395 + t309)) * 91.93734375 * t329 -
-       t296 * 900.0 * t349 - t320 * 0.125 * t314 + t297 * t370 * 0.29296875 -
-       28.5 * t138 * t378 * t67 + ((-t317 * 9.80665 * t304 - t303 * t329 * 9.80665)) * u[4] -
-       t329 * 8825.984999999999 * t312 - t356 * t302 * 0.29296875 +
-       t329 * t138 * t65 * 279.48952499999996 + 91.93734375 * t317 * t302 + u[3] -
-       t163 * 0.25 * t389 * t74 - ((t333 * t304 + t303 * t342)) * u[4] -
-       t296 * 8825.984999999999 * t317 - t316 * 0.03125 * t435);
+      (-600.0 * x[3] - t141 * t329 * t70 * 279.48952499999996 - 900.0 * t415 * t324 +
+       t340 * 28.5 * t141 * t68 - ((t320 + t406 + t407 + t321)) * 91.93734375 * t341 -
+       t308 * 900.0 * t361 - t332 * 0.125 * t326 + t309 * t382 * 0.29296875 -
+       28.5 * t141 * t390 * t70 + ((-t329 * 9.80665 * t316 - t315 * t341 * 9.80665)) * u[4] -
+       t341 * 8825.984999999999 * t324 - t368 * t314 * 0.29296875 +
+       t341 * t141 * t68 * 279.48952499999996 + 91.93734375 * t329 * t314 + u[3] -
+       t166 * 0.25 * t401 * t77 - ((t345 * t316 + t315 * t354)) * u[4] -
+       t308 * 8825.984999999999 * t329 - t328 * 0.03125 * t447);
   d_force[0] =
-      (-t329 * 15690.64 * t404 + t166 * 0.5 * t389 * t165 - t329 * 1863.2634999999998 * t405 +
-       ((-t317 * t277 * 9.80665 - t340 * t329 * 9.80665)) * u[4] - 8825.984999999999 * t282 * t317 -
-       t329 * t393 * 1078.7314999999999 + t329 * 22.9843359375 * t368 - 0.5 * t164 * t74 * t448 -
-       t266 * 15690.64 * t317 + t317 * 22.9843359375 * t354 - 0.5 * t389 * t74 * t125 -
-       t371 * t317 * 1863.2634999999998 + t17 * t18 * t445 - t19 * t445 * t21 -
-       t317 * 1863.2634999999998 * t345 - t329 * 8825.984999999999 * t401 -
-       t329 * 1863.2634999999998 * t321 +
-       t18 *
-           ((-4e+08 * t18 * t20 - t18 * 2e+08 * t439 * t20 * t436 +
-             t440 * t18 * 2e+08 * t20 * t443 -
-             ((t18 * t441 * pow(t442, (-1.5)) * t20 - t18 * t437 * pow(t438, (-1.5)) * t20 +
-               t18 * t439 * t20 - t18 * t20 * t443)) *
-                 t18 * 2e+06 * x[2] * t20 +
-             2e+06 * x[2] * t19 * t444 * t21 - t17 * t18 * 2e+06 * x[2] * t444)) *
-           t20 -
-       t390 * t317 * 1078.7314999999999);
-  d_force[1] = (-t376 * t317 * 1863.2634999999998 + t449 + t352 * t317 * 22.9843359375 + t450 +
-                t451 + t452 * 0.25 * t164 * t74 - t329 * t325 * 1863.2634999999998 -
-                t207 * 0.5 * t389 * t74 + t453 + t454);
+      (-t341 * 15690.64 * t416 + t169 * 0.5 * t401 * t168 - t341 * 1863.2634999999998 * t417 +
+       ((-t329 * t289 * 9.80665 - t352 * t341 * 9.80665)) * u[4] - 8825.984999999999 * t294 * t329 -
+       t341 * t405 * 1078.7314999999999 + t341 * 22.9843359375 * t380 - 0.5 * t167 * t77 * t460 -
+       t278 * 15690.64 * t329 + t329 * 22.9843359375 * t366 - 0.5 * t401 * t77 * t128 -
+       t383 * t329 * 1863.2634999999998 + t36 * t9 * t457 - t37 * t457 * t38 -
+       t329 * 1863.2634999999998 * t357 - t341 * 8825.984999999999 * t413 -
+       t341 * 1863.2634999999998 * t333 +
+       t9 *
+           ((-4e+08 * t9 * t14 - t9 * 2e+08 * t451 * t14 * t448 + t452 * t9 * 2e+08 * t14 * t455 -
+             ((t9 * t453 * pow(t454, (-1.5)) * t14 - t9 * t449 * pow(t450, (-1.5)) * t14 +
+               t9 * t451 * t14 - t9 * t14 * t455)) *
+                 t9 * 2e+06 * x[2] * t14 +
+             2e+06 * x[2] * t37 * t456 * t38 - t36 * t9 * 2e+06 * x[2] * t456)) *
+           t14 -
+       t402 * t329 * 1078.7314999999999);
+  d_force[1] = (-t388 * t329 * 1863.2634999999998 + t461 + t364 * t329 * 22.9843359375 + t462 +
+                t463 + t464 * 0.25 * t167 * t77 - t341 * t337 * 1863.2634999999998 -
+                t212 * 0.5 * t401 * t77 + t465 + t466);
   d_force[2] =
-      (-t295 * 380.0 * x[2] * t345 - t347 * t279 * 1800.0 + t456 * 0.29296875 * t300 -
-       t393 * 220.0 * x[2] * t268 - 2.0 * ((t273 * t332 + t341 * t277)) * u[4] -
-       0.125 * t246 * t457 - 190.0 * t458 * t287 - 0.5859375 * t301 * t355 - 190.0 * t247 * t459 -
-       t387 * t166 * 2e+06 * t460 - t402 * t282 * 1800.0 - 3200.0 * t266 * t404 * x[2] -
-       t390 * 220.0 * t265 * x[2] - 2e+06 * t283 * t444 * t21 - t461 * t264 * 0.03125 -
-       380.0 * x[2] * t405 * t289 - t392 * t294 * 2.0 * x[2] - t269 * 3200.0 * t266 * x[2] -
-       1500.0 - t392 * 2.0 * x[2] * t286);
+      (-t307 * 380.0 * x[2] * t357 - t359 * t291 * 1800.0 + t468 * 0.29296875 * t312 -
+       t405 * 220.0 * x[2] * t280 - 2.0 * ((t285 * t344 + t353 * t289)) * u[4] -
+       0.125 * t258 * t469 - 190.0 * t470 * t299 - 0.5859375 * t313 * t367 - 190.0 * t259 * t471 -
+       t399 * t169 * 2e+06 * t472 - t414 * t294 * 1800.0 - 3200.0 * t278 * t416 * x[2] -
+       t402 * 220.0 * t277 * x[2] - 2e+06 * t295 * t456 * t38 - t473 * t276 * 0.03125 -
+       380.0 * x[2] * t417 * t301 - t404 * t306 * 2.0 * x[2] - t281 * 3200.0 * t278 * x[2] -
+       1500.0 - t404 * 2.0 * x[2] * t298);
   d_force[3] =
-      (-t282 * t400 * 1800.0 - 0.5859375 * t363 * t300 - 0.125 * t246 * t462 - 190.0 * t247 * t463 -
-       0.5859375 * t353 * t301 - 190.0 * t464 * t287 - t348 * t279 * 1800.0 -
-       t264 * t465 * 0.03125 - ((t338 * t277 + t273 * t331)) * 2.0 * u[4] + t466);
-  d_force[6] = t18 * 0.02454369260617026 * t20;
-  d_force[7] = 0.01134900346109313 * t164 * t74;
-  d_force[8] = t18 * t20 * (-0.016846790604875265);
-  d_force[9] = (-0.005694136684631502) * t164 * t74;
+      (-t294 * t412 * 1800.0 - 0.5859375 * t375 * t312 - 0.125 * t258 * t474 - 190.0 * t259 * t475 -
+       0.5859375 * t365 * t313 - 190.0 * t476 * t299 - t360 * t291 * 1800.0 -
+       t276 * t477 * 0.03125 - ((t350 * t289 + t285 * t343)) * 2.0 * u[4] + t478);
+  d_force[6] = t9 * 0.02454369260617026 * t14;
+  d_force[7] = 0.01134900346109313 * t167 * t77;
+  d_force[8] = t9 * t14 * (-0.016846790604875265);
+  d_force[9] = (-0.005694136684631502) * t167 * t77;
   d_force[10] =
-      (-t467 * t317 * 22.9843359375 + t449 - t162 * 0.25 * t389 * t74 +
-       t96 * t138 * t65 * t317 * 139.74476249999998 + t450 + t451 -
-       69.87238124999999 * t161 * t317 * t67 + 69.87238124999999 * t161 * t329 * t65 +
-       t329 * t96 * t138 * 139.74476249999998 * t67 + t453 - t163 * 0.25 * t74 * t448 + t454);
+      (-t479 * t329 * 22.9843359375 + t461 - t165 * 0.25 * t401 * t77 +
+       t99 * t141 * t68 * t329 * 139.74476249999998 + t462 + t463 -
+       69.87238124999999 * t164 * t329 * t70 + 69.87238124999999 * t164 * t341 * t68 +
+       t341 * t99 * t141 * 139.74476249999998 * t70 + t465 - t166 * 0.25 * t77 * t460 + t466);
   d_force[11] =
-      (t329 * 139.74476249999998 * t67 * t202 + t449 + t450 - t317 * 22.9843359375 * t468 +
-       t329 * 22.9843359375 * t359 + 69.87238124999999 * t201 * t329 * t65 +
-       t65 * t317 * 139.74476249999998 * t202 - 69.87238124999999 * t201 * t317 * t67 +
-       0.125 * t389 * t165 * t208 - 0.25 * t389 * t74 * t205 + t452 * 0.125 * t163 * t74 + t453);
-  d_force[12] = (-2.0 * ((t303 * t341 + t332 * t304)) * u[4] - 0.5859375 * t355 * t302 +
-                 t297 * t456 * 0.29296875 - t458 * 28.5 * t138 * t67 + 28.5 * t138 * t459 * t65 -
-                 t296 * t347 * 1800.0 - t461 * t316 * 0.03125 - t402 * 1800.0 * t312 -
-                 0.125 * t457 * t314 + t466);
-  d_force[13] = (-t400 * 1800.0 * t312 - 2.0 * u[4] * ((t338 * t303 + t331 * t304)) -
-                 0.5859375 * t353 * t302 - 0.5859375 * t297 * t363 - 0.125 * t314 * t462 -
-                 t387 * t460 * 5e+05 * t208 - 600.0 - 28.5 * t138 * t464 * t67 -
-                 t316 * t465 * 0.03125 + 28.5 * t138 * t65 * t463 - t296 * t348 * 1800.0);
-  d_force[17] = t163 * 0.005674501730546565 * t74;
-  d_force[19] = t163 * (-0.002847068342315751) * t74;
+      (t341 * 139.74476249999998 * t70 * t207 + t461 + t462 - t329 * 22.9843359375 * t480 +
+       t341 * 22.9843359375 * t371 + 69.87238124999999 * t206 * t341 * t68 +
+       t68 * t329 * 139.74476249999998 * t207 - 69.87238124999999 * t206 * t329 * t70 +
+       0.125 * t401 * t168 * t213 - 0.25 * t401 * t77 * t210 + t464 * 0.125 * t166 * t77 + t465);
+  d_force[12] = (-2.0 * ((t315 * t353 + t344 * t316)) * u[4] - 0.5859375 * t367 * t314 +
+                 t309 * t468 * 0.29296875 - t470 * 28.5 * t141 * t70 + 28.5 * t141 * t471 * t68 -
+                 t308 * t359 * 1800.0 - t473 * t328 * 0.03125 - t414 * 1800.0 * t324 -
+                 0.125 * t469 * t326 + t478);
+  d_force[13] = (-t412 * 1800.0 * t324 - 2.0 * u[4] * ((t350 * t315 + t343 * t316)) -
+                 0.5859375 * t365 * t314 - 0.5859375 * t309 * t375 - 0.125 * t326 * t474 -
+                 t399 * t472 * 5e+05 * t213 - 600.0 - 28.5 * t141 * t476 * t70 -
+                 t328 * t477 * 0.03125 + 28.5 * t141 * t68 * t475 - t308 * t360 * 1800.0);
+  d_force[17] = t166 * 0.005674501730546565 * t77;
+  d_force[19] = t166 * (-0.002847068342315751) * t77;
   d_mass[0] =
-      (t392 * t286 + t269 * 3200.0 * t266 + 380.0 * t405 * t289 + t282 * t279 * 1800.0 +
-       0.125 * t246 * t123 + 0.5859375 * t301 * t354 + 0.5859375 * t368 * t300 +
-       t469 * 0.125 * t263 +
-       t285 *
-           ((t12 * 12.021927866666665 * t283 * t16 + t12 * 12.021927866666665 * t283 * t4 +
-             12.021927866666665 * t283 * t16 * t284 - t391 * t12 * t20 * t284 * 24.04385573333333 +
-             t12 * 12.021927866666665 * t13 * t283 - t391 * t13 * t20 * t4 * 24.04385573333333)) -
-       t264 * t427 * 0.03125 + t470 * t96 * 0.5 + ((t273 * t277 + t340 * t277)) * 2.0 * u[4] +
-       t393 * 220.0 * t268 +
-       t285 *
-           ((t12 * 20.765148133333334 * t13 * t283 + t12 * 20.765148133333334 * t283 * t4 +
-             t12 * 20.765148133333334 * t283 * t16 - t391 * t12 * 41.53029626666667 * t20 * t284 -
-             t391 * t13 * 41.53029626666667 * t20 * t4 + 20.765148133333334 * t283 * t16 * t284)) +
-       t282 * 1800.0 * t401 + t295 * 380.0 * t345 + t371 * 380.0 * t287 + t392 * t294 +
-       t390 * 220.0 * t265 + 3200.0 * t266 * t404 + t247 * 380.0 * t321);
-  d_mass[1] = t475;
-  d_mass[2] = t475;
+      (t404 * t298 + t281 * 3200.0 * t278 + 380.0 * t417 * t301 + t294 * t291 * 1800.0 +
+       0.125 * t258 * t126 + 0.5859375 * t313 * t366 + 0.5859375 * t380 * t312 +
+       t481 * 0.125 * t275 +
+       t297 *
+           ((t13 * 12.021927866666665 * t295 * t35 + t13 * 12.021927866666665 * t295 * t4 +
+             12.021927866666665 * t295 * t35 * t296 - t403 * t13 * t14 * t296 * 24.04385573333333 +
+             t13 * 12.021927866666665 * t10 * t295 - t403 * t10 * t14 * t4 * 24.04385573333333)) -
+       t276 * t439 * 0.03125 + t482 * t99 * 0.5 + ((t285 * t289 + t352 * t289)) * 2.0 * u[4] +
+       t405 * 220.0 * t280 +
+       t297 *
+           ((t13 * 20.765148133333334 * t10 * t295 + t13 * 20.765148133333334 * t295 * t4 +
+             t13 * 20.765148133333334 * t295 * t35 - t403 * t13 * 41.53029626666667 * t14 * t296 -
+             t403 * t10 * 41.53029626666667 * t14 * t4 + 20.765148133333334 * t295 * t35 * t296)) +
+       t294 * 1800.0 * t413 + t307 * 380.0 * t357 + t383 * 380.0 * t299 + t404 * t306 +
+       t402 * 220.0 * t277 + 3200.0 * t278 * t416 + t259 * 380.0 * t333);
+  d_mass[1] = t487;
+  d_mass[2] = t487;
   d_mass[3] =
-      (t161 * 2.1374999999999997 * t138 * t203 - 0.5859375 * t297 * t362 +
-       t138 * 0.5 *
-           ((-t62 * t133 * t76 * 8.0 * t80 * t91 + t133 * 4.0 * t57 * t85 * t91 + t476 +
-             t93 * 4.0 * t137 * t57 * t91 - t63 * t100 * t101 * t137 * t57 * 8.0 -
-             t63 * t137 * t76 * 8.0 * t80 * t91 + t477 - t100 * t62 * t133 * t101 * t57 * 8.0)) +
-       t480 + t161 * 2.1374999999999997 * t204 * t138 + t481 -
-       0.125 * t311 *
-           ((t307 * t424 * t408 * t252 * 0.15625 + t251 * t307 * 0.3125 * t426 -
-             t251 * t310 * 0.3125 * t257 - t259 * t310 * t424 * t408 * 0.15625 +
-             t251 * t252 * 0.15625 * t433 + t482)) -
-       t434 * t316 * 0.03125 + t161 * 0.125 * t314 + t483 - 0.5859375 * t467 * t302);
+      (t164 * 2.1374999999999997 * t141 * t208 - 0.5859375 * t309 * t374 +
+       t141 * 0.5 *
+           ((-t65 * t136 * t79 * 8.0 * t83 * t94 + t136 * 4.0 * t60 * t88 * t94 + t488 +
+             t96 * 4.0 * t140 * t60 * t94 - t66 * t103 * t104 * t140 * t60 * 8.0 -
+             t66 * t140 * t79 * 8.0 * t83 * t94 + t489 - t103 * t65 * t136 * t104 * t60 * 8.0)) +
+       t492 + t164 * 2.1374999999999997 * t209 * t141 + t493 -
+       0.125 * t323 *
+           ((t319 * t436 * t420 * t264 * 0.15625 + t263 * t319 * 0.3125 * t438 -
+             t263 * t322 * 0.3125 * t269 - t271 * t322 * t436 * t420 * 0.15625 +
+             t263 * t264 * 0.15625 * t445 + t494)) -
+       t446 * t328 * 0.03125 + t164 * 0.125 * t326 + t495 - 0.5859375 * t479 * t314);
   d_mass[4] =
-      (t96 * t484 * 0.5 + t279 * 1800.0 * t312 + 0.125 * t263 * t485 + 380.0 * t376 * t287 +
-       t247 * 380.0 * t325 - 0.5859375 * t362 * t300 + t414 * t264 * 0.03125 + 0.125 * t246 * t206 +
-       ((t472 + t473)) * 2.0 * u[4] + 0.5859375 * t352 * t301 + t282 * 1800.0 * t398);
-  d_mass[5] = t486;
-  d_mass[6] = t486;
-  d_mass[7] = (-0.125 * t311 *
-                   ((t259 * t310 * t408 * t410 * 0.15625 + t251 * t420 * t252 * 0.15625 +
-                     t251 * t310 * t307 * 0.3125 - t307 * t408 * t410 * t252 * 0.15625 -
-                     t259 * t251 * t421 * 0.15625 + t251 * t406 * t307 * 0.3125)) -
-               0.5859375 * t302 * t468 + t480 + t481 + t201 * 2.1374999999999997 * t138 * t203 +
-               0.5859375 * t297 * t359 + t201 * 0.125 * t314 + t422 * t316 * 0.03125 +
-               t201 * 2.1374999999999997 * t204 * t138 +
-               t138 * 0.5 *
-                   ((-t62 * t133 * t76 * 8.0 * t128 * t91 + t63 * 2.0 * t194 * t57 * t91 +
-                     4.0 * t137 * t57 * t130 * t91 - t63 * t100 * t184 * t137 * t57 * 8.0 -
-                     t63 * t137 * t76 * 8.0 * t128 * t91 - t133 * 4.0 * t57 * t135 * t91 -
-                     t100 * t62 * t133 * t184 * t57 * 8.0 + t62 * 2.0 * t57 * t200 * t91)) +
-               t483);
+      (t99 * t496 * 0.5 + t291 * 1800.0 * t324 + 0.125 * t275 * t497 + 380.0 * t388 * t299 +
+       t259 * 380.0 * t337 - 0.5859375 * t374 * t312 + t426 * t276 * 0.03125 + 0.125 * t258 * t211 +
+       ((t484 + t485)) * 2.0 * u[4] + 0.5859375 * t364 * t313 + t294 * 1800.0 * t410);
+  d_mass[5] = t498;
+  d_mass[6] = t498;
+  d_mass[7] = (-0.125 * t323 *
+                   ((t271 * t322 * t420 * t422 * 0.15625 + t263 * t432 * t264 * 0.15625 +
+                     t263 * t322 * t319 * 0.3125 - t319 * t420 * t422 * t264 * 0.15625 -
+                     t271 * t263 * t433 * 0.15625 + t263 * t418 * t319 * 0.3125)) -
+               0.5859375 * t314 * t480 + t492 + t493 + t206 * 2.1374999999999997 * t141 * t208 +
+               0.5859375 * t309 * t371 + t206 * 0.125 * t326 + t434 * t328 * 0.03125 +
+               t206 * 2.1374999999999997 * t209 * t141 +
+               t141 * 0.5 *
+                   ((-t65 * t136 * t79 * 8.0 * t131 * t94 + t66 * 2.0 * t199 * t60 * t94 +
+                     4.0 * t140 * t60 * t133 * t94 - t66 * t103 * t189 * t140 * t60 * 8.0 -
+                     t66 * t140 * t79 * 8.0 * t131 * t94 - t136 * 4.0 * t60 * t138 * t94 -
+                     t103 * t65 * t136 * t189 * t60 * 8.0 + t65 * 2.0 * t60 * t205 * t94)) +
+               t495);
   // -dh/dq by central differences (see codegen/symbolic_model.cc).
   for (int c = 0; c < kNumJoints; ++c) {
     double shifted[kNumStates];

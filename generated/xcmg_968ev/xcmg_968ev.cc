@@ -320,215 +320,220 @@ void PlantRhs(double /*t*/, const double* x, const double* u, double* xdot) {
   using std::sqrt;
   double mass[kNumJoints * kNumJoints];
   double acceleration[kNumJoints];
-  const double t0 = cos(x[0]);
-  const double t1 = sin(x[0]);
-  const double t2 = (0.194 * t0 + 1.595 + t1 * 0.857);
-  const double t3 = (-0.194) * t1;
-  const double t4 = 0.857 * t0;
-  const double t5 = (t3 + t4 - 1.339);
-  const double t6 = ((t2 * t2) + (t5 * t5));
-  const double t7 = sqrt(t6);
-  const double t8 = (-2.8e+07 + x[6]);
-  const double t9 = (t2 * ((t3 + t4)) + ((-t1 * 0.857 - 0.194 * t0)) * t5);
-  const double t10 = (1.0 / sqrt(t6));
-  const double t11 = sqrt(((x[4] * x[4]) + 1e-06));
-  const double t12 = (x[4] + t11);
-  const double t13 = (x[6] - u[6]);
+  const double t0 = (-2.8e+07 + x[6]);
+  const double t1 = cos(x[0]);
+  const double t2 = sin(x[0]);
+  const double t3 = (0.194 * t1 + 1.595 + t2 * 0.857);
+  const double t4 = (-0.194) * t2;
+  const double t5 = 0.857 * t1;
+  const double t6 = (t4 + t5 - 1.339);
+  const double t7 = (t3 * ((t4 + t5)) + ((-t2 * 0.857 - 0.194 * t1)) * t6);
+  const double t8 = ((t3 * t3) + (t6 * t6));
+  const double t9 = (1.0 / sqrt(t8));
+  const double t10 = (x[6] - u[6]);
+  const double t11 = (-x[6] + u[6] + sqrt(((t10 * t10) + 1e+08)));
+  const double t12 = sqrt(((x[4] * x[4]) + 1e-06));
+  const double t13 = (x[4] + t12);
   const double t14 = (x[6] - 2e+05);
   const double t15 = (t14 * t14);
-  const double t16 = (-t11 + x[4]);
-  const double t17 = (x[0] + x[1]);
-  const double t18 = cos(t17);
-  const double t19 = sin(t17);
-  const double t20 = (0.389 * t18 + t1 * 0.5249999999999999 - 0.365 * t0 + t19 * 0.159);
-  const double t21 = 0.159 * t18;
-  const double t22 = t19 * (-0.389);
-  const double t23 = (0.365 * t1 + t21 + t22 + t0 * 0.5249999999999999);
-  const double t24 = (t23 * t23);
-  const double t25 = (t20 * t20);
-  const double t26 = (t24 + t25 - 0.38752);
-  const double t27 = (t24 + t25);
-  const double t28 = (1.0 / sqrt(t27));
-  const double t29 = (t26 * t26);
-  const double t30 = (1.0 / (t27));
-  const double t31 = (0.567009 - 0.25 * t29 * t30);
-  const double t32 = sqrt(t31);
-  const double t33 = (t20 * t26 * t28 + 2.0 * t23 * t32);
-  const double t34 = (-t20 * 2.0 * t32 + t26 * t23 * t28);
-  const double t35 = atan2(0.5 * t33 * t28, t34 * 0.5 * t28);
-  const double t36 = cos(t35);
-  const double t37 = sin(t35);
-  const double t38 = (-0.15500000000000003 * t0 - 0.141 * t36 + t1 * 2.093 - t37 * 0.853);
-  const double t39 = t1 * 0.15500000000000003;
-  const double t40 = 2.093 * t0;
-  const double t41 = (0.141 * t37 + t39 - 0.853 * t36 + t40);
-  const double t42 = ((t38 * t38) + (t41 * t41));
-  const double t43 = sqrt(t42);
-  const double t44 = sqrt(((x[5] * x[5]) + 1e-06));
-  const double t45 = (t44 + x[5]);
-  const double t46 = (x[7] - u[7]);
-  const double t47 = (1.0 / sqrt(t42));
-  const double t48 = (1.0 / sqrt(t31));
-  const double t49 = (1.0 / (t27 * t27));
-  const double t50 = (t21 + t22);
-  const double t51 = (-0.389) * t18;
-  const double t52 = t19 * (-0.159);
-  const double t53 = (t51 + t52);
-  const double t54 = (t50 * t20 + t53 * t23);
-  const double t55 = (-t49 * t29 * t54 + 2.0 * t26 * t30 * t54);
-  const double t56 = pow(t27, (-1.5));
-  const double t57 = (1.0 / ((((t33 * t33) * t30 + (t34 * t34) * t30))));
-  const double t58 =
-      (-((((-t20 * t48 * t55 - 2.0 * t26 * t53 * t28 - 4.0 * t23 * t54 * t28 +
-            2.0 * t26 * t23 * t56 * t54 + t50 * 4.0 * t32)) *
-              t28 +
-          t34 * 2.0 * t56 * t54)) *
-           t33 * t57 * t28 +
-       t34 *
-           ((2.0 * t33 * t56 * t54 - ((-t20 * 2.0 * t26 * t56 * t54 + t50 * 2.0 * t26 * t28 +
-                                       t20 * 4.0 * t54 * t28 - t48 * t23 * t55 + 4.0 * t53 * t32)) *
-                                         t28)) *
-           t57 * t28);
-  const double t59 = (t38 * ((-0.0705 * t37 * t58 + 0.4265 * t36 * t58)) +
-                      ((-0.0705 * t36 * t58 - t37 * 0.4265 * t58)) * t41);
-  const double t60 = (x[7] - 2e+05);
-  const double t61 = (t60 * t60);
-  const double t62 = (t51 - t1 * 0.5249999999999999 + 0.365 * t0 + t52);
-  const double t63 = (t62 * t23 + t20 * t23);
-  const double t64 = (-2.0 * t26 * t63 * t30 + t49 * t63 * t29);
-  const double t65 =
-      (((t34 * 2.0 * t63 * t56 - ((t62 * 2.0 * t26 * t28 - 4.0 * t23 * t32 + 4.0 * t23 * t63 * t28 -
-                                   t20 * t48 * t64 - 2.0 * t26 * t23 * t63 * t56)) *
-                                     t28)) *
-           t33 * t57 * t28 +
-       t34 *
-           ((((t62 * 4.0 * t32 + t48 * t64 * t23 - t20 * 2.0 * t26 * t63 * t56 +
-               t20 * 4.0 * t63 * t28 + 2.0 * t26 * t23 * t28)) *
-                 t28 -
-             2.0 * t63 * t33 * t56)) *
-           t57 * t28);
-  const double t66 =
-      (((t37 * 0.4265 * t65 + 0.0705 * t36 * t65 - t1 * 2.093 + 0.15500000000000003 * t0)) * t41 +
-       t38 * ((0.0705 * t37 * t65 + t39 - 0.4265 * t36 * t65 + t40)));
-  const double t67 = (-t44 + x[5]);
-  const double t68 = (-2.8e+07 + x[7]);
-  const double t69 = (x[8] - u[6]);
-  const double t70 = (x[8] - 2e+05);
-  const double t71 = (t70 * t70);
-  const double t72 = (-2.8e+07 + x[8]);
-  const double t73 = (x[9] - 2e+05);
+  const double t16 = (-t12 + x[4]);
+  const double t17 = sqrt(t8);
+  const double t18 = (x[0] + x[1]);
+  const double t19 = cos(t18);
+  const double t20 = sin(t18);
+  const double t21 = (0.389 * t19 + t2 * 0.5249999999999999 - 0.365 * t1 + t20 * 0.159);
+  const double t22 = 0.159 * t19;
+  const double t23 = t20 * (-0.389);
+  const double t24 = (0.365 * t2 + t22 + t23 + t1 * 0.5249999999999999);
+  const double t25 = (t24 * t24);
+  const double t26 = (t21 * t21);
+  const double t27 = (t25 + t26 - 0.38752);
+  const double t28 = (t25 + t26);
+  const double t29 = (1.0 / sqrt(t28));
+  const double t30 = (t27 * t27);
+  const double t31 = (1.0 / (t28));
+  const double t32 = (0.567009 - 0.25 * t30 * t31);
+  const double t33 = sqrt(t32);
+  const double t34 = (t21 * t27 * t29 + 2.0 * t24 * t33);
+  const double t35 = (-t21 * 2.0 * t33 + t27 * t24 * t29);
+  const double t36 = atan2(0.5 * t34 * t29, t35 * 0.5 * t29);
+  const double t37 = cos(t36);
+  const double t38 = sin(t36);
+  const double t39 = (-0.15500000000000003 * t1 - 0.141 * t37 + t2 * 2.093 - t38 * 0.853);
+  const double t40 = t2 * 0.15500000000000003;
+  const double t41 = 2.093 * t1;
+  const double t42 = (0.141 * t38 + t40 - 0.853 * t37 + t41);
+  const double t43 = ((t39 * t39) + (t42 * t42));
+  const double t44 = sqrt(t43);
+  const double t45 = (x[7] - u[7]);
+  const double t46 = (x[7] - u[7] - sqrt((1e+08 + (t45 * t45))));
+  const double t47 = sqrt(((x[5] * x[5]) + 1e-06));
+  const double t48 = (t47 + x[5]);
+  const double t49 = (1.0 / sqrt(t43));
+  const double t50 = (1.0 / sqrt(t32));
+  const double t51 = (1.0 / (t28 * t28));
+  const double t52 = (t22 + t23);
+  const double t53 = (-0.389) * t19;
+  const double t54 = t20 * (-0.159);
+  const double t55 = (t53 + t54);
+  const double t56 = (t52 * t21 + t55 * t24);
+  const double t57 = (-t51 * t30 * t56 + 2.0 * t27 * t31 * t56);
+  const double t58 = pow(t28, (-1.5));
+  const double t59 = (1.0 / ((((t34 * t34) * t31 + (t35 * t35) * t31))));
+  const double t60 =
+      (-((((-t21 * t50 * t57 - 2.0 * t27 * t55 * t29 - 4.0 * t24 * t56 * t29 +
+            2.0 * t27 * t24 * t58 * t56 + t52 * 4.0 * t33)) *
+              t29 +
+          t35 * 2.0 * t58 * t56)) *
+           t34 * t59 * t29 +
+       t35 *
+           ((2.0 * t34 * t58 * t56 - ((-t21 * 2.0 * t27 * t58 * t56 + t52 * 2.0 * t27 * t29 +
+                                       t21 * 4.0 * t56 * t29 - t50 * t24 * t57 + 4.0 * t55 * t33)) *
+                                         t29)) *
+           t59 * t29);
+  const double t61 = (t39 * ((-0.0705 * t38 * t60 + 0.4265 * t37 * t60)) +
+                      ((-0.0705 * t37 * t60 - t38 * 0.4265 * t60)) * t42);
+  const double t62 = (x[7] - 2e+05);
+  const double t63 = (t62 * t62);
+  const double t64 = (t53 - t2 * 0.5249999999999999 + 0.365 * t1 + t54);
+  const double t65 = (t64 * t24 + t21 * t24);
+  const double t66 = (-2.0 * t27 * t65 * t31 + t51 * t65 * t30);
+  const double t67 =
+      (((t35 * 2.0 * t65 * t58 - ((t64 * 2.0 * t27 * t29 - 4.0 * t24 * t33 + 4.0 * t24 * t65 * t29 -
+                                   t21 * t50 * t66 - 2.0 * t27 * t24 * t65 * t58)) *
+                                     t29)) *
+           t34 * t59 * t29 +
+       t35 *
+           ((((t64 * 4.0 * t33 + t50 * t66 * t24 - t21 * 2.0 * t27 * t65 * t58 +
+               t21 * 4.0 * t65 * t29 + 2.0 * t27 * t24 * t29)) *
+                 t29 -
+             2.0 * t65 * t34 * t58)) *
+           t59 * t29);
+  const double t68 =
+      (((t38 * 0.4265 * t67 + 0.0705 * t37 * t67 - t2 * 2.093 + 0.15500000000000003 * t1)) * t42 +
+       t39 * ((0.0705 * t38 * t67 + t40 - 0.4265 * t37 * t67 + t41)));
+  const double t69 = (-t47 + x[5]);
+  const double t70 = (-2.8e+07 + x[7]);
+  const double t71 = (x[8] - u[6]);
+  const double t72 = (-sqrt(((t71 * t71) + 1e+08)) + x[8] - u[6]);
+  const double t73 = (x[8] - 2e+05);
   const double t74 = (t73 * t73);
-  const double t75 = (-2.8e+07 + x[9]);
-  const double t76 = (-x[9] + u[7]);
-  const double t77 = (-t1 * 0.1 + 1.55 * t0);
-  const double t78 = t19 * (-0.55);
-  const double t79 = (-0.25) * t18;
-  const double t80 = t1 * (-3.11);
-  const double t81 = (t78 + t79 + t80);
-  const double t82 = t19 * (-0.16343387866394005);
-  const double t83 = 3.11 * t0;
-  const double t84 = 0.4011545671438309 * t18;
+  const double t75 = (-2.8e+07 + x[8]);
+  const double t76 = (x[9] - 2e+05);
+  const double t77 = (t76 * t76);
+  const double t78 = (-x[9] + u[7]);
+  const double t79 = (-x[9] + u[7] + sqrt(((t78 * t78) + 1e+08)));
+  const double t80 = (-2.8e+07 + x[9]);
+  const double t81 = (-t2 * 0.1 + 1.55 * t1);
+  const double t82 = t20 * (-0.55);
+  const double t83 = (-0.25) * t19;
+  const double t84 = t2 * (-3.11);
   const double t85 = (t82 + t83 + t84);
-  const double t86 = t19 * (-0.4011545671438309);
-  const double t87 = (-0.16343387866394005) * t18;
-  const double t88 = (t86 + t87 + t80);
-  const double t89 = t19 * (-0.25);
-  const double t90 = 0.55 * t18;
-  const double t91 = (t83 + t89 + t90);
-  const double t92 = (-1.55 * t1 - 0.1 * t0);
-  const double t93 = (t86 + t87);
-  const double t94 = (t82 + t84);
-  const double t95 = (t89 + t90);
-  const double t96 = (t78 + t79);
-  const double t97 =
-      (((t88 * t93 + t85 * t94)) * u[4] + 600.0 + t95 * t91 * 1800.0 + t81 * 1800.0 * t96);
-  const double t98 = cos(u[5]);
-  const double t99 = (-2.51 + t7);
-  const double t100 = (1e-06 + (t99 * t99));
-  const double t101 = (t7 - 1.4);
-  const double t102 = (1e-06 + (t101 * t101));
-  const double t103 = (x[2] * x[2]);
-  const double t104 = sin(u[5]);
-  const double t105 = t19 * 0.16343387866394005;
-  const double t106 = (-0.4011545671438309) * t18;
-  const double t107 = (t105 + t106);
-  const double t108 = t107 * x[3];
-  const double t109 = (-3.11) * t0;
-  const double t110 =
-      (x[2] * ((t108 + ((t109 + t105 + t106)) * x[2])) + ((t108 + t107 * x[2])) * x[3]);
-  const double t111 = t93 * x[3];
-  const double t112 = (((t93 * x[2] + t111)) * x[3] + ((t111 + t88 * x[2])) * x[2]);
-  const double t113 = (-1.59 + t43);
-  const double t114 = ((t113 * t113) + 1e-06);
-  const double t115 = (t43 - 2.9000000000000004);
-  const double t116 = ((t115 * t115) + 1e-06);
-  const double t117 =
-      (-sqrt(t114) * 2e+08 - 8.98e+08 -
-       ((t47 * t59 * 2e+06 * x[3] + t47 * t66 * 2e+06 * x[2])) *
-           ((t113 * (1.0 / sqrt(t114)) - t115 * (1.0 / sqrt(t116)) - 2.0)) -
-       0.06283185307179587 * x[7] + sqrt(t116) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t43);
-  const double t118 = t19 * 0.25;
-  const double t119 = (-0.55) * t18;
-  const double t120 = (t118 + t119);
-  const double t121 = x[3] * t120;
-  const double t122 =
-      (((t121 + x[2] * t120)) * x[3] + ((((t118 + t109 + t119)) * x[2] + t121)) * x[2]);
-  const double t123 = x[3] * t96;
-  const double t124 = (((t123 + t81 * x[2])) * x[2] + x[3] * ((t123 + x[2] * t96)));
+  const double t86 = t20 * (-0.16343387866394005);
+  const double t87 = 3.11 * t1;
+  const double t88 = 0.4011545671438309 * t19;
+  const double t89 = (t86 + t87 + t88);
+  const double t90 = t20 * (-0.4011545671438309);
+  const double t91 = (-0.16343387866394005) * t19;
+  const double t92 = (t90 + t91 + t84);
+  const double t93 = t20 * (-0.25);
+  const double t94 = 0.55 * t19;
+  const double t95 = (t87 + t93 + t94);
+  const double t96 = (-1.55 * t2 - 0.1 * t1);
+  const double t97 = (t90 + t91);
+  const double t98 = (t86 + t88);
+  const double t99 = (t93 + t94);
+  const double t100 = (t82 + t83);
+  const double t101 =
+      (((t92 * t97 + t89 * t98)) * u[4] + 600.0 + t99 * t95 * 1800.0 + t85 * 1800.0 * t100);
+  const double t102 = cos(u[5]);
+  const double t103 = (-2.51 + t17);
+  const double t104 = (1e-06 + (t103 * t103));
+  const double t105 = (t17 - 1.4);
+  const double t106 = (1e-06 + (t105 * t105));
+  const double t107 = (x[2] * x[2]);
+  const double t108 = sin(u[5]);
+  const double t109 = t20 * 0.16343387866394005;
+  const double t110 = (-0.4011545671438309) * t19;
+  const double t111 = (t109 + t110);
+  const double t112 = t111 * x[3];
+  const double t113 = (-3.11) * t1;
+  const double t114 =
+      (x[2] * ((t112 + ((t113 + t109 + t110)) * x[2])) + ((t112 + t111 * x[2])) * x[3]);
+  const double t115 = t97 * x[3];
+  const double t116 = (((t97 * x[2] + t115)) * x[3] + ((t115 + t92 * x[2])) * x[2]);
+  const double t117 = (-1.59 + t44);
+  const double t118 = ((t117 * t117) + 1e-06);
+  const double t119 = (t44 - 2.9000000000000004);
+  const double t120 = ((t119 * t119) + 1e-06);
+  const double t121 =
+      (-sqrt(t118) * 2e+08 - 8.98e+08 -
+       ((t49 * t61 * 2e+06 * x[3] + t49 * t68 * 2e+06 * x[2])) *
+           ((t117 * (1.0 / sqrt(t118)) - t119 * (1.0 / sqrt(t120)) - 2.0)) -
+       0.06283185307179587 * x[7] + sqrt(t120) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t44);
+  const double t122 = t20 * 0.25;
+  const double t123 = (-0.55) * t19;
+  const double t124 = (t122 + t123);
+  const double t125 = x[3] * t124;
+  const double t126 =
+      (((t125 + x[2] * t124)) * x[3] + ((((t122 + t113 + t123)) * x[2] + t125)) * x[2]);
+  const double t127 = x[3] * t100;
+  const double t128 = (((t127 + t85 * x[2])) * x[2] + x[3] * ((t127 + x[2] * t100)));
   xdot[0] = x[2];
   xdot[1] = x[3];
   xdot[4] = (12.5 * u[0] - 12.5 * x[4]);
   xdot[5] = (12.5 * u[1] - 12.5 * x[5]);
   xdot[6] = 1.2e+09 *
-            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t8 * t8))) + 0.094 -
-              6.666666666666667e-09 * x[6] - t9 * t10 * 0.05089380098815465 * x[2] -
-              t12 * 2.721655269759087e-06 * pow((4e+10 + (t13 * t13)), (-0.25)) * t13 +
+            ((-3.3333333333333334e-09 * sqrt((1e+10 + (t0 * t0))) + 0.094 -
+              6.666666666666667e-09 * x[6] - t7 * t9 * 0.05089380098815465 * x[2] +
+              1.3608276348795436e-06 * t11 * t13 * pow((4e+10 + 0.25 * (t11 * t11)), (-0.25)) +
               3.3333333333333334e-09 * sqrt((t15 + 1e+10)) +
               t16 * pow((4e+10 + t15), (-0.25)) * 2.721655269759087e-06 * t14)) /
-            (((t7 * 0.05089380098815465 - 0.06725132138341651)));
+            (((t17 * 0.05089380098815465 - 0.06725132138341651)));
   xdot[7] = 1.2e+09 *
-            ((-t45 * pow((4e+10 + (t46 * t46)), (-0.25)) * 2.0412414523193154e-06 * t46 -
-              x[7] * 5e-09 - t47 * 0.031415926535897934 * t59 * x[3] + 0.07050000000000001 +
-              sqrt((1e+10 + t61)) * 2.5e-09 - t47 * 0.031415926535897934 * t66 * x[2] +
-              t67 * 2.0412414523193154e-06 * t60 * pow((4e+10 + t61), (-0.25)) -
-              2.5e-09 * sqrt((1e+10 + (t68 * t68))))) /
-            (((0.031415926535897934 * t43 - 0.04695132319207772)));
-  xdot[8] = 1.2e+09 *
-            ((t9 * t10 * x[2] * 0.03817035074111599 +
-              t16 * pow((4e+10 + (t69 * t69)), (-0.25)) * 2.721655269759087e-06 * t69 + 0.094 -
-              6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t71 + 1e+10)) -
-              pow((4e+10 + t71), (-0.25)) * t12 * 2.721655269759087e-06 * t70 -
-              3.3333333333333334e-09 * sqrt(((t72 * t72) + 1e+10)))) /
-            (((-t7 * 0.03817035074111599 + 0.09980758036020113)));
+            ((-x[7] * 5e-09 -
+              t46 * t48 * pow((4e+10 + 0.25 * (t46 * t46)), (-0.25)) * 1.0206207261596577e-06 -
+              t49 * 0.031415926535897934 * t61 * x[3] + 0.07050000000000001 +
+              sqrt((1e+10 + t63)) * 2.5e-09 - t49 * 0.031415926535897934 * t68 * x[2] +
+              t69 * 2.0412414523193154e-06 * t62 * pow((4e+10 + t63), (-0.25)) -
+              2.5e-09 * sqrt((1e+10 + (t70 * t70))))) /
+            (((0.031415926535897934 * t44 - 0.04695132319207772)));
+  xdot[8] = ((t7 * t9 * x[2] * 0.03817035074111599 + 0.094 +
+              pow((4e+10 + 0.25 * (t72 * t72)), (-0.25)) * 1.3608276348795436e-06 * t16 * t72 -
+              6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt((t74 + 1e+10)) -
+              pow((4e+10 + t74), (-0.25)) * t13 * 2.721655269759087e-06 * t73 -
+              3.3333333333333334e-09 * sqrt(((t75 * t75) + 1e+10)))) *
+            1.2e+09 / (((-t17 * 0.03817035074111599 + 0.09980758036020113)));
   xdot[9] =
       1.2e+09 *
-      ((sqrt((1e+10 + t74)) * 2.5e-09 + t47 * 0.023561944901923454 * t66 * x[2] - x[9] * 5e-09 -
-        t45 * 2.0412414523193154e-06 * pow((4e+10 + t74), (-0.25)) * t73 + 0.07050000000000001 -
-        2.5e-09 * sqrt(((t75 * t75) + 1e+10)) + t47 * t59 * 0.023561944901923454 * x[3] -
-        t76 * t67 * pow(((t76 * t76) + 4e+10), (-0.25)) * 2.0412414523193154e-06)) /
-      (((0.07132964021557801 - 0.023561944901923454 * t43)));
-  mass[0] = (2600.0 * (t77 * t77) + 1800.0 * (t81 * t81) + (((t85 * t85) + (t88 * t88))) * u[4] +
-             (t91 * t91) * 1800.0 + 2600.0 * (t92 * t92) + 2900.0);
-  mass[1] = t97;
-  mass[2] = t97;
-  mass[3] =
-      ((t95 * t95) * 1800.0 + 600.0 + (((t93 * t93) + (t94 * t94))) * u[4] + (t96 * t96) * 1800.0);
+      ((sqrt((1e+10 + t77)) * 2.5e-09 -
+        t79 * t69 * 1.0206207261596577e-06 * pow(((t79 * t79) * 0.25 + 4e+10), (-0.25)) +
+        t49 * 0.023561944901923454 * t68 * x[2] - x[9] * 5e-09 -
+        t48 * 2.0412414523193154e-06 * pow((4e+10 + t77), (-0.25)) * t76 + 0.07050000000000001 -
+        2.5e-09 * sqrt(((t80 * t80) + 1e+10)) + t49 * t61 * 0.023561944901923454 * x[3])) /
+      (((0.07132964021557801 - 0.023561944901923454 * t44)));
+  mass[0] = (2600.0 * (t81 * t81) + 1800.0 * (t85 * t85) + (((t89 * t89) + (t92 * t92))) * u[4] +
+             (t95 * t95) * 1800.0 + 2600.0 * (t96 * t96) + 2900.0);
+  mass[1] = t101;
+  mass[2] = t101;
+  mass[3] = ((t99 * t99) * 1800.0 + 600.0 + (((t97 * t97) + (t98 * t98))) * u[4] +
+             (t100 * t100) * 1800.0);
   acceleration[0] =
-      (-t91 * t98 * 17651.969999999998 +
-       t9 * t10 *
-           ((-2e+08 * sqrt(t100) - x[8] * 0.03817035074111599 -
-             ((-(1.0 / sqrt(t102)) * t101 + 2.0 + (1.0 / sqrt(t100)) * t99)) * t9 * t10 * 2e+06 *
+      (-t95 * t102 * 17651.969999999998 +
+       t7 * t9 *
+           ((-2e+08 * sqrt(t104) - x[8] * 0.03817035074111599 -
+             ((-(1.0 / sqrt(t106)) * t105 + 2.0 + (1.0 / sqrt(t104)) * t103)) * t7 * t9 * 2e+06 *
                  x[2] +
-             7.82e+08 + 2e+08 * sqrt(t102) - 4e+08 * t7 + 0.05089380098815465 * x[6])) -
-       2000.0 * x[2] - 2600.0 * t103 * t92 * ((t1 * 0.1 - 1.55 * t0)) -
-       t92 * t104 * 25497.289999999997 - 2600.0 * t77 * t103 * t92 -
-       t104 * t81 * 17651.969999999998 + ((-t104 * t88 * 9.80665 - t85 * t98 * 9.80665)) * u[4] +
-       u[2] - ((t110 * t88 + t85 * t112)) * u[4] - t47 * t66 * t117 * 0.5 - t81 * t122 * 1800.0 -
-       t77 * t98 * 25497.289999999997 - t91 * 1800.0 * t124);
-  acceleration[1] = (-((t112 * t94 + t110 * t93)) * u[4] - t47 * t59 * t117 * 0.5 +
-                     ((-t94 * t98 * 9.80665 - t104 * t93 * 9.80665)) * u[4] - t95 * 1800.0 * t124 -
-                     800.0 * x[3] - t104 * 17651.969999999998 * t96 -
-                     t95 * t98 * 17651.969999999998 + u[3] - t122 * 1800.0 * t96);
+             7.82e+08 + 2e+08 * sqrt(t106) - 4e+08 * t17 + 0.05089380098815465 * x[6])) -
+       2000.0 * x[2] - 2600.0 * t107 * t96 * ((t2 * 0.1 - 1.55 * t1)) -
+       t96 * t108 * 25497.289999999997 - 2600.0 * t81 * t107 * t96 -
+       t108 * t85 * 17651.969999999998 + ((-t108 * t92 * 9.80665 - t89 * t102 * 9.80665)) * u[4] +
+       u[2] - ((t114 * t92 + t89 * t116)) * u[4] - t49 * t68 * t121 * 0.5 - t85 * t126 * 1800.0 -
+       t81 * t102 * 25497.289999999997 - t95 * 1800.0 * t128);
+  acceleration[1] = (-((t116 * t98 + t114 * t97)) * u[4] - t49 * t61 * t121 * 0.5 +
+                     ((-t98 * t102 * 9.80665 - t108 * t97 * 9.80665)) * u[4] - t99 * 1800.0 * t128 -
+                     800.0 * x[3] - t108 * 17651.969999999998 * t100 -
+                     t99 * t102 * 17651.969999999998 + u[3] - t126 * 1800.0 * t100);
   Factor(mass);
   Solve(mass, acceleration);
   std::copy(acceleration, acceleration + kNumJoints, xdot + kNumJoints);
@@ -616,391 +621,404 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   const double t12 = (t11 * 0.05089380098815465 - 0.06725132138341651);
   const double t13 = (-2.8e+07 + x[6]);
   const double t14 = (1e+10 + (t13 * t13));
-  const double t15 = ((x[4] * x[4]) + 1e-06);
-  const double t16 = sqrt(t15);
-  const double t17 = (x[4] + t16);
-  const double t18 = (x[6] - u[6]);
-  const double t19 = (t18 * t18);
-  const double t20 = (4e+10 + t19);
-  const double t21 = pow(t20, (-0.25));
-  const double t22 = (x[6] - 2e+05);
-  const double t23 = (t22 * t22);
-  const double t24 = (t23 + 1e+10);
-  const double t25 = (-t16 + x[4]);
-  const double t26 = (4e+10 + t23);
-  const double t27 = pow(t26, (-0.25));
-  const double t28 = pow(t9, (-1.5));
-  const double t29 = (t8 * t8);
-  const double t30 = ((t6 * t6) + (t5 * t5) + t7 * ((0.194 * t1 - t4)) + t6 * t2);
-  const double t31 = (1.0 / (t12));
-  const double t32 = (1.0 / sqrt(t15)) * x[4];
-  const double t33 = (1.0 + t32);
-  const double t34 = (t32 - 1.0);
-  const double t35 = 2.0 * x[6];
-  const double t36 = (-4e+05 + t35);
-  const double t37 = (x[0] + x[1]);
-  const double t38 = cos(t37);
-  const double t39 = sin(t37);
-  const double t40 = (0.389 * t38 + t1 * 0.5249999999999999 - 0.365 * t0 + t39 * 0.159);
-  const double t41 = 0.159 * t38;
-  const double t42 = t39 * (-0.389);
-  const double t43 = (0.365 * t1 + t41 + t42 + t0 * 0.5249999999999999);
-  const double t44 = (t43 * t43);
-  const double t45 = (t40 * t40);
-  const double t46 = (t44 + t45 - 0.38752);
-  const double t47 = (t44 + t45);
-  const double t48 = (1.0 / sqrt(t47));
-  const double t49 = (t46 * t46);
-  const double t50 = (1.0 / (t47));
-  const double t51 = (0.567009 - 0.25 * t49 * t50);
-  const double t52 = sqrt(t51);
-  const double t53 = (t40 * t46 * t48 + 2.0 * t43 * t52);
-  const double t54 = (-t40 * 2.0 * t52 + t46 * t43 * t48);
-  const double t55 = atan2(0.5 * t53 * t48, t54 * 0.5 * t48);
-  const double t56 = cos(t55);
-  const double t57 = sin(t55);
-  const double t58 = (-0.15500000000000003 * t0 - 0.141 * t56 + t1 * 2.093 - t57 * 0.853);
-  const double t59 = t1 * 0.15500000000000003;
-  const double t60 = 2.093 * t0;
-  const double t61 = (0.141 * t57 + t59 - 0.853 * t56 + t60);
-  const double t62 = ((t58 * t58) + (t61 * t61));
-  const double t63 = (1.0 / sqrt(t62));
-  const double t64 = (-0.389) * t38;
-  const double t65 = t39 * (-0.159);
-  const double t66 = (t64 - t1 * 0.5249999999999999 + 0.365 * t0 + t65);
-  const double t67 = (t66 * t43 + t40 * t43);
-  const double t68 = pow(t47, (-1.5));
-  const double t69 = (1.0 / sqrt(t51));
-  const double t70 = (1.0 / (t47 * t47));
-  const double t71 = (-2.0 * t46 * t67 * t50 + t70 * t67 * t49);
-  const double t72 = (t66 * 2.0 * t46 * t48 - 4.0 * t43 * t52 + 4.0 * t43 * t67 * t48 -
-                      t40 * t69 * t71 - 2.0 * t46 * t43 * t67 * t68);
-  const double t73 = (t54 * 2.0 * t67 * t68 - t72 * t48);
-  const double t74 = (t53 * t53);
-  const double t75 = (t54 * t54);
-  const double t76 = (t74 * t50 + t75 * t50);
-  const double t77 = (1.0 / (t76));
-  const double t78 = (t66 * 4.0 * t52 + t69 * t71 * t43 - t40 * 2.0 * t46 * t67 * t68 +
-                      t40 * 4.0 * t67 * t48 + 2.0 * t46 * t43 * t48);
-  const double t79 = (t78 * t48 - 2.0 * t67 * t53 * t68);
-  const double t80 = (t73 * t53 * t77 * t48 + t54 * t79 * t77 * t48);
-  const double t81 = t1 * (-2.093);
-  const double t82 = 0.15500000000000003 * t0;
-  const double t83 = (t57 * 0.4265 * t80 + 0.0705 * t56 * t80 + t81 + t82);
-  const double t84 = (0.0705 * t57 * t80 + t59 - 0.4265 * t56 * t80 + t60);
-  const double t85 = (t83 * t61 + t58 * t84);
-  const double t86 = ((x[5] * x[5]) + 1e-06);
-  const double t87 = sqrt(t86);
-  const double t88 = (t87 + x[5]);
-  const double t89 = (x[7] - u[7]);
-  const double t90 = (t89 * t89);
-  const double t91 = (4e+10 + t90);
-  const double t92 = pow(t91, (-0.25));
-  const double t93 = (t41 + t42);
-  const double t94 = (t64 + t65);
-  const double t95 = (t93 * t40 + t94 * t43);
-  const double t96 = (-t70 * t49 * t95 + 2.0 * t46 * t50 * t95);
-  const double t97 = (-t40 * t69 * t96 - 2.0 * t46 * t94 * t48 - 4.0 * t43 * t95 * t48 +
-                      2.0 * t46 * t43 * t68 * t95 + t93 * 4.0 * t52);
-  const double t98 = (t97 * t48 + t54 * 2.0 * t68 * t95);
-  const double t99 = (-t40 * 2.0 * t46 * t68 * t95 + t93 * 2.0 * t46 * t48 + t40 * 4.0 * t95 * t48 -
-                      t69 * t43 * t96 + 4.0 * t94 * t52);
-  const double t100 = (2.0 * t53 * t68 * t95 - t99 * t48);
-  const double t101 = (-t98 * t53 * t77 * t48 + t54 * t100 * t77 * t48);
-  const double t102 = (-0.0705 * t57 * t101 + 0.4265 * t56 * t101);
-  const double t103 = (-0.0705 * t56 * t101 - t57 * 0.4265 * t101);
-  const double t104 = (t58 * t102 + t103 * t61);
-  const double t105 = (x[7] - 2e+05);
-  const double t106 = (t105 * t105);
-  const double t107 = (1e+10 + t106);
-  const double t108 = (-t87 + x[5]);
-  const double t109 = (4e+10 + t106);
-  const double t110 = pow(t109, (-0.25));
-  const double t111 = (-2.8e+07 + x[7]);
-  const double t112 = (1e+10 + (t111 * t111));
-  const double t113 = (-t88 * t92 * 2.0412414523193154e-06 * t89 - x[7] * 5e-09 -
-                       t63 * 0.031415926535897934 * t104 * x[3] + 0.07050000000000001 +
-                       sqrt(t107) * 2.5e-09 - t63 * 0.031415926535897934 * t85 * x[2] +
-                       t108 * 2.0412414523193154e-06 * t105 * t110 - 2.5e-09 * sqrt(t112));
-  const double t114 = sqrt(t62);
-  const double t115 = (0.031415926535897934 * t114 - 0.04695132319207772);
-  const double t116 = (1.0 / (t115 * t115));
-  const double t117 = (1.0 / (t115));
-  const double t118 = (-0.159) * t38;
-  const double t119 = t39 * 0.389;
-  const double t120 = (t118 - t0 * 0.5249999999999999 - 0.365 * t1 + t119);
-  const double t121 = (t120 * t43 + t44 + (t66 * t66) + t66 * t40);
-  const double t122 = (t67 * t67);
-  const double t123 = (1.0 / (t47 * t47 * t47));
-  const double t124 = (-t46 * t122 * t70 * 8.0 - t70 * t121 * t49 + 2.0 * t46 * t121 * t50 +
-                       4.0 * t122 * t50 + 4.0 * t123 * t122 * t49);
-  const double t125 = pow(t47, (-2.5));
-  const double t126 = pow(t51, (-1.5));
-  const double t127 = (t71 * t71);
-  const double t128 =
-      (-2.0 * t75 * t70 * t67 - 2.0 * t74 * t70 * t67 + t54 * t72 * t50 + t53 * t50 * t78);
-  const double t129 = (1.0 / (t76 * t76));
+  const double t15 = (x[6] - u[6]);
+  const double t16 = ((t15 * t15) + 1e+08);
+  const double t17 = (-x[6] + u[6] + sqrt(t16));
+  const double t18 = ((x[4] * x[4]) + 1e-06);
+  const double t19 = sqrt(t18);
+  const double t20 = (x[4] + t19);
+  const double t21 = (t17 * t17);
+  const double t22 = (4e+10 + 0.25 * t21);
+  const double t23 = pow(t22, (-0.25));
+  const double t24 = (x[6] - 2e+05);
+  const double t25 = (t24 * t24);
+  const double t26 = (t25 + 1e+10);
+  const double t27 = (-t19 + x[4]);
+  const double t28 = (4e+10 + t25);
+  const double t29 = pow(t28, (-0.25));
+  const double t30 = pow(t9, (-1.5));
+  const double t31 = (t8 * t8);
+  const double t32 = ((t6 * t6) + (t5 * t5) + t7 * ((0.194 * t1 - t4)) + t6 * t2);
+  const double t33 = (1.0 / (t12));
+  const double t34 = (1.0 / sqrt(t18)) * x[4];
+  const double t35 = (1.0 + t34);
+  const double t36 = (t34 - 1.0);
+  const double t37 = ((1.0 / sqrt(t16)) * t15 - 1.0);
+  const double t38 = 2.0 * x[6];
+  const double t39 = (-4e+05 + t38);
+  const double t40 = (x[0] + x[1]);
+  const double t41 = cos(t40);
+  const double t42 = sin(t40);
+  const double t43 = (0.389 * t41 + t1 * 0.5249999999999999 - 0.365 * t0 + t42 * 0.159);
+  const double t44 = 0.159 * t41;
+  const double t45 = t42 * (-0.389);
+  const double t46 = (0.365 * t1 + t44 + t45 + t0 * 0.5249999999999999);
+  const double t47 = (t46 * t46);
+  const double t48 = (t43 * t43);
+  const double t49 = (t47 + t48 - 0.38752);
+  const double t50 = (t47 + t48);
+  const double t51 = (1.0 / sqrt(t50));
+  const double t52 = (t49 * t49);
+  const double t53 = (1.0 / (t50));
+  const double t54 = (0.567009 - 0.25 * t52 * t53);
+  const double t55 = sqrt(t54);
+  const double t56 = (t43 * t49 * t51 + 2.0 * t46 * t55);
+  const double t57 = (-t43 * 2.0 * t55 + t49 * t46 * t51);
+  const double t58 = atan2(0.5 * t56 * t51, t57 * 0.5 * t51);
+  const double t59 = cos(t58);
+  const double t60 = sin(t58);
+  const double t61 = (-0.15500000000000003 * t0 - 0.141 * t59 + t1 * 2.093 - t60 * 0.853);
+  const double t62 = t1 * 0.15500000000000003;
+  const double t63 = 2.093 * t0;
+  const double t64 = (0.141 * t60 + t62 - 0.853 * t59 + t63);
+  const double t65 = ((t61 * t61) + (t64 * t64));
+  const double t66 = sqrt(t65);
+  const double t67 = (0.031415926535897934 * t66 - 0.04695132319207772);
+  const double t68 = (1.0 / (t67));
+  const double t69 = (1.0 / sqrt(t65));
+  const double t70 = (-0.159) * t41;
+  const double t71 = t42 * 0.389;
+  const double t72 = (t70 - t0 * 0.5249999999999999 - 0.365 * t1 + t71);
+  const double t73 = (-0.389) * t41;
+  const double t74 = t42 * (-0.159);
+  const double t75 = (t73 - t1 * 0.5249999999999999 + 0.365 * t0 + t74);
+  const double t76 = (t72 * t46 + t47 + (t75 * t75) + t75 * t43);
+  const double t77 = pow(t50, (-1.5));
+  const double t78 = (1.0 / sqrt(t54));
+  const double t79 = (t75 * t46 + t43 * t46);
+  const double t80 = (t79 * t79);
+  const double t81 = (1.0 / (t50 * t50));
+  const double t82 = (1.0 / (t50 * t50 * t50));
+  const double t83 = (-t49 * t80 * t81 * 8.0 - t81 * t76 * t52 + 2.0 * t49 * t76 * t53 +
+                      4.0 * t80 * t53 + 4.0 * t82 * t80 * t52);
+  const double t84 = (-2.0 * t49 * t79 * t53 + t81 * t79 * t52);
+  const double t85 = pow(t50, (-2.5));
+  const double t86 = pow(t54, (-1.5));
+  const double t87 = (t84 * t84);
+  const double t88 = (t75 * 2.0 * t49 * t51 - 4.0 * t46 * t55 + 4.0 * t46 * t79 * t51 -
+                      t43 * t78 * t84 - 2.0 * t49 * t46 * t79 * t77);
+  const double t89 = (t56 * t56);
+  const double t90 = (t57 * t57);
+  const double t91 = (t89 * t53 + t90 * t53);
+  const double t92 = (1.0 / (t91));
+  const double t93 = (t75 * 4.0 * t55 + t78 * t84 * t46 - t43 * 2.0 * t49 * t79 * t77 +
+                      t43 * 4.0 * t79 * t51 + 2.0 * t49 * t46 * t51);
+  const double t94 = (t93 * t51 - 2.0 * t79 * t56 * t77);
+  const double t95 = (t57 * 2.0 * t79 * t77 - t88 * t51);
+  const double t96 =
+      (-2.0 * t90 * t81 * t79 - 2.0 * t89 * t81 * t79 + t57 * t88 * t53 + t56 * t53 * t93);
+  const double t97 = (1.0 / (t91 * t91));
+  const double t98 =
+      (((t57 * 8.0 * t76 * t77 -
+         ((-t75 * 16.0 * t55 + t43 * 4.0 * t78 * t83 - t75 * 16.0 * t49 * t79 * t77 +
+           t75 * 32.0 * t79 * t51 - t49 * 8.0 * t76 * t46 * t77 - t78 * 8.0 * t84 * t46 +
+           16.0 * t76 * t46 * t51 - 32.0 * t80 * t46 * t77 + 24.0 * t49 * t80 * t85 * t46 +
+           t72 * t49 * 8.0 * t51 + t43 * t86 * t87)) *
+             t51 -
+         t57 * 24.0 * t80 * t85 + t88 * 8.0 * t79 * t77)) *
+           t56 * t92 * t51 -
+       t57 * t94 * 4.0 * t79 * t77 * t92 - t95 * 4.0 * t79 * t56 * t77 * t92 +
+       t95 * 2.0 * t92 * t93 * t51 + t94 * 2.0 * t88 * t92 * t51 +
+       t57 *
+           ((((-t43 * t49 * 8.0 * t76 * t77 - 16.0 * t49 * t46 * t79 * t77 -
+               t43 * 32.0 * t80 * t77 + t43 * 16.0 * t76 * t51 + t75 * t49 * 8.0 * t51 +
+               t43 * 24.0 * t49 * t80 * t85 + 32.0 * t46 * t79 * t51 - 4.0 * t78 * t83 * t46 -
+               t86 * t46 * t87 + t72 * 16.0 * t55 + t75 * t78 * 8.0 * t84)) *
+                 t51 -
+             8.0 * t76 * t56 * t77 + 24.0 * t80 * t85 * t56 - 8.0 * t79 * t77 * t93)) *
+           t92 * t51 -
+       t57 * t94 * t96 * 4.0 * t97 * t51 - t95 * t96 * 4.0 * t97 * t56 * t51);
+  const double t99 = t1 * (-2.093);
+  const double t100 = 0.15500000000000003 * t0;
+  const double t101 = (t95 * t56 * t92 * t51 + t57 * t94 * t92 * t51);
+  const double t102 = (t101 * t101);
+  const double t103 = (t60 * 0.4265 * t101 + 0.0705 * t59 * t101 + t99 + t100);
+  const double t104 = (0.0705 * t60 * t101 + t62 - 0.4265 * t59 * t101 + t63);
+  const double t105 = (((-0.106625 * t98 * t59 + t99 + t100 + 0.21325 * t60 * t102 +
+                         t60 * 0.017625 * t98 + t59 * t102 * 0.03525)) *
+                           t61 +
+                       ((t60 * 0.106625 * t98 + 0.017625 * t98 * t59 - t63 + 0.21325 * t59 * t102 -
+                         t62 - t60 * t102 * 0.03525)) *
+                           t64 +
+                       (t103 * t103) + (t104 * t104));
+  const double t106 = pow(t65, (-1.5));
+  const double t107 = (t103 * t64 + t61 * t104);
+  const double t108 = (t107 * t107);
+  const double t109 = (t44 + t45);
+  const double t110 = (t73 + t74);
+  const double t111 = (t109 * t43 + t110 * t46);
+  const double t112 = (-t81 * t52 * t111 + 2.0 * t49 * t53 * t111);
+  const double t113 = (-t43 * t78 * t112 - 2.0 * t49 * t110 * t51 - 4.0 * t46 * t111 * t51 +
+                       2.0 * t49 * t46 * t77 * t111 + t109 * 4.0 * t55);
+  const double t114 = (t113 * t51 + t57 * 2.0 * t77 * t111);
+  const double t115 = (-t43 * 2.0 * t49 * t77 * t111 + t109 * 2.0 * t49 * t51 +
+                       t43 * 4.0 * t111 * t51 - t78 * t46 * t112 + 4.0 * t110 * t55);
+  const double t116 = (2.0 * t56 * t77 * t111 - t115 * t51);
+  const double t117 = (-t114 * t56 * t92 * t51 + t57 * t116 * t92 * t51);
+  const double t118 = (-0.0705 * t59 * t117 - t60 * 0.4265 * t117);
+  const double t119 = t103 * t118;
+  const double t120 = t59 * t117 * (-0.03525) * t101;
+  const double t121 = (-0.21325) * t60 * t117 * t101;
+  const double t122 = t43 * t110;
+  const double t123 = (t70 + t71);
+  const double t124 = t123 * t46;
+  const double t125 = (t75 * t110 + t109 * t46 + t122 + t124);
+  const double t126 = (-2.0 * t125 * t49 * t53 - 4.0 * t82 * t79 * t52 * t111 + t125 * t81 * t52 -
+                       4.0 * t79 * t53 * t111 + t49 * t81 * 8.0 * t79 * t111);
+  const double t127 = t49 * (-8.0) * t110 * t51;
+  const double t128 = (-16.0) * t123 * t55;
+  const double t129 =
+      ((((t43 * t125 * t49 * 8.0 * t77 - t43 * 16.0 * t125 * t51 - t86 * t84 * t46 * t112 +
+          t43 * 32.0 * t79 * t77 * t111 - 16.0 * t46 * t111 * t51 + t49 * 8.0 * t46 * t77 * t111 -
+          4.0 * t78 * t46 * t126 - t43 * 24.0 * t49 * t85 * t79 * t111 + t75 * 4.0 * t78 * t112 +
+          t109 * t49 * 8.0 * t79 * t77 + t127 + t128 - t109 * 16.0 * t79 * t51 -
+          4.0 * t110 * t78 * t84)) *
+            t51 +
+        t125 * 8.0 * t56 * t77 + 4.0 * t115 * t79 * t77 + 4.0 * t77 * t111 * t93 -
+        24.0 * t85 * t79 * t56 * t111)) *
+      t57 * t92 * t51;
   const double t130 =
-      (((t54 * 8.0 * t121 * t68 -
-         ((-t66 * 16.0 * t52 + t40 * 4.0 * t69 * t124 - t66 * 16.0 * t46 * t67 * t68 +
-           t66 * 32.0 * t67 * t48 - t46 * 8.0 * t121 * t43 * t68 - t69 * 8.0 * t71 * t43 +
-           16.0 * t121 * t43 * t48 - 32.0 * t122 * t43 * t68 + 24.0 * t46 * t122 * t125 * t43 +
-           t120 * t46 * 8.0 * t48 + t40 * t126 * t127)) *
-             t48 -
-         t54 * 24.0 * t122 * t125 + t72 * 8.0 * t67 * t68)) *
-           t53 * t77 * t48 -
-       t54 * t79 * 4.0 * t67 * t68 * t77 - t73 * 4.0 * t67 * t53 * t68 * t77 +
-       t73 * 2.0 * t77 * t78 * t48 + t79 * 2.0 * t72 * t77 * t48 +
-       t54 *
-           ((((-t40 * t46 * 8.0 * t121 * t68 - 16.0 * t46 * t43 * t67 * t68 -
-               t40 * 32.0 * t122 * t68 + t40 * 16.0 * t121 * t48 + t66 * t46 * 8.0 * t48 +
-               t40 * 24.0 * t46 * t122 * t125 + 32.0 * t43 * t67 * t48 - 4.0 * t69 * t124 * t43 -
-               t126 * t43 * t127 + t120 * 16.0 * t52 + t66 * t69 * 8.0 * t71)) *
-                 t48 -
-             8.0 * t121 * t53 * t68 + 24.0 * t122 * t125 * t53 - 8.0 * t67 * t68 * t78)) *
-           t77 * t48 -
-       t54 * t79 * t128 * 4.0 * t129 * t48 - t73 * t128 * 4.0 * t129 * t53 * t48);
-  const double t131 = (t80 * t80);
-  const double t132 = (((-0.106625 * t130 * t56 + t81 + t82 + 0.21325 * t57 * t131 +
-                         t57 * 0.017625 * t130 + t56 * t131 * 0.03525)) *
-                           t58 +
-                       ((t57 * 0.106625 * t130 + 0.017625 * t130 * t56 - t60 +
-                         0.21325 * t56 * t131 - t59 - t57 * t131 * 0.03525)) *
-                           t61 +
-                       (t83 * t83) + (t84 * t84));
-  const double t133 = pow(t62, (-1.5));
-  const double t134 = (t85 * t85);
-  const double t135 = t83 * t103;
-  const double t136 = t56 * t101 * (-0.03525) * t80;
-  const double t137 = (-0.21325) * t57 * t101 * t80;
-  const double t138 = t40 * t94;
-  const double t139 = (t118 + t119);
-  const double t140 = t139 * t43;
-  const double t141 = (t66 * t94 + t93 * t43 + t138 + t140);
-  const double t142 = (-2.0 * t141 * t46 * t50 - 4.0 * t123 * t67 * t49 * t95 + t141 * t70 * t49 -
-                       4.0 * t67 * t50 * t95 + t46 * t70 * 8.0 * t67 * t95);
-  const double t143 = t46 * (-8.0) * t94 * t48;
-  const double t144 = (-16.0) * t139 * t52;
-  const double t145 =
-      ((((t40 * t141 * t46 * 8.0 * t68 - t40 * 16.0 * t141 * t48 - t126 * t71 * t43 * t96 +
-          t40 * 32.0 * t67 * t68 * t95 - 16.0 * t43 * t95 * t48 + t46 * 8.0 * t43 * t68 * t95 -
-          4.0 * t69 * t43 * t142 - t40 * 24.0 * t46 * t125 * t67 * t95 + t66 * 4.0 * t69 * t96 +
-          t93 * t46 * 8.0 * t67 * t68 + t143 + t144 - t93 * 16.0 * t67 * t48 -
-          4.0 * t94 * t69 * t71)) *
-            t48 +
-        t141 * 8.0 * t53 * t68 + 4.0 * t99 * t67 * t68 + 4.0 * t68 * t95 * t78 -
-        24.0 * t125 * t67 * t53 * t95)) *
-      t54 * t77 * t48;
-  const double t146 = ((-((t139 * t46 * 8.0 * t48 - 16.0 * t94 * t52 - t46 * t94 * 8.0 * t67 * t68 -
-                           t93 * 4.0 * t69 * t71 + t66 * 16.0 * t95 * t48 + 4.0 * t69 * t43 * t96 -
-                           32.0 * t43 * t67 * t68 * t95 - t40 * 4.0 * t69 * t142 +
-                           16.0 * t94 * t67 * t48 - t66 * t46 * 8.0 * t68 * t95 +
-                           16.0 * t141 * t43 * t48 + 24.0 * t46 * t125 * t43 * t67 * t95 -
-                           t40 * t126 * t71 * t96 - t141 * t46 * 8.0 * t43 * t68)) *
-                            t48 +
-                        t54 * t141 * 8.0 * t68 + 4.0 * t72 * t68 * t95 -
-                        t54 * 24.0 * t125 * t67 * t95 - 4.0 * t97 * t67 * t68)) *
-                      (-1.0) * t53 * t77 * t48;
-  const double t147 =
-      (t128 * 4.0 * t129 * t98 * t53 * t48 + t145 - t54 * t100 * t128 * 4.0 * t129 * t48 +
-       4.0 * t98 * t67 * t53 * t68 * t77 - t54 * t100 * 4.0 * t67 * t68 * t77 +
-       t100 * 2.0 * t72 * t77 * t48 + t146 - 2.0 * t98 * t77 * t78 * t48);
-  const double t148 = (-0.21325) * t56 * t101 * t80;
-  const double t149 = t57 * t101 * 0.03525 * t80;
-  const double t150 = t84 * t102;
-  const double t151 =
-      (t135 + ((t136 + t137 - t57 * 0.017625 * t147 + 0.106625 * t56 * t147)) * t58 +
-       ((t148 + t149 - 0.017625 * t56 * t147 - t57 * 0.106625 * t147)) * t61 + t150);
-  const double t152 = (t104 * t104);
-  const double t153 = (t101 * t101);
-  const double t154 =
-      (-t54 * t97 * t50 - 2.0 * t74 * t70 * t95 - 2.0 * t75 * t70 * t95 + t99 * t53 * t50);
-  const double t155 = (t95 * t95);
-  const double t156 = ((t94 * t94) + (t93 * t93) + t138 + t140);
-  const double t157 = (t46 * t70 * t155 * 8.0 - 4.0 * t123 * t155 * t49 - 4.0 * t155 * t50 -
-                       2.0 * t156 * t46 * t50 + t156 * t70 * t49);
-  const double t158 = (t96 * t96);
+      ((-((t123 * t49 * 8.0 * t51 - 16.0 * t110 * t55 - t49 * t110 * 8.0 * t79 * t77 -
+           t109 * 4.0 * t78 * t84 + t75 * 16.0 * t111 * t51 + 4.0 * t78 * t46 * t112 -
+           32.0 * t46 * t79 * t77 * t111 - t43 * 4.0 * t78 * t126 + 16.0 * t110 * t79 * t51 -
+           t75 * t49 * 8.0 * t77 * t111 + 16.0 * t125 * t46 * t51 +
+           24.0 * t49 * t85 * t46 * t79 * t111 - t43 * t86 * t84 * t112 -
+           t125 * t49 * 8.0 * t46 * t77)) *
+            t51 +
+        t57 * t125 * 8.0 * t77 + 4.0 * t88 * t77 * t111 - t57 * 24.0 * t85 * t79 * t111 -
+        4.0 * t113 * t79 * t77)) *
+      (-1.0) * t56 * t92 * t51;
+  const double t131 =
+      (t96 * 4.0 * t97 * t114 * t56 * t51 + t129 - t57 * t116 * t96 * 4.0 * t97 * t51 +
+       4.0 * t114 * t79 * t56 * t77 * t92 - t57 * t116 * 4.0 * t79 * t77 * t92 +
+       t116 * 2.0 * t88 * t92 * t51 + t130 - 2.0 * t114 * t92 * t93 * t51);
+  const double t132 = (-0.21325) * t59 * t117 * t101;
+  const double t133 = t60 * t117 * 0.03525 * t101;
+  const double t134 = (-0.0705 * t60 * t117 + 0.4265 * t59 * t117);
+  const double t135 = t104 * t134;
+  const double t136 =
+      (t119 + ((t120 + t121 - t60 * 0.017625 * t131 + 0.106625 * t59 * t131)) * t61 +
+       ((t132 + t133 - 0.017625 * t59 * t131 - t60 * 0.106625 * t131)) * t64 + t135);
+  const double t137 = (t61 * t134 + t118 * t64);
+  const double t138 = (1.0 / (t67 * t67));
+  const double t139 = (x[7] - u[7]);
+  const double t140 = (1e+08 + (t139 * t139));
+  const double t141 = (x[7] - u[7] - sqrt(t140));
+  const double t142 = ((x[5] * x[5]) + 1e-06);
+  const double t143 = sqrt(t142);
+  const double t144 = (t143 + x[5]);
+  const double t145 = (t141 * t141);
+  const double t146 = (4e+10 + 0.25 * t145);
+  const double t147 = pow(t146, (-0.25));
+  const double t148 = (x[7] - 2e+05);
+  const double t149 = (t148 * t148);
+  const double t150 = (1e+10 + t149);
+  const double t151 = (-t143 + x[5]);
+  const double t152 = (4e+10 + t149);
+  const double t153 = pow(t152, (-0.25));
+  const double t154 = (-2.8e+07 + x[7]);
+  const double t155 = (1e+10 + (t154 * t154));
+  const double t156 = (-x[7] * 5e-09 - t141 * t144 * t147 * 1.0206207261596577e-06 -
+                       t69 * 0.031415926535897934 * t137 * x[3] + 0.07050000000000001 +
+                       sqrt(t150) * 2.5e-09 - t69 * 0.031415926535897934 * t107 * x[2] +
+                       t151 * 2.0412414523193154e-06 * t148 * t153 - 2.5e-09 * sqrt(t155));
+  const double t157 = (t137 * t137);
+  const double t158 = (t117 * t117);
   const double t159 =
-      (-t54 * t100 * t154 * 4.0 * t129 * t48 - 2.0 * t99 * t98 * t77 * t48 +
-       t54 *
-           ((-24.0 * t125 * t155 * t53 + t99 * 8.0 * t68 * t95 + t156 * 8.0 * t53 * t68 +
-             ((-t93 * 32.0 * t95 * t48 - t157 * 4.0 * t69 * t43 + t143 + t144 -
-               t40 * 16.0 * t156 * t48 + t126 * t158 * t43 + t93 * 16.0 * t46 * t68 * t95 +
-               t94 * t69 * 8.0 * t96 + t40 * t156 * t46 * 8.0 * t68 + t40 * 32.0 * t155 * t68 -
-               t40 * 24.0 * t46 * t125 * t155)) *
-                 t48)) *
-           t77 * t48 -
-       t54 * t100 * 4.0 * t68 * t77 * t95 +
-       ((-((-16.0 * t156 * t43 * t48 - 32.0 * t94 * t95 * t48 - t139 * t46 * 8.0 * t48 -
-            24.0 * t46 * t125 * t155 * t43 - t40 * t126 * t158 - t93 * t69 * 8.0 * t96 +
-            32.0 * t155 * t43 * t68 + 16.0 * t46 * t94 * t68 * t95 + 16.0 * t94 * t52 +
-            t156 * t46 * 8.0 * t43 * t68 + t40 * t157 * 4.0 * t69)) *
-             t48 +
-         t54 * 24.0 * t125 * t155 - t54 * t156 * 8.0 * t68 + t97 * 8.0 * t68 * t95)) *
-           t53 * t77 * t48 -
-       t100 * 2.0 * t97 * t77 * t48 + t154 * 4.0 * t129 * t98 * t53 * t48 +
-       4.0 * t98 * t53 * t68 * t77 * t95);
-  const double t160 = (((0.21325 * t153 * t56 - 0.017625 * t56 * t159 - t57 * t153 * 0.03525 -
-                         t57 * 0.106625 * t159)) *
+      (-t57 * t113 * t53 - 2.0 * t89 * t81 * t111 - 2.0 * t90 * t81 * t111 + t115 * t56 * t53);
+  const double t160 = (t111 * t111);
+  const double t161 = ((t110 * t110) + (t109 * t109) + t122 + t124);
+  const double t162 = (t49 * t81 * t160 * 8.0 - 4.0 * t82 * t160 * t52 - 4.0 * t160 * t53 -
+                       2.0 * t161 * t49 * t53 + t161 * t81 * t52);
+  const double t163 = (t112 * t112);
+  const double t164 =
+      (-t57 * t116 * t159 * 4.0 * t97 * t51 - 2.0 * t115 * t114 * t92 * t51 +
+       t57 *
+           ((-24.0 * t85 * t160 * t56 + t115 * 8.0 * t77 * t111 + t161 * 8.0 * t56 * t77 +
+             ((-t109 * 32.0 * t111 * t51 - t162 * 4.0 * t78 * t46 + t127 + t128 -
+               t43 * 16.0 * t161 * t51 + t86 * t163 * t46 + t109 * 16.0 * t49 * t77 * t111 +
+               t110 * t78 * 8.0 * t112 + t43 * t161 * t49 * 8.0 * t77 + t43 * 32.0 * t160 * t77 -
+               t43 * 24.0 * t49 * t85 * t160)) *
+                 t51)) *
+           t92 * t51 -
+       t57 * t116 * 4.0 * t77 * t92 * t111 +
+       ((-((-16.0 * t161 * t46 * t51 - 32.0 * t110 * t111 * t51 - t123 * t49 * 8.0 * t51 -
+            24.0 * t49 * t85 * t160 * t46 - t43 * t86 * t163 - t109 * t78 * 8.0 * t112 +
+            32.0 * t160 * t46 * t77 + 16.0 * t49 * t110 * t77 * t111 + 16.0 * t110 * t55 +
+            t161 * t49 * 8.0 * t46 * t77 + t43 * t162 * 4.0 * t78)) *
+             t51 +
+         t57 * 24.0 * t85 * t160 - t57 * t161 * 8.0 * t77 + t113 * 8.0 * t77 * t111)) *
+           t56 * t92 * t51 -
+       t116 * 2.0 * t113 * t92 * t51 + t159 * 4.0 * t97 * t114 * t56 * t51 +
+       4.0 * t114 * t56 * t77 * t92 * t111);
+  const double t165 = (((0.21325 * t158 * t59 - 0.017625 * t59 * t164 - t60 * t158 * 0.03525 -
+                         t60 * 0.106625 * t164)) *
+                           t64 +
+                       (t134 * t134) +
+                       ((0.106625 * t59 * t164 + 0.21325 * t60 * t158 - t60 * 0.017625 * t164 +
+                         t158 * t59 * 0.03525)) *
                            t61 +
-                       (t102 * t102) +
-                       ((0.106625 * t56 * t159 + 0.21325 * t57 * t153 - t57 * 0.017625 * t159 +
-                         t153 * t56 * 0.03525)) *
-                           t58 +
-                       (t103 * t103));
-  const double t161 = (t54 * t79 * t154 * 4.0 * t129 * t48 - t73 * 2.0 * t99 * t77 * t48 + t145 +
-                       t73 * t154 * 4.0 * t129 * t53 * t48 + t79 * 2.0 * t97 * t77 * t48 + t146 +
-                       t73 * 4.0 * t53 * t68 * t77 * t95 + t54 * t79 * 4.0 * t68 * t77 * t95);
-  const double t162 =
-      (t58 * ((-t57 * 0.017625 * t161 + 0.106625 * t56 * t161 + t136 + t137)) + t135 +
-       ((-0.017625 * t56 * t161 - t57 * 0.106625 * t161 + t148 + t149)) * t61 + t150);
-  const double t163 = (1.0 / sqrt(t86)) * x[5];
-  const double t164 = (t163 - 1.0);
-  const double t165 = (t163 + 1.0);
-  const double t166 = 2.0 * x[7];
-  const double t167 = (-4e+05 + t166);
-  const double t168 = (x[8] - u[6]);
-  const double t169 = (t168 * t168);
-  const double t170 = (4e+10 + t169);
-  const double t171 = pow(t170, (-0.25));
-  const double t172 = (x[8] - 2e+05);
-  const double t173 = (t172 * t172);
-  const double t174 = (t173 + 1e+10);
-  const double t175 = (4e+10 + t173);
-  const double t176 = pow(t175, (-0.25));
-  const double t177 = (-2.8e+07 + x[8]);
-  const double t178 = ((t177 * t177) + 1e+10);
-  const double t179 = (-t11 * 0.03817035074111599 + 0.09980758036020113);
-  const double t180 = (1.0 / (t179));
-  const double t181 = 2.0 * x[8];
-  const double t182 = (-4e+05 + t181);
-  const double t183 = (0.07132964021557801 - 0.023561944901923454 * t114);
-  const double t184 = (1.0 / (t183));
-  const double t185 = (1.0 / (t183 * t183));
-  const double t186 = (x[9] - 2e+05);
-  const double t187 = (t186 * t186);
-  const double t188 = (1e+10 + t187);
-  const double t189 = (4e+10 + t187);
-  const double t190 = pow(t189, (-0.25));
-  const double t191 = (-2.8e+07 + x[9]);
-  const double t192 = ((t191 * t191) + 1e+10);
-  const double t193 = (-x[9] + u[7]);
-  const double t194 = (t193 * t193);
-  const double t195 = (t194 + 4e+10);
-  const double t196 = pow(t195, (-0.25));
-  const double t197 =
-      (sqrt(t188) * 2.5e-09 + t63 * 0.023561944901923454 * t85 * x[2] - x[9] * 5e-09 -
-       t88 * 2.0412414523193154e-06 * t190 * t186 + 0.07050000000000001 - 2.5e-09 * sqrt(t192) +
-       t63 * t104 * 0.023561944901923454 * x[3] - t193 * t108 * t196 * 2.0412414523193154e-06);
-  const double t198 = 2.0 * x[9];
-  const double t199 = (-4e+05 + t198);
-  const double t200 = (-t1 * 0.1 + 1.55 * t0);
-  const double t201 = t39 * (-0.55);
-  const double t202 = (-0.25) * t38;
-  const double t203 = t1 * (-3.11);
-  const double t204 = (t201 + t202 + t203);
-  const double t205 = t39 * (-0.16343387866394005);
-  const double t206 = 3.11 * t0;
-  const double t207 = 0.4011545671438309 * t38;
-  const double t208 = (t205 + t206 + t207);
-  const double t209 = t39 * (-0.4011545671438309);
-  const double t210 = (-0.16343387866394005) * t38;
-  const double t211 = (t209 + t210 + t203);
-  const double t212 = t39 * (-0.25);
-  const double t213 = 0.55 * t38;
-  const double t214 = (t206 + t212 + t213);
-  const double t215 = (-1.55 * t1 - 0.1 * t0);
-  const double t216 = (t209 + t210);
-  const double t217 = (t205 + t207);
-  const double t218 = (t212 + t213);
-  const double t219 = (t201 + t202);
-  const double t220 =
-      (((t211 * t216 + t208 * t217)) * u[4] + 600.0 + t218 * t214 * 1800.0 + t204 * 1800.0 * t219);
-  const double t221 = cos(u[5]);
-  const double t222 = (-2.51 + t11);
-  const double t223 = (t222 * t222);
-  const double t224 = (1e-06 + t223);
-  const double t225 = (t11 - 1.4);
-  const double t226 = (t225 * t225);
-  const double t227 = (1e-06 + t226);
-  const double t228 = (1.0 / sqrt(t227));
-  const double t229 = (1.0 / sqrt(t224));
-  const double t230 = (-t228 * t225 + 2.0 + t229 * t222);
-  const double t231 =
-      (-2e+08 * sqrt(t224) - x[8] * 0.03817035074111599 - t230 * t8 * t10 * 2e+06 * x[2] +
-       7.82e+08 + 2e+08 * sqrt(t227) - 4e+08 * t11 + 0.05089380098815465 * x[6]);
-  const double t232 = (x[2] * x[2]);
-  const double t233 = (t1 * 0.1 - 1.55 * t0);
-  const double t234 = sin(u[5]);
-  const double t235 = t39 * 0.16343387866394005;
-  const double t236 = (-0.4011545671438309) * t38;
-  const double t237 = (t235 + t236);
-  const double t238 = t237 * x[3];
-  const double t239 = (-3.11) * t0;
-  const double t240 = (t239 + t235 + t236);
-  const double t241 = (t238 + t240 * x[2]);
-  const double t242 = (t238 + t237 * x[2]);
-  const double t243 = (x[2] * t241 + t242 * x[3]);
-  const double t244 = t216 * x[3];
-  const double t245 = (t216 * x[2] + t244);
-  const double t246 = (t244 + t211 * x[2]);
-  const double t247 = (t245 * x[3] + t246 * x[2]);
-  const double t248 = (-1.59 + t114);
-  const double t249 = (t248 * t248);
-  const double t250 = (t249 + 1e-06);
-  const double t251 = (t63 * t104 * 2e+06 * x[3] + t63 * t85 * 2e+06 * x[2]);
-  const double t252 = (1.0 / sqrt(t250));
-  const double t253 = (t114 - 2.9000000000000004);
-  const double t254 = (t253 * t253);
-  const double t255 = (t254 + 1e-06);
-  const double t256 = (1.0 / sqrt(t255));
-  const double t257 = (t248 * t252 - t253 * t256 - 2.0);
-  const double t258 = (-sqrt(t250) * 2e+08 - 8.98e+08 - t251 * t257 - 0.06283185307179587 * x[7] +
-                       sqrt(t255) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t114);
-  const double t259 = t39 * 0.25;
-  const double t260 = (-0.55) * t38;
-  const double t261 = (t259 + t260);
-  const double t262 = x[3] * t261;
-  const double t263 = (t262 + x[2] * t261);
-  const double t264 = (t259 + t239 + t260);
-  const double t265 = (t264 * x[2] + t262);
-  const double t266 = (t263 * x[3] + t265 * x[2]);
-  const double t267 = x[3] * t219;
-  const double t268 = (t267 + t204 * x[2]);
-  const double t269 = (t267 + x[2] * t219);
-  const double t270 = (t268 * x[2] + x[3] * t269);
-  const double t271 = pow(t250, (-1.5));
-  const double t272 = pow(t255, (-1.5));
-  const double t273 =
-      (t63 * 4e+08 * t85 -
-       t257 * ((-t133 * t134 * 2e+06 * x[2] + t63 * t132 * 2e+06 * x[2] +
-                t63 * 2e+06 * x[3] * t151 - t133 * t104 * t85 * 2e+06 * x[3])) -
-       t248 * t63 * t85 * t252 * 2e+08 + t63 * t253 * t85 * 2e+08 * t256 -
-       ((t63 * t85 * t252 - t63 * t249 * t85 * t271 - t63 * t85 * t256 + t63 * t254 * t85 * t272)) *
-           t251);
-  const double t274 = (-17651.969999999998) * t221 * t219;
-  const double t275 = u[4] * ((-t216 * t221 * 9.80665 - t234 * t237 * 9.80665));
-  const double t276 = (-17651.969999999998) * t234 * t261;
-  const double t277 = (-t248 * t63 * t104 * t252 * 2e+08 + t63 * 4e+08 * t104 -
-                       t251 * ((t63 * t104 * t252 - t63 * t104 * t256 + t63 * t104 * t254 * t272 -
-                                t63 * t104 * t249 * t271)) +
-                       t63 * t253 * t104 * 2e+08 * t256 -
-                       t257 * ((t63 * 2e+06 * x[2] * t162 - t133 * 2e+06 * x[3] * t152 +
-                                t63 * t160 * 2e+06 * x[3] - t133 * t104 * t85 * 2e+06 * x[2])));
-  const double t278 = t133 * t104 * t85 * t258 * 0.5;
-  const double t279 = (1.0 / (t62));
-  const double t280 = t279 * t104 * t85 * t257 * 1e+06;
-  const double t281 = t214 * 1800.0 * t219;
-  const double t282 = t204 * 1800.0 * t261;
-  const double t283 = t208 * t216;
-  const double t284 = t211 * t237;
-  const double t285 = (t281 + t282 + t218 * t204 * 1800.0 + t264 * 1800.0 * t219 +
-                       ((t211 * t217 + t283 + t216 * t240 + t284)) * u[4]);
-  const double t286 = t216 * t237;
-  const double t287 = t216 * t217;
-  const double t288 = (2.0 * ((t286 + t287)) * u[4] + 3600.0 * t261 * t219 + 3600.0 * t218 * t219);
-  const double t289 = (1800.0 * t261 * t219 + ((t286 + t283 + t287 + t284)) * u[4] + t281 +
-                       t218 * 1800.0 * t219 + t282);
+                       (t118 * t118));
+  const double t166 = (t57 * t94 * t159 * 4.0 * t97 * t51 - t95 * 2.0 * t115 * t92 * t51 + t129 +
+                       t95 * t159 * 4.0 * t97 * t56 * t51 + t94 * 2.0 * t113 * t92 * t51 + t130 +
+                       t95 * 4.0 * t56 * t77 * t92 * t111 + t57 * t94 * 4.0 * t77 * t92 * t111);
+  const double t167 =
+      (t61 * ((-t60 * 0.017625 * t166 + 0.106625 * t59 * t166 + t120 + t121)) + t119 +
+       ((-0.017625 * t59 * t166 - t60 * 0.106625 * t166 + t132 + t133)) * t64 + t135);
+  const double t168 = (1.0 / sqrt(t142)) * x[5];
+  const double t169 = (t168 + 1.0);
+  const double t170 = (t168 - 1.0);
+  const double t171 = 2.0 * x[7];
+  const double t172 = (-4e+05 + t171);
+  const double t173 = ((1.0 / sqrt(t140)) * t139 - 1.0);
+  const double t174 = (-t11 * 0.03817035074111599 + 0.09980758036020113);
+  const double t175 = (1.0 / (t174));
+  const double t176 = (x[8] - u[6]);
+  const double t177 = ((t176 * t176) + 1e+08);
+  const double t178 = (-sqrt(t177) + x[8] - u[6]);
+  const double t179 = (t178 * t178);
+  const double t180 = (4e+10 + 0.25 * t179);
+  const double t181 = pow(t180, (-0.25));
+  const double t182 = (x[8] - 2e+05);
+  const double t183 = (t182 * t182);
+  const double t184 = (t183 + 1e+10);
+  const double t185 = (4e+10 + t183);
+  const double t186 = pow(t185, (-0.25));
+  const double t187 = (-2.8e+07 + x[8]);
+  const double t188 = ((t187 * t187) + 1e+10);
+  const double t189 = ((1.0 / sqrt(t177)) * t176 - 1.0);
+  const double t190 = 2.0 * x[8];
+  const double t191 = (-4e+05 + t190);
+  const double t192 = (0.07132964021557801 - 0.023561944901923454 * t66);
+  const double t193 = (1.0 / (t192));
+  const double t194 = (1.0 / (t192 * t192));
+  const double t195 = (x[9] - 2e+05);
+  const double t196 = (t195 * t195);
+  const double t197 = (1e+10 + t196);
+  const double t198 = (-x[9] + u[7]);
+  const double t199 = ((t198 * t198) + 1e+08);
+  const double t200 = (-x[9] + u[7] + sqrt(t199));
+  const double t201 = (t200 * t200);
+  const double t202 = (t201 * 0.25 + 4e+10);
+  const double t203 = pow(t202, (-0.25));
+  const double t204 = (4e+10 + t196);
+  const double t205 = pow(t204, (-0.25));
+  const double t206 = (-2.8e+07 + x[9]);
+  const double t207 = ((t206 * t206) + 1e+10);
+  const double t208 = (sqrt(t197) * 2.5e-09 - t200 * t151 * 1.0206207261596577e-06 * t203 +
+                       t69 * 0.023561944901923454 * t107 * x[2] - x[9] * 5e-09 -
+                       t144 * 2.0412414523193154e-06 * t205 * t195 + 0.07050000000000001 -
+                       2.5e-09 * sqrt(t207) + t69 * t137 * 0.023561944901923454 * x[3]);
+  const double t209 = 2.0 * x[9];
+  const double t210 = (-4e+05 + t209);
+  const double t211 = (t198 * (1.0 / sqrt(t199)) + 1.0);
+  const double t212 = (-t1 * 0.1 + 1.55 * t0);
+  const double t213 = t42 * (-0.55);
+  const double t214 = (-0.25) * t41;
+  const double t215 = t1 * (-3.11);
+  const double t216 = (t213 + t214 + t215);
+  const double t217 = t42 * (-0.16343387866394005);
+  const double t218 = 3.11 * t0;
+  const double t219 = 0.4011545671438309 * t41;
+  const double t220 = (t217 + t218 + t219);
+  const double t221 = t42 * (-0.4011545671438309);
+  const double t222 = (-0.16343387866394005) * t41;
+  const double t223 = (t221 + t222 + t215);
+  const double t224 = t42 * (-0.25);
+  const double t225 = 0.55 * t41;
+  const double t226 = (t218 + t224 + t225);
+  const double t227 = (-1.55 * t1 - 0.1 * t0);
+  const double t228 = (t221 + t222);
+  const double t229 = (t217 + t219);
+  const double t230 = (t224 + t225);
+  const double t231 = (t213 + t214);
+  const double t232 =
+      (((t223 * t228 + t220 * t229)) * u[4] + 600.0 + t230 * t226 * 1800.0 + t216 * 1800.0 * t231);
+  const double t233 = cos(u[5]);
+  const double t234 = (-2.51 + t11);
+  const double t235 = (t234 * t234);
+  const double t236 = (1e-06 + t235);
+  const double t237 = (t11 - 1.4);
+  const double t238 = (t237 * t237);
+  const double t239 = (1e-06 + t238);
+  const double t240 = (1.0 / sqrt(t239));
+  const double t241 = (1.0 / sqrt(t236));
+  const double t242 = (-t240 * t237 + 2.0 + t241 * t234);
+  const double t243 =
+      (-2e+08 * sqrt(t236) - x[8] * 0.03817035074111599 - t242 * t8 * t10 * 2e+06 * x[2] +
+       7.82e+08 + 2e+08 * sqrt(t239) - 4e+08 * t11 + 0.05089380098815465 * x[6]);
+  const double t244 = (x[2] * x[2]);
+  const double t245 = (t1 * 0.1 - 1.55 * t0);
+  const double t246 = sin(u[5]);
+  const double t247 = t42 * 0.16343387866394005;
+  const double t248 = (-0.4011545671438309) * t41;
+  const double t249 = (t247 + t248);
+  const double t250 = t249 * x[3];
+  const double t251 = (-3.11) * t0;
+  const double t252 = (t251 + t247 + t248);
+  const double t253 = (t250 + t252 * x[2]);
+  const double t254 = (t250 + t249 * x[2]);
+  const double t255 = (x[2] * t253 + t254 * x[3]);
+  const double t256 = t228 * x[3];
+  const double t257 = (t228 * x[2] + t256);
+  const double t258 = (t256 + t223 * x[2]);
+  const double t259 = (t257 * x[3] + t258 * x[2]);
+  const double t260 = (-1.59 + t66);
+  const double t261 = (t260 * t260);
+  const double t262 = (t261 + 1e-06);
+  const double t263 = (t69 * t137 * 2e+06 * x[3] + t69 * t107 * 2e+06 * x[2]);
+  const double t264 = (1.0 / sqrt(t262));
+  const double t265 = (t66 - 2.9000000000000004);
+  const double t266 = (t265 * t265);
+  const double t267 = (t266 + 1e-06);
+  const double t268 = (1.0 / sqrt(t267));
+  const double t269 = (t260 * t264 - t265 * t268 - 2.0);
+  const double t270 = (-sqrt(t262) * 2e+08 - 8.98e+08 - t263 * t269 - 0.06283185307179587 * x[7] +
+                       sqrt(t267) * 2e+08 + 0.04712388980384691 * x[9] + 4e+08 * t66);
+  const double t271 = t42 * 0.25;
+  const double t272 = (-0.55) * t41;
+  const double t273 = (t271 + t272);
+  const double t274 = x[3] * t273;
+  const double t275 = (t274 + x[2] * t273);
+  const double t276 = (t271 + t251 + t272);
+  const double t277 = (t276 * x[2] + t274);
+  const double t278 = (t275 * x[3] + t277 * x[2]);
+  const double t279 = x[3] * t231;
+  const double t280 = (t279 + t216 * x[2]);
+  const double t281 = (t279 + x[2] * t231);
+  const double t282 = (t280 * x[2] + x[3] * t281);
+  const double t283 = pow(t262, (-1.5));
+  const double t284 = pow(t267, (-1.5));
+  const double t285 = (t69 * 4e+08 * t107 -
+                       t269 * ((-t106 * t108 * 2e+06 * x[2] + t69 * t105 * 2e+06 * x[2] +
+                                t69 * 2e+06 * x[3] * t136 - t106 * t137 * t107 * 2e+06 * x[3])) -
+                       t260 * t69 * t107 * t264 * 2e+08 + t69 * t265 * t107 * 2e+08 * t268 -
+                       ((t69 * t107 * t264 - t69 * t261 * t107 * t283 - t69 * t107 * t268 +
+                         t69 * t266 * t107 * t284)) *
+                           t263);
+  const double t286 = (-17651.969999999998) * t233 * t231;
+  const double t287 = u[4] * ((-t228 * t233 * 9.80665 - t246 * t249 * 9.80665));
+  const double t288 = (-17651.969999999998) * t246 * t273;
+  const double t289 = (-t260 * t69 * t137 * t264 * 2e+08 + t69 * 4e+08 * t137 -
+                       t263 * ((t69 * t137 * t264 - t69 * t137 * t268 + t69 * t137 * t266 * t284 -
+                                t69 * t137 * t261 * t283)) +
+                       t69 * t265 * t137 * 2e+08 * t268 -
+                       t269 * ((t69 * 2e+06 * x[2] * t167 - t106 * 2e+06 * x[3] * t157 +
+                                t69 * t165 * 2e+06 * x[3] - t106 * t137 * t107 * 2e+06 * x[2])));
+  const double t290 = t106 * t137 * t107 * t270 * 0.5;
+  const double t291 = (1.0 / (t65));
+  const double t292 = t291 * t137 * t107 * t269 * 1e+06;
+  const double t293 = t226 * 1800.0 * t231;
+  const double t294 = t216 * 1800.0 * t273;
+  const double t295 = t220 * t228;
+  const double t296 = t223 * t249;
+  const double t297 = (t293 + t294 + t230 * t216 * 1800.0 + t276 * 1800.0 * t231 +
+                       ((t223 * t229 + t295 + t228 * t252 + t296)) * u[4]);
+  const double t298 = t228 * t249;
+  const double t299 = t228 * t229;
+  const double t300 = (2.0 * ((t298 + t299)) * u[4] + 3600.0 * t273 * t231 + 3600.0 * t230 * t231);
+  const double t301 = (1800.0 * t273 * t231 + ((t298 + t295 + t299 + t296)) * u[4] + t293 +
+                       t230 * 1800.0 * t231 + t294);
   jacobian[2] = 1.0;
   jacobian[13] = 1.0;
   jacobian[44] = (-12.5);
@@ -1008,148 +1026,149 @@ void PlantJacobian(double /*t*/, const double* x, const double* u, double* jacob
   jacobian[60] =
       (-t8 * 61072561.185785584 * t10 *
            ((-3.3333333333333334e-09 * sqrt(t14) + 0.094 - 6.666666666666667e-09 * x[6] -
-             t8 * t10 * 0.05089380098815465 * x[2] - t17 * 2.721655269759087e-06 * t21 * t18 +
-             3.3333333333333334e-09 * sqrt(t24) + t25 * t27 * 2.721655269759087e-06 * t22)) /
+             t8 * t10 * 0.05089380098815465 * x[2] + 1.3608276348795436e-06 * t17 * t20 * t23 +
+             3.3333333333333334e-09 * sqrt(t26) + t27 * t29 * 2.721655269759087e-06 * t24)) /
            (t12 * t12) +
-       ((t28 * 0.05089380098815465 * x[2] * t29 - t10 * 0.05089380098815465 * t30 * x[2])) *
-           1.2e+09 * t31);
-  jacobian[62] = t8 * t10 * (-61072561.185785584) * t31;
+       ((t30 * 0.05089380098815465 * x[2] * t31 - t10 * 0.05089380098815465 * t32 * x[2])) *
+           1.2e+09 * t33);
+  jacobian[62] = t8 * t10 * (-61072561.185785584) * t33;
   jacobian[64] =
-      ((-2.721655269759087e-06 * t21 * t18 * t33 - t34 * t27 * 2.721655269759087e-06 * t22)) *
-      1.2e+09 * t31;
-  jacobian[66] = 1.2e+09 *
-                 ((-t17 * 2.721655269759087e-06 * t21 -
-                   t36 * pow(t26, (-1.25)) * t25 * t22 * 6.804138174397718e-07 +
-                   t36 * 1.6666666666666667e-09 * (1.0 / sqrt(t24)) - 6.666666666666667e-09 -
-                   1.6666666666666667e-09 * ((-5.6e+07 + t35)) * (1.0 / sqrt(t14)) +
-                   t25 * t27 * 2.721655269759087e-06 +
-                   pow(t20, (-1.25)) * 1.3608276348795436e-06 * t19 * t17)) *
-                 t31;
+      ((1.3608276348795436e-06 * t17 * t35 * t23 - t36 * t29 * 2.721655269759087e-06 * t24)) *
+      1.2e+09 * t33;
+  jacobian[66] = ((-t37 * pow(t22, (-1.25)) * t20 * t21 * 1.7010345435994295e-07 +
+                   1.3608276348795436e-06 * t37 * t20 * t23 -
+                   t39 * pow(t28, (-1.25)) * t27 * t24 * 6.804138174397718e-07 +
+                   t39 * 1.6666666666666667e-09 * (1.0 / sqrt(t26)) - 6.666666666666667e-09 -
+                   1.6666666666666667e-09 * ((-5.6e+07 + t38)) * (1.0 / sqrt(t14)) +
+                   t27 * t29 * 2.721655269759087e-06)) *
+                 1.2e+09 * t33;
   jacobian[70] =
-      (-t63 * t85 * 37699111.84307752 * t113 * t116 +
-       t117 * 1.2e+09 *
-           ((-t63 * 0.031415926535897934 * t132 * x[2] + t133 * 0.031415926535897934 * t134 * x[2] -
-             t63 * 0.031415926535897934 * x[3] * t151 +
-             t133 * 0.031415926535897934 * t104 * t85 * x[3])));
+      (t68 * 1.2e+09 *
+           ((-t69 * 0.031415926535897934 * t105 * x[2] + t106 * 0.031415926535897934 * t108 * x[2] -
+             t69 * 0.031415926535897934 * x[3] * t136 +
+             t106 * 0.031415926535897934 * t137 * t107 * x[3])) -
+       t69 * t107 * 37699111.84307752 * t138 * t156);
   jacobian[71] =
-      (-t63 * t104 * 37699111.84307752 * t113 * t116 +
-       t117 * 1.2e+09 *
-           ((t133 * 0.031415926535897934 * x[3] * t152 - t63 * 0.031415926535897934 * t160 * x[3] +
-             t133 * 0.031415926535897934 * t104 * t85 * x[2] -
-             t63 * 0.031415926535897934 * x[2] * t162)));
-  jacobian[72] = t63 * (-37699111.84307752) * t117 * t85;
-  jacobian[73] = t63 * (-37699111.84307752) * t104 * t117;
-  jacobian[75] =
-      t117 * 1.2e+09 *
-      ((-2.0412414523193154e-06 * t164 * t105 * t110 - t165 * t92 * 2.0412414523193154e-06 * t89));
-  jacobian[77] = t117 * 1.2e+09 *
-                 ((-t88 * t92 * 2.0412414523193154e-06 -
-                   t167 * 5.103103630798288e-07 * pow(t109, (-1.25)) * t108 * t105 +
-                   (1.0 / sqrt(t107)) * t167 * 1.25e-09 + t108 * 2.0412414523193154e-06 * t110 +
-                   pow(t91, (-1.25)) * t88 * t90 * 1.0206207261596577e-06 -
-                   (1.0 / sqrt(t112)) * 1.25e-09 * ((-5.6e+07 + t166)) - 5e-09));
+      (t68 * 1.2e+09 *
+           ((t106 * 0.031415926535897934 * x[3] * t157 - t69 * 0.031415926535897934 * t165 * x[3] +
+             t106 * 0.031415926535897934 * t137 * t107 * x[2] -
+             t69 * 0.031415926535897934 * x[2] * t167)) -
+       t69 * t137 * 37699111.84307752 * t138 * t156);
+  jacobian[72] = t69 * (-37699111.84307752) * t68 * t107;
+  jacobian[73] = t69 * (-37699111.84307752) * t137 * t68;
+  jacobian[75] = t68 * 1.2e+09 *
+                 ((-t169 * t141 * t147 * 1.0206207261596577e-06 -
+                   2.0412414523193154e-06 * t170 * t148 * t153));
+  jacobian[77] = t68 * 1.2e+09 *
+                 ((-t172 * 5.103103630798288e-07 * pow(t152, (-1.25)) * t151 * t148 -
+                   t173 * 1.275775907699572e-07 * pow(t146, (-1.25)) * t144 * t145 +
+                   t173 * t144 * t147 * 1.0206207261596577e-06 +
+                   (1.0 / sqrt(t150)) * t172 * 1.25e-09 + t151 * 2.0412414523193154e-06 * t153 -
+                   (1.0 / sqrt(t155)) * 1.25e-09 * ((-5.6e+07 + t171)) - 5e-09));
   jacobian[80] =
-      (t8 * t10 *
-           ((t8 * t10 * x[2] * 0.03817035074111599 + t25 * t171 * 2.721655269759087e-06 * t168 +
-             0.094 - 6.666666666666667e-09 * x[8] + 3.3333333333333334e-09 * sqrt(t174) -
-             t176 * t17 * 2.721655269759087e-06 * t172 - 3.3333333333333334e-09 * sqrt(t178))) *
-           45804420.889339186 / (t179 * t179) +
-       1.2e+09 * t180 *
-           ((t10 * t30 * x[2] * 0.03817035074111599 - t28 * x[2] * 0.03817035074111599 * t29)));
-  jacobian[82] = t8 * t10 * 45804420.889339186 * t180;
+      (1.2e+09 * t175 *
+           ((t10 * t32 * x[2] * 0.03817035074111599 - t30 * x[2] * 0.03817035074111599 * t31)) +
+       t8 *
+           ((t8 * t10 * x[2] * 0.03817035074111599 + 0.094 +
+             t181 * 1.3608276348795436e-06 * t27 * t178 - 6.666666666666667e-09 * x[8] +
+             3.3333333333333334e-09 * sqrt(t184) - t186 * t20 * 2.721655269759087e-06 * t182 -
+             3.3333333333333334e-09 * sqrt(t188))) *
+           t10 * 45804420.889339186 / (t174 * t174));
+  jacobian[82] = t8 * t10 * 45804420.889339186 * t175;
   jacobian[84] =
-      1.2e+09 *
-      ((-t176 * 2.721655269759087e-06 * t33 * t172 - t171 * t34 * 2.721655269759087e-06 * t168)) *
-      t180;
+      1.2e+09 * t175 *
+      ((-t181 * 1.3608276348795436e-06 * t36 * t178 - t186 * 2.721655269759087e-06 * t35 * t182));
   jacobian[88] =
-      1.2e+09 * t180 *
-      ((-1.3608276348795436e-06 * t25 * t169 * pow(t170, (-1.25)) -
-        1.6666666666666667e-09 * (1.0 / sqrt(t178)) * ((-5.6e+07 + t181)) -
-        t176 * t17 * 2.721655269759087e-06 + t182 * 1.6666666666666667e-09 * (1.0 / sqrt(t174)) +
-        t25 * t171 * 2.721655269759087e-06 - 6.666666666666667e-09 +
-        t182 * t17 * t172 * pow(t175, (-1.25)) * 6.804138174397718e-07));
+      1.2e+09 *
+      ((t27 * t189 * pow(t180, (-1.25)) * t179 * 1.7010345435994295e-07 -
+        t181 * 1.3608276348795436e-06 * t27 * t189 -
+        1.6666666666666667e-09 * (1.0 / sqrt(t188)) * ((-5.6e+07 + t190)) -
+        t186 * t20 * 2.721655269759087e-06 + t191 * 1.6666666666666667e-09 * (1.0 / sqrt(t184)) -
+        6.666666666666667e-09 + t191 * t20 * t182 * pow(t185, (-1.25)) * 6.804138174397718e-07)) *
+      t175;
   jacobian[90] =
-      (((t63 * 0.023561944901923454 * x[3] * t151 -
-         t133 * t104 * 0.023561944901923454 * t85 * x[3] +
-         t63 * 0.023561944901923454 * t132 * x[2] - t133 * t134 * 0.023561944901923454 * x[2])) *
-           t184 * 1.2e+09 +
-       t63 * t85 * 28274333.882308144 * t185 * t197);
+      (((t69 * 0.023561944901923454 * x[3] * t136 -
+         t106 * t137 * 0.023561944901923454 * t107 * x[3] +
+         t69 * 0.023561944901923454 * t105 * x[2] - t106 * t108 * 0.023561944901923454 * x[2])) *
+           t193 * 1.2e+09 +
+       t69 * t107 * 28274333.882308144 * t194 * t208);
   jacobian[91] =
-      (t63 * t104 * 28274333.882308144 * t185 * t197 +
-       t184 * 1.2e+09 *
-           ((t63 * 0.023561944901923454 * x[2] * t162 + t63 * t160 * 0.023561944901923454 * x[3] -
-             t133 * 0.023561944901923454 * x[3] * t152 -
-             t133 * t104 * 0.023561944901923454 * t85 * x[2])));
-  jacobian[92] = t63 * t184 * t85 * 28274333.882308144;
-  jacobian[93] = t63 * t104 * t184 * 28274333.882308144;
-  jacobian[95] = ((-t165 * 2.0412414523193154e-06 * t190 * t186 +
-                   t193 * t196 * 2.0412414523193154e-06 * t164)) *
-                 t184 * 1.2e+09;
+      (t69 * t137 * 28274333.882308144 * t194 * t208 +
+       t193 * 1.2e+09 *
+           ((t69 * 0.023561944901923454 * x[2] * t167 + t69 * t165 * 0.023561944901923454 * x[3] -
+             t106 * 0.023561944901923454 * x[3] * t157 -
+             t106 * t137 * 0.023561944901923454 * t107 * x[2])));
+  jacobian[92] = t69 * t193 * t107 * 28274333.882308144;
+  jacobian[93] = t69 * t137 * t193 * 28274333.882308144;
+  jacobian[95] =
+      t193 * 1.2e+09 *
+      ((t200 * 1.0206207261596577e-06 * t203 * t170 - t169 * 2.0412414523193154e-06 * t205 * t195));
   jacobian[99] =
-      ((t199 * t88 * 5.103103630798288e-07 * pow(t189, (-1.25)) * t186 -
-        t194 * pow(t195, (-1.25)) * t108 * 1.0206207261596577e-06 -
-        (1.0 / sqrt(t192)) * 1.25e-09 * ((-5.6e+07 + t198)) + t199 * (1.0 / sqrt(t188)) * 1.25e-09 +
-        t108 * t196 * 2.0412414523193154e-06 - t88 * 2.0412414523193154e-06 * t190 - 5e-09)) *
-      t184 * 1.2e+09;
+      ((t210 * t144 * 5.103103630798288e-07 * pow(t204, (-1.25)) * t195 -
+        1.275775907699572e-07 * t201 * t211 * pow(t202, (-1.25)) * t151 -
+        (1.0 / sqrt(t207)) * 1.25e-09 * ((-5.6e+07 + t209)) +
+        t211 * t151 * 1.0206207261596577e-06 * t203 + t210 * (1.0 / sqrt(t197)) * 1.25e-09 -
+        t144 * 2.0412414523193154e-06 * t205 - 5e-09)) *
+      t193 * 1.2e+09;
   mass[0] =
-      (2600.0 * (t200 * t200) + 1800.0 * (t204 * t204) + (((t208 * t208) + (t211 * t211))) * u[4] +
-       (t214 * t214) * 1800.0 + 2600.0 * (t215 * t215) + 2900.0);
-  mass[1] = t220;
-  mass[2] = t220;
-  mass[3] = ((t218 * t218) * 1800.0 + 600.0 + (((t216 * t216) + (t217 * t217))) * u[4] +
-             (t219 * t219) * 1800.0);
+      (2600.0 * (t212 * t212) + 1800.0 * (t216 * t216) + (((t220 * t220) + (t223 * t223))) * u[4] +
+       (t226 * t226) * 1800.0 + 2600.0 * (t227 * t227) + 2900.0);
+  mass[1] = t232;
+  mass[2] = t232;
+  mass[3] = ((t230 * t230) * 1800.0 + 600.0 + (((t228 * t228) + (t229 * t229))) * u[4] +
+             (t231 * t231) * 1800.0);
   acceleration[0] =
-      (-t214 * t221 * 17651.969999999998 + t8 * t10 * t231 - 2000.0 * x[2] -
-       2600.0 * t232 * t215 * t233 - t215 * t234 * 25497.289999999997 -
-       2600.0 * t200 * t232 * t215 - t234 * t204 * 17651.969999999998 +
-       ((-t234 * t211 * 9.80665 - t208 * t221 * 9.80665)) * u[4] + u[2] -
-       ((t243 * t211 + t208 * t247)) * u[4] - t63 * t85 * t258 * 0.5 - t204 * t266 * 1800.0 -
-       t200 * t221 * 25497.289999999997 - t214 * 1800.0 * t270);
-  acceleration[1] = (-((t247 * t217 + t243 * t216)) * u[4] - t63 * t104 * t258 * 0.5 +
-                     ((-t217 * t221 * 9.80665 - t234 * t216 * 9.80665)) * u[4] -
-                     t218 * 1800.0 * t270 - 800.0 * x[3] - t234 * 17651.969999999998 * t219 -
-                     t218 * t221 * 17651.969999999998 + u[3] - t266 * 1800.0 * t219);
+      (-t226 * t233 * 17651.969999999998 + t8 * t10 * t243 - 2000.0 * x[2] -
+       2600.0 * t244 * t227 * t245 - t227 * t246 * 25497.289999999997 -
+       2600.0 * t212 * t244 * t227 - t246 * t216 * 17651.969999999998 +
+       ((-t246 * t223 * 9.80665 - t220 * t233 * 9.80665)) * u[4] + u[2] -
+       ((t255 * t223 + t220 * t259)) * u[4] - t69 * t107 * t270 * 0.5 - t216 * t278 * 1800.0 -
+       t212 * t233 * 25497.289999999997 - t226 * 1800.0 * t282);
+  acceleration[1] = (-((t259 * t229 + t255 * t228)) * u[4] - t69 * t137 * t270 * 0.5 +
+                     ((-t229 * t233 * 9.80665 - t246 * t228 * 9.80665)) * u[4] -
+                     t230 * 1800.0 * t282 - 800.0 * x[3] - t246 * 17651.969999999998 * t231 -
+                     t230 * t233 * 17651.969999999998 + u[3] - t278 * 1800.0 * t231);
   d_force[0] =
-      (t10 * t30 * t231 - t234 * t264 * 17651.969999999998 - t234 * t233 * 25497.289999999997 +
+      (t10 * t32 * t243 - t246 * t276 * 17651.969999999998 - t246 * t245 * 25497.289999999997 +
        t8 * t10 *
            ((-t8 * t10 * 2e+06 *
-                 ((t8 * t10 * t229 + t8 * t10 * t226 * pow(t227, (-1.5)) - t8 * t10 * t228 -
-                   t8 * pow(t224, (-1.5)) * t10 * t223)) *
+                 ((t8 * t10 * t241 + t8 * t10 * t238 * pow(t239, (-1.5)) - t8 * t10 * t240 -
+                   t8 * pow(t236, (-1.5)) * t10 * t235)) *
                  x[2] -
-             t8 * 4e+08 * t10 - t8 * t10 * 2e+08 * t229 * t222 + t8 * t10 * 2e+08 * t228 * t225 -
-             t230 * t10 * 2e+06 * t30 * x[2] + t230 * 2e+06 * t28 * x[2] * t29)) +
-       t133 * t134 * t258 * 0.5 + u[4] * ((-t211 * t221 * 9.80665 - t234 * t240 * 9.80665)) -
-       t63 * t132 * t258 * 0.5 - t273 * t63 * t85 * 0.5 - t28 * t231 * t29 -
-       t215 * t221 * 25497.289999999997 - t204 * t221 * 17651.969999999998);
-  d_force[1] = (t274 + t275 + t276 - t63 * t258 * 0.5 * t162 - t63 * t85 * 0.5 * t277 + t278);
-  d_force[2] = (-2.0 * u[4] * ((t208 * t246 + t211 * t241)) + t279 * t134 * t257 * 1e+06 -
-                t230 * 2e+06 * t29 / (t9)-2000.0 - t200 * t215 * 5200.0 * x[2] -
-                3600.0 * t265 * t204 - 3600.0 * t268 * t214 - t215 * 5200.0 * t233 * x[2]);
-  d_force[3] = (-3600.0 * t214 * t269 - 2.0 * u[4] * ((t242 * t211 + t208 * t245)) + t280 -
-                3600.0 * t204 * t263);
+             t8 * 4e+08 * t10 - t8 * t10 * 2e+08 * t241 * t234 + t8 * t10 * 2e+08 * t240 * t237 -
+             t242 * t10 * 2e+06 * t32 * x[2] + t242 * 2e+06 * t30 * x[2] * t31)) +
+       t106 * t108 * t270 * 0.5 + u[4] * ((-t223 * t233 * 9.80665 - t246 * t252 * 9.80665)) -
+       t69 * t105 * t270 * 0.5 - t285 * t69 * t107 * 0.5 - t30 * t243 * t31 -
+       t227 * t233 * 25497.289999999997 - t216 * t233 * 17651.969999999998);
+  d_force[1] = (t286 + t287 + t288 - t69 * t270 * 0.5 * t167 - t69 * t107 * 0.5 * t289 + t290);
+  d_force[2] = (-2.0 * u[4] * ((t220 * t258 + t223 * t253)) + t291 * t108 * t269 * 1e+06 -
+                t242 * 2e+06 * t31 / (t9)-2000.0 - t212 * t227 * 5200.0 * x[2] -
+                3600.0 * t277 * t216 - 3600.0 * t280 * t226 - t227 * 5200.0 * t245 * x[2]);
+  d_force[3] = (-3600.0 * t226 * t281 - 2.0 * u[4] * ((t254 * t223 + t220 * t257)) + t292 -
+                3600.0 * t216 * t275);
   d_force[6] = t8 * t10 * 0.05089380098815465;
-  d_force[7] = t63 * 0.031415926535897934 * t85;
+  d_force[7] = t69 * 0.031415926535897934 * t107;
   d_force[8] = t8 * t10 * (-0.03817035074111599);
-  d_force[9] = t63 * t85 * (-0.023561944901923454);
-  d_force[10] = (t274 - t273 * t63 * t104 * 0.5 + t275 + t276 - t63 * t258 * 0.5 * t151 + t278);
-  d_force[11] = (t133 * t258 * 0.5 * t152 + t274 + t275 + t276 - t63 * t104 * 0.5 * t277 -
-                 t63 * t160 * t258 * 0.5);
-  d_force[12] = (t280 - 2.0 * u[4] * ((t246 * t217 + t216 * t241)) - 3600.0 * t265 * t219 -
-                 3600.0 * t218 * t268);
-  d_force[13] = (-2.0 * u[4] * ((t242 * t216 + t245 * t217)) + t279 * t257 * 1e+06 * t152 - 800.0 -
-                 3600.0 * t218 * t269 - 3600.0 * t263 * t219);
-  d_force[17] = t63 * 0.031415926535897934 * t104;
-  d_force[19] = t63 * t104 * (-0.023561944901923454);
+  d_force[9] = t69 * t107 * (-0.023561944901923454);
+  d_force[10] = (t286 - t285 * t69 * t137 * 0.5 + t287 + t288 - t69 * t270 * 0.5 * t136 + t290);
+  d_force[11] = (t106 * t270 * 0.5 * t157 + t286 + t287 + t288 - t69 * t137 * 0.5 * t289 -
+                 t69 * t165 * t270 * 0.5);
+  d_force[12] = (t292 - 2.0 * u[4] * ((t258 * t229 + t228 * t253)) - 3600.0 * t277 * t231 -
+                 3600.0 * t230 * t280);
+  d_force[13] = (-2.0 * u[4] * ((t254 * t228 + t257 * t229)) + t291 * t269 * 1e+06 * t157 - 800.0 -
+                 3600.0 * t230 * t281 - 3600.0 * t275 * t231);
+  d_force[17] = t69 * 0.031415926535897934 * t137;
+  d_force[19] = t69 * t137 * (-0.023561944901923454);
   d_mass[0] =
-      (t215 * 5200.0 * t233 + 3600.0 * t204 * t214 + 2.0 * ((t211 * t240 + t208 * t211)) * u[4] +
-       t200 * t215 * 5200.0 + 3600.0 * t264 * t204);
-  d_mass[1] = t285;
-  d_mass[2] = t285;
-  d_mass[3] = t288;
-  d_mass[4] = (3600.0 * t204 * t261 + ((t283 + t284)) * 2.0 * u[4] + 3600.0 * t214 * t219);
-  d_mass[5] = t289;
-  d_mass[6] = t289;
-  d_mass[7] = t288;
+      (t227 * 5200.0 * t245 + 3600.0 * t216 * t226 + 2.0 * ((t223 * t252 + t220 * t223)) * u[4] +
+       t212 * t227 * 5200.0 + 3600.0 * t276 * t216);
+  d_mass[1] = t297;
+  d_mass[2] = t297;
+  d_mass[3] = t300;
+  d_mass[4] = (3600.0 * t216 * t273 + ((t295 + t296)) * 2.0 * u[4] + 3600.0 * t226 * t231);
+  d_mass[5] = t301;
+  d_mass[6] = t301;
+  d_mass[7] = t300;
   // -dh/dq by central differences (see codegen/symbolic_model.cc).
   for (int c = 0; c < kNumJoints; ++c) {
     double shifted[kNumStates];

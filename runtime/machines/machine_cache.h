@@ -26,7 +26,8 @@ namespace autoshovel::machines {
 
 /// Version of the machine-library contract: the meaning of generated::MachineFunctions and the
 /// entry points below. Part of every ABI tag; raise it when either changes meaning.
-inline constexpr int kMachineLayoutVersion = 1;
+/// 2: plant_rhs with the valve sections' load check valves (issue 41).
+inline constexpr int kMachineLayoutVersion = 2;
 
 /// The extern "C" entry points of a machine library.
 inline constexpr const char* kFunctionsSymbol = "autoshovel_machine_functions";

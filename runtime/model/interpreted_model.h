@@ -19,8 +19,9 @@
 // u = [valve command after dead zone and delay (J), external torque (J), payload mass,
 // pitch of frame M, supply pressure p_P of each joint's valve section (J)]):
 //   ẋ_s = (u_j − x_s)/τ_s
-//   Q_A = K_v [pos(x_s) g(p_P − p_A) − pos(−x_s) g(p_A − p_T)]
-//   Q_B = K_v [pos(−x_s) g(p_P − p_B) − pos(x_s) g(p_B − p_T)]
+//   Q_A = K_v [pos(x_s) g(c(p_P − p_A)) − pos(−x_s) g(p_A − p_T)]
+//   Q_B = K_v [pos(−x_s) g(c(p_P − p_B)) − pos(x_s) g(p_B − p_T)]
+//   (c: the section's load check valve, a smooth positive part: no flow back into the supply)
 //   ṗ_A = β/V_A (Q_A − A_A ṡ + Q_makeup(p_A) − Q_relief(p_A)), V_A = V_0 + A_A s
 //   ṗ_B = β/V_B (Q_B + A_B ṡ + Q_makeup(p_B) − Q_relief(p_B)), V_B = V_0 + A_B (S − s)
 //   F = p_A A_A − p_B A_B + F_endstop(s, ṡ) (spring and cushion damper past either end);
@@ -384,10 +385,15 @@ void InterpretedModel::PlantRhs(const S* x, const double* u, S* xdot) const {
     }
     const S open_a = SmoothPositive(xs[j], plant::kSpoolUnderlap);
     const S open_b = SmoothPositive(S(-xs[j]), plant::kSpoolUnderlap);
-    const S flow_a = valve.flow_gain * (open_a * OrificeRoot(S(p_pump - pa[j])) -
-                                        open_b * OrificeRoot(S(pa[j] - p_tank)));
-    const S flow_b = valve.flow_gain * (open_b * OrificeRoot(S(p_pump - pb[j])) -
-                                        open_a * OrificeRoot(S(pb[j] - p_tank)));
+    // From the supply only through the section's load check valve (plant_constants.h).
+    const S flow_a =
+        valve.flow_gain *
+        (open_a * OrificeRoot(SmoothPositive(S(p_pump - pa[j]), plant::kCheckValveWidth)) -
+         open_b * OrificeRoot(S(pa[j] - p_tank)));
+    const S flow_b =
+        valve.flow_gain *
+        (open_b * OrificeRoot(SmoothPositive(S(p_pump - pb[j]), plant::kCheckValveWidth)) -
+         open_a * OrificeRoot(S(pb[j] - p_tank)));
     const double relief_gain = valve.rated_flow / plant::kReliefFullFlowOverpressure;
     auto relief = [&](const S& p) {
       // Relief to tank above the setting, anti-cavitation make-up from tank below tank pressure.

@@ -15,6 +15,13 @@ inline constexpr double kSpoolUnderlap = 1e-3;
 /// sign(Δp)·sqrt|Δp| above it and linear below (a two-regime orifice in the spirit of Ellman &
 /// Piché 1999, smooth so that CVODE's Newton iteration sees a finite Jacobian).
 inline constexpr double kOrificeTransitionPressure = 2e5;
+/// Smoothing width of each valve section's load check valve [Pa]: a spool's path from the supply
+/// passes flow only while the supply is above the chamber it feeds, f(p_S − p_c) with the drop
+/// taken through a smooth positive part (x + sqrt(x² + w²))/2. Without it a chamber pushed
+/// above its supply (soil on the bucket, a pump at its limit) drove oil back through the spool
+/// into the supply line, and the arm gave way; real sections hold it with a check valve. At the
+/// 15 bar margin the smoothing changes the flow by 1e-5.
+inline constexpr double kCheckValveWidth = 1e4;
 /// Pressure width of the relief and anti-cavitation valves' opening [Pa].
 inline constexpr double kReliefPressureWidth = 1e5;
 /// Overpressure at which a relief valve passes the valve's rated flow [Pa].

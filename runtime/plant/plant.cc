@@ -166,12 +166,13 @@ class Plant::System : public OdeSystem {
       const model::Actuator& act = machine_.hydraulics.actuators[actuator_of_joint(j)];
       const double xs = y[2 * J + j], pa = y[3 * J + j], pb = y[4 * J + j];
       const double supply = held_.section_supply[j];
-      const double in_a = act.valve.flow_gain *
-                          model::internal::SmoothPositive(xs, model::plant::kSpoolUnderlap) *
-                          model::internal::OrificeRoot(supply - pa);
-      const double in_b = act.valve.flow_gain *
-                          model::internal::SmoothPositive(-xs, model::plant::kSpoolUnderlap) *
-                          model::internal::OrificeRoot(supply - pb);
+      using model::internal::OrificeRoot;
+      using model::internal::SmoothPositive;
+      constexpr double kCheck = model::plant::kCheckValveWidth;
+      const double in_a = act.valve.flow_gain * SmoothPositive(xs, model::plant::kSpoolUnderlap) *
+                          OrificeRoot(SmoothPositive(supply - pa, kCheck));
+      const double in_b = act.valve.flow_gain * SmoothPositive(-xs, model::plant::kSpoolUnderlap) *
+                          OrificeRoot(SmoothPositive(supply - pb, kCheck));
       flow += std::max(in_a, 0.0) + std::max(in_b, 0.0);
     }
     out.hydraulic_power = pump * flow / machine_.hydraulics.pump_efficiency;
@@ -272,8 +273,11 @@ class Plant::System : public OdeSystem {
       const double supply = held_.section_supply[j];
       const double open_a = SmoothPositive(xs, model::plant::kSpoolUnderlap);
       const double open_b = SmoothPositive(-xs, model::plant::kSpoolUnderlap);
-      const double in_a = valve.flow_gain * open_a * OrificeRoot(supply - pa);
-      const double in_b = valve.flow_gain * open_b * OrificeRoot(supply - pb);
+      constexpr double kCheck = model::plant::kCheckValveWidth;
+      const double in_a =
+          valve.flow_gain * open_a * OrificeRoot(SmoothPositive(supply - pa, kCheck));
+      const double in_b =
+          valve.flow_gain * open_b * OrificeRoot(SmoothPositive(supply - pb, kCheck));
       const double out_a = valve.flow_gain * open_b * OrificeRoot(pa - tank);
       const double out_b = valve.flow_gain * open_a * OrificeRoot(pb - tank);
       const double relief_gain = valve.rated_flow / model::plant::kReliefFullFlowOverpressure;
@@ -633,7 +637,8 @@ void Plant::LoadSensing(const std::vector<double>& spool_reference,
   // Pressure-compensated load sensing: each valve section's compensator keeps the drop across
   // its spool at the margin, so it is supplied at (pressure of the chamber it feeds + margin);
   // the pump follows the highest such demand, up to its maximum. A section whose demand exceeds
-  // the maximum gets no flow (its load check valve closes: supply = load). Held over a segment:
+  // the maximum is fed at the pump's maximum and passes flow only while its chamber is below it
+  // (its load check valve). Held over a segment:
   // a real pump and compensator respond in tens of milliseconds, a control tick is 10 ms.
   //
   // A pump with a largest delivery Q_max (Hydraulics::pump_max_flow) cannot keep the margin when
@@ -683,7 +688,10 @@ void Plant::LoadSensing(const std::vector<double>& spool_reference,
   for (int j = 0; j < J; ++j) {
     const double xs = y_[2 * J + j];
     const double opening = spool_reference[j] != 0 ? spool_reference[j] : xs;
-    double supply = flowing[j] ? fed[j] + drop : std::max(fed[j], hyd.tank_pressure);
+    // A section whose load needs more than the pump can give sees the pump at its cut-off; its
+    // load check valve (plant_constants.h) keeps the chamber from pushing oil back, and it fills
+    // again only once its pressure falls below the pump's.
+    double supply = flowing[j] ? fed[j] + drop : hyd.pump_pressure;
     // A compensator does not chase every pascal: within its dead band (kCompensatorBand) the
     // previous supply is kept, which also spares the integrator a reset at every tick.
     const std::vector<double>& previous = system_->held().section_supply;

@@ -225,9 +225,13 @@ void MotionDelayIsThePlantsAsTheChainSeesIt(const Recovery& r) {
     // Not before the spool opens.
     EXPECT_GE(delay, opens - 0.010);
     // The equivalent delay is the truth's: ±10 ms, and the oil-spring mode's own share of it,
-    // 2ζ/ω ≈ 2·0.045/15 rad/s ≈ 6 ms (the noise-free 80 % step rings at 2.4 Hz, its overshoot
-    // decaying to 0.76 per period), which the chain has no term for.
-    EXPECT_NEAR(equivalent, truth_equivalent, 0.016);
+    // which the chain has no term for. Lowering (down) it is 2ζ/ω ≈ 2·0.045/15 rad/s ≈ 6 ms
+    // (the noise-free 80 % step rings at 2.4 Hz, its overshoot decaying to 0.76 per period).
+    // Lifting (up) it is larger since the valve sections have load check valves (issue 41): the
+    // cap chamber's overshoot over its supply, which an open spool used to vent back into the
+    // supply line, now stays, and the lift gets under way sooner than the chain alone says
+    // (noise-free plant 225.5 ms against the truth chain's 250 ms; 234–250 ms before).
+    EXPECT_NEAR(equivalent, truth_equivalent, d.sign > 0 ? 0.030 : 0.016);
     // Sensor noise does not move it: the same fit on the noise-free plant.
     EXPECT_NEAR(equivalent, clean_equivalent, 0.010);
   }

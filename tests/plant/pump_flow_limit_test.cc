@@ -84,3 +84,53 @@ TEST(PumpFlowLimit, ALimitAboveTheDemandChangesNothing) {
 
 }  // namespace
 }  // namespace autoshovel::plant
+
+namespace autoshovel::plant {
+namespace {
+
+// A valve section's load check valve: a chamber above its supply gets no oil back into the supply
+// line through an open spool (the arm would give way), in the interpreted model and in the
+// generated code alike; below it, the same spool fills the chamber.
+TEST(LoadCheckValve, NoFlowFromAChamberBackIntoTheSupply) {
+  const model::MachineDescription machine = testing::LoadMachine("xcmg_968ev");
+  const generated::MachineFunctions& f = testing::Functions("xcmg_968ev");
+  const model::InterpretedModel reference(machine);
+  const int J = f.num_joints;
+  std::vector<double> x(f.num_states, 0.0), u(f.num_inputs, 0.0), xdot(f.num_states);
+  std::vector<double> xdot_generated(f.num_states);
+  x[0] = -0.2, x[1] = 0.2;             // mid-range: no end stop
+  x[2 * J] = 1.0;                      // boom spool fully open to extend
+  x[4 * J] = 10e5;                     // rod side near tank
+  x[4 * J + 1] = x[3 * J + 1] = 30e5;  // tilt held
+  u[0] = 1.0;
+  u[2 * J] = 0.0;  // no payload
+  const double area = machine.hydraulics.actuators[0].count * std::numbers::pi / 4 *
+                      std::pow(machine.hydraulics.actuators[0].bore, 2);
+  const double volume = machine.hydraulics.actuators[0].dead_volume;  // lower bound of V_A
+  const double bulk = machine.hydraulics.bulk_modulus;
+  // ṗ_A = β/V_A (Q_A − A ṡ − Q_relief) with ṡ = 0: the chamber's net flow at a given supply,
+  // spool fully open. Against a supply 100 bar below the chamber (where the check valve holds
+  // for sure) the relief's and the tank path's flows cancel and the supply path's remains.
+  const double volume_a = volume + area * (reference.CylinderLength<double>(0, x.data()) -
+                                           machine.hydraulics.actuators[0].retracted_length);
+  x[2 * J] = 1.0;
+  x[3 * J] = 260e5;  // below the 280 bar relief
+  auto net_flow = [&](double supply) {
+    u[2 * J + 2] = supply;  // the boom section's supply
+    u[2 * J + 3] = 50e5;
+    reference.PlantRhs(x.data(), u.data(), xdot.data());
+    f.plant_rhs(0.0, x.data(), u.data(), xdot_generated.data());
+    EXPECT_NEAR(xdot_generated[3 * J], xdot[3 * J], 1e-6 * std::abs(xdot[3 * J]) + 1e-3);
+    return xdot[3 * J] * volume_a / bulk;
+  };
+  const double held = net_flow(x[3 * J] - 100e5);
+  const double rated = machine.hydraulics.actuators[0].valve.rated_flow;
+  // 10 bar above its supply: nothing flows back (an open path would pass 80 % of rated back, and
+  // the difference to 100 bar above would be 1.7 times rated).
+  EXPECT_NEAR(net_flow(x[3 * J] - 10e5) - held, 0.0, 1e-4 * rated) << "oil flowed back";
+  // 15 bar below (the rated drop): the spool's rated flow in.
+  EXPECT_NEAR(net_flow(x[3 * J] + 15e5) - held, rated, 0.05 * rated);
+}
+
+}  // namespace
+}  // namespace autoshovel::plant

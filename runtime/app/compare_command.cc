@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/app/compare_run_options.h"
 #include "runtime/app/shovel_run.h"
 #include "runtime/prediction/shipped_models.h"
 
@@ -72,21 +73,7 @@ CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
   return c;
 }
 
-ShovelRunOptions Base(const CompareOptions& o) {
-  ShovelRunOptions r;
-  r.models_dir = o.models_dir;
-  r.cycles = 1;
-  r.figures = false;
-  r.truth_labels = !o.network;
-  r.pressure_threshold = o.pressure_threshold;
-  r.scoop_deceleration = o.scoop_deceleration;
-  r.attack_speed = o.attack_speed;
-  r.target_fill = o.target_fill;
-  r.attitude_feed_forward = o.attitude_feed_forward;
-  r.predictor = o.predictor;
-  r.machine = o.machine;
-  return r;
-}
+ShovelRunOptions Base(const CompareOptions& o) { return SingleCycleRunOptions(o); }
 
 int Table4(const CompareOptions& o, std::ostream& out, std::ostream& err) {
   std::set<std::string> warned;
@@ -237,6 +224,22 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
 }
 
 }  // namespace
+
+ShovelRunOptions SingleCycleRunOptions(const CompareOptions& o) {
+  ShovelRunOptions r;
+  r.models_dir = o.models_dir;
+  r.cycles = 1;
+  r.figures = false;
+  r.truth_labels = !o.network;
+  r.pressure_threshold = o.pressure_threshold;
+  r.scoop_deceleration = o.scoop_deceleration;
+  r.attack_speed = o.attack_speed;
+  r.target_fill = o.target_fill;
+  r.attitude_feed_forward = o.attitude_feed_forward;
+  r.predictor = o.predictor;
+  r.machine = o.machine;
+  return r;
+}
 
 int RunCompare(const CompareOptions& options, std::ostream& out, std::ostream& err) {
   if (options.trials < 1) {

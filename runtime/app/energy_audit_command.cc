@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/app/compare_run_options.h"
 #include "runtime/app/shovel_run.h"
 #include "runtime/core/file_output.h"
 #include "runtime/plot/stacked_area_plot.h"
@@ -258,17 +259,7 @@ int RunEnergyAudit(const CompareOptions& o, const std::filesystem::path& output_
     for (const Case& c : kCases) {
       CaseResult r;
       for (int t = 1; t <= o.trials; ++t) {
-        ShovelRunOptions options;
-        options.models_dir = o.models_dir;
-        options.cycles = 1;
-        options.figures = false;
-        options.truth_labels = !o.network;
-        options.scoop_deceleration = o.scoop_deceleration;
-        options.attack_speed = o.attack_speed;
-        options.target_fill = o.target_fill;
-        options.attitude_feed_forward = o.attitude_feed_forward;
-        options.predictor = o.predictor;
-        options.machine = o.machine;
+        ShovelRunOptions options = SingleCycleRunOptions(o);
         options.scenario = "mixing_station";
         options.bins = {c.bin};
         options.policy = c.policy;

@@ -12,20 +12,23 @@
 #include <stdexcept>
 
 #include "runtime/plot/axis_ticks.h"
+#include "runtime/plot/drawing.h"
 #include "runtime/plot/image_file.h"
 
 namespace autoshovel::plot {
 namespace {
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kLeft = 90, kRight = 25, kTop = 50, kBottom = 65;  // margins [px]
 const cv::Scalar kBlack(0, 0, 0);
 const cv::Scalar kGridColor(225, 225, 225);
 
+using internal::DrawSegment;
 using internal::NiceStep;
+using internal::PutText;
+using internal::PutVerticalText;
+using internal::TextSize;
 using internal::TickLabel;
-
-cv::Scalar ToScalar(Color c) { return cv::Scalar(c.b, c.g, c.r); }
+using internal::ToScalar;
 
 struct Range {
   double lo = std::numeric_limits<double>::infinity();
@@ -48,46 +51,6 @@ void Widen(Range& r) {
     r.lo -= pad;
     r.hi += pad;
   }
-}
-
-void DrawSegment(cv::Mat& image, cv::Point2d a, cv::Point2d b, const cv::Scalar& color,
-                 int thickness, bool dashed) {
-  if (!dashed) {
-    cv::line(image, a, b, color, thickness, cv::LINE_AA);
-    return;
-  }
-  const double length = cv::norm(b - a);
-  constexpr double kDash = 9.0, kGap = 6.0;
-  for (double s = 0.0; s < length; s += kDash + kGap) {
-    const double e = std::min(s + kDash, length);
-    cv::line(image, a + (b - a) * (s / length), a + (b - a) * (e / length), color, thickness,
-             cv::LINE_AA);
-  }
-}
-
-void PutText(cv::Mat& image, const std::string& text, cv::Point origin, double scale,
-             const cv::Scalar& color = kBlack, int thickness = 1) {
-  cv::putText(image, text, origin, kFont, scale, color, thickness, cv::LINE_AA);
-}
-
-cv::Size TextSize(const std::string& text, double scale, int thickness = 1) {
-  int baseline = 0;
-  return cv::getTextSize(text, kFont, scale, thickness, &baseline);
-}
-
-// Text rotated 90° counter-clockwise, centred vertically at `center_y`, left edge at `x`.
-void PutVerticalText(cv::Mat& image, const std::string& text, int x, int center_y, double scale) {
-  const cv::Size size = TextSize(text, scale);
-  cv::Mat horizontal(size.height + 8, size.width + 4, CV_8UC3, cv::Scalar(255, 255, 255));
-  PutText(horizontal, text, cv::Point(2, size.height + 2), scale);
-  cv::Mat vertical;
-  cv::rotate(horizontal, vertical, cv::ROTATE_90_COUNTERCLOCKWISE);
-  const int top =
-      std::clamp(center_y - vertical.rows / 2, 0, std::max(0, image.rows - vertical.rows));
-  const cv::Rect roi(x, top, std::min(vertical.cols, image.cols - x),
-                     std::min(vertical.rows, image.rows - top));
-  if (roi.width > 0 && roi.height > 0)
-    vertical(cv::Rect(0, 0, roi.width, roi.height)).copyTo(image(roi));
 }
 
 cv::Mat DrawLinePlot(const LinePlot& plot) {

@@ -12,15 +12,20 @@
 #include <vector>
 
 #include "runtime/plot/axis_ticks.h"
+#include "runtime/plot/drawing.h"
 #include "runtime/plot/image_file.h"
 
 namespace autoshovel::plot {
 namespace {
 
+using internal::DrawSegment;
 using internal::NiceStep;
+using internal::PutText;
+using internal::PutVerticalText;
+using internal::TextSize;
 using internal::TickLabel;
+using internal::ToScalar;
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kLeft = 90, kBottom = 65, kMinRight = 25;  // margins [px]
 constexpr int kTitleBaseline = 30;                       // [px] from the top
 constexpr int kLabelRow = 18;                            // marker label rows above the frame [px]
@@ -30,52 +35,8 @@ const cv::Scalar kBlack(0, 0, 0);
 const cv::Scalar kGridColor(225, 225, 225);
 const cv::Vec3b kTotalColor(40, 40, 40);  // the stack's total line
 
-cv::Scalar ToScalar(Color c) { return cv::Scalar(c.b, c.g, c.r); }
-
 // Header contract: negative and non-finite values are drawn as 0.
 double Drawn(double v) { return std::isfinite(v) && v > 0.0 ? v : 0.0; }
-
-void PutText(cv::Mat& image, const std::string& text, cv::Point origin, double scale,
-             const cv::Scalar& color = kBlack, int thickness = 1) {
-  cv::putText(image, text, origin, kFont, scale, color, thickness, cv::LINE_AA);
-}
-
-cv::Size TextSize(const std::string& text, double scale, int thickness = 1) {
-  int baseline = 0;
-  return cv::getTextSize(text, kFont, scale, thickness, &baseline);
-}
-
-// As line_plot.cc: dashes of 9 px with gaps of 6 px.
-void DrawSegment(cv::Mat& image, cv::Point2d a, cv::Point2d b, const cv::Scalar& color,
-                 int thickness, bool dashed) {
-  const double length = cv::norm(b - a);
-  if (!dashed || length <= 0.0) {
-    cv::line(image, a, b, color, thickness, cv::LINE_AA);
-    return;
-  }
-  constexpr double kDash = 9.0, kGap = 6.0;
-  for (double s = 0.0; s < length; s += kDash + kGap) {
-    const double e = std::min(s + kDash, length);
-    cv::line(image, a + (b - a) * (s / length), a + (b - a) * (e / length), color, thickness,
-             cv::LINE_AA);
-  }
-}
-
-// As line_plot.cc: text rotated 90° counter-clockwise, centred at `center_y`, left edge at `x`.
-void PutVerticalText(cv::Mat& image, const std::string& text, int x, int center_y, double scale) {
-  if (text.empty()) return;
-  const cv::Size size = TextSize(text, scale);
-  cv::Mat horizontal(size.height + 8, size.width + 4, CV_8UC3, cv::Scalar(255, 255, 255));
-  PutText(horizontal, text, cv::Point(2, size.height + 2), scale);
-  cv::Mat vertical;
-  cv::rotate(horizontal, vertical, cv::ROTATE_90_COUNTERCLOCKWISE);
-  const int top =
-      std::clamp(center_y - vertical.rows / 2, 0, std::max(0, image.rows - vertical.rows));
-  const cv::Rect roi(x, top, std::min(vertical.cols, image.cols - x),
-                     std::min(vertical.rows, image.rows - top));
-  if (roi.width > 0 && roi.height > 0)
-    vertical(cv::Rect(0, 0, roi.width, roi.height)).copyTo(image(roi));
-}
 
 void Validate(const StackedAreaPlot& plot) {
   const std::string where = "stacked area plot '" + plot.title + "'";

@@ -28,6 +28,10 @@ grep -qE "broken.yaml:[0-9]+:[0-9]+: chassis.track_width: must be > 0 m, got -2.
   || fail "unexpected message: $(cat "$tmp/err")"
 [ ! -e "$tmp/out" ] || fail "output written for a malformed description"
 "$autoshovel" --models "$source_dir/models" describe no_such_machine 2>/dev/null && fail "unknown machine accepted"
+# The Z-bar candidate of docs/energy_audit.md stays a valid description that reaches the SAE dump.
+out=$("$autoshovel" --models "$source_dir/models" describe \
+  "$source_dir/examples/xcmg_968ev_zbar/xcmg_968ev.yaml") || fail "describe the Z-bar candidate"
+grep -q "dump clearance at 45 deg" <<<"$out" || fail "Z-bar candidate: SAE J732 dump not reached"
 # plant step: a CSV with the documented columns; the same seed gives the same bytes.
 "$autoshovel" --models "$source_dir/models" plant step --machine xcmg_968ev --actuator boom \
   --amplitude 0.6 --duration 1.5 --noise --seed 7 -o "$tmp/step.csv" || fail "plant step"

@@ -98,7 +98,8 @@ class Plant::System : public OdeSystem {
   int size() const override { return layout_.size(); }
   int quadrature_size() const override { return audit_model_ ? kEnergyTermCount : 0; }
   void Quadrature(double, const double* y, double* integrand) override {
-    AuditPowers(y, integrand);
+    const EnergyAudit powers = AuditPowers(y);
+    std::copy(powers.terms.begin(), powers.terms.end(), integrand);
   }
   const Layout& layout() const { return layout_; }
   Held& held() { return held_; }
@@ -249,12 +250,10 @@ class Plant::System : public OdeSystem {
   }
 
   // The powers of the energy audit at state y (energy_audit.h gives the identities they obey).
-  void AuditPowers(const double* y, double* power) {
+  EnergyAudit AuditPowers(const double* y) {
     using model::internal::OrificeRoot;
     using model::internal::SmoothPositive;
-    EnergyAudit& p = *reinterpret_cast<EnergyAudit*>(power);
-    static_assert(sizeof(EnergyAudit) == sizeof(double) * kEnergyTermCount);
-    p = EnergyAudit{};
+    EnergyAudit p;
     audit_ydot_.resize(layout_.size());
     const Outputs out = Evaluate(y, audit_ydot_.data());  // also sets u_ (τ_ext)
     const int J = layout_.joints;
@@ -336,7 +335,7 @@ class Plant::System : public OdeSystem {
       p[EnergyTerm::kArmFriction] += b * qd[i] * qd[i];
       p[EnergyTerm::kSoilByArm] -= u_[J + i] * qd[i];
     }
-    if (!is_loader_) return;
+    if (!is_loader_) return p;
     const DriveRates& d = out.drive;
     const double v = y[layout_.speed()], w = y[layout_.wheel()];
     const double r = machine_.chassis.wheel_radius;
@@ -351,6 +350,7 @@ class Plant::System : public OdeSystem {
     p[EnergyTerm::kSoilByDrive] = -out.tip_force.x() * v;
     p[EnergyTerm::kMachineKinetic] =
         d.mass * v * d.speed_dot + options_.drive.wheel_inertia * w * d.wheel_speed_dot;
+    return p;
   }
 
   int actuator_of_joint(int j) const { return actuator_of_joint_[j]; }

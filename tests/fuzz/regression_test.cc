@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -21,6 +22,7 @@
 #include "identification/hydraulics/log_reader.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
+#include "runtime/results/results_db.h"
 #include "tests/fuzz/hydraulic_log_formats.h"
 #include "tests/fuzz/refusal.h"
 
@@ -133,6 +135,42 @@ TEST(FuzzRegressions, ImageHeader) {
   ExpectBothKinds(CheckTarget("image_header", [](const std::string& path) {
     return Refusal([&] { identification::ReadImageHeader(path); });
   }));
+}
+
+// The results database read back as fuzz_results_db reads it. Its refusal is ResultsDbError
+// naming the file (not a located InputError: the file is SQLite's, not a text format). A valid
+// seed from before the predicted-travel column (issue 41) reads that column as not measured.
+TEST(FuzzRegressions, ResultsDb) {
+  Counts counts;
+  for (const char* kind : {"corpus", "regressions"}) {
+    for (const fs::path& file : FilesIn(kFuzzDir / kind / "results_db")) {
+      const std::string path = file.string();
+      SCOPED_TRACE(path);
+      const bool valid =
+          std::string(kind) == "corpus" && file.filename().string().starts_with("valid_");
+      try {
+        const results::ResultsDb db(path, results::ResultsDb::Access::kReadOnly);
+        std::size_t cycles = 0;
+        for (const results::RunInfo& run : db.Runs()) cycles += db.Cycles(run.run_id, true).size();
+        const auto crowding = db.CrowdingSamples();
+        EXPECT_TRUE(valid) << "a malformed database was read";
+        EXPECT_EQ(cycles, 1u);
+        ASSERT_EQ(crowding.size(), 1u);
+        EXPECT_GT(crowding[0].sample.penetration, 0.0);
+        if (file.filename().string().find("before_predicted") != std::string::npos) {
+          EXPECT_TRUE(std::isnan(crowding[0].sample.predicted_penetration));
+        } else {
+          EXPECT_GT(crowding[0].sample.predicted_penetration, 0.0);
+        }
+        ++counts.valid;
+      } catch (const results::ResultsDbError& e) {
+        EXPECT_FALSE(valid) << "a valid seed was refused: " << e.what();
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        ++counts.refused;
+      }
+    }
+  }
+  ExpectBothKinds(counts);
 }
 
 }  // namespace

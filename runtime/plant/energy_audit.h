@@ -3,17 +3,22 @@
 // integrates the terms as CVODES quadratures (PlantOptions::energy_audit), so the audit never
 // changes the trajectory it audits.
 //
-// Travel drive (energy drawn E_travel = ∫ max(T ω, 0)/η dt, wheel torque T, lumped wheel ω):
+// Travel drive (energy drawn E_travel = ∫ P_drawn dt, wheel torque T, lumped wheel ω; P_drawn =
+// T ω + P_loss(T, ω) for an electric drive's loss map, max(T ω, 0)/η for a diesel's flat η,
+// power_losses.h):
 //   T ω = I_w ω ω̇ + T_brake ω + r F_x ω                       (wheel, drive.h)
 //   r F_x ω = F_x (ω r − v) + F_x v                            (tyre slip + traction on the body)
 //   F_x v = m v v̇ + F_roll v − F_soil,x v                      (body)
-// so max(Tω,0)/η = drive loss + not recovered (motor braking) + brake + slip + rolling
-//                  + soil pushed by the drive + kinetic energy of the machine.
+// so P_drawn = drive loss + not recovered (motor braking) + brake + slip + rolling
+//           + soil pushed by the drive + kinetic energy of the machine.
+// An electric drive that credits regeneration books nothing as not recovered: braking with the
+// motor makes T ω, and P_drawn with it, negative.
 //
-// Hydraulics (drawn E_hyd = ∫ p_pump Σ Q_in/η dt; per valve section j its supply p_S,j, per
+// Hydraulics (drawn E_hyd = ∫ p_pump Σ Q_in + P_loss(p_pump, Σ Q_in) dt, the pump's and its
+// motor's loss map (power_losses.h); per valve section j its supply p_S,j, per
 // chamber c fed from the supply at pressure p_c): with Q_in,c the spool's flow from the supply,
 // Q_out,c its flow to tank and Q_rel,c the relief's (interpreted_model.h),
-//   p_pump ΣQ⁺_in/η = pump loss + Σ(p_pump − p_S)Q⁺_in [compensators] + Σ(p_S − p_c)Q⁺_in
+//   p_pump ΣQ⁺_in + P_loss = pump loss + Σ(p_pump − p_S)Q⁺_in [compensators] + Σ(p_S − p_c)Q⁺_in
 //   [meter-in,
 //                     the load-sensing margin] + Σ p_c (Q⁺_in − Q_in) [backflow] + Σ p_c Q_in
 //   p_c Q_in = p_c Q_out [meter-out] + p_c Q_rel [relief] + p_c V_c/β ṗ_c [compression]
@@ -32,15 +37,16 @@ namespace autoshovel::plant {
 
 enum class EnergyTerm : int {
   // The travel drive.
-  kTravelDriveLoss,     ///< motor, inverter and drivetrain: max(Tω, 0)(1/η − 1)
-  kTravelNotRecovered,  ///< motor braking (T ω < 0), not fed back: max(Tω, 0) − Tω
+  kTravelDriveLoss,     ///< motor, inverter and drivetrain: P_loss(T, ω) or max(Tω,0)(1/η − 1)
+  kTravelNotRecovered,  ///< motor braking (T ω < 0) not fed back: 0 when regeneration is
+                        ///< credited, else what the battery would have received (flat: −Tω)
   kBrake,               ///< service brake T_brake ω
   kTyreSlip,            ///< F_x (ω r − v)
   kRolling,             ///< F_roll v
   kSoilByDrive,         ///< −F_soil,x v: the drive pushing the bucket into the pile
   kMachineKinetic,      ///< d/dt (½ m v² + ½ I_w ω²)
   // The hydraulic pump.
-  kPumpLoss,     ///< pump and its drive: P_hyd (1 − η)
+  kPumpLoss,     ///< pump and its electric motor: P_loss(p_pump, Σ Q_in), or p Q (1/η − 1)
   kCompensator,  ///< Σ (p_pump − p_S) Q⁺_in: sections fed below the highest load
   kMeterIn,      ///< Σ (p_S − p_c) Q⁺_in: the load-sensing margin across the spools
   kBackflow,     ///< Σ p_c (Q⁺_in − Q_in): a chamber above its supply pushing back

@@ -23,7 +23,8 @@
 // pressure of the chamber it feeds plus a margin (the valves' rated drop), so a spool passes
 // flow in proportion to its opening whatever the other loads; the pump runs at the highest such
 // demand, within its maximum. Section supplies are inputs of the generated model, held per
-// segment. Hydraulic energy is p_pump·ΣQ_in/η (compensator losses included).
+// segment. Hydraulic energy is p_pump·ΣQ_in plus the pump's (and its motor's) loss map
+// (power_losses.h; compensator losses included).
 //
 // Events that reset the integrator: a valve command reaching its spool (exactly τ_d after it was
 // issued, see valve_command.h), any change of the held inputs at a control tick (command, payload,
@@ -51,6 +52,7 @@
 #include "runtime/plant/energy_audit.h"
 #include "runtime/plant/machine_state.h"
 #include "runtime/plant/ode_integrator.h"
+#include "runtime/plant/power_losses.h"
 #include "runtime/plant/valve_command.h"
 #include "runtime/plant/world.h"
 
@@ -61,6 +63,8 @@ struct PlantOptions {
   /// and time constant by < 0.1 % against 1e-6, at three times the speed (plant_bench).
   IntegratorOptions integrator{.relative_tolerance = 1e-4, .absolute_tolerance = {}};
   DriveConstants drive;
+  /// Loss maps of the travel drive and the pump (power_losses.h) behind the energy counters.
+  PowerLossOptions losses;
   /// How often the terrain relaxes to its angle of repose around the bucket [s].
   double relax_period = 0.25;
   double relax_half_window = 1.5;  ///< beyond the bucket pivot's foot [m]
@@ -79,8 +83,10 @@ struct PlantOptions {
 
 /// Energy in J, cumulative.
 struct Energy {
-  double travel = 0;     ///< ∫ max(T_wheel ω, 0) dt / η_drive
-  double hydraulic = 0;  ///< ∫ p_supply Σ Q_in dt / η_pump
+  /// ∫ (T_wheel ω + P_loss(T, ω)) dt (electric, power_losses.h: negative while regenerating)
+  /// or ∫ max(T_wheel ω, 0) dt / η (diesel)
+  double travel = 0;
+  double hydraulic = 0;  ///< ∫ (p_pump Σ Q_in + P_loss(p_pump, Σ Q_in)) dt (power_losses.h)
   double total() const { return travel + hydraulic; }
 };
 
@@ -140,6 +146,7 @@ class Plant {
   const PlantCounters& counters() const { return counters_; }
   const BucketTerrain& bucket() const { return *bucket_terrain_; }
   World& world() { return world_; }
+  const World& world() const { return world_; }
   const model::MachineDescription& machine() const { return machine_; }
 
   /// Cap-side (A) and rod-side (B) pressure of an actuator [Pa]: the boom cylinder pressure that

@@ -202,8 +202,53 @@ MachineTexts MachineCode(const model::MachineDescription& m) {
        "void MechanicalEnergy(const double* q, const double* qd, double payload, double pitch, "
        "double* energy);\n"
        "/// Everything above behind the common interface of the registry.\n"
-       "const MachineFunctions& Functions();\n\n"
-    << "}  // namespace autoshovel::generated::" << ns << "\n";
+       "const MachineFunctions& Functions();\n\n";
+  // The same rigid-body terms and lever arms, templated on the scalar: an optimiser
+  // (runtime/optimal/) differentiates them exactly with dual numbers (ceres::Jet) instead of by
+  // finite differences. The double versions above stay plain functions behind the registry.
+  {
+    std::vector<Assignment> dynamics = Assign("mass", s.mass_matrix);
+    for (auto& a : Assign("bias", s.bias)) dynamics.push_back(a);
+    h << "/// MassMatrix and BiasForces together, templated on the scalar (ceres::Jet for exact\n"
+         "/// derivatives): M(q) q'' + bias(q, q') = actuator + external torques.\n"
+         "template <typename T>\n"
+         "void ArmDynamics(const T* q, const T* qd, const T& payload, const T& pitch, T* mass,\n"
+         "                 T* bias) {\n"
+      << kUsingMath << "  T x[kNumStates] = {};\n  T u[kNumInputs] = {};\n"
+      << "  for (int j = 0; j < kNumJoints; ++j) {\n    x[j] = q[j];\n"
+         "    x[kNumJoints + j] = qd[j];\n  }\n"
+      << "  u[2 * kNumJoints] = payload;\n  u[2 * kNumJoints + 1] = pitch;\n"
+      << PrintAssignments(dynamics, "T") << "}\n\n";
+    std::vector<Assignment> kinematics = Assign("pose", s.pose);
+    for (auto& a : Assign("d_pose_d_angles", s.d_pose_d_angles)) kinematics.push_back(a);
+    h << "/// Eq. (1)-(2) with d_pose_d_angles (4 x kNumAngles, row-major), templated on the "
+         "scalar\n"
+         "/// (ForwardKinematicsJacobians without the parameter Jacobian).\n"
+         "template <typename T>\n"
+         "void ForwardKinematicsWithJacobian(const T* angles, const T* params, T* pose,\n"
+         "                                   T* d_pose_d_angles) {\n"
+      << kUsingMath << PrintAssignments(kinematics, "T") << "}\n\n";
+    h << "/// Pin-to-pin length of `actuator` [m] (a motor: its joint angle) and its gradient "
+         "over\n"
+         "/// all joints [m/rad] (a Z-bar's tilt cylinder depends on the boom too: force times "
+         "the\n"
+         "/// gradient is the generalised force), templated on the scalar. Returns false for an\n"
+         "/// unknown actuator.\n"
+         "template <typename T>\n"
+         "bool CylinderGeometry(int actuator, const T* q, T* length, T* d_length_d_q) {\n"
+      << kUsingMath << "  switch (actuator) {\n";
+    for (int i = 0; i < A; ++i) {
+      std::vector<Assignment> geometry{{"length[0]", s.cylinder_length[i]}};
+      for (int j = 0; j < J; ++j) {
+        geometry.push_back(
+            {"d_length_d_q[" + std::to_string(j) + "]", s.cylinder_length[i].diff(s.q[j])});
+      }
+      h << "    case " << i << ": {\n"
+        << PrintAssignments(geometry, "T", 6) << "      return true;\n    }\n";
+    }
+    h << "    default:\n      return false;\n  }\n}\n\n";
+  }
+  h << "}  // namespace autoshovel::generated::" << ns << "\n";
 
   std::ostringstream c;
   c << banner << "#include \"generated/" << ns << "/" << ns << ".h\"\n\n"
@@ -470,10 +515,13 @@ std::string BannerPath(const std::string& description_path) {
 std::vector<fs::path> EmitRegistry(const EmitOptions& options) {
   const std::string formatter = FindClangFormat(options.clang_format);
   const std::vector<std::string> machines = MachineFolders(options.output_dir);
-  std::string includes, entries, sources;
+  std::string includes, entries, sources, templated_entries;
   for (const auto& name : machines) {
     includes += "#include \"generated/" + name + "/" + name + ".h\"\n";
     entries += "      &" + name + "::Functions(),\n";
+    templated_entries += "      {\"" + name + "\", &" + name + "::ArmDynamics<T>, &" + name +
+                         "::ForwardKinematicsWithJacobian<T>, &" + name +
+                         "::CylinderGeometry<T>},\n";
     sources += "    " + name + "/" + name + ".cc\n";
   }
   const std::string registry_h =
@@ -498,6 +546,31 @@ std::vector<fs::path> EmitRegistry(const EmitOptions& options) {
       "  for (const MachineFunctions* machine : AllMachines()) {\n"
       "    if (name == machine->name) return machine;\n  }\n  return nullptr;\n}\n\n"
       "}  // namespace autoshovel::generated\n";
+  // The templated terms, for code that differentiates them with dual numbers: a header, so the
+  // scalar types are instantiated only where they are used (runtime/optimal/).
+  const std::string templated_h =
+      CommonBanner() +
+      "//\n// The templated arm terms of every generated machine (ArmDynamics,\n"
+      "// ForwardKinematicsWithJacobian, CylinderGeometry), found by name for a scalar type T "
+      "(ceres::Jet\n"
+      "// for exact derivatives). Include only where T is instantiated: it includes every "
+      "machine.\n"
+      "#pragma once\n\n#include <string_view>\n\n" +
+      includes +
+      "\nnamespace autoshovel::generated {\n\n"
+      "template <typename T>\nstruct TemplatedArm {\n  const char* name;\n"
+      "  void (*dynamics)(const T* q, const T* qd, const T& payload, const T& pitch, T* mass,\n"
+      "                   T* bias);\n"
+      "  void (*kinematics)(const T* angles, const T* params, T* pose, T* d_pose_d_angles);\n"
+      "  bool (*cylinder)(int actuator, const T* q, T* length, T* d_length_d_q);\n};\n\n"
+      "/// The machine called `name`, or nullptr.\n"
+      "template <typename T>\nconst TemplatedArm<T>* FindTemplatedArm(std::string_view name) {\n"
+      "  static const TemplatedArm<T> machines[] = {\n" +
+      templated_entries +
+      "  };\n"
+      "  for (const TemplatedArm<T>& machine : machines) {\n"
+      "    if (name == machine.name) return &machine;\n  }\n  return nullptr;\n}\n\n"
+      "}  // namespace autoshovel::generated\n";
   const std::string cmake =
       "# Generated by autoshovel codegen -- do not edit.\n"
       "add_library(autoshovel_generated\n    registry.cc\n" +
@@ -511,9 +584,10 @@ std::vector<fs::path> EmitRegistry(const EmitOptions& options) {
   WriteFormatted(dir / "machine_functions.h", InterfaceHeader(), formatter);
   WriteFormatted(dir / "registry.h", registry_h, formatter);
   WriteFormatted(dir / "registry.cc", registry_cc, formatter);
+  WriteFormatted(dir / "templated_registry.h", templated_h, formatter);
   core::WriteFileAtomically(dir / "CMakeLists.txt", cmake);
   return {dir / "machine_functions.h", dir / "registry.h", dir / "registry.cc",
-          dir / "CMakeLists.txt"};
+          dir / "templated_registry.h", dir / "CMakeLists.txt"};
 }
 
 std::vector<fs::path> EmitMachine(const model::MachineDescription& machine,

@@ -239,8 +239,14 @@ std::string PrintAssignments(const std::vector<Assignment>& assignments, const s
     out += pad + "const " + scalar + " " + name + " = " + printer.Print(e, true) + ";\n";
     temps.emplace(e, name);
   }
+  // A constant assigned to a non-double scalar is wrapped in its constructor: ceres::Jet has no
+  // assignment or copy-initialisation from a double.
+  const bool wrap_constants = scalar != "double";
   for (const auto& a : assignments) {
-    out += pad + a.target + " = " + printer.Print(a.value) + ";\n";
+    const std::string value = printer.Print(a.value);
+    out += pad + a.target + " = " +
+           (wrap_constants && is_a<GiNaC::numeric>(a.value) ? scalar + "(" + value + ")" : value) +
+           ";\n";
   }
   return out;
 }

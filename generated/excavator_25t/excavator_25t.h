@@ -125,4 +125,351 @@ void MechanicalEnergy(const double* q, const double* qd, double payload, double 
 /// Everything above behind the common interface of the registry.
 const MachineFunctions& Functions();
 
+/// MassMatrix and BiasForces together, templated on the scalar (ceres::Jet for exact
+/// derivatives): M(q) q'' + bias(q, q') = actuator + external torques.
+template <typename T>
+void ArmDynamics(const T* q, const T* qd, const T& payload, const T& pitch, T* mass, T* bias) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  T x[kNumStates] = {};
+  T u[kNumInputs] = {};
+  for (int j = 0; j < kNumJoints; ++j) {
+    x[j] = q[j];
+    x[kNumJoints + j] = qd[j];
+  }
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const T t0 = cos(x[0]);
+  const T t1 = sin(x[0]);
+  const T t2 = (-0.35 * t0 - t1 * 2.6);
+  const T t3 = 5.7 * t0;
+  const T t4 = (x[0] + x[1]);
+  const T t5 = sin(t4);
+  const T t6 = t5 * (-0.1);
+  const T t7 = cos(t4);
+  const T t8 = 1.1 * t7;
+  const T t9 = (t3 + t6 + t8);
+  const T t10 = t1 * (-0.35);
+  const T t11 = 2.6 * t0;
+  const T t12 = (t10 + t11);
+  const T t13 = t1 * (-5.7);
+  const T t14 = t7 * (-0.1);
+  const T t15 = t5 * (-1.1);
+  const T t16 = (t13 + t14 + t15);
+  const T t17 = (x[2] + x[0] + x[1]);
+  const T t18 = cos(t17);
+  const T t19 = t18 * 0.567857142857143;
+  const T t20 = 2.9 * t7;
+  const T t21 = sin(t17);
+  const T t22 = t21 * 0.0578571428571429;
+  const T t23 = (t19 + t3 + t20 + t22);
+  const T t24 = t18 * 0.0578571428571429;
+  const T t25 = t5 * (-2.9);
+  const T t26 = t21 * (-0.567857142857143);
+  const T t27 = (t24 + t25 + t13 + t26);
+  const T t28 = t21 * (-0.7);
+  const T t29 = t18 * (-0.3);
+  const T t30 = (t28 + t25 + t13 + t29);
+  const T t31 = t21 * (-0.3);
+  const T t32 = t18 * 0.7;
+  const T t33 = (t31 + t3 + t20 + t32);
+  const T t34 = (t28 + t25 + t29);
+  const T t35 = (t6 + t8);
+  const T t36 = (t19 + t20 + t22);
+  const T t37 = (t24 + t25 + t26);
+  const T t38 = (t31 + t20 + t32);
+  const T t39 = (t14 + t15);
+  const T t40 = (1150.0 + 950.0 * t30 * t34 + t9 * t35 * 1100.0 + u[8] * ((t23 * t36 + t27 * t37)) +
+                 t38 * 950.0 * t33 + 1100.0 * t16 * t39);
+  const T t41 = (t31 + t32);
+  const T t42 = (t28 + t29);
+  const T t43 = (t19 + t22);
+  const T t44 = (t24 + t26);
+  const T t45 = (950.0 * t33 * t41 + 250.0 + t42 * 950.0 * t30 + ((t23 * t43 + t44 * t27)) * u[8]);
+  const T t46 = (t42 * 950.0 * t34 + 250.0 + t38 * 950.0 * t41 + ((t44 * t37 + t36 * t43)) * u[8]);
+  const T t47 = (-t5 * 110.0 + t7 * 1210.0 + 6270.0 * t0 + 165.0);
+  const T t48 = (t19 + t3 + t20 + 0.15 + t22);
+  const T t49 = (-t21 * 285.0 + 665.0 * t18 + t7 * 2755.0 + 142.5 + 5415.0 * t0);
+  const T t50 = (5720.0 * t0 + 330.0 - t1 * 770.0);
+  const T t51 = t42 * x[6];
+  const T t52 = x[5] * t34;
+  const T t53 = (t52 + t30 * x[4] + t51);
+  const T t54 =
+      (((t42 * x[5] + t42 * x[4] + t51)) * x[6] + ((t52 + x[4] * t34 + t51)) * x[5] + x[4] * t53);
+  const T t55 = (x[4] * x[4]);
+  const T t56 = t21 * (-0.0578571428571429);
+  const T t57 = (-2.9) * t7;
+  const T t58 = (-5.7) * t0;
+  const T t59 = (-0.567857142857143) * t18;
+  const T t60 = (t56 + t57 + t59);
+  const T t61 = x[5] * t60;
+  const T t62 = (t56 + t59);
+  const T t63 = t62 * x[6];
+  const T t64 = (x[4] * ((x[4] * ((t56 + t57 + t58 + t59)) + t61 + t63)) +
+                 x[5] * ((x[4] * t60 + t61 + t63)) + ((t63 + t62 * x[5] + t62 * x[4])) * x[6]);
+  const T t65 = x[5] * t37;
+  const T t66 = t44 * x[6];
+  const T t67 = (t65 + x[4] * t27 + t66);
+  const T t68 =
+      (x[5] * ((x[4] * t37 + t65 + t66)) + x[4] * t67 + ((t44 * x[5] + t66 + t44 * x[4])) * x[6]);
+  const T t69 = cos(u[9]);
+  const T t70 = sin(u[9]);
+  const T t71 = (x[7] * x[7]);
+  const T t72 = x[5] * t39;
+  const T t73 = (t16 * x[4] + t72);
+  const T t74 = (x[4] * t73 + x[5] * ((x[4] * t39 + t72)));
+  const T t75 = t5 * 0.1;
+  const T t76 = t7 * (-1.1);
+  const T t77 = (t75 + t76);
+  const T t78 = t77 * x[5];
+  const T t79 = (x[5] * ((t78 + t77 * x[4])) + ((t78 + ((t75 + t76 + t58)) * x[4])) * x[4]);
+  const T t80 = t21 * 0.3;
+  const T t81 = t18 * (-0.7);
+  const T t82 = (t80 + t57 + t81);
+  const T t83 = t82 * x[5];
+  const T t84 = (t80 + t81);
+  const T t85 = t84 * x[6];
+  const T t86 = (x[4] * ((((t80 + t57 + t58 + t81)) * x[4] + t83 + t85)) +
+                 x[6] * ((t84 * x[5] + t85 + t84 * x[4])) + ((t82 * x[4] + t83 + t85)) * x[5]);
+  mass[0] = (7650.0 + 2200.0 * (t2 * t2) + (t9 * t9) * 1100.0 + (t12 * t12) * 2200.0 +
+             1100.0 * (t16 * t16) + (((t23 * t23) + (t27 * t27))) * u[8] + 950.0 * (t30 * t30) +
+             (t33 * t33) * 950.0);
+  mass[1] = t40;
+  mass[2] = t45;
+  mass[3] = T(0.0);
+  mass[4] = t40;
+  mass[5] = ((t39 * t39) * 1100.0 + 1150.0 + 950.0 * (t34 * t34) + (t38 * t38) * 950.0 +
+             u[8] * (((t37 * t37) + (t36 * t36))) + 1100.0 * (t35 * t35));
+  mass[6] = t46;
+  mass[7] = T(0.0);
+  mass[8] = t45;
+  mass[9] = t46;
+  mass[10] =
+      ((((t44 * t44) + (t43 * t43))) * u[8] + (t42 * t42) * 950.0 + 250.0 + (t41 * t41) * 950.0);
+  mass[11] = T(0.0);
+  mass[12] = T(0.0);
+  mass[13] = T(0.0);
+  mass[14] = T(0.0);
+  mass[15] = (((t3 + t6 + t8 + 0.15)) * t47 + 60000.0 + (t48 * t48) * u[8] +
+              ((t31 + t3 + t20 + 0.15 + t32)) * t49 + t50 * ((t10 + 0.15 + t11)));
+  bias[0] =
+      (950.0 * t33 * t54 + t55 * t2 * t12 * 2200.0 + ((t64 * t27 + t23 * t68)) * u[8] -
+       ((-t23 * t69 * 9.80665 - t70 * 9.80665 * t27)) * u[8] - t71 * t2 * t50 - t71 * t16 * t47 +
+       t9 * 1100.0 * t74 + t79 * 1100.0 * t16 + t12 * t69 * 21574.629999999997 +
+       t55 * t2 * 2200.0 * ((t1 * 0.35 - t11)) - t71 * t30 * t49 - t71 * t48 * u[8] * t27 +
+       t9 * t69 * 10787.314999999999 + t33 * t69 * 9316.3175 + t70 * t30 * 9316.3175 +
+       t70 * t16 * 10787.314999999999 + 950.0 * t30 * t86 + t2 * t70 * 21574.629999999997);
+  bias[1] =
+      (t38 * t69 * 9316.3175 - t71 * t34 * t49 + t70 * t34 * 9316.3175 +
+       t70 * 10787.314999999999 * t39 + t38 * 950.0 * t54 + 950.0 * t86 * t34 + t79 * 1100.0 * t39 -
+       t71 * t48 * u[8] * t37 - t71 * t39 * t47 -
+       u[8] * ((-t36 * t69 * 9.80665 - t70 * 9.80665 * t37)) + ((t64 * t37 + t36 * t68)) * u[8] +
+       t35 * 1100.0 * t74 + t35 * t69 * 10787.314999999999);
+  bias[2] = (-t71 * t48 * t44 * u[8] + t42 * 950.0 * t86 + 950.0 * t54 * t41 +
+             u[8] * ((t64 * t44 + t43 * t68)) + t69 * t41 * 9316.3175 - t71 * t42 * t49 +
+             t42 * t70 * 9316.3175 - ((-t70 * t44 * 9.80665 - t69 * t43 * 9.80665)) * u[8]);
+  bias[3] = (((330.0 + 12540.0 * t0 + 2420.0 * t7 - t5 * 220.0)) * x[7] * t73 +
+             t2 * x[7] * x[4] * ((11440.0 * t0 + 660.0 - t1 * 1540.0)) +
+             x[7] * ((-t21 * 570.0 + 285.0 + 10830.0 * t0 + 5510.0 * t7 + 1330.0 * t18)) * t53 +
+             t48 * 2.0 * x[7] * u[8] * t67);
+}
+
+/// Eq. (1)-(2) with d_pose_d_angles (4 x kNumAngles, row-major), templated on the scalar
+/// (ForwardKinematicsJacobians without the parameter Jacobian).
+template <typename T>
+void ForwardKinematicsWithJacobian(const T* angles, const T* params, T* pose, T* d_pose_d_angles) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const T t0 = (angles[2] + params[4] - angles[0]);
+  const T t1 = cos(t0);
+  const T t2 = t1 * params[1];
+  const T t3 = (angles[3] + params[5] - angles[0]);
+  const T t4 = cos(t3);
+  const T t5 = params[2] * t4;
+  const T t6 = (angles[1] + params[3] - angles[0]);
+  const T t7 = cos(t6);
+  const T t8 = params[0] * t7;
+  const T t9 = (t2 + t5 + t8 + 0.15);
+  const T t10 = cos(angles[4]);
+  const T t11 = t9 * t10;
+  const T t12 = sin(angles[4]);
+  const T t13 = sin(t3);
+  const T t14 = params[2] * t13;
+  const T t15 = sin(t0);
+  const T t16 = params[1] * t15;
+  const T t17 = sin(t6);
+  const T t18 = params[0] * t17;
+  const T t19 = (t14 + t16 + t18);
+  pose[0] = t11;
+  pose[1] = t9 * t12;
+  pose[2] = (1.95 + t14 + t16 + t18);
+  pose[3] = t3;
+  d_pose_d_angles[0] = t19 * t10;
+  d_pose_d_angles[1] = params[0] * t17 * t10 * (-1.0);
+  d_pose_d_angles[2] = params[1] * t10 * t15 * (-1.0);
+  d_pose_d_angles[3] = params[2] * t10 * t13 * (-1.0);
+  d_pose_d_angles[4] = t9 * t12 * (-1.0);
+  d_pose_d_angles[5] = t19 * t12;
+  d_pose_d_angles[6] = params[0] * t17 * t12 * (-1.0);
+  d_pose_d_angles[7] = params[1] * t15 * t12 * (-1.0);
+  d_pose_d_angles[8] = params[2] * t13 * t12 * (-1.0);
+  d_pose_d_angles[9] = t11;
+  d_pose_d_angles[10] = (-t5 - t2 - t8);
+  d_pose_d_angles[11] = t8;
+  d_pose_d_angles[12] = t2;
+  d_pose_d_angles[13] = t5;
+  d_pose_d_angles[14] = T(0.0);
+  d_pose_d_angles[15] = T((-1.0));
+  d_pose_d_angles[16] = T(0.0);
+  d_pose_d_angles[17] = T(0.0);
+  d_pose_d_angles[18] = T(1.0);
+  d_pose_d_angles[19] = T(0.0);
+}
+
+/// Pin-to-pin length of `actuator` [m] (a motor: its joint angle) and its gradient over
+/// all joints [m/rad] (a Z-bar's tilt cylinder depends on the boom too: force times the
+/// gradient is the generalised force), templated on the scalar. Returns false for an
+/// unknown actuator.
+template <typename T>
+bool CylinderGeometry(int actuator, const T* q, T* length, T* d_length_d_q) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  switch (actuator) {
+    case 0: {
+      const T t0 = cos(q[0]);
+      const T t1 = sin(q[0]);
+      const T t2 = (1.09 - 0.236 * t0 + t1 * 2.979);
+      const T t3 = 0.236 * t1;
+      const T t4 = t0 * 2.979;
+      const T t5 = (t3 - 0.356 + t4);
+      const T t6 = ((t2 * t2) + (t5 * t5));
+      length[0] = sqrt(t6);
+      d_length_d_q[0] = ((t2 * ((t3 + t4)) + ((-t1 * 2.979 + 0.236 * t0)) * t5)) * (1.0 / sqrt(t6));
+      d_length_d_q[1] = T(0.0);
+      d_length_d_q[2] = T(0.0);
+      d_length_d_q[3] = T(0.0);
+      return true;
+    }
+    case 1: {
+      const T t0 = (q[0] + q[1]);
+      const T t1 = sin(t0);
+      const T t2 = (-0.104) * t1;
+      const T t3 = cos(q[0]);
+      const T t4 = sin(q[0]);
+      const T t5 = cos(t0);
+      const T t6 = (-0.8) * t5;
+      const T t7 = (t2 + 3.136 * t3 + 1.11 * t4 + t6);
+      const T t8 = (-t1 * 0.8 - 1.11 * t3 + 0.104 * t5 + 3.136 * t4);
+      const T t9 = ((t7 * t7) + (t8 * t8));
+      const T t10 = (1.0 / sqrt(t9));
+      const T t11 = t1 * 0.8;
+      const T t12 = (-0.104) * t5;
+      length[0] = sqrt(t9);
+      d_length_d_q[0] = t10 * ((t7 * t8 + t7 * ((-3.136 * t4 + 1.11 * t3 + t11 + t12))));
+      d_length_d_q[1] = ((t8 * ((t2 + t6)) + t7 * ((t11 + t12)))) * t10;
+      d_length_d_q[2] = T(0.0);
+      d_length_d_q[3] = T(0.0);
+      return true;
+    }
+    case 2: {
+      const T t0 = (q[2] + q[0] + q[1]);
+      const T t1 = cos(t0);
+      const T t2 = (q[0] + q[1]);
+      const T t3 = sin(t2);
+      const T t4 = sin(t0);
+      const T t5 = cos(t2);
+      const T t6 = (0.552 * t1 + t3 * 0.15700000000000003 - t4 * 0.016 + 0.315 * t5);
+      const T t7 = (-0.016) * t1;
+      const T t8 = t4 * (-0.552);
+      const T t9 = (0.15700000000000003 * t5 + t7 + t8 - 0.315 * t3);
+      const T t10 = (t9 * t9);
+      const T t11 = (t6 * t6);
+      const T t12 = (0.21712699999999996 + t10 + t11);
+      const T t13 = (t10 + t11);
+      const T t14 = (1.0 / sqrt(t13));
+      const T t15 = (t12 * t12);
+      const T t16 = (1.0 / (t13));
+      const T t17 = (-0.25 * t15 * t16 + 0.48441599999999996);
+      const T t18 = sqrt(t17);
+      const T t19 = (t6 * t12 * t14 + 2.0 * t9 * t18);
+      const T t20 = (-t9 * t12 * t14 + t6 * 2.0 * t18);
+      const T t21 = atan2(t19 * 0.5 * t14, t20 * (-0.5) * t14);
+      const T t22 = sin(t21);
+      const T t23 = (0.696 * t22 - 0.623 * t5 + t3 * 3.081);
+      const T t24 = cos(t21);
+      const T t25 = 3.081 * t5;
+      const T t26 = t3 * 0.623;
+      const T t27 = (t24 * 0.696 + t25 + t26);
+      const T t28 = ((t23 * t23) + (t27 * t27));
+      const T t29 = (1.0 / sqrt(t28));
+      const T t30 = t1 * (-0.552);
+      const T t31 = t4 * 0.016;
+      const T t32 = (-0.315 * t5 - t3 * 0.15700000000000003 + t30 + t31);
+      const T t33 = (t6 * t9 + t32 * t9);
+      const T t34 = pow(t13, (-1.5));
+      const T t35 = (1.0 / (t13 * t13));
+      const T t36 = (-t33 * 2.0 * t12 * t16 + t33 * t35 * t15);
+      const T t37 = (1.0 / sqrt(t17));
+      const T t38 = (1.0 / ((((t20 * t20) * t16 + (t19 * t19) * t16))));
+      const T t39 =
+          (((t33 * t19 * 2.0 * t34 - ((t6 * t33 * 4.0 * t14 + t32 * 4.0 * t18 + t36 * t9 * t37 +
+                                       2.0 * t9 * t12 * t14 - t6 * t33 * 2.0 * t12 * t34)) *
+                                         t14)) *
+               t20 * t38 * t14 -
+           t19 * t38 *
+               ((t33 * t20 * 2.0 * t34 +
+                 ((-t33 * 2.0 * t9 * t12 * t34 + t32 * 2.0 * t12 * t14 - t36 * t6 * t37 +
+                   t33 * t9 * 4.0 * t14 - t9 * 4.0 * t18)) *
+                     t14)) *
+               t14);
+      const T t40 = t29 * ((((0.623 * t5 - 0.348 * t22 * t39 - t3 * 3.081)) * t27 +
+                            ((t25 + 0.348 * t24 * t39 + t26)) * t23));
+      const T t41 = (t7 + t8);
+      const T t42 = (t30 + t31);
+      const T t43 = (t6 * t41 + t9 * t42);
+      const T t44 = (t35 * t15 * t43 - 2.0 * t12 * t43 * t16);
+      const T t45 = (-t19 * t38 *
+                         ((-((-t9 * 4.0 * t43 * t14 + 2.0 * t9 * t12 * t43 * t34 + t6 * t44 * t37 +
+                              t41 * 4.0 * t18 - 2.0 * t42 * t12 * t14)) *
+                               t14 +
+                           t20 * 2.0 * t43 * t34)) *
+                         t14 +
+                     t20 * t38 *
+                         ((-((t9 * t44 * t37 - t6 * 2.0 * t12 * t43 * t34 + t6 * 4.0 * t43 * t14 +
+                              4.0 * t42 * t18 + t41 * 2.0 * t12 * t14)) *
+                               t14 +
+                           t19 * 2.0 * t43 * t34)) *
+                         t14);
+      length[0] = sqrt(t28);
+      d_length_d_q[0] = t40;
+      d_length_d_q[1] = t40;
+      d_length_d_q[2] = t29 * ((-t45 * 0.696 * t27 * t22 + t23 * t45 * t24 * 0.696)) * 0.5;
+      d_length_d_q[3] = T(0.0);
+      return true;
+    }
+    case 3: {
+      length[0] = q[3];
+      d_length_d_q[0] = T(0.0);
+      d_length_d_q[1] = T(0.0);
+      d_length_d_q[2] = T(0.0);
+      d_length_d_q[3] = T(1.0);
+      return true;
+    }
+    default:
+      return false;
+  }
+}
+
 }  // namespace autoshovel::generated::excavator_25t

@@ -41,7 +41,7 @@ void ForwardKinematics(const T* angles, const T* params, T* pose) {
   const T t0 = (angles[2] + params[3] - angles[0]);
   const T t1 = (angles[1] + params[2] - angles[0]);
   pose[0] = (params[1] * cos(t0) + params[0] * cos(t1) + 0.6);
-  pose[1] = 0.0;
+  pose[1] = T(0.0);
   pose[2] = (1.7 + params[1] * sin(t0) + params[0] * sin(t1));
   pose[3] = t0;
 }
@@ -117,5 +117,567 @@ void MechanicalEnergy(const double* q, const double* qd, double payload, double 
                       double* energy);
 /// Everything above behind the common interface of the registry.
 const MachineFunctions& Functions();
+
+/// MassMatrix and BiasForces together, templated on the scalar (ceres::Jet for exact
+/// derivatives): M(q) q'' + bias(q, q') = actuator + external torques.
+template <typename T>
+void ArmDynamics(const T* q, const T* qd, const T& payload, const T& pitch, T* mass, T* bias) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  T x[kNumStates] = {};
+  T u[kNumInputs] = {};
+  for (int j = 0; j < kNumJoints; ++j) {
+    x[j] = q[j];
+    x[kNumJoints + j] = qd[j];
+  }
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const T t0 = cos(x[0]);
+  const T t1 = 0.6894 * t0;
+  const T t2 = sin(x[0]);
+  const T t3 = t2 * 0.1216;
+  const T t4 = (t1 + t3 + 0.3235);
+  const T t5 = (1.2074 + 0.6894 * t2 - 0.1216 * t0);
+  const T t6 = ((t4 * t4) + (t5 * t5));
+  const T t7 = (1.0 / sqrt(t6));
+  const T t8 = (t1 + t3);
+  const T t9 = t2 * (-0.6894);
+  const T t10 = 0.1216 * t0;
+  const T t11 = (t9 + t10);
+  const T t12 = (t8 * t5 + t11 * t4);
+  const T t13 = pow(t6, (-1.5));
+  const T t14 = (t1 + t3 - 0.5726 * t7 * t8 + 0.5726 * t12 * t13 * t5);
+  const T t15 = (x[0] + x[1]);
+  const T t16 = sin(t15);
+  const T t17 = t16 * (-0.45);
+  const T t18 = cos(t15);
+  const T t19 = (-0.22) * t18;
+  const T t20 = t2 * (-2.982);
+  const T t21 = (t17 + t19 + t20);
+  const T t22 = 0.5399000000000003 * t0;
+  const T t23 = (-0.0898) * t18;
+  const T t24 = t16 * (-0.3758);
+  const T t25 = 0.4749 * t2;
+  const T t26 = (t22 + t23 + t24 + t25);
+  const T t27 = t18 * (-0.3758);
+  const T t28 = t16 * 0.0898;
+  const T t29 = (0.4749 * t0 - t2 * 0.5399000000000003 + t27 + t28);
+  const T t30 = (-0.4749) * t0;
+  const T t31 = (t30 + t2 * 0.5399000000000003 - t28 + 0.3758 * t18);
+  const T t32 = (t26 * t29 + t26 * t31);
+  const T t33 = (t31 * t31);
+  const T t34 = (t26 * t26);
+  const T t35 = (t33 + t34);
+  const T t36 = pow(t35, (-1.5));
+  const T t37 = (-0.09333387000000004 + t33 + t34);
+  const T t38 = (t37 * t37);
+  const T t39 = (1.0 / (t35));
+  const T t40 = (-t38 * 0.25 * t39 + 0.26594649000000004);
+  const T t41 = sqrt(t40);
+  const T t42 = (1.0 / sqrt(t35));
+  const T t43 = (t41 * 2.0 * t31 + t26 * t37 * t42);
+  const T t44 = 0.0449 * t16;
+  const T t45 = (1.0 / sqrt(t40));
+  const T t46 = (1.0 / (t35 * t35));
+  const T t47 = (t38 * t32 * t46 - t37 * 2.0 * t32 * t39);
+  const T t48 = (t26 * t32 * 4.0 * t42 - t26 * t37 * 2.0 * t32 * t36 + t37 * t29 * 2.0 * t42 +
+                 t26 * t41 * 4.0 + t45 * t47 * t31);
+  const T t49 = (-0.1879) * t18;
+  const T t50 =
+      (-t32 * 0.25 * t36 * t43 - 2.71205 * t2 - 0.23745 * t0 + t44 + t48 * 0.125 * t42 + t49);
+  const T t51 = t16 * (-0.2090281052825221);
+  const T t52 = t18 * 0.4650337029259214;
+  const T t53 = t0 * 2.982;
+  const T t54 = (t51 + t52 + t53);
+  const T t55 = t16 * (-0.4650337029259214);
+  const T t56 = t18 * (-0.2090281052825221);
+  const T t57 = (t55 + t20 + t56);
+  const T t58 = t11 * t7 * (-0.5726);
+  const T t59 = (t9 + t58 + t10 + 0.5726 * t12 * t13 * t4);
+  const T t60 = (-t2 * 0.12 + 1.4 * t0);
+  const T t61 = (-0.4749) * t2;
+  const T t62 = (-t37 * t31 * t42 + t26 * t41 * 2.0);
+  const T t63 = atan2(t62 * t42 * (-0.5), 0.5 * t43 * t42);
+  const T t64 = cos(t63);
+  const T t65 = (t62 * t62);
+  const T t66 = (t43 * t43);
+  const T t67 = (t65 * t39 + t39 * t66);
+  const T t68 = (1.0 / (t67));
+  const T t69 = t32 * t36 * (-2.0) * t43;
+  const T t70 = t48 * t42;
+  const T t71 = (t69 + t70);
+  const T t72 = t62 * 2.0 * t32 * t36;
+  const T t73 = (t37 * 2.0 * t32 * t36 * t31 - t26 * t37 * 2.0 * t42 - t32 * 4.0 * t31 * t42 +
+                 t29 * t41 * 4.0 + t26 * t45 * t47);
+  const T t74 = t73 * t42 * (-1.0);
+  const T t75 = (t72 + t74);
+  const T t76 = (t68 * t62 * t71 * t42 + t68 * t43 * t75 * t42);
+  const T t77 = (t61 + 2.4421 * t0 + 0.128925 * t64 * t76);
+  const T t78 = (2.71205 * t0 - t16 * 0.1879 - 0.0449 * t18 + t62 * t32 * 0.25 * t36 -
+                 0.23745 * t2 - 0.125 * t73 * t42);
+  const T t79 = (1.0 / (t6));
+  const T t80 = (-1.2074 + t9 + t10);
+  const T t81 = (t8 * t79 * t4 + t11 * t79 * t80);
+  const T t82 = (20.765148133333334 * t8 * t79 * t4 + t11 * 20.765148133333334 * t79 * t80);
+  const T t83 = t16 * (-0.3592);
+  const T t84 = (-1.8996) * t0;
+  const T t85 = 1.5032 * t18;
+  const T t86 = (2.159600000000001 * t2 + t69 + t83 + t84 + t70 + t85);
+  const T t87 = (-0.9498 * t0 + 0.7516 * t18 + t2 * 1.0798000000000005 - t16 * 0.1796 + t62 * t42);
+  const T t88 = (t22 + t23 - 0.5 * t43 * t42 + t24 + t25);
+  const T t89 = ((t87 * t87) + (t88 * t88) * 4.0);
+  const T t90 = (1.0 / (t89));
+  const T t91 = (-1.0798000000000005 * t0 - t2 * 0.9498 + t18 * 0.1796 + t16 * 0.7516 + t43 * t42);
+  const T t92 = t16 * 1.5032;
+  const T t93 = 0.3592 * t18;
+  const T t94 = t2 * (-1.8996);
+  const T t95 = (t92 + t93 + t72 + t74 - 2.159600000000001 * t0 + t94);
+  const T t96 = (t86 * t90 * t87 * 2.5 + t90 * 2.5 * t91 * t95);
+  const T t97 = (-0.12 * t0 - t2 * 1.4);
+  const T t98 = t2 * (-2.4421);
+  const T t99 = sin(t63);
+  const T t100 = (t30 + t98 - 0.128925 * t99 * t76);
+  const T t101 = 0.5726 * t11 * t7;
+  const T t102 = (-0.5726 * t12 * t13 * t4 + t101);
+  const T t103 = (t68 * t43 * t75 * t42 * 8.0 + t68 * t62 * t71 * t42 * 8.0);
+  const T t104 = t16 * (-0.22);
+  const T t105 = 0.45 * t18;
+  const T t106 = (t104 + t105 + t53);
+  const T t107 = (12.021927866666665 * t8 * t79 * t4 + t11 * 12.021927866666665 * t79 * t80);
+  const T t108 = (-0.5726 * t12 * t13 * t5 + 0.5726 * t7 * t8);
+  const T t109 = 2.0 * t32 * t36 * t43;
+  const T t110 = 1.8996 * t0;
+  const T t111 = t48 * t42 * (-1.0);
+  const T t112 = (t109 + t110 + 21.6964 * t2 + t83 + t85 + t111);
+  const T t113 = (t23 + t24);
+  const T t114 = (t27 + t28);
+  const T t115 = (t113 * t31 + t26 * t114);
+  const T t116 = (t37 * t115 * 2.0 * t39 - t115 * t38 * t46);
+  const T t117 = (-t26 * t37 * t115 * 2.0 * t36 + t41 * 4.0 * t113 + t37 * 2.0 * t42 * t114 +
+                  t26 * t115 * 4.0 * t42 - t45 * t31 * t116);
+  const T t118 = t42 * t117 * (-1.0);
+  const T t119 = t115 * 2.0 * t36 * t43;
+  const T t120 = (t118 + t83 + t85 + t119);
+  const T t121 = t115 * t36 * (-2.0) * t43;
+  const T t122 = t42 * t117;
+  const T t123 = (t121 + t122);
+  const T t124 = (t41 * 4.0 * t114 - t115 * 4.0 * t31 * t42 - t26 * t45 * t116 -
+                  t37 * 2.0 * t113 * t42 + t37 * t115 * 2.0 * t36 * t31);
+  const T t125 = t42 * t124;
+  const T t126 = t62 * t115 * t36 * (-2.0);
+  const T t127 = (t125 + t126);
+  const T t128 = (-t68 * t62 * t123 * t42 + t68 * t43 * t42 * t127);
+  const T t129 = (t104 + t105);
+  const T t130 = (t55 + t56);
+  const T t131 = (t51 + t52);
+  const T t132 = (t121 + t83 + t122 + t85);
+  const T t133 = t18 * (-0.3592);
+  const T t134 = t16 * (-1.5032);
+  const T t135 = (t133 + t134 + t125 + t126);
+  const T t136 = (-t90 * t87 * t132 + t90 * t91 * t135);
+  const T t137 = (t92 + t73 * t42 + t93 - 21.6964 * t0 + t2 * 1.8996 - t72);
+  const T t138 = (t92 + t93 + t125 + t126);
+  const T t139 = (t17 + t19);
+  const T t140 =
+      (t112 * 1.171875 * t120 - t77 * t128 * 24.49575 * t64 + 950.0 * t106 * t129 +
+       t100 * t99 * t128 * 24.49575 + 300.0 + ((t130 * t57 + t54 * t131)) * u[4] -
+       t96 * 0.5 * t136 + t137 * t138 * 1.171875 - 0.5 * t128 * t103 + 950.0 * t139 * t21);
+  const T t141 = (-t90 * 2.5 * t91 * t135 + t90 * t87 * 2.5 * t132);
+  const T t142 = (t128 * t128);
+  const T t143 = (t68 * t62 * t123 * t42 * 8.0 - t68 * t43 * t42 * t127 * 8.0);
+  const T t144 = (-t115 * 0.25 * t36 * t43 + 0.125 * t42 * t117 + t44 + t49);
+  const T t145 = (x[2] * x[2]);
+  const T t146 = cos(u[5]);
+  const T t147 = sin(u[5]);
+  const T t148 = t32 * t36 * t73 * 8.0;
+  const T t149 = t16 * 0.3758;
+  const T t150 = 0.0898 * t18;
+  const T t151 = (t149 + t61 + t150 - t22);
+  const T t152 = (t29 * t31 + t34 + t26 * t151 + (t29 * t29));
+  const T t153 = t62 * t36 * 8.0 * t152;
+  const T t154 = (t32 * t32);
+  const T t155 = pow(t35, (-2.5));
+  const T t156 = (1.0 / (t35 * t35 * t35));
+  const T t157 = (-t38 * t152 * t46 + t37 * 2.0 * t39 * t152 + 4.0 * t39 * t154 -
+                  t37 * 8.0 * t154 * t46 + t38 * 4.0 * t156 * t154);
+  const T t158 = pow(t40, (-1.5));
+  const T t159 = (t47 * t47);
+  const T t160 =
+      ((-32.0 * t36 * t31 * t154 + 16.0 * t31 * t42 * t152 + t37 * 24.0 * t31 * t154 * t155 -
+        t26 * t37 * 16.0 * t32 * t36 + t26 * 32.0 * t32 * t42 + t37 * t29 * t42 * 8.0 -
+        t45 * t47 * t29 * 8.0 + t26 * t45 * t157 * 4.0 - t37 * t36 * t31 * 8.0 * t152 -
+        16.0 * t41 * t151 + t26 * t158 * t159)) *
+      t42;
+  const T t161 = t16 * 1.4368;
+  const T t162 = (-7.5984) * t0;
+  const T t163 = t18 * (-6.0128);
+  const T t164 = t62 * (-24.0) * t154 * t155;
+  const T t165 = t115 * 4.0 * t36 * t73;
+  const T t166 = t31 * t114;
+  const T t167 = (t149 + t150);
+  const T t168 = t26 * t167;
+  const T t169 = (t166 + t29 * t114 + t26 * t113 + t168);
+  const T t170 = (-16.0) * t41 * t167;
+  const T t171 = (-t169 * t38 * t46 + t115 * t32 * 4.0 * t39 + t115 * t38 * t32 * 4.0 * t156 -
+                  t37 * t115 * t32 * 8.0 * t46 + t169 * t37 * 2.0 * t39);
+  const T t172 = t37 * t42 * t114 * 8.0;
+  const T t173 = ((-t169 * t37 * t36 * t31 * 8.0 + t170 + t37 * t115 * t32 * 24.0 * t31 * t155 +
+                   t26 * t115 * 16.0 * t42 + t169 * 16.0 * t31 * t42 - t26 * t158 * t47 * t116 +
+                   t26 * t45 * 4.0 * t171 + t172 - t37 * t32 * t36 * t113 * 8.0 +
+                   16.0 * t32 * t113 * t42 + t45 * t29 * 4.0 * t116 - t45 * t47 * 4.0 * t114 -
+                   t115 * 32.0 * t32 * t36 * t31 - t26 * t37 * t115 * t36 * 8.0)) *
+                 t42;
+  const T t174 = t62 * (-24.0) * t115 * t32 * t155;
+  const T t175 = t32 * 4.0 * t36 * t124;
+  const T t176 = t62 * t169 * t36 * 8.0;
+  const T t177 = (t165 + t173 + t174 + t175 + t161 + t163 + t176);
+  const T t178 = t16 * (-1.4368);
+  const T t179 = (t115 * t115);
+  const T t180 = (t166 + (t113 * t113) + t168 + (t114 * t114));
+  const T t181 = (t116 * t116);
+  const T t182 = (-4.0 * t39 * t179 + t37 * 8.0 * t46 * t179 - t38 * 4.0 * t156 * t179 +
+                  t38 * t180 * t46 - t37 * t180 * 2.0 * t39);
+  const T t183 =
+      (-32.0 * t36 * t31 * t179 + t170 - t37 * t180 * t36 * t31 * 8.0 + t115 * 32.0 * t113 * t42 +
+       t26 * t158 * t181 + 16.0 * t180 * t31 * t42 + t172 - t26 * t45 * t182 * 4.0 +
+       t37 * 24.0 * t31 * t155 * t179 + t45 * t116 * t114 * 8.0 - t37 * t115 * 16.0 * t36 * t113);
+  const T t184 = t18 * 6.0128;
+  const T t185 =
+      (x[2] * ((((t148 + t153 + t160 - 86.7856 * t2 + t161 + t162 + t163 + t164)) * x[2] +
+                t177 * x[3])) +
+       x[3] * ((-((-t115 * t36 * 8.0 * t124 + t178 - t42 * t183 + t184 - t62 * t180 * t36 * 8.0 +
+                   t62 * 24.0 * t155 * t179)) *
+                    x[3] +
+                t177 * x[2])));
+  const T t186 = t16 * 0.22;
+  const T t187 = (-0.45) * t18;
+  const T t188 = (t186 + t187);
+  const T t189 = x[3] * t188;
+  const T t190 = (-2.982) * t0;
+  const T t191 = (x[3] * ((x[2] * t188 + t189)) + ((t189 + ((t186 + t190 + t187)) * x[2])) * x[2]);
+  const T t192 = 0.0644625 * t99 * t128 * t76;
+  const T t193 = t68 * ((t165 + t173 + t174 + t175 + t176)) * t43 * t42;
+  const T t194 = (1.0 / (t67 * t67));
+  const T t195 =
+      (-t62 * t39 * t124 + t115 * 2.0 * t65 * t46 + t115 * 2.0 * t66 * t46 - t39 * t43 * t117);
+  const T t196 = t169 * t36 * t43 * 8.0;
+  const T t197 = (-24.0) * t115 * t32 * t43 * t155;
+  const T t198 = t48 * t115 * 4.0 * t36;
+  const T t199 = 16.0 * t41 * t114;
+  const T t200 = t37 * t167 * t42 * 8.0;
+  const T t201 =
+      ((-t45 * 4.0 * t171 * t31 + t26 * t37 * t115 * t32 * 24.0 * t155 -
+        t26 * t115 * 32.0 * t32 * t36 + t115 * 16.0 * t29 * t42 - t37 * t115 * t29 * t36 * 8.0 +
+        t26 * t169 * 16.0 * t42 + t45 * t47 * 4.0 * t113 + 16.0 * t32 * t42 * t114 + t199 -
+        t26 * t45 * 4.0 * t116 - t37 * t32 * t36 * t114 * 8.0 - t26 * t169 * t37 * t36 * 8.0 +
+        t158 * t47 * t31 * t116 + t200)) *
+      t42 * (-1.0);
+  const T t202 = t32 * 4.0 * t36 * t117;
+  const T t203 = t68 * t62 * ((t196 + t197 + t198 + t201 + t202)) * t42 * (-1.0);
+  const T t204 = (t193 + t62 * t71 * 4.0 * t42 * t194 * t195 + t68 * 2.0 * t75 * t42 * t117 +
+                  t68 * 2.0 * t71 * t42 * t124 + 4.0 * t43 * t75 * t42 * t194 * t195 -
+                  t68 * t115 * 4.0 * t36 * t43 * t75 + t203 - t68 * t62 * t115 * t71 * 4.0 * t36);
+  const T t205 = t180 * t36 * t43 * 8.0;
+  const T t206 = t115 * t36 * 8.0 * t117;
+  const T t207 = ((t115 * 32.0 * t42 * t114 - t26 * 32.0 * t36 * t179 - t158 * t31 * t181 -
+                   t26 * t37 * t180 * t36 * 8.0 + t26 * 16.0 * t180 * t42 -
+                   t45 * t113 * t116 * 8.0 + t26 * t37 * 24.0 * t155 * t179 + t199 +
+                   t45 * t182 * 4.0 * t31 - t37 * t115 * 16.0 * t36 * t114 + t200)) *
+                 t42 * (-1.0);
+  const T t208 = (-24.0) * t43 * t155 * t179;
+  const T t209 = t62 * (-24.0) * t155 * t179;
+  const T t210 = t62 * t180 * t36 * 8.0;
+  const T t211 = t115 * t36 * 8.0 * t124;
+  const T t212 = t42 * t183;
+  const T t213 =
+      (-t68 * t62 * ((t205 + t206 + t207 + t208)) * t42 - 4.0 * t43 * t42 * t127 * t194 * t195 -
+       t68 * 2.0 * t42 * t127 * t117 + t62 * 4.0 * t123 * t42 * t194 * t195 +
+       t68 * 2.0 * t123 * t42 * t124 - t68 * t62 * t115 * 4.0 * t36 * t123 +
+       t68 * t43 * t42 * ((t209 + t210 + t211 + t212)) + t68 * t115 * 4.0 * t36 * t43 * t127);
+  const T t214 =
+      (-t48 * t39 * t43 + 2.0 * t32 * t66 * t46 + 2.0 * t32 * t65 * t46 - t62 * t39 * t73);
+  const T t215 = (t62 * 4.0 * t214 * t123 * t42 * t194 + t193 - t68 * t62 * t32 * 4.0 * t36 * t123 -
+                  t68 * t48 * 2.0 * t42 * t127 + t68 * 2.0 * t73 * t123 * t42 -
+                  4.0 * t214 * t43 * t42 * t127 * t194 + t203 + t68 * t32 * 4.0 * t36 * t43 * t127);
+  const T t216 = (t76 * t76);
+  const T t217 = (t26 * t37 * 24.0 * t154 * t155 - t158 * t159 * t31 - t26 * 32.0 * t36 * t154 +
+                  t26 * 16.0 * t42 * t152 - t37 * 16.0 * t29 * t32 * t36 -
+                  t26 * t37 * t36 * 8.0 * t152 - t45 * t157 * 4.0 * t31 + t26 * t45 * t47 * 8.0 +
+                  16.0 * t29 * t41 + 32.0 * t29 * t32 * t42 + t37 * t42 * 8.0 * t151);
+  const T t218 =
+      (t68 * 2.0 * t71 * t73 * t42 +
+       t68 * t62 * t42 *
+           ((24.0 * t43 * t154 * t155 + t217 * t42 - t36 * t43 * 8.0 * t152 -
+             t48 * t32 * t36 * 8.0)) -
+       t68 * t62 * t71 * t32 * 4.0 * t36 - t68 * t32 * 4.0 * t36 * t43 * t75 +
+       t68 * t48 * 2.0 * t75 * t42 + t62 * t71 * 4.0 * t214 * t42 * t194 +
+       t68 * ((t148 + t153 + t160 + t164)) * t43 * t42 + 4.0 * t214 * t43 * t75 * t42 * t194);
+  const T t219 = (x[3] * ((((t192 + 0.03223125 * t64 * t204)) * x[2] +
+                           ((-0.0644625 * t142 * t99 + 0.03223125 * t213 * t64)) * x[3])) +
+                  ((((t192 + 0.03223125 * t215 * t64)) * x[3] +
+                    ((t30 + t98 - 0.0644625 * t216 * t99 + 0.03223125 * t64 * t218)) * x[2])) *
+                      x[2]);
+  const T t220 = pow(t6, (-2.5));
+  const T t221 = (t12 * t12);
+  const T t222 = t2 * (-0.1216);
+  const T t223 = (-0.6894) * t0;
+  const T t224 = (t222 + t223);
+  const T t225 = ((t11 * t11) + (t8 * t8) + t4 * t224 + t11 * t5);
+  const T t226 = t16 * 0.3592;
+  const T t227 = t18 * (-1.5032);
+  const T t228 = t130 * x[3];
+  const T t229 = (x[3] * ((t228 + t130 * x[2])) + ((x[2] * t57 + t228)) * x[2]);
+  const T t230 = t16 * 0.2090281052825221;
+  const T t231 = (-0.4650337029259214) * t18;
+  const T t232 = (t230 + t231);
+  const T t233 = t232 * x[3];
+  const T t234 = (x[3] * ((t232 * x[2] + t233)) + ((((t190 + t230 + t231)) * x[2] + t233)) * x[2]);
+  const T t235 = (1.0 / (t6 * t6));
+  const T t236 = (-t235 * t11 * 2.0 * t12 * t80 + t11 * t8 * t79 + t11 * t79 * t4 +
+                  t11 * t79 * t224 + t79 * t224 * t80 - t235 * t8 * 2.0 * t12 * t4);
+  const T t237 = (x[3] * ((x[2] * t204 + t213 * x[3])) + ((x[2] * t218 + t215 * x[3])) * x[2]);
+  const T t238 = t48 * t32 * t36 * 8.0;
+  const T t239 = t217 * t42 * (-1.0);
+  const T t240 = t16 * (-6.0128);
+  const T t241 = (-24.0) * t43 * t154 * t155;
+  const T t242 = (-1.4368) * t18;
+  const T t243 = t2 * (-7.5984);
+  const T t244 = t36 * t43 * 8.0 * t152;
+  const T t245 = (t196 + t197 + t198 + t201 + t240 + t242 + t202);
+  const T t246 =
+      (((x[2] * ((t238 + 86.7856 * t0 + t239 + t240 + t241 + t242 + t243 + t244)) + t245 * x[3])) *
+           x[2] +
+       ((x[3] * ((t205 + t240 + t206 + t242 + t207 + t208)) + t245 * x[2])) * x[3]);
+  const T t247 = x[3] * t139;
+  const T t248 = (x[2] * ((x[2] * t21 + t247)) + ((x[2] * t139 + t247)) * x[3]);
+  const T t249 = 0.0644625 * t128 * t64 * t76;
+  const T t250 =
+      (((x[2] * ((t249 - 0.03223125 * t99 * t204)) +
+         ((-0.0644625 * t142 * t64 - 0.03223125 * t213 * t99)) * x[3])) *
+           x[3] +
+       ((x[3] * ((t249 - 0.03223125 * t215 * t99)) +
+         x[2] * ((-0.0644625 * t216 * t64 - 0.03223125 * t99 * t218 - 2.4421 * t0 + t25)))) *
+           x[2]);
+  const T t251 = (-2.159600000000001 * t2 + t226 + t109 + t110 + t227 + t111);
+  const T t252 = t90 * ((t165 + t178 + t173 + t174 + t175 + t184 + t176)) * t91;
+  const T t253 = t16 * 6.0128;
+  const T t254 = t18 * 1.4368;
+  const T t255 = t90 * t87 * ((t196 + t197 + t198 + t201 + t253 + t254 + t202)) * (-1.0);
+  const T t256 = (t86 * t91 - t87 * t95);
+  const T t257 = (1.0 / (t89 * t89));
+  const T t258 = (t87 * t135 + t132 * t91);
+  const T t259 = (t226 + t118 + t227 + t119);
+  const T t260 =
+      (((((-t90 * 2.0 * t132 * t95 + t90 * 2.0 * t251 * t135 + t252 + t255 +
+           t256 * t257 * 4.0 * t91 * t135 - t87 * t256 * t257 * 4.0 * t132)) *
+             x[3] -
+         x[2] * ((t86 * t90 * 2.0 * t95 + t90 * 2.0 * t251 * t95 -
+                  t90 * t91 *
+                      ((t178 + t148 + t153 + t160 + t184 + t162 + t2 * 8.638400000000004 + t164)) +
+                  t90 * t87 *
+                      ((t238 + t239 + t241 + t253 + t243 + t254 - 8.638400000000004 * t0 + t244)) +
+                  t86 * t87 * t256 * t257 * 4.0 + t256 * t257 * 4.0 * t91 * t95)))) *
+           x[2] +
+       ((x[3] *
+             ((t90 * 2.0 * t132 * t135 - t90 * t87 * ((t205 + t206 + t253 + t254 + t207 + t208)) -
+               t258 * t87 * t257 * 4.0 * t132 + t90 * 2.0 * t259 * t135 +
+               t90 * ((t209 + t178 + t210 + t211 + t212 + t184)) * t91 +
+               t258 * t257 * 4.0 * t91 * t135)) +
+         x[2] * ((-t258 * t86 * t87 * t257 * 4.0 + t86 * t90 * 2.0 * t135 - t90 * 2.0 * t259 * t95 +
+                  t252 - t258 * t257 * 4.0 * t91 * t95 + t255)))) *
+           x[3]);
+  mass[0] = (110.0 * (t14 * t14) + 950.0 * (t21 * t21) + (t50 * t50) * 75.0 + 1400.0 +
+             (((t54 * t54) + (t57 * t57))) * u[4] + 110.0 * (t59 * t59) + (t60 * t60) * 1350.0 +
+             190.0 * (t77 * t77) + (t78 * t78) * 75.0 + t81 * t82 +
+             t96 * ((t86 * t90 * t87 + t90 * t91 * t95)) * 0.5 + (t97 * t97) * 1350.0 +
+             190.0 * (t100 * t100) + 190.0 * (t102 * t102) + 0.5 * t76 * t103 +
+             950.0 * (t106 * t106) + t81 * t107 + 190.0 * (t108 * t108));
+  mass[1] = t140;
+  mass[2] = t140;
+  mass[3] = (-0.5 * t136 * t141 + (t138 * t138) * 1.171875 + 950.0 * (t139 * t139) + 300.0 +
+             950.0 * (t129 * t129) + 3.1581145687500007 * (t64 * t64) * t142 - 0.5 * t128 * t143 +
+             u[4] * (((t130 * t130) + (t131 * t131))) + 3.1581145687500007 * (t99 * t99) * t142 +
+             (t144 * t144) * 75.0);
+  bias[0] =
+      (t145 * t60 * 1350.0 * t97 + t106 * t146 * 9316.3175 + t147 * 1863.2634999999998 * t102 -
+       t137 * t185 * 0.29296875 + t191 * 950.0 * t21 + 190.0 * t77 * t219 +
+       190.0 * t145 *
+           ((t220 * 1.7178 * t4 * t221 + 0.5726 * t7 * t224 - t11 * t12 * t13 * 1.1452 -
+             t225 * 0.5726 * t13 * t4)) *
+           t102 +
+       91.93734375 * t147 * ((t226 + t69 + t84 + t70 + t227 - 21.6964 * t2)) +
+       t108 * t146 * 1863.2634999999998 + u[4] * ((t54 * t229 + t234 * t57)) +
+       t108 * 190.0 * t145 *
+           ((t220 * 1.7178 * t221 * t5 - t8 * t12 * t13 * 1.1452 - t225 * 0.5726 * t13 * t5 +
+             t101)) +
+       t147 * 13238.977499999999 * t97 + t236 * t145 * t107 -
+       ((-t54 * t146 * 9.80665 - t147 * 9.80665 * t57)) * u[4] + t236 * t145 * t82 +
+       0.125 * t237 * t103 + 91.93734375 * t146 * ((t72 + t74 + t133 + t134 + 21.6964 * t0 + t94)) +
+       t246 * t112 * 0.29296875 + t14 * t146 * 1078.7314999999999 +
+       t100 * t147 * 1863.2634999999998 + 13238.977499999999 * t60 * t146 +
+       ((-t220 * 1.7178 * t221 * t5 + t9 + t58 + t8 * t12 * t13 * 1.1452 + t10 +
+         t225 * 0.5726 * t13 * t5)) *
+           t145 * 110.0 * t14 +
+       t145 * 110.0 *
+           ((t222 + t11 * t12 * t13 * 1.1452 + t225 * 0.5726 * t13 * t4 - 0.5726 * t7 * t224 +
+             t223 - t220 * 1.7178 * t4 * t221)) *
+           t59 +
+       t77 * t146 * 1863.2634999999998 + t147 * t21 * 9316.3175 + t147 * t59 * 1078.7314999999999 +
+       950.0 * t248 * t106 + t145 * ((-1.4 * t0 + t2 * 0.12)) * 1350.0 * t97 + t100 * 190.0 * t250 +
+       0.125 * t260 * t96);
+  bias[1] =
+      (91.93734375 * t147 * ((t226 + t121 + t122 + t227)) + t146 * t129 * 9316.3175 +
+       950.0 * t248 * t129 + t147 * t99 * t128 * 240.2212467375 +
+       ((t130 * t234 + t131 * t229)) * u[4] -
+       ((-t131 * t146 * 9.80665 - t147 * t130 * 9.80665)) * u[4] + t147 * t139 * 9316.3175 -
+       t185 * t138 * 0.29296875 + t191 * 950.0 * t139 - t128 * 24.49575 * t64 * t219 -
+       91.93734375 * t138 * t146 + 0.125 * t260 * t141 + t246 * 0.29296875 * t120 +
+       t99 * t128 * t250 * 24.49575 + 0.125 * t237 * t143 - t146 * t128 * 240.2212467375 * t64);
+}
+
+/// Eq. (1)-(2) with d_pose_d_angles (4 x kNumAngles, row-major), templated on the scalar
+/// (ForwardKinematicsJacobians without the parameter Jacobian).
+template <typename T>
+void ForwardKinematicsWithJacobian(const T* angles, const T* params, T* pose, T* d_pose_d_angles) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const T t0 = (angles[2] + params[3] - angles[0]);
+  const T t1 = cos(t0);
+  const T t2 = params[1] * t1;
+  const T t3 = (angles[1] + params[2] - angles[0]);
+  const T t4 = cos(t3);
+  const T t5 = params[0] * t4;
+  const T t6 = sin(t0);
+  const T t7 = params[1] * t6;
+  const T t8 = sin(t3);
+  const T t9 = params[0] * t8;
+  pose[0] = (t2 + t5 + 0.6);
+  pose[1] = T(0.0);
+  pose[2] = (1.7 + t7 + t9);
+  pose[3] = t0;
+  d_pose_d_angles[0] = (t7 + t9);
+  d_pose_d_angles[1] = params[0] * t8 * (-1.0);
+  d_pose_d_angles[2] = params[1] * t6 * (-1.0);
+  d_pose_d_angles[3] = T(0.0);
+  d_pose_d_angles[4] = T(0.0);
+  d_pose_d_angles[5] = T(0.0);
+  d_pose_d_angles[6] = (-t5 - t2);
+  d_pose_d_angles[7] = t5;
+  d_pose_d_angles[8] = t2;
+  d_pose_d_angles[9] = T((-1.0));
+  d_pose_d_angles[10] = T(0.0);
+  d_pose_d_angles[11] = T(1.0);
+}
+
+/// Pin-to-pin length of `actuator` [m] (a motor: its joint angle) and its gradient over
+/// all joints [m/rad] (a Z-bar's tilt cylinder depends on the boom too: force times the
+/// gradient is the generalised force), templated on the scalar. Returns false for an
+/// unknown actuator.
+template <typename T>
+bool CylinderGeometry(int actuator, const T* q, T* length, T* d_length_d_q) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  switch (actuator) {
+    case 0: {
+      const T t0 = sin(q[0]);
+      const T t1 = 0.1216 * t0;
+      const T t2 = cos(q[0]);
+      const T t3 = 0.6894 * t2;
+      const T t4 = (0.3235 + t1 + t3);
+      const T t5 = (0.6894 * t0 - t2 * 0.1216 + 1.2074);
+      const T t6 = ((t4 * t4) + (t5 * t5));
+      length[0] = sqrt(t6);
+      d_length_d_q[0] =
+          (1.0 / sqrt(t6)) * ((((t2 * 0.1216 - 0.6894 * t0)) * t4 + ((t1 + t3)) * t5));
+      d_length_d_q[1] = T(0.0);
+      return true;
+    }
+    case 1: {
+      const T t0 = (q[0] + q[1]);
+      const T t1 = sin(t0);
+      const T t2 = t1 * (-0.3758);
+      const T t3 = cos(q[0]);
+      const T t4 = sin(q[0]);
+      const T t5 = cos(t0);
+      const T t6 = (-0.0898) * t5;
+      const T t7 = (t2 + t3 * 0.5399000000000003 + 0.4749 * t4 + t6);
+      const T t8 = (-0.4749) * t3;
+      const T t9 = (0.3758 * t5 + 0.5399000000000003 * t4 + t8 - 0.0898 * t1);
+      const T t10 = (t9 * t9);
+      const T t11 = (t7 * t7);
+      const T t12 = (t10 + t11);
+      const T t13 = (1.0 / (t12));
+      const T t14 = (-0.09333387000000004 + t10 + t11);
+      const T t15 = (t14 * t14);
+      const T t16 = (0.26594649000000004 - 0.25 * t13 * t15);
+      const T t17 = sqrt(t16);
+      const T t18 = (1.0 / sqrt(t12));
+      const T t19 = (-t7 * 2.0 * t17 + t18 * t14 * t9);
+      const T t20 = (2.0 * t17 * t9 + t7 * t18 * t14);
+      const T t21 = atan2(t19 * t18 * 0.5, t18 * 0.5 * t20);
+      const T t22 = sin(t21);
+      const T t23 = t3 * 2.4421;
+      const T t24 = cos(t21);
+      const T t25 = (-0.4749) * t4;
+      const T t26 = (t22 * 2e-04 + t23 - 1.0001 * t24 - 0.6968 + t25);
+      const T t27 = 0.4749 * t3;
+      const T t28 = (0.0904 - t22 * 1.0001 + t27 - 2e-04 * t24 + 2.4421 * t4);
+      const T t29 = ((t26 * t26) + (t28 * t28));
+      const T t30 = 0.0898 * t1;
+      const T t31 = (-0.3758) * t5;
+      const T t32 = (t30 + t31 + t27 - 0.5399000000000003 * t4);
+      const T t33 = (t32 * t7 + t7 * t9);
+      const T t34 = pow(t12, (-1.5));
+      const T t35 = (1.0 / sqrt(t16));
+      const T t36 = (1.0 / (t12 * t12));
+      const T t37 = (2.0 * t13 * t14 * t33 - t36 * t33 * t15);
+      const T t38 = (1.0 / (((t13 * (t19 * t19) + (t20 * t20) * t13))));
+      const T t39 = (t19 *
+                         ((t18 * ((-t32 * 2.0 * t18 * t14 - t7 * 4.0 * t18 * t33 - t7 * 4.0 * t17 +
+                                   t7 * 2.0 * t34 * t14 * t33 + t35 * t37 * t9)) +
+                           2.0 * t34 * t33 * t20)) *
+                         t18 * t38 -
+                     t18 * t38 * t20 *
+                         ((t18 * ((t32 * 4.0 * t17 - t7 * 2.0 * t18 * t14 - 4.0 * t18 * t33 * t9 -
+                                   t7 * t35 * t37 + 2.0 * t34 * t14 * t33 * t9)) +
+                           t19 * 2.0 * t34 * t33)));
+      const T t40 = (1.0 / sqrt(t29));
+      const T t41 = (t2 + t6);
+      const T t42 = (t30 + t31);
+      const T t43 = (t41 * t9 + t7 * t42);
+      const T t44 = (t36 * t15 * t43 - 2.0 * t13 * t14 * t43);
+      const T t45 = (-t19 * t18 * t38 *
+                         ((2.0 * t34 * t20 * t43 +
+                           t18 * ((-2.0 * t18 * t14 * t42 - t7 * 4.0 * t18 * t43 - t44 * t35 * t9 -
+                                   4.0 * t41 * t17 + t7 * 2.0 * t34 * t14 * t43)))) +
+                     ((t19 * 2.0 * t34 * t43 +
+                       ((t7 * t44 * t35 - 4.0 * t18 * t9 * t43 + 2.0 * t34 * t14 * t9 * t43 -
+                         2.0 * t18 * t14 * t41 + 4.0 * t42 * t17)) *
+                           t18)) *
+                         t18 * t38 * t20);
+      length[0] = sqrt(t29);
+      d_length_d_q[0] = ((t26 * ((t22 * t39 * 0.50005 + t8 - 2.4421 * t4 + 1e-04 * t39 * t24)) +
+                          ((-t39 * 0.50005 * t24 + t22 * 1e-04 * t39 + t23 + t25)) * t28)) *
+                        t40;
+      d_length_d_q[1] = t40 * ((t28 * ((-t22 * 1e-04 * t45 + 0.50005 * t24 * t45)) +
+                                t26 * ((-t22 * 0.50005 * t45 - 1e-04 * t24 * t45))));
+      return true;
+    }
+    default:
+      return false;
+  }
+}
 
 }  // namespace autoshovel::generated::hyundai_hl740_9s

@@ -41,7 +41,7 @@ void ForwardKinematics(const T* angles, const T* params, T* pose) {
   const T t0 = (angles[2] + params[3] - angles[0]);
   const T t1 = (angles[1] + params[2] - angles[0]);
   pose[0] = (params[1] * cos(t0) + params[0] * cos(t1) + 0.6);
-  pose[1] = 0.0;
+  pose[1] = T(0.0);
   pose[2] = (1.7 + params[1] * sin(t0) + params[0] * sin(t1));
   pose[3] = t0;
 }
@@ -117,5 +117,561 @@ void MechanicalEnergy(const double* q, const double* qd, double payload, double 
                       double* energy);
 /// Everything above behind the common interface of the registry.
 const MachineFunctions& Functions();
+
+/// MassMatrix and BiasForces together, templated on the scalar (ceres::Jet for exact
+/// derivatives): M(q) q'' + bias(q, q') = actuator + external torques.
+template <typename T>
+void ArmDynamics(const T* q, const T* qd, const T& payload, const T& pitch, T* mass, T* bias) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  T x[kNumStates] = {};
+  T u[kNumInputs] = {};
+  for (int j = 0; j < kNumJoints; ++j) {
+    x[j] = q[j];
+    x[kNumJoints + j] = qd[j];
+  }
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const T t0 = (x[0] + x[1]);
+  const T t1 = cos(t0);
+  const T t2 = 0.5 * t1;
+  const T t3 = sin(x[0]);
+  const T t4 = t3 * 0.5499999999999998;
+  const T t5 = sin(t0);
+  const T t6 = t5 * (-0.1);
+  const T t7 = (t2 + t4 + t6);
+  const T t8 = t5 * (-0.5);
+  const T t9 = t1 * (-0.1);
+  const T t10 = cos(x[0]);
+  const T t11 = t10 * 0.5499999999999998;
+  const T t12 = (t8 + t9 + t11);
+  const T t13 = (t12 * t12);
+  const T t14 = (t7 * t7);
+  const T t15 = (-0.06250000000000006 + t13 + t14);
+  const T t16 = (t13 + t14);
+  const T t17 = (1.0 / sqrt(t16));
+  const T t18 = (t15 * t15);
+  const T t19 = (1.0 / (t16));
+  const T t20 = (0.36 - t18 * 0.25 * t19);
+  const T t21 = sqrt(t20);
+  const T t22 = (t7 * t15 * t17 + t12 * t21 * 2.0);
+  const T t23 = pow(t16, (-1.5));
+  const T t24 = t5 * 0.1;
+  const T t25 = t1 * (-0.5);
+  const T t26 = (t24 + t25 - t4);
+  const T t27 = (t12 * t26 + t12 * t7);
+  const T t28 = t22 * 2.0 * t23 * t27;
+  const T t29 = (1.0 / sqrt(t20));
+  const T t30 = (1.0 / (t16 * t16));
+  const T t31 = (-t15 * 2.0 * t19 * t27 + t30 * t18 * t27);
+  const T t32 = (-t7 * t15 * 2.0 * t23 * t27 + t12 * t15 * 2.0 * t17 + t7 * 4.0 * t17 * t27 +
+                 t12 * t29 * t31 + t21 * 4.0 * t26);
+  const T t33 = t17 * (-1.0) * t32;
+  const T t34 = (t28 + t33);
+  const T t35 = (-t12 * t15 * t17 + t7 * t21 * 2.0);
+  const T t36 = (t22 * t22);
+  const T t37 = (t35 * t35);
+  const T t38 = (t36 * t19 + t37 * t19);
+  const T t39 = (1.0 / (t38));
+  const T t40 = t35 * 2.0 * t23 * t27;
+  const T t41 = (t7 * t29 * t31 + t12 * t21 * 4.0 + t12 * t15 * 2.0 * t23 * t27 -
+                 t15 * 2.0 * t17 * t26 - t12 * 4.0 * t17 * t27);
+  const T t42 = t41 * t17 * (-1.0);
+  const T t43 = (t40 + t42);
+  const T t44 = (t34 * t35 * t17 * t39 - t43 * t22 * t17 * t39);
+  const T t45 = (t34 * t35 * t17 * 8.0 * t39 - t43 * t22 * t17 * 8.0 * t39);
+  const T t46 = atan2(t22 * 0.5 * t17, t35 * t17 * (-0.5));
+  const T t47 = sin(t46);
+  const T t48 = t3 * (-2.4314);
+  const T t49 = (-t44 * t47 * 0.15 + t48);
+  const T t50 = (t8 + t9 + t35 * 0.5 * t17 + t11);
+  const T t51 = (t2 - t22 * 0.5 * t17 + t4 + t6);
+  const T t52 = ((t50 * t50) + (t51 * t51));
+  const T t53 = (1.0 / (t52));
+  const T t54 = (-1.0999999999999996 * t10 + t5 + 0.2 * t1 - t35 * t17);
+  const T t55 = t5 * 2.0;
+  const T t56 = 0.4 * t1;
+  const T t57 = t22 * t23 * (-2.0) * t27;
+  const T t58 = t17 * t32;
+  const T t59 = (t55 + t56 - 2.1999999999999993 * t10 + t57 + t58);
+  const T t60 = t5 * (-0.2);
+  const T t61 = (-t22 * t17 + t60 + t3 * 1.0999999999999996 + t1);
+  const T t62 = t5 * (-0.4);
+  const T t63 = 2.0 * t1;
+  const T t64 = (t62 + t3 * 2.1999999999999993 + t40 + t63 + t42);
+  const T t65 = (t53 * 0.625 * t54 * t59 + t61 * t53 * t64 * 0.625);
+  const T t66 = 0.6894 * t10;
+  const T t67 = t3 * 0.1216;
+  const T t68 = (t66 + t67 + 0.3235);
+  const T t69 = (1.2074 + 0.6894 * t3 - 0.1216 * t10);
+  const T t70 = ((t68 * t68) + (t69 * t69));
+  const T t71 = (1.0 / sqrt(t70));
+  const T t72 = (t66 + t67);
+  const T t73 = t3 * (-0.6894);
+  const T t74 = 0.1216 * t10;
+  const T t75 = (t73 + t74);
+  const T t76 = (t72 * t69 + t75 * t68);
+  const T t77 = pow(t70, (-1.5));
+  const T t78 = (t66 + t67 - 0.5726 * t71 * t72 + 0.5726 * t76 * t77 * t69);
+  const T t79 = (-0.15 * t10 - 1.39 * t3);
+  const T t80 = t75 * t71 * (-0.5726);
+  const T t81 = (t73 + t80 + t74 + 0.5726 * t76 * t77 * t68);
+  const T t82 = (-t3 * 0.15 + 1.39 * t10);
+  const T t83 = t5 * (-0.20276316964285715);
+  const T t84 = 0.4231954017857143 * t1;
+  const T t85 = 2.9814 * t10;
+  const T t86 = (t83 + t84 + t85);
+  const T t87 = t5 * (-0.4231954017857143);
+  const T t88 = (-0.20276316964285715) * t1;
+  const T t89 = (-2.9814) * t3;
+  const T t90 = (t87 + t88 + t89);
+  const T t91 = 0.42 * t1;
+  const T t92 = (t60 + t85 + t91);
+  const T t93 = t5 * (-0.42);
+  const T t94 = t1 * (-0.2);
+  const T t95 = (t93 + t94 + t89);
+  const T t96 = (1.0 / (t70));
+  const T t97 = (-1.2074 + t73 + t74);
+  const T t98 = (t72 * t96 * t68 + t75 * t96 * t97);
+  const T t99 = (20.765148133333334 * t72 * t96 * t68 + t75 * 20.765148133333334 * t96 * t97);
+  const T t100 = cos(t46);
+  const T t101 = (t44 * 0.15 * t100 + 2.4314 * t10);
+  const T t102 = 0.5726 * t75 * t71;
+  const T t103 = (-0.5726 * t76 * t77 * t68 + t102);
+  const T t104 =
+      (-t5 * 0.25 - 0.05 * t1 - t22 * 0.25 * t23 * t27 + 0.125 * t17 * t32 + t10 * 2.7064);
+  const T t105 = t5 * 0.05;
+  const T t106 = (-0.25) * t1;
+  const T t107 = (t105 + t106 + t35 * 0.25 * t23 * t27 - t41 * 0.125 * t17 - t3 * 2.7064);
+  const T t108 = (12.021927866666665 * t72 * t96 * t68 + t75 * 12.021927866666665 * t96 * t97);
+  const T t109 = (-0.5726 * t76 * t77 * t69 + 0.5726 * t71 * t72);
+  const T t110 = (t60 + t91);
+  const T t111 = (t8 + t9);
+  const T t112 = (t24 + t25);
+  const T t113 = (t12 * t112 + t7 * t111);
+  const T t114 = (t15 * 2.0 * t19 * t113 - t30 * t18 * t113);
+  const T t115 = (t111 * t21 * 4.0 - t112 * t15 * 2.0 * t17 + t12 * t15 * 2.0 * t23 * t113 -
+                  t12 * 4.0 * t17 * t113 - t7 * t29 * t114);
+  const T t116 = t17 * t115;
+  const T t117 = t35 * t23 * (-2.0) * t113;
+  const T t118 = (t62 + t116 + t117 + t63);
+  const T t119 = t35 * t23 * (-2.0) * t27;
+  const T t120 = t41 * t17;
+  const T t121 = (t62 + t119 + t63 + t120 + t3 * 21.6512);
+  const T t122 = (t116 + t117);
+  const T t123 = t22 * 2.0 * t23 * t113;
+  const T t124 = (t7 * t15 * 2.0 * t23 * t113 - t7 * 4.0 * t17 * t113 - t112 * t21 * 4.0 -
+                  t111 * t15 * 2.0 * t17 + t12 * t29 * t114);
+  const T t125 = t17 * t124;
+  const T t126 = (t123 + t125);
+  const T t127 = (t22 * t122 * t17 * t39 + t35 * t126 * t17 * t39);
+  const T t128 = (t28 + t55 + t56 + t33 - 21.6512 * t10);
+  const T t129 = (t123 + t55 + t56 + t125);
+  const T t130 = (t87 + t88);
+  const T t131 = (t83 + t84);
+  const T t132 = t5 * (-2.0);
+  const T t133 = t1 * (-0.4);
+  const T t134 = (t123 + t132 + t133 + t125);
+  const T t135 = t17 * t115 * (-1.0);
+  const T t136 = t35 * 2.0 * t23 * t113;
+  const T t137 = (t135 + t62 + t136 + t63);
+  const T t138 = (t53 * t134 * t54 - t61 * t53 * t137);
+  const T t139 = (t93 + t94);
+  const T t140 = (t110 * 900.0 * t92 + t118 * 1.171875 * t121 + 28.5 * t127 * t100 * t101 + 280.0 +
+                  t127 * t45 * 0.5 - t49 * 28.5 * t127 * t47 + t128 * t129 * 1.171875 +
+                  u[4] * ((t130 * t90 + t86 * t131)) - 0.125 * t138 * t65 + 900.0 * t95 * t139);
+  const T t141 = (t22 * t122 * t17 * 8.0 * t39 + t35 * t126 * t17 * 8.0 * t39);
+  const T t142 = (t127 * t127);
+  const T t143 = (t105 + t106 - 0.125 * t17 * t115 + t35 * 0.25 * t23 * t113);
+  const T t144 = (-t53 * t134 * 0.625 * t54 + t61 * t53 * t137 * 0.625);
+  const T t145 = x[3] * t139;
+  const T t146 = (((t95 * x[2] + t145)) * x[2] + ((t145 + x[2] * t139)) * x[3]);
+  const T t147 = sin(u[5]);
+  const T t148 = (x[2] * x[2]);
+  const T t149 = pow(t70, (-2.5));
+  const T t150 = (t76 * t76);
+  const T t151 = t3 * (-0.1216);
+  const T t152 = (-0.6894) * t10;
+  const T t153 = (t151 + t152);
+  const T t154 = ((t75 * t75) + (t72 * t72) + t68 * t153 + t75 * t69);
+  const T t155 = cos(u[5]);
+  const T t156 = (-2.0) * t1;
+  const T t157 = t5 * 0.4;
+  const T t158 = (t116 + t156 + t117 + t157);
+  const T t159 = t112 * t7;
+  const T t160 = 0.1 * t1;
+  const T t161 = t5 * 0.5;
+  const T t162 = (t160 + t161);
+  const T t163 = t12 * t162;
+  const T t164 = (t159 + t112 * t26 + t12 * t111 + t163);
+  const T t165 = t35 * t23 * 8.0 * t164;
+  const T t166 = 4.0 * t23 * t115 * t27;
+  const T t167 = (1.0 / (t16 * t16 * t16));
+  const T t168 = (t15 * 2.0 * t19 * t164 - t15 * t30 * 8.0 * t113 * t27 - t30 * t18 * t164 +
+                  4.0 * t19 * t113 * t27 + t167 * t18 * 4.0 * t113 * t27);
+  const T t169 = t112 * (-16.0) * t21;
+  const T t170 = pow(t20, (-1.5));
+  const T t171 = pow(t16, (-2.5));
+  const T t172 = t15 * t162 * t17 * 8.0;
+  const T t173 =
+      t17 * ((t7 * t168 * t29 * 4.0 + t169 - t111 * t29 * 4.0 * t31 - t112 * t15 * t23 * 8.0 * t27 -
+              t170 * t7 * t114 * t31 + t12 * t15 * t171 * 24.0 * t113 * t27 +
+              t12 * 16.0 * t17 * t164 - t12 * 32.0 * t23 * t113 * t27 + t112 * 16.0 * t17 * t27 +
+              16.0 * t17 * t26 * t113 - t15 * t23 * t26 * 8.0 * t113 + t12 * t29 * 4.0 * t114 +
+              t172 - t12 * t15 * t23 * 8.0 * t164));
+  const T t174 = t5 * (-8.0);
+  const T t175 = t1 * (-1.6);
+  const T t176 = t35 * (-24.0) * t171 * t113 * t27;
+  const T t177 = t41 * 4.0 * t23 * t113;
+  const T t178 = (t165 + t166 + t173 + t174 + t175 + t176 + t177);
+  const T t179 = (1.0 / (t52 * t52));
+  const T t180 = t5 * 0.2;
+  const T t181 = (t180 - t1 + t22 * t17 - t3 * 1.0999999999999996);
+  const T t182 = (t134 * t181 - t137 * t54);
+  const T t183 = (t112 * t29 * 4.0 * t31 - t12 * t168 * t29 * 4.0 + t12 * 16.0 * t17 * t113 +
+                  16.0 * t21 * t162 - t111 * t15 * t23 * 8.0 * t27 - t7 * 32.0 * t23 * t113 * t27 +
+                  t7 * 16.0 * t17 * t164 - t29 * 4.0 * t114 * t26 + t112 * t15 * t17 * 8.0 +
+                  t12 * t170 * t114 * t31 + t111 * 16.0 * t17 * t27 - t7 * t15 * t23 * 8.0 * t164 -
+                  t12 * t15 * t23 * 8.0 * t113 + t7 * t15 * t171 * 24.0 * t113 * t27);
+  const T t184 = t17 * t183 * (-1.0);
+  const T t185 = (-24.0) * t22 * t171 * t113 * t27;
+  const T t186 = t22 * t23 * 8.0 * t164;
+  const T t187 = t5 * 1.6;
+  const T t188 = t23 * (-4.0) * t124 * t27;
+  const T t189 = (-8.0) * t1;
+  const T t190 = 4.0 * t23 * t32 * t113;
+  const T t191 = (t159 + (t112 * t112) + t163 + (t111 * t111));
+  const T t192 = (t113 * t113);
+  const T t193 = (-t191 * t30 * t18 + t167 * t18 * 4.0 * t192 + t191 * t15 * 2.0 * t19 +
+                  4.0 * t19 * t192 - t15 * t30 * 8.0 * t192);
+  const T t194 = (t114 * t114);
+  const T t195 =
+      (t112 * t29 * t114 * 8.0 + t7 * t191 * t15 * t23 * 8.0 + t111 * t15 * 16.0 * t23 * t113 -
+       t7 * t191 * 16.0 * t17 - t111 * 32.0 * t17 * t113 + t12 * t29 * 4.0 * t193 +
+       t7 * 32.0 * t23 * t192 - 16.0 * t21 * t162 - t7 * t15 * t171 * 24.0 * t192 -
+       t112 * t15 * t17 * 8.0 + t12 * t170 * t194);
+  const T t196 = t1 * 8.0;
+  const T t197 = t5 * (-1.6);
+  const T t198 = t35 * t191 * (-8.0) * t23;
+  const T t199 =
+      ((t112 * 32.0 * t17 * t113 + t12 * t191 * 16.0 * t17 + t169 + t170 * t194 * t7 +
+        t111 * t29 * t114 * 8.0 + t12 * t15 * t171 * 24.0 * t192 + t172 + t7 * t29 * 4.0 * t193 -
+        t112 * t15 * 16.0 * t23 * t113 - t12 * t191 * t15 * t23 * 8.0 - t12 * 32.0 * t23 * t192)) *
+      t17 * (-1.0);
+  const T t200 = t5 * 8.0;
+  const T t201 = 1.6 * t1;
+  const T t202 = t35 * t171 * 24.0 * t192;
+  const T t203 = (-8.0) * t23 * t115 * t113;
+  const T t204 = (t27 * t27);
+  const T t205 = t35 * t171 * 24.0 * t204;
+  const T t206 = t41 * (-8.0) * t23 * t27;
+  const T t207 = (t160 - t11 + t161);
+  const T t208 = (t7 * t26 + (t26 * t26) + t13 + t12 * t207);
+  const T t209 = (-t15 * 2.0 * t208 * t19 + t15 * t30 * t204 * 8.0 + t30 * t18 * t208 -
+                  t167 * t18 * 4.0 * t204 - 4.0 * t204 * t19);
+  const T t210 = (t31 * t31);
+  const T t211 = (-16.0 * t21 * t26 + t15 * t207 * t17 * 8.0 + t12 * 16.0 * t208 * t17 +
+                  t12 * t15 * t171 * 24.0 * t204 - t209 * t7 * t29 * 4.0 - t12 * 32.0 * t204 * t23 -
+                  t15 * 16.0 * t23 * t26 * t27 + 32.0 * t17 * t26 * t27 + t170 * t7 * t210 -
+                  t12 * t15 * t208 * t23 * 8.0 - t12 * t29 * 8.0 * t31);
+  const T t212 = t211 * t17 * (-1.0);
+  const T t213 = t35 * t208 * (-8.0) * t23;
+  const T t214 = (t64 * t54 + t181 * t59);
+  const T t215 = t23 * 8.0 * t32 * t27;
+  const T t216 = t22 * t208 * t23 * 8.0;
+  const T t217 = ((t29 * t26 * 8.0 * t31 + t15 * t17 * t26 * 8.0 - t7 * t15 * t208 * t23 * 8.0 +
+                   t7 * 16.0 * t208 * t17 + 16.0 * t207 * t21 + t7 * t15 * t171 * 24.0 * t204 -
+                   t12 * t170 * t210 + t12 * 32.0 * t17 * t27 - t12 * t15 * 16.0 * t23 * t27 +
+                   t12 * t209 * t29 * 4.0 - t7 * 32.0 * t204 * t23)) *
+                 t17 * (-1.0);
+  const T t218 = (-24.0) * t22 * t171 * t204;
+  const T t219 = (t119 - t3 * 2.1999999999999993 + t156 + t157 + t120);
+  const T t220 =
+      (((((-t53 * t158 * 2.0 * t59 + t61 * t178 * t53 + t61 * t64 * t179 * t182 +
+           t179 * t182 * t54 * t59 -
+           t53 * ((t184 + t185 + t186 + t187 + t188 + t189 + t190)) * t54 +
+           t53 * t134 * t64 * 2.0)) *
+             x[2] +
+         ((t53 *
+               ((-t195 * t17 + t23 * 8.0 * t124 * t113 + t22 * t171 * 24.0 * t192 -
+                 t191 * t22 * t23 * 8.0 + t196 + t197)) *
+               t54 +
+           t53 * t158 * t134 * 2.0 + t61 * t137 * t179 * t182 + t53 * t137 * t134 * 2.0 -
+           t134 * t179 * t182 * t54 - t61 * t53 * ((t198 + t199 + t200 + t201 + t202 + t203)))) *
+             x[3])) *
+           x[3] -
+       ((((((t205 + t206 - 8.799999999999997 * t10 + t200 + t201 + t212 + t213)) * t61 * t53 +
+           t214 * t179 * t54 * t59 +
+           t53 * t54 * ((t215 - t3 * 8.799999999999997 + t216 + t217 + t187 + t189 + t218)) +
+           t61 * t64 * t214 * t179 + t53 * 2.0 * t59 * t219 + t53 * t64 * 2.0 * t59)) *
+             x[2] +
+         ((-t61 * t178 * t53 - t53 * t134 * 2.0 * t219 - t134 * t214 * t179 * t54 +
+           t53 * t137 * 2.0 * t59 -
+           t53 * t54 *
+               ((-t190 + t17 * t183 + t22 * t171 * 24.0 * t113 * t27 - t186 + t196 +
+                 4.0 * t23 * t124 * t27 + t197)) +
+           t61 * t137 * t214 * t179)) *
+             x[3])) *
+           x[2]);
+  const T t221 = (1.0 / (t70 * t70));
+  const T t222 = (-t221 * t75 * 2.0 * t76 * t97 + t75 * t72 * t96 + t75 * t96 * t68 +
+                  t75 * t96 * t153 + t96 * t153 * t97 - t221 * t72 * 2.0 * t76 * t68);
+  const T t223 = (-24.0) * t22 * t171 * t192;
+  const T t224 = t191 * t22 * t23 * 8.0;
+  const T t225 = t195 * t17;
+  const T t226 = (-8.0) * t23 * t124 * t113;
+  const T t227 = (t184 + t185 + t186 + t188 + t196 + t197 + t190);
+  const T t228 =
+      (((x[3] * ((t223 + t224 + t196 + t197 + t225 + t226)) + t227 * x[2])) * x[3] +
+       ((x[2] * ((t215 + t216 + t217 + t196 + t197 + t218 + 86.6048 * t3)) + t227 * x[3])) * x[2]);
+  const T t229 = (-0.42) * t1;
+  const T t230 = (t180 + t229);
+  const T t231 = x[3] * t230;
+  const T t232 = (-2.9814) * t10;
+  const T t233 = (((t231 + x[2] * t230)) * x[3] + ((t231 + x[2] * ((t232 + t180 + t229)))) * x[2]);
+  const T t234 = t130 * x[3];
+  const T t235 = (x[3] * ((t234 + t130 * x[2])) + ((x[2] * t90 + t234)) * x[2]);
+  const T t236 = t5 * 0.20276316964285715;
+  const T t237 = t1 * (-0.4231954017857143);
+  const T t238 = (t236 + t237);
+  const T t239 = x[3] * t238;
+  const T t240 = (((t239 + x[2] * t238)) * x[3] + ((t239 + ((t232 + t236 + t237)) * x[2])) * x[2]);
+  const T t241 = (1.0 / (t38 * t38));
+  const T t242 =
+      (t22 * t19 * t32 + t41 * t35 * t19 - t37 * t30 * 2.0 * t27 - t36 * t30 * 2.0 * t27);
+  const T t243 =
+      (t43 * t22 * 4.0 * t23 * t27 * t39 - t34 * t35 * t241 * t242 * 4.0 * t17 +
+       t43 * t241 * t22 * t242 * 4.0 * t17 - t43 * 2.0 * t17 * t32 * t39 -
+       t34 * t35 * 4.0 * t23 * t27 * t39 + t34 * t41 * 2.0 * t17 * t39 -
+       t22 * ((t41 * t23 * 8.0 * t27 + t35 * t208 * t23 * 8.0 + t211 * t17 - t205)) * t17 * t39 +
+       t35 * t17 * ((t215 + t216 + t217 + t218)) * t39);
+  const T t244 = (t44 * t44);
+  const T t245 = (-0.075) * t44 * t127 * t100;
+  const T t246 = t22 * t17 * ((t165 + t166 + t173 + t176 + t177)) * (-1.0) * t39;
+  const T t247 = t35 * ((t184 + t185 + t186 + t188 + t190)) * t17 * t39;
+  const T t248 =
+      (-t22 * t122 * 4.0 * t23 * t27 * t39 + t246 + t247 - t35 * t241 * t242 * 4.0 * t126 * t17 +
+       t122 * 2.0 * t17 * t32 * t39 - t35 * 4.0 * t126 * t23 * t27 * t39 -
+       t241 * t22 * t122 * t242 * 4.0 * t17 + t41 * 2.0 * t126 * t17 * t39);
+  const T t249 =
+      (t35 * t19 * t115 - t22 * t19 * t124 - t37 * t30 * 2.0 * t113 - t36 * t30 * 2.0 * t113);
+  const T t250 = (t43 * t22 * 4.0 * t23 * t113 * t39 + t43 * 2.0 * t17 * t124 * t39 + t246 + t247 +
+                  t43 * t241 * t22 * 4.0 * t249 * t17 - t34 * t35 * t241 * 4.0 * t249 * t17 -
+                  t34 * t35 * 4.0 * t23 * t113 * t39 + t34 * 2.0 * t17 * t115 * t39);
+  const T t251 =
+      (-t241 * t22 * t122 * 4.0 * t249 * t17 + 2.0 * t126 * t17 * t115 * t39 +
+       t35 * ((t223 + t224 + t225 + t226)) * t17 * t39 - t35 * 4.0 * t126 * t23 * t113 * t39 +
+       t22 * t17 * ((t198 + t199 + t202 + t203)) * t39 - t122 * 2.0 * t17 * t124 * t39 -
+       t22 * t122 * 4.0 * t23 * t113 * t39 - t35 * t241 * 4.0 * t249 * t126 * t17);
+  const T t252 = (((x[2] * ((-2.4314 * t10 - t47 * t243 * 0.0375 - 0.075 * t100 * t244)) +
+                    ((t245 - t248 * t47 * 0.0375)) * x[3])) *
+                      x[2] +
+                  ((((t245 - t47 * t250 * 0.0375)) * x[2] +
+                    ((-0.075 * t100 * t142 - t251 * t47 * 0.0375)) * x[3])) *
+                      x[3]);
+  const T t253 = (((t248 * x[3] + x[2] * t243)) * x[2] + ((t251 * x[3] + t250 * x[2])) * x[3]);
+  const T t254 = (-0.075) * t44 * t127 * t47;
+  const T t255 = (((((t100 * t243 * 0.0375 - 0.075 * t47 * t244 + t48)) * x[2] +
+                    x[3] * ((t254 + t248 * t100 * 0.0375)))) *
+                      x[2] +
+                  ((((t251 * t100 * 0.0375 - 0.075 * t47 * t142)) * x[3] +
+                    ((t250 * t100 * 0.0375 + t254)) * x[2])) *
+                      x[3]);
+  const T t256 = (t165 + t200 + t166 + t173 + t201 + t176 + t177);
+  const T t257 =
+      (-((x[3] * ((t198 + t199 + t174 + t175 + t202 + t203)) - t256 * x[2])) * x[3] +
+       ((-x[2] * ((t205 + t206 + 86.6048 * t10 + t174 + t212 + t175 + t213)) + t256 * x[3])) *
+           x[2]);
+  mass[0] =
+      (t44 * t45 * 0.5 + 190.0 * (t49 * t49) + 0.125 * ((t53 * t54 * t59 + t61 * t53 * t64)) * t65 +
+       110.0 * (t78 * t78) + 1600.0 * (t79 * t79) + 110.0 * (t81 * t81) + 1600.0 * (t82 * t82) +
+       u[4] * (((t86 * t86) + (t90 * t90))) + 1580.0 + 900.0 * (t92 * t92) + 900.0 * (t95 * t95) +
+       t98 * t99 + (t101 * t101) * 190.0 + 190.0 * (t103 * t103) + 75.0 * (t104 * t104) +
+       (t107 * t107) * 75.0 + t98 * t108 + 190.0 * (t109 * t109));
+  mass[1] = t140;
+  mass[2] = t140;
+  mass[3] =
+      ((t129 * t129) * 1.171875 + t127 * 0.5 * t141 + (t100 * t100) * 4.2749999999999995 * t142 +
+       280.0 + (t143 * t143) * 75.0 + (t47 * t47) * 4.2749999999999995 * t142 -
+       0.125 * t138 * t144 + u[4] * (((t131 * t131) + (t130 * t130))) + (t110 * t110) * 900.0 +
+       900.0 * (t139 * t139));
+  bias[0] = (900.0 * t92 * t146 + t147 * 8825.984999999999 * t95 +
+             1600.0 * t148 * t79 * ((t3 * 0.15 - 1.39 * t10)) + t147 * 1863.2634999999998 * t103 +
+             190.0 * t148 *
+                 ((t149 * 1.7178 * t68 * t150 + 0.5726 * t71 * t153 - t75 * t76 * t77 * 1.1452 -
+                   t154 * 0.5726 * t77 * t68)) *
+                 t103 +
+             t109 * t155 * 1863.2634999999998 +
+             t109 * 190.0 * t148 *
+                 ((t149 * 1.7178 * t150 * t69 - t72 * t76 * t77 * 1.1452 -
+                   t154 * 0.5726 * t77 * t69 + t102)) +
+             t65 * 0.03125 * t220 - u[4] * ((-t147 * t90 * 9.80665 - t86 * t155 * 9.80665)) +
+             8825.984999999999 * t155 * t92 + t222 * t148 * t108 + t128 * t228 * 0.29296875 +
+             900.0 * t233 * t95 + t82 * 15690.64 * t155 +
+             91.93734375 * t147 * ((t156 + t40 + t157 - t3 * 21.6512 + t42)) + t222 * t148 * t99 +
+             ((t86 * t235 + t240 * t90)) * u[4] + t147 * t79 * 15690.64 +
+             t49 * t147 * 1863.2634999999998 +
+             91.93734375 * ((t132 + t133 + 21.6512 * t10 + t57 + t58)) * t155 +
+             t78 * t155 * 1078.7314999999999 + 190.0 * t252 * t49 + 1600.0 * t82 * t148 * t79 +
+             ((-t149 * 1.7178 * t150 * t69 + t73 + t80 + t72 * t76 * t77 * 1.1452 + t74 +
+               t154 * 0.5726 * t77 * t69)) *
+                 t148 * 110.0 * t78 +
+             t148 * 110.0 *
+                 ((t151 + t75 * t76 * t77 * 1.1452 + t154 * 0.5726 * t77 * t68 -
+                   0.5726 * t71 * t153 + t152 - t149 * 1.7178 * t68 * t150)) *
+                 t81 +
+             t253 * 0.125 * t45 + t155 * 1863.2634999999998 * t101 +
+             t147 * t81 * 1078.7314999999999 + 190.0 * t255 * t101 - t257 * 0.29296875 * t121);
+  bias[1] =
+      (t253 * 0.125 * t141 + ((t135 + t156 + t157 + t136)) * 91.93734375 * t147 -
+       ((-t155 * 9.80665 * t131 - t130 * t147 * 9.80665)) * u[4] + t110 * 8825.984999999999 * t155 +
+       28.5 * t127 * t255 * t100 - t118 * t257 * 0.29296875 - t252 * 28.5 * t127 * t47 +
+       t127 * t155 * t100 * 279.48952499999996 - t147 * t127 * t47 * 279.48952499999996 +
+       t147 * 8825.984999999999 * t139 - 91.93734375 * t155 * t129 + t228 * t129 * 0.29296875 +
+       t110 * 900.0 * t146 + t144 * 0.03125 * t220 + 900.0 * t233 * t139 +
+       ((t235 * t131 + t130 * t240)) * u[4]);
+}
+
+/// Eq. (1)-(2) with d_pose_d_angles (4 x kNumAngles, row-major), templated on the scalar
+/// (ForwardKinematicsJacobians without the parameter Jacobian).
+template <typename T>
+void ForwardKinematicsWithJacobian(const T* angles, const T* params, T* pose, T* d_pose_d_angles) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const T t0 = (angles[2] + params[3] - angles[0]);
+  const T t1 = cos(t0);
+  const T t2 = params[1] * t1;
+  const T t3 = (angles[1] + params[2] - angles[0]);
+  const T t4 = cos(t3);
+  const T t5 = params[0] * t4;
+  const T t6 = sin(t0);
+  const T t7 = params[1] * t6;
+  const T t8 = sin(t3);
+  const T t9 = params[0] * t8;
+  pose[0] = (t2 + t5 + 0.6);
+  pose[1] = T(0.0);
+  pose[2] = (1.7 + t7 + t9);
+  pose[3] = t0;
+  d_pose_d_angles[0] = (t7 + t9);
+  d_pose_d_angles[1] = params[0] * t8 * (-1.0);
+  d_pose_d_angles[2] = params[1] * t6 * (-1.0);
+  d_pose_d_angles[3] = T(0.0);
+  d_pose_d_angles[4] = T(0.0);
+  d_pose_d_angles[5] = T(0.0);
+  d_pose_d_angles[6] = (-t5 - t2);
+  d_pose_d_angles[7] = t5;
+  d_pose_d_angles[8] = t2;
+  d_pose_d_angles[9] = T((-1.0));
+  d_pose_d_angles[10] = T(0.0);
+  d_pose_d_angles[11] = T(1.0);
+}
+
+/// Pin-to-pin length of `actuator` [m] (a motor: its joint angle) and its gradient over
+/// all joints [m/rad] (a Z-bar's tilt cylinder depends on the boom too: force times the
+/// gradient is the generalised force), templated on the scalar. Returns false for an
+/// unknown actuator.
+template <typename T>
+bool CylinderGeometry(int actuator, const T* q, T* length, T* d_length_d_q) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  switch (actuator) {
+    case 0: {
+      const T t0 = sin(q[0]);
+      const T t1 = 0.1216 * t0;
+      const T t2 = cos(q[0]);
+      const T t3 = 0.6894 * t2;
+      const T t4 = (0.3235 + t1 + t3);
+      const T t5 = (0.6894 * t0 - t2 * 0.1216 + 1.2074);
+      const T t6 = ((t4 * t4) + (t5 * t5));
+      length[0] = sqrt(t6);
+      d_length_d_q[0] =
+          (1.0 / sqrt(t6)) * ((((t2 * 0.1216 - 0.6894 * t0)) * t4 + ((t1 + t3)) * t5));
+      d_length_d_q[1] = T(0.0);
+      return true;
+    }
+    case 1: {
+      const T t0 = (q[0] + q[1]);
+      const T t1 = sin(t0);
+      const T t2 = t1 * (-0.5);
+      const T t3 = cos(q[0]);
+      const T t4 = cos(t0);
+      const T t5 = (-0.1) * t4;
+      const T t6 = (t2 + t3 * 0.5499999999999998 + t5);
+      const T t7 = (t6 * t6);
+      const T t8 = sin(q[0]);
+      const T t9 = (-t1 * 0.1 + 0.5 * t4 + t8 * 0.5499999999999998);
+      const T t10 = (t9 * t9);
+      const T t11 = (t7 + t10);
+      const T t12 = (1.0 / sqrt(t11));
+      const T t13 = (-0.06250000000000006 + t7 + t10);
+      const T t14 = (t13 * t13);
+      const T t15 = (1.0 / (t11));
+      const T t16 = (0.36 - t14 * 0.25 * t15);
+      const T t17 = sqrt(t16);
+      const T t18 = (t9 * t12 * t13 + t17 * 2.0 * t6);
+      const T t19 = (-t12 * t13 * t6 + t9 * t17 * 2.0);
+      const T t20 = atan2(t12 * 0.5 * t18, t12 * (-0.5) * t19);
+      const T t21 = cos(t20);
+      const T t22 = t3 * 2.4314;
+      const T t23 = (-t21 * 0.55 + t22 - 0.1);
+      const T t24 = sin(t20);
+      const T t25 = (t8 * 2.4314 - 0.55 * t24 + 0.5);
+      const T t26 = ((t23 * t23) + (t25 * t25));
+      const T t27 = (1.0 / sqrt(t26));
+      const T t28 = (1.0 / ((((t18 * t18) * t15 + (t19 * t19) * t15))));
+      const T t29 = t1 * 0.1;
+      const T t30 = (-0.5) * t4;
+      const T t31 = (-t8 * 0.5499999999999998 + t29 + t30);
+      const T t32 = (t6 * t31 + t9 * t6);
+      const T t33 = pow(t11, (-1.5));
+      const T t34 = (1.0 / (t11 * t11));
+      const T t35 = (-t13 * 2.0 * t32 * t15 + t34 * t14 * t32);
+      const T t36 = (1.0 / sqrt(t16));
+      const T t37 =
+          (-t12 * t28 * t18 *
+               ((-2.0 * t32 * t33 * t19 +
+                 t12 * ((-t12 * t13 * 2.0 * t31 + t17 * 4.0 * t6 - t12 * 4.0 * t6 * t32 +
+                         t9 * t35 * t36 + t13 * 2.0 * t6 * t32 * t33)))) +
+           t12 * t28 *
+               ((-2.0 * t18 * t32 * t33 +
+                 t12 * ((t35 * t36 * t6 - t9 * t13 * 2.0 * t32 * t33 + t9 * t12 * 4.0 * t32 +
+                         t12 * t13 * 2.0 * t6 + t17 * 4.0 * t31)))) *
+               t19);
+      const T t38 = (t29 + t30);
+      const T t39 = (t2 + t5);
+      const T t40 = (t6 * t38 + t9 * t39);
+      const T t41 = (-t13 * 2.0 * t40 * t15 + t34 * t14 * t40);
+      const T t42 = (t12 *
+                         ((-2.0 * t40 * t18 * t33 +
+                           t12 * ((-t9 * t13 * 2.0 * t40 * t33 + t12 * t13 * 2.0 * t39 +
+                                   t17 * 4.0 * t38 + t9 * t12 * t40 * 4.0 + t36 * t41 * t6)))) *
+                         t28 * t19 +
+                     t12 *
+                         ((-t12 * ((t17 * 4.0 * t39 + t13 * 2.0 * t40 * t6 * t33 + t9 * t36 * t41 -
+                                    t12 * t13 * 2.0 * t38 - t12 * t40 * 4.0 * t6)) +
+                           2.0 * t40 * t33 * t19)) *
+                         t28 * t18);
+      length[0] = sqrt(t26);
+      d_length_d_q[0] =
+          t27 * ((((-t8 * 2.4314 - 0.275 * t24 * t37)) * t23 + t25 * ((t21 * 0.275 * t37 + t22))));
+      d_length_d_q[1] = t27 * ((-t42 * t23 * 0.55 * t24 + t21 * t42 * 0.55 * t25)) * 0.5;
+      return true;
+    }
+    default:
+      return false;
+  }
+}
 
 }  // namespace autoshovel::generated::hyundai_hl740tm_7

@@ -42,7 +42,7 @@ void ForwardKinematics(const T* angles, const T* params, T* pose) {
   const T t0 = (angles[2] + params[3] - angles[0]);
   const T t1 = (angles[1] + params[2] - angles[0]);
   pose[0] = (params[1] * cos(t0) + params[0] * cos(t1) + 1.1);
-  pose[1] = 0.0;
+  pose[1] = T(0.0);
   pose[2] = (2.0 + params[1] * sin(t0) + params[0] * sin(t1));
   pose[3] = t0;
 }
@@ -118,5 +118,223 @@ void MechanicalEnergy(const double* q, const double* qd, double payload, double 
                       double* energy);
 /// Everything above behind the common interface of the registry.
 const MachineFunctions& Functions();
+
+/// MassMatrix and BiasForces together, templated on the scalar (ceres::Jet for exact
+/// derivatives): M(q) q'' + bias(q, q') = actuator + external torques.
+template <typename T>
+void ArmDynamics(const T* q, const T* qd, const T& payload, const T& pitch, T* mass, T* bias) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  T x[kNumStates] = {};
+  T u[kNumInputs] = {};
+  for (int j = 0; j < kNumJoints; ++j) {
+    x[j] = q[j];
+    x[kNumJoints + j] = qd[j];
+  }
+  u[2 * kNumJoints] = payload;
+  u[2 * kNumJoints + 1] = pitch;
+  const T t0 = sin(x[0]);
+  const T t1 = cos(x[0]);
+  const T t2 = (-t0 * 0.1 + 1.55 * t1);
+  const T t3 = (x[0] + x[1]);
+  const T t4 = sin(t3);
+  const T t5 = t4 * (-0.55);
+  const T t6 = cos(t3);
+  const T t7 = (-0.25) * t6;
+  const T t8 = t0 * (-3.11);
+  const T t9 = (t5 + t7 + t8);
+  const T t10 = t4 * (-0.16343387866394005);
+  const T t11 = 3.11 * t1;
+  const T t12 = 0.4011545671438309 * t6;
+  const T t13 = (t10 + t11 + t12);
+  const T t14 = t4 * (-0.4011545671438309);
+  const T t15 = (-0.16343387866394005) * t6;
+  const T t16 = (t14 + t15 + t8);
+  const T t17 = t4 * (-0.25);
+  const T t18 = 0.55 * t6;
+  const T t19 = (t11 + t17 + t18);
+  const T t20 = (-1.55 * t0 - 0.1 * t1);
+  const T t21 = (t14 + t15);
+  const T t22 = (t10 + t12);
+  const T t23 = (t17 + t18);
+  const T t24 = (t5 + t7);
+  const T t25 = (((t16 * t21 + t13 * t22)) * u[4] + 600.0 + t23 * t19 * 1800.0 + t9 * 1800.0 * t24);
+  const T t26 = sin(u[5]);
+  const T t27 = cos(u[5]);
+  const T t28 = t4 * 0.16343387866394005;
+  const T t29 = (-0.4011545671438309) * t6;
+  const T t30 = (t28 + t29);
+  const T t31 = t30 * x[3];
+  const T t32 = (-3.11) * t1;
+  const T t33 = (x[2] * ((t31 + ((t32 + t28 + t29)) * x[2])) + ((t31 + t30 * x[2])) * x[3]);
+  const T t34 = t21 * x[3];
+  const T t35 = (((t21 * x[2] + t34)) * x[3] + ((t34 + t16 * x[2])) * x[2]);
+  const T t36 = (x[2] * x[2]);
+  const T t37 = x[3] * t24;
+  const T t38 = (((t37 + t9 * x[2])) * x[2] + x[3] * ((t37 + x[2] * t24)));
+  const T t39 = t4 * 0.25;
+  const T t40 = (-0.55) * t6;
+  const T t41 = (t39 + t40);
+  const T t42 = x[3] * t41;
+  const T t43 = (((t42 + x[2] * t41)) * x[3] + ((((t39 + t32 + t40)) * x[2] + t42)) * x[2]);
+  mass[0] = (2600.0 * (t2 * t2) + 1800.0 * (t9 * t9) + (((t13 * t13) + (t16 * t16))) * u[4] +
+             (t19 * t19) * 1800.0 + 2600.0 * (t20 * t20) + 2900.0);
+  mass[1] = t25;
+  mass[2] = t25;
+  mass[3] =
+      ((t23 * t23) * 1800.0 + 600.0 + (((t21 * t21) + (t22 * t22))) * u[4] + (t24 * t24) * 1800.0);
+  bias[0] =
+      (-((-t26 * t16 * 9.80665 - t13 * t27 * 9.80665)) * u[4] + ((t33 * t16 + t13 * t35)) * u[4] +
+       t2 * t27 * 25497.289999999997 + 2600.0 * t2 * t36 * t20 + t19 * 1800.0 * t38 +
+       t9 * t43 * 1800.0 + t19 * t27 * 17651.969999999998 + t26 * t9 * 17651.969999999998 +
+       t20 * t26 * 25497.289999999997 + 2600.0 * t36 * t20 * ((t0 * 0.1 - 1.55 * t1)));
+  bias[1] = (t23 * t27 * 17651.969999999998 + t26 * 17651.969999999998 * t24 -
+             ((-t22 * t27 * 9.80665 - t26 * t21 * 9.80665)) * u[4] + t23 * 1800.0 * t38 +
+             t43 * 1800.0 * t24 + ((t35 * t22 + t33 * t21)) * u[4]);
+}
+
+/// Eq. (1)-(2) with d_pose_d_angles (4 x kNumAngles, row-major), templated on the scalar
+/// (ForwardKinematicsJacobians without the parameter Jacobian).
+template <typename T>
+void ForwardKinematicsWithJacobian(const T* angles, const T* params, T* pose, T* d_pose_d_angles) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  const T t0 = (angles[2] + params[3] - angles[0]);
+  const T t1 = cos(t0);
+  const T t2 = params[1] * t1;
+  const T t3 = (angles[1] + params[2] - angles[0]);
+  const T t4 = cos(t3);
+  const T t5 = params[0] * t4;
+  const T t6 = sin(t0);
+  const T t7 = params[1] * t6;
+  const T t8 = sin(t3);
+  const T t9 = params[0] * t8;
+  pose[0] = (t2 + t5 + 1.1);
+  pose[1] = T(0.0);
+  pose[2] = (2.0 + t7 + t9);
+  pose[3] = t0;
+  d_pose_d_angles[0] = (t7 + t9);
+  d_pose_d_angles[1] = params[0] * t8 * (-1.0);
+  d_pose_d_angles[2] = params[1] * t6 * (-1.0);
+  d_pose_d_angles[3] = T(0.0);
+  d_pose_d_angles[4] = T(0.0);
+  d_pose_d_angles[5] = T(0.0);
+  d_pose_d_angles[6] = (-t5 - t2);
+  d_pose_d_angles[7] = t5;
+  d_pose_d_angles[8] = t2;
+  d_pose_d_angles[9] = T((-1.0));
+  d_pose_d_angles[10] = T(0.0);
+  d_pose_d_angles[11] = T(1.0);
+}
+
+/// Pin-to-pin length of `actuator` [m] (a motor: its joint angle) and its gradient over
+/// all joints [m/rad] (a Z-bar's tilt cylinder depends on the boom too: force times the
+/// gradient is the generalised force), templated on the scalar. Returns false for an
+/// unknown actuator.
+template <typename T>
+bool CylinderGeometry(int actuator, const T* q, T* length, T* d_length_d_q) {
+  using std::acos;
+  using std::atan2;
+  using std::cos;
+  using std::pow;
+  using std::sin;
+  using std::sqrt;
+  switch (actuator) {
+    case 0: {
+      const T t0 = cos(q[0]);
+      const T t1 = 0.857 * t0;
+      const T t2 = sin(q[0]);
+      const T t3 = (-0.194) * t2;
+      const T t4 = (t1 - 1.339 + t3);
+      const T t5 = (0.194 * t0 + 0.857 * t2 + 1.595);
+      const T t6 = ((t4 * t4) + (t5 * t5));
+      length[0] = sqrt(t6);
+      d_length_d_q[0] = (1.0 / sqrt(t6)) * ((((-0.857 * t2 - 0.194 * t0)) * t4 + ((t1 + t3)) * t5));
+      d_length_d_q[1] = T(0.0);
+      return true;
+    }
+    case 1: {
+      const T t0 = cos(q[0]);
+      const T t1 = (q[0] + q[1]);
+      const T t2 = sin(t1);
+      const T t3 = (-0.389) * t2;
+      const T t4 = cos(t1);
+      const T t5 = 0.159 * t4;
+      const T t6 = sin(q[0]);
+      const T t7 = (t3 + t0 * 0.5249999999999999 + t5 + 0.365 * t6);
+      const T t8 = (t7 * t7);
+      const T t9 = (0.159 * t2 - 0.365 * t0 + t6 * 0.5249999999999999 + 0.389 * t4);
+      const T t10 = (t9 * t9);
+      const T t11 = (t8 + t10);
+      const T t12 = (1.0 / sqrt(t11));
+      const T t13 = (t8 + t10 - 0.38752);
+      const T t14 = (t13 * t13);
+      const T t15 = (1.0 / (t11));
+      const T t16 = (-t14 * t15 * 0.25 + 0.567009);
+      const T t17 = sqrt(t16);
+      const T t18 = (t17 * t7 * 2.0 + t12 * t13 * t9);
+      const T t19 = (-t12 * t7 * t13 + t17 * 2.0 * t9);
+      const T t20 = atan2(t12 * 0.5 * t18, t12 * t19 * (-0.5));
+      const T t21 = cos(t20);
+      const T t22 = sin(t20);
+      const T t23 = (-t0 * 0.15500000000000003 - 0.141 * t21 - 0.853 * t22 + 2.093 * t6);
+      const T t24 = t0 * 2.093;
+      const T t25 = 0.15500000000000003 * t6;
+      const T t26 = (-0.853 * t21 + t24 + t25 + 0.141 * t22);
+      const T t27 = ((t23 * t23) + (t26 * t26));
+      const T t28 = (1.0 / sqrt(t27));
+      const T t29 = (1.0 / (((t15 * (t19 * t19) + (t18 * t18) * t15))));
+      const T t30 = pow(t11, (-1.5));
+      const T t31 = (-0.389) * t4;
+      const T t32 = (-0.159) * t2;
+      const T t33 = (0.365 * t0 + t31 - t6 * 0.5249999999999999 + t32);
+      const T t34 = (t33 * t7 + t7 * t9);
+      const T t35 = (1.0 / (t11 * t11));
+      const T t36 = (t13 * 2.0 * t15 * t34 - t35 * t14 * t34);
+      const T t37 = (1.0 / sqrt(t16));
+      const T t38 = (-t12 * t29 *
+                         ((t19 * 2.0 * t30 * t34 +
+                           t12 * ((-t17 * t7 * 4.0 + t36 * t9 * t37 + t33 * t12 * t13 * 2.0 +
+                                   t12 * t7 * 4.0 * t34 - t7 * t13 * 2.0 * t30 * t34)))) *
+                         t18 +
+                     t12 *
+                         ((t12 * ((-t17 * t33 * 4.0 + t13 * 2.0 * t30 * t9 * t34 -
+                                   t12 * 4.0 * t9 * t34 + t7 * t36 * t37 - t12 * t7 * t13 * 2.0)) +
+                           2.0 * t30 * t34 * t18)) *
+                         t19 * t29);
+      const T t39 = (t31 + t32);
+      const T t40 = (t3 + t5);
+      const T t41 = (t39 * t7 + t9 * t40);
+      const T t42 = (t41 * t35 * t14 - t41 * t13 * 2.0 * t15);
+      const T t43 = (t12 * t29 * t18 *
+                         ((t12 * ((t41 * t12 * t7 * 4.0 + t39 * t12 * t13 * 2.0 - t17 * 4.0 * t40 -
+                                   t42 * t9 * t37 - t41 * t7 * t13 * 2.0 * t30)) +
+                           t41 * t19 * 2.0 * t30)) +
+                     t12 * t19 * t29 *
+                         ((t12 * ((t12 * t13 * 2.0 * t40 + t41 * t12 * 4.0 * t9 + t7 * t42 * t37 -
+                                   t41 * t13 * 2.0 * t30 * t9 + t17 * t39 * 4.0)) -
+                           t41 * 2.0 * t30 * t18)));
+      length[0] = sqrt(t27);
+      d_length_d_q[0] =
+          t28 *
+          ((t23 * ((0.0705 * t38 * t22 + t24 - t38 * 0.4265 * t21 + t25)) +
+            ((t38 * 0.4265 * t22 - 2.093 * t6 + t0 * 0.15500000000000003 + 0.0705 * t38 * t21)) *
+                t26));
+      d_length_d_q[1] = t28 * ((((-0.0705 * t43 * t21 - 0.4265 * t22 * t43)) * t26 +
+                                t23 * ((-0.0705 * t22 * t43 + 0.4265 * t43 * t21))));
+      return true;
+    }
+    default:
+      return false;
+  }
+}
 
 }  // namespace autoshovel::generated::xcmg_968ev

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <string>
@@ -11,6 +13,7 @@
 
 #include "runtime/app/compare_run_options.h"
 #include "runtime/app/shovel_run.h"
+#include "runtime/optimal/scoop_ocp.h"
 #include "runtime/prediction/shipped_models.h"
 
 namespace autoshovel::app {
@@ -24,11 +27,58 @@ struct CellStats {
   double trigger_after_contact = 0;
   double min_clearance = INFINITY;
   std::string strategies;  ///< strategy counts
+  // The optimal scoop from the same contacts (trials where it solved).
+  int optimal_solved = 0;
+  double optimal_energy = 0;   ///< mean [kJ]
+  double strategy_energy = 0;  ///< the strategy's contact → scoop end on those trials [kJ]
+  double optimal_seconds = 0;  ///< mean solve time [s]
+  std::string optimal_failure;
 };
+
+// The least energy that takes what the strategy took, from its contact on the same pile, within
+// its time (optimal/scoop_ocp.h); warm-started from the previous solve through `ocp`.
+std::optional<optimal::ScoopOcpSolution> OptimalFromContact(
+    const model::MachineDescription& machine, const CycleOutcome& outcome,
+    std::unique_ptr<optimal::ScoopOcp>& ocp, std::unique_ptr<optimal::ScoopModel>& model,
+    std::string* why) {
+  const ContactSnapshot& c = outcome.contact;
+  const model::Material* material = machine.FindMaterial(c.material);
+  if (!c.valid || material == nullptr || c.profile_heights.size() < 2) {
+    *why = "no contact recorded";
+    return std::nullopt;
+  }
+  try {
+    model = std::make_unique<optimal::ScoopModel>(
+        machine, *material,
+        optimal::PileProfile(c.profile_start, c.profile_spacing, c.profile_heights));
+  } catch (const std::invalid_argument& e) {
+    *why = e.what();
+    return std::nullopt;
+  }
+  optimal::ScoopOcpOptions options;
+  // Equal fill, up to 97 % of the rated capacity: the smooth intake closes over the last 3 %.
+  options.target_volume = std::min(outcome.record.payload_m3, 0.97 * model->heaped_capacity());
+  options.max_time = outcome.record.time_s.crowd + outcome.record.time_s.scoop;
+  options.min_time = std::min(1.0, 0.5 * options.max_time);
+  if (!ocp) {
+    ocp = std::make_unique<optimal::ScoopOcp>(*model, options);
+  } else {
+    ocp->set_model(*model);
+    ocp->set_options(options);
+  }
+  optimal::ScoopStart start;
+  start.speed = std::max(c.speed, 0.0);
+  start.q = c.q;
+  start.volume = std::min(c.payload_volume, options.target_volume);
+  optimal::ScoopOcpSolution solution = ocp->Solve(start);
+  if (!solution.ok) *why = solution.status + " (worst: " + solution.worst_constraint + ")";
+  return solution;
+}
 
 // `warned`: the warnings already printed (a model trained on another machine is said once).
 CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
-                  std::set<std::string>& warned) {
+                  std::set<std::string>& warned,
+                  std::unique_ptr<optimal::ScoopOcp>* ocp = nullptr) {
   CellStats c;
   std::vector<std::pair<std::string, int>> counts;
   for (int t = 1; t <= trials; ++t) {
@@ -55,6 +105,21 @@ CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
     c.scoop_time += r.time_s.scoop;
     c.scoop_energy += r.energy_kj.scoop;
     c.trigger_after_contact += out.scoop.trigger_after_contact;
+    if (ocp != nullptr) {
+      std::unique_ptr<optimal::ScoopModel> model;
+      std::string why;
+      const std::optional<optimal::ScoopOcpSolution> best =
+          OptimalFromContact(job.machine(), out, *ocp, model, &why);
+      if (best && best->ok) {
+        ++c.optimal_solved;
+        c.optimal_energy += best->energy / 1e3;
+        c.strategy_energy += r.energy_kj.crowd + r.energy_kj.scoop;
+        c.optimal_seconds += best->solve_seconds;
+      } else if (c.optimal_failure.empty()) {
+        c.optimal_failure = why;
+        err << "  " << options.scenario << " seed " << t << ": optimal scoop: " << why << "\n";
+      }
+    }
     bool found = false;
     for (auto& [name, n] : counts) {
       if (name == r.strategy) ++n, found = true;
@@ -67,6 +132,11 @@ CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
   const double n = std::max(1, c.completed);
   c.crowd_time /= n, c.crowd_energy /= n, c.scoop_time /= n, c.scoop_energy /= n;
   c.trigger_after_contact /= n;
+  if (c.optimal_solved > 0) {
+    c.optimal_energy /= c.optimal_solved;
+    c.strategy_energy /= c.optimal_solved;
+    c.optimal_seconds /= c.optimal_solved;
+  }
   for (const auto& [name, k] : counts) {
     c.strategies += (c.strategies.empty() ? "" : " ") + name + "×" + std::to_string(k);
   }
@@ -181,6 +251,16 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
        NAN,
        {NAN, NAN},
        {NAN, NAN}},
+      // Not in the seed: the optimal-control scoop planned at contact and tracked (no trigger).
+      {"plan at contact",
+       TriggerChoice::kPredicted,
+       "optimal",
+       control::ScoopPolicy::kOptimal,
+       NAN,
+       NAN,
+       NAN,
+       {NAN, NAN},
+       {NAN, NAN}},
   };
   out << "Table 5: trigger and scooping strategy (" << o.trials
       << " trials per material; pressure threshold " << o.pressure_threshold / 1e5
@@ -192,11 +272,21 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       << (o.machine.empty() ? std::string() : "; machine " + o.machine)
       << "). Seed columns: its three figures per row (crowd time s, crowd energy kJ, and "
          "the third column as printed); contact → scoop end is the seed's field measure (bucket "
-         "contact to the end of the scooping motion, travel + hydraulic; Tables 6–7).\n\n";
+         "contact to the end of the scooping motion, travel + hydraulic; Tables 6–7).";
+  if (o.optimum) {
+    out << " Optimum: the least energy of the optimal-control scoop (runtime/optimal) from each "
+           "trial's contact on the same pile, taking what the strategy took (up to 97 % of "
+           "capacity) within the strategy's own contact → scoop end time, on its smooth model; "
+           "gap: the strategy's energy over it, on the trials where it solved.";
+  }
+  out << "\n\n";
   out << "| trigger | strategy | material | crowd s (seed) | crowd kJ (seed) | scoop s | scoop kJ "
          "(seed 3rd) | contact → scoop end s (seed field) | contact → scoop end kJ (seed field) | "
-         "trigger after contact s | fill % | strategies chosen |\n"
-         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+         "trigger after contact s | fill % | strategies chosen |"
+      << (o.optimum ? " optimum kJ | gap % | solved | solve s |" : "")
+      << "\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+      << (o.optimum ? " --- | --- | --- | --- |" : "") << "\n";
+  std::unique_ptr<optimal::ScoopOcp> ocp;  // one solver: each solve warm-starts the next
   for (const Row& row : rows) {
     for (const char* bin : {"bin_1", "bin_4"}) {
       ShovelRunOptions options = Base(o);
@@ -205,19 +295,30 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       options.trigger = row.trigger;
       options.policy = row.policy;
       options.stairway_steps = 3;
-      const CellStats c = RunCell(options, o.trials, err, warned);
+      const CellStats c = RunCell(options, o.trials, err, warned, o.optimum ? &ocp : nullptr);
       const int m = std::string(bin) == "bin_1" ? 0 : 1;
       char line[500];
       std::snprintf(
           line, sizeof line,
           "| %s | %s | %s | %.2f (%.2f) | %.1f (%.1f) | %.2f | %.1f (%.1f) | %.2f (%.2f) | "
-          "%.1f (%.1f) | %.2f | %.1f | %s |\n",
+          "%.1f (%.1f) | %.2f | %.1f | %s |",
           row.trigger_name, row.policy_name, m == 0 ? "gravel" : "sand", c.crowd_time,
           row.seed_crowd_time, c.crowd_energy, row.seed_crowd_energy, c.scoop_time, c.scoop_energy,
           row.seed_third, c.crowd_time + c.scoop_time, row.field_time[m],
           c.crowd_energy + c.scoop_energy, row.field_energy[m], c.trigger_after_contact,
           100 * c.fill, c.strategies.c_str());
-      out << line << std::flush;
+      out << line;
+      if (o.optimum) {
+        if (c.optimal_solved > 0) {
+          std::snprintf(line, sizeof line, " %.1f | %+.0f | %d/%d | %.1f |", c.optimal_energy,
+                        100 * (c.strategy_energy / c.optimal_energy - 1), c.optimal_solved,
+                        c.completed, c.optimal_seconds);
+          out << line;
+        } else {
+          out << " – | – | 0/" << c.completed << " | – |";
+        }
+      }
+      out << "\n" << std::flush;
     }
   }
   return 0;

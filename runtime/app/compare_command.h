@@ -34,6 +34,9 @@ struct CompareOptions {
   /// Name or path of a wheel-loader description to run instead of the scenario's (the
   /// predictor warns when it was trained on another machine); empty: the scenario's.
   std::string machine;
+  /// Table 5: beside every row, the optimal scoop (runtime/optimal) from each trial's contact on
+  /// the same pile at the strategy's fill and within its time.
+  bool optimum = true;
 };
 
 /// Prints the table; returns 0, or 2 on bad input.

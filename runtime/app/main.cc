@@ -523,8 +523,10 @@ int main(int argc, char** argv) {
                     "Simulator labels instead of the segmentation network");
   run_cmd->add_option("--segmenter", run.segmenter, "ONNX segmentation network");
   run_cmd->add_option("--predictor", run.predictor, "Penetration SVR (path without .model)");
-  run_cmd->add_option("--policy", run_policy, "auto | just_in_out | stairway | stairway_fixed")
-      ->check(CLI::IsMember({"auto", "just_in_out", "stairway", "stairway_fixed"}))
+  run_cmd
+      ->add_option("--policy", run_policy,
+                   "auto | just_in_out | stairway | stairway_fixed | optimal")
+      ->check(CLI::IsMember({"auto", "just_in_out", "stairway", "stairway_fixed", "optimal"}))
       ->capture_default_str();
   run_cmd->add_option("--trigger", run_trigger, "predicted | perception | pressure")
       ->check(CLI::IsMember({"predicted", "perception", "pressure"}))
@@ -614,6 +616,9 @@ int main(int argc, char** argv) {
   compare_cmd->add_option("--trials", compare.trials, "Single-cycle runs per cell")
       ->check(autoshovel::app::IntegerIn(1, 1000))
       ->capture_default_str();
+  bool compare_no_optimum = false;
+  compare_cmd->add_flag("--no-optimum", compare_no_optimum,
+                        "table5: leave out the optimal scoop beside each row (saves its solves)");
   compare_cmd->add_flag("--network", compare.network,
                         "Segmentation network instead of the simulator's labels");
   compare_cmd
@@ -667,6 +672,7 @@ int main(int argc, char** argv) {
       compare.models_dir = models_dir;
       compare.pressure_threshold = compare_pressure_bar * 1e5;
       compare.attitude_feed_forward = !compare_no_feed_forward;
+      compare.optimum = !compare_no_optimum;
       if (compare.table == "audit") {
         return autoshovel::app::RunEnergyAudit(compare, compare_output, std::cout, std::cerr);
       }
@@ -708,6 +714,7 @@ int main(int argc, char** argv) {
       run.policy = run_policy == "auto"          ? ScoopPolicy::kAutoSelection
                    : run_policy == "just_in_out" ? ScoopPolicy::kJustInOut
                    : run_policy == "stairway"    ? ScoopPolicy::kStairway
+                   : run_policy == "optimal"     ? ScoopPolicy::kOptimal
                                                  : ScoopPolicy::kStairwayFixed;
       using autoshovel::app::TriggerChoice;
       run.trigger = run_trigger == "predicted"    ? TriggerChoice::kPredicted

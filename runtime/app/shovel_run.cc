@@ -20,6 +20,7 @@
 #include "runtime/control/path_follower.h"
 #include "runtime/control/speed_pid.h"
 #include "runtime/core/strings.h"
+#include "runtime/optimal/scoop_ocp.h"
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/machine_footprint.h"
 #include "runtime/perception/map_render.h"
@@ -165,6 +166,10 @@ const ShovelRunOptions& Validated(const ShovelRunOptions& o) {
 
 struct ShovelJob::State {
   ShovelRunOptions options;
+  // ScoopPolicy::kOptimal: one solver for the run, so that each plan warm-starts from the last,
+  // and the model of the pile it last planned on.
+  std::unique_ptr<optimal::ScoopModel> optimal_model;
+  std::unique_ptr<optimal::ScoopOcp> optimal_ocp;
   plant::ScenarioWithMachine setup;
   std::vector<std::string> site_names;
   std::vector<Site> sites;
@@ -299,6 +304,8 @@ const std::vector<std::string>& ShovelJob::sites() const { return state_->site_n
 const std::string& ShovelJob::scenario_name() const { return state_->setup.scenario.name; }
 const std::string& ShovelJob::machine_name() const { return state_->setup.machine.name; }
 
+const model::MachineDescription& ShovelJob::machine() const { return state_->setup.machine; }
+
 std::string ShovelJob::PredictorMismatch() const {
   const prediction::FeatureScaling& scaling = state_->predictor.scaling();
   // The speed feature's range is the speeds seen at the training runs' triggers: at most the
@@ -346,6 +353,7 @@ std::string ShovelJob::ConfigYaml() const {
     << "pressure_threshold_bar: " << o.pressure_threshold / 1e5 << "\n"
     << "stairway_steps: " << o.stairway_steps << "\n"
     << "scoop_deceleration_mps2: " << o.scoop_deceleration << "\n"
+    << "optimal_max_time_s: " << o.optimal_max_time << "\n"
     << "attack_speed_mps: " << o.attack_speed << "\n"
     << "target_fill: " << o.target_fill << "\n"
     << "attitude_feed_forward: " << (o.attitude_feed_forward ? "true" : "false") << "\n"
@@ -378,6 +386,83 @@ CycleOutcome ShovelJob::RunCycle(int index, const std::filesystem::path& figures
   }
   return out;
 }
+
+namespace {
+
+// ScoopPolicy::kOptimal's planner: the optimal-control scoop (runtime/optimal) on the pile the
+// map saw, to V_t (up to 97 % of capacity: the smooth intake closes over the last 3 %) within
+// `max_time`, warm-started from the run's last plan.
+std::optional<control::PlannedScoop> PlanOptimalScoop(std::unique_ptr<optimal::ScoopModel>& model,
+                                                      std::unique_ptr<optimal::ScoopOcp>& ocp,
+                                                      const model::MachineDescription& machine,
+                                                      const model::Material& material,
+                                                      const control::ScoopPlanRequest& request,
+                                                      double max_time, std::string* why) {
+  try {
+    model = std::make_unique<optimal::ScoopModel>(
+        machine, material,
+        optimal::PileProfile(0.0, request.profile_spacing, request.profile_heights));
+  } catch (const std::invalid_argument& e) {
+    *why = e.what();
+    return std::nullopt;
+  }
+  optimal::ScoopOcpOptions options;
+  options.target_volume = std::min(request.target_volume, 0.97 * model->heaped_capacity());
+  options.max_time = max_time;
+  options.min_time = std::min(1.0, 0.5 * max_time);
+  if (!ocp) {
+    ocp = std::make_unique<optimal::ScoopOcp>(*model, options);
+  } else {
+    ocp->set_model(*model);
+    ocp->set_options(options);
+  }
+  optimal::ScoopStart start;
+  start.speed = request.speed;
+  start.q = {request.q_boom, request.q_bucket};
+  start.volume = std::min(request.payload_volume, options.target_volume);
+  const optimal::ScoopOcpSolution solution = ocp->Solve(start);
+  if (!solution.ok) {
+    *why = solution.status + " (worst: " + solution.worst_constraint + ")";
+    return std::nullopt;
+  }
+  control::PlannedScoop plan;
+  plan.time = solution.time_at;
+  for (const auto& x : solution.state) {
+    plan.speed.push_back(x[optimal::kV]);
+    plan.q_boom.push_back(x[optimal::kQ]);
+    plan.q_bucket.push_back(x[optimal::kQ + 1]);
+  }
+  plan.energy = solution.energy;
+  plan.volume = solution.volume;
+  plan.solve_seconds = solution.solve_seconds;
+  return plan;
+}
+
+// The machine and the pile as the bucket touches it: what an optimal scoop from the same start
+// needs (runtime/optimal). The pile is the plant's own terrain (simulation truth) sampled along
+// the front frame's heading from the hinge, heights above the ground under the hinge.
+ContactSnapshot SnapshotAtContact(const plant::Plant& plant, const results::CycleRecord& rec) {
+  ContactSnapshot c;
+  const plant::MachineState& state = plant.state();
+  c.valid = state.q.size() >= 2;
+  if (!c.valid) return c;
+  c.speed = state.speed;
+  c.q = {state.q[0], state.q[1]};
+  c.payload_volume = state.payload_volume;
+  c.material = rec.material;
+  const plant::Terrain& terrain = plant.world().terrain;
+  const Eigen::Vector2d forward(std::cos(state.heading), std::sin(state.heading));
+  const double ground = terrain.HeightAt(state.hinge_xy.x(), state.hinge_xy.y());
+  c.profile_start = 0;
+  c.profile_spacing = 0.05;
+  for (double x = 0; x <= 14.0 + 1e-9; x += c.profile_spacing) {
+    const Eigen::Vector2d p = state.hinge_xy + x * forward;
+    c.profile_heights.push_back(terrain.HeightAt(p.x(), p.y()) - ground);
+  }
+  return c;
+}
+
+}  // namespace
 
 CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
                                    const std::filesystem::path& figures_dir,
@@ -1038,6 +1123,14 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
       scoop =
           std::make_unique<control::ScoopCycle>(machine, *st.setup.functions, pre_contact,
                                                 *material, *trigger, &st.predictor, scoop_options);
+      if (o.policy == control::ScoopPolicy::kOptimal) {
+        const double max_time = o.optimal_max_time;
+        scoop->SetPlanner([&st, &machine, material, max_time](
+                              const control::ScoopPlanRequest& request, std::string* why) {
+          return PlanOptimalScoop(st.optimal_model, st.optimal_ocp, machine, *material, request,
+                                  max_time, why);
+        });
+      }
       scoop->Start(machine_io);
       stage = Stage::kScoop;
       say("attack (" + std::string(control::ToString(o.policy)) + ", trigger " +
@@ -1135,6 +1228,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     plant.Advance(1.0 / o.control_rate);
     if (scoop && scoop->phase_name() != last_phase) {
       last_phase = scoop->phase_name();
+      if (last_phase == "crowd" && !out.contact.valid) out.contact = SnapshotAtContact(plant, rec);
       if (last_phase != "approach" && last_phase != "done") {
         say(last_phase + " at t = " + Fixed(plant.time() - t0, 2) + " s");
       }

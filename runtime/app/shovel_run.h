@@ -13,6 +13,7 @@
 // left them, and the map keeps what it has seen (the loader's own map, updated at 7 Hz).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -63,6 +64,9 @@ struct ShovelRunOptions {
   /// Fall of the drive's speed reference once the scoop moves the arm
   /// (control::ScoopCycleOptions::scoop_deceleration) [m/s²].
   double scoop_deceleration = 0.6;
+  /// control::ScoopPolicy::kOptimal: the time bound of the optimal-control scoop planned at
+  /// contact, contact to the end of the scooping motion (runtime/optimal/scoop_ocp.h) [s].
+  double optimal_max_time = 6.0;
   /// Approach and crowding speed (control::ScoopCycleOptions::attack_speed) [m/s].
   double attack_speed = 1.5;
   /// V_t as a fraction of the bucket's rated capacity (control::ScoopCycleOptions::target_fill):
@@ -136,8 +140,23 @@ struct ShovelRunOptions {
 };
 
 /// What one cycle did (one row of the results database, plus what the figures need).
+/// The machine and the pile when the bucket touched it (the crowd phase began): the start of
+/// an optimal scoop on the same pile (runtime/optimal, `compare table5`).
+struct ContactSnapshot {
+  bool valid = false;
+  double speed = 0;           ///< [m/s]
+  std::array<double, 2> q{};  ///< boom, bucket [rad]
+  double payload_volume = 0;  ///< already in the bucket [m³]
+  std::string material;
+  /// The terrain along the heading from the hinge, every `profile_spacing` from
+  /// `profile_start` [m], heights above the ground under the hinge [m].
+  double profile_start = 0, profile_spacing = 0.05;
+  std::vector<double> profile_heights;
+};
+
 struct CycleOutcome {
   results::CycleRecord record;
+  ContactSnapshot contact;
   control::ScoopResult scoop;
   std::string failure;           ///< empty when completed
   bool no_shovel_point = false;  ///< failed before moving: no feasible candidate at the site
@@ -176,6 +195,7 @@ class ShovelJob {
   const std::vector<std::string>& sites() const;
   const std::string& scenario_name() const;
   const std::string& machine_name() const;
+  const model::MachineDescription& machine() const;
   /// The resolved configuration, as YAML (config.yaml of the run folder).
   std::string ConfigYaml() const;
   /// Empty, or why the predictor does not fit the scoop profile: its training speeds end below

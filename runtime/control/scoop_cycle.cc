@@ -55,6 +55,8 @@ const char* ToString(ScoopPolicy policy) {
       return "stairway";
     case ScoopPolicy::kStairwayFixed:
       return "stairway_fixed";
+    case ScoopPolicy::kOptimal:
+      return "optimal";
   }
   return "?";
 }
@@ -117,6 +119,8 @@ double ScoopResult::ContactToScoopEndEnergy() const {
 // Everything that changes during one Run().
 struct ScoopCycle::Runtime {
   Phase phase = Phase::kApproach;
+  std::optional<PlannedScoop> plan;  ///< ScoopPolicy::kOptimal, from contact
+  double plan_start = NAN;           ///< machine clock at contact [s]
   ScoopResult result;
   double phase_start_time = 0;
   double phase_start_energy = 0;
@@ -208,7 +212,27 @@ ScoopCycle::ScoopCycle(const model::MachineDescription& machine,
   bucket_delay_ticks_ = static_cast<std::size_t>(std::lround(bucket_delay_ / options.tick));
   // "The bucket's upper edge is leveled" (§6.2).
   level_attitude_ = model::BucketLevelAttitude(machine) + options.finishing.carry_tilt_back;
+  // A planned trajectory's joint references go out this far ahead: a command reaches the spool
+  // after the pilot and transport delays.
+  for (int valve_index : {boom_valve_, bucket_valve_}) {
+    const model::Valve& v = machine.hydraulics.actuators[valve_index].valve;
+    plan_lead_ = std::max(plan_lead_, v.pilot_delay + v.transport_delay);
+  }
 }
+
+namespace {
+
+// A plan's reference at time t since contact, linear between its nodes, held at the ends.
+double PlanAt(const std::vector<double>& time, const std::vector<double>& value, double t) {
+  if (t <= time.front()) return value.front();
+  if (t >= time.back()) return value.back();
+  const auto it = std::upper_bound(time.begin(), time.end(), t);
+  const std::size_t k = static_cast<std::size_t>(it - time.begin()) - 1;
+  const double w = (t - time[k]) / std::max(time[k + 1] - time[k], 1e-9);
+  return (1 - w) * value[k] + w * value[k + 1];
+}
+
+}  // namespace
 
 double ScoopCycle::BucketTargetForAttitude(double attitude, double q_boom) const {
   return std::clamp(attitude - q_boom, machine_.links[1].joint_min, limits_.bucket_max);
@@ -334,6 +358,49 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
   }
 }
 
+void ScoopCycle::StartPlan(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
+  ScoopPlanRequest request;
+  request.speed = std::max(s.speed, 0.0);
+  request.q_boom = s.q_boom;
+  request.q_bucket = s.q_bucket;
+  request.payload_volume = machine.PayloadVolume();
+  request.target_volume = rt.result.target_volume;
+  // The pile ahead as the pre-contact map saw it; unknown cells and noise below read as floor.
+  const Eigen::Vector2d forward(std::cos(s.heading), std::sin(s.heading));
+  for (double x = 0; x <= 14.0 + 1e-9; x += request.profile_spacing) {
+    const Eigen::Vector2d p = s.hinge_xy + x * forward;
+    const double h = map_.HeightAt(p.x(), p.y());
+    request.profile_heights.push_back(std::isfinite(h) ? std::max(h, 0.0) : 0.0);
+  }
+  std::string why = "no planner";
+  std::optional<PlannedScoop> plan = planner_ ? planner_(request, &why) : std::nullopt;
+  if (!plan || plan->time.size() < 2 || plan->speed.size() != plan->time.size() ||
+      plan->q_boom.size() != plan->time.size() || plan->q_bucket.size() != plan->time.size()) {
+    rt.result.failure = "optimal scoop: no plan at contact: " + why;
+    rt.phase = Phase::kDone;
+    return;
+  }
+  ScoopResult& r = rt.result;
+  r.strategy = ScoopStrategy::kOptimal;
+  r.trigger_time = s.time;
+  r.trigger_after_contact = 0;
+  r.trigger_reason = "plan";
+  r.v1_at_trigger = rt.v1;
+  r.planned_energy = plan->energy;
+  r.planned_volume = plan->volume;
+  r.plan_solve_seconds = plan->solve_seconds;
+  rt.trigger_hinge = s.hinge_xy;
+  rt.trigger_heading = s.heading;
+  r.travel_after_trigger = 0;
+  rt.q_bucket_at_trigger = s.q_bucket;
+  rt.q_boom_at_trigger = s.q_boom;
+  rt.plan = std::move(plan);
+  rt.plan_start = s.time;
+  rt.hold_attitude = NAN;
+  EnterPhase(machine, Phase::kCrowd, s, rt);  // a crowd of no time: contact → scoop end is whole
+  EnterPhase(machine, Phase::kScoop, s, rt);
+}
+
 void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
   const bool stopped = rt.stop.Update(s.speed) || !rt.stop_request.empty();
   if (rt.phase == Phase::kApproach || rt.phase == Phase::kCrowd || rt.phase == Phase::kScoop) {
@@ -354,6 +421,10 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         rt.result.boom_pressure_at_contact = s.boom_pressure;
         rt.contact_hinge = s.hinge_xy;
         rt.stop.Reset();
+        if (options_.policy == ScoopPolicy::kOptimal) {
+          StartPlan(machine, s, rt);
+          return;
+        }
         EnterPhase(machine, Phase::kCrowd, s, rt);
       } else if (elapsed > options_.max_approach) {
         rt.result.failure =
@@ -426,6 +497,23 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
           rt.result.travel_after_trigger,
           (s.hinge_xy - rt.trigger_hinge)
               .dot(Eigen::Vector2d(std::cos(rt.trigger_heading), std::sin(rt.trigger_heading))));
+      if (rt.plan) {
+        // The plan ends at rest: once its time is over and the joints have had the valves'
+        // delay to follow, the scoop is over.
+        if (s.time - rt.plan_start >= rt.plan->time.back() + plan_lead_) {
+          rt.result.feedback_volume = rt.v1;
+          rt.result.payload_after_scoop = machine.PayloadVolume();
+          rt.result.payload_at_actions.push_back(machine.PayloadVolume());
+          EnterPhase(machine, Phase::kLevel, s, rt);
+          rt.hold_attitude = level_attitude_;
+          rt.arrived_at = NAN;
+        } else if (elapsed > options_.max_scoop) {
+          rt.result.failure =
+              "scoop not complete within " + std::to_string(options_.max_scoop) + " s";
+          rt.phase = Phase::kDone;
+        }
+        return;
+      }
       // The running action is over once arrived and paused, or timed out.
       if (rt.action) {
         const bool bucket = rt.action->kind == AtomicKind::kRetractBucket;
@@ -648,6 +736,15 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     case Phase::kCrowd:
       break;
     case Phase::kScoop:
+      if (rt.plan) {
+        // The plan: the speed now, the joints where the plan has them one valve dead time
+        // ahead (what is commanded now reaches the spools then).
+        const double t = s.time - rt.plan_start;
+        speed_target = std::max(PlanAt(rt.plan->time, rt.plan->speed, t), 0.0);
+        rt.targets.boom = PlanAt(rt.plan->time, rt.plan->q_boom, t + plan_lead_);
+        rt.targets.bucket = PlanAt(rt.plan->time, rt.plan->q_bucket, t + plan_lead_);
+        break;
+      }
       // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
       // rate once the final rack/lift runs and the arm moves.
       if (rt.finishing_drive && rt.arm_moving) {

@@ -25,6 +25,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -68,6 +69,32 @@ struct Proprioception {
   double pump_pressure = NAN;
 };
 
+/// What a planner is given at contact: the machine, the pile ahead and the volume wanted.
+struct ScoopPlanRequest {
+  double speed = 0;                 ///< [m/s]
+  double q_boom = 0, q_bucket = 0;  ///< [rad]
+  double payload_volume = 0;        ///< already in the bucket [m³]
+  double target_volume = 0;         ///< V_t [m³]
+  /// The pre-contact map's heights along the heading from the hinge, every `profile_spacing`
+  /// metres from the hinge, above the floor (unknown cells read as floor) [m].
+  double profile_spacing = 0.05;
+  std::vector<double> profile_heights;
+};
+
+/// A planned scoop: references over the time since contact, ending at rest.
+struct PlannedScoop {
+  std::vector<double> time;              ///< since contact, increasing [s]
+  std::vector<double> speed;             ///< [m/s]
+  std::vector<double> q_boom, q_bucket;  ///< [rad]
+  double energy = 0;                     ///< what the plan expects to draw [J]
+  double volume = 0;                     ///< and to take [m³]
+  double solve_seconds = 0;              ///< planning time [s]
+};
+
+/// Plans a scoop at contact; nullopt (and `why`) when it cannot.
+using ScoopPlanner =
+    std::function<std::optional<PlannedScoop>(const ScoopPlanRequest& request, std::string* why)>;
+
 /// The machine as the scoop cycle sees it.
 class ScoopMachine {
  public:
@@ -90,6 +117,9 @@ enum class ScoopPolicy {
   kJustInOut,
   kStairway,       ///< adaptive (volume feedback between actions)
   kStairwayFixed,  ///< "Stairway #N", N = StrategyParameters::fixed_steps
+  /// A trajectory planned at contact by a ScoopPlanner (the optimal-control scoop of
+  /// runtime/optimal in app/), tracked by the speed and joint PIDs; no trigger.
+  kOptimal,
 };
 const char* ToString(ScoopPolicy policy);
 
@@ -219,6 +249,9 @@ struct ScoopResult {
   /// has_features_at_trigger and the prediction succeeded. Against travel_after_trigger it shows
   /// how the predictor does in the closed loop (issue 41, item 5).
   double predicted_travel_at_trigger = NAN;
+  /// ScoopPolicy::kOptimal: what the plan expected (energy [J], volume [m³]) and its solve
+  /// time [s]; NaN otherwise.
+  double planned_energy = NAN, planned_volume = NAN, plan_solve_seconds = NAN;
 
   const PhaseRecord* Phase(const std::string& name) const;
   /// Contact to the end of the scoop phase (the seed's Table 6/7 "time"): crowd + scoop.
@@ -268,12 +301,16 @@ class ScoopCycle {
   void JointStalledUnderLoad(int joint, const std::string& reason);
   const char* phase_name() const;
   double tick() const { return options_.tick; }
+  /// The planner ScoopPolicy::kOptimal asks at contact (required for that policy).
+  void SetPlanner(ScoopPlanner planner) { planner_ = std::move(planner); }
 
  private:
   enum class Phase { kApproach, kCrowd, kScoop, kLevel, kShake, kRetreat, kDone };
   struct Runtime;
   void Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
   double ComputeV2(const Proprioception& s, double v1, Runtime& rt);
+  /// ScoopPolicy::kOptimal at contact: asks the planner and starts tracking its plan.
+  void StartPlan(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
   void EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s, Runtime& rt);
   /// The bucket joint target that gives `attitude` (q_boom + q_bucket) at this boom angle,
   /// within the bucket's range.
@@ -303,6 +340,8 @@ class ScoopCycle {
   std::size_t boom_delay_ticks_ = 0, bucket_delay_ticks_ = 0;     ///< valve delays in ticks
   double level_attitude_ = 0;  ///< bucket attitude with the opening level, plus carry tilt [rad]
   std::unique_ptr<Runtime> rt_;
+  ScoopPlanner planner_;
+  double plan_lead_ = 0;  ///< valve dead time the joint references are sent ahead by [s]
 };
 
 }  // namespace autoshovel::control

@@ -18,6 +18,8 @@ const char* ToString(ScoopStrategy strategy) {
       return "stairway";
     case ScoopStrategy::kStairwayFixed:
       return "stairway_fixed";
+    case ScoopStrategy::kOptimal:
+      return "optimal";
   }
   return "?";
 }

@@ -22,7 +22,8 @@
 
 namespace autoshovel::control {
 
-enum class ScoopStrategy { kJustInOut, kStairway, kStairwayFixed };
+/// kOptimal: a planned trajectory tracked from contact (ScoopPolicy::kOptimal, scoop_cycle.h).
+enum class ScoopStrategy { kJustInOut, kStairway, kStairwayFixed, kOptimal };
 const char* ToString(ScoopStrategy strategy);
 
 struct StrategyParameters {

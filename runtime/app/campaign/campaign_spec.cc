@@ -68,8 +68,9 @@ control::ScoopPolicy ParseScoopPolicy(const std::string& name) {
   if (name == "just_in_out") return control::ScoopPolicy::kJustInOut;
   if (name == "stairway") return control::ScoopPolicy::kStairway;
   if (name == "stairway_fixed") return control::ScoopPolicy::kStairwayFixed;
+  if (name == "optimal") return control::ScoopPolicy::kOptimal;
   throw std::invalid_argument("unknown scooping policy '" + name +
-                              "' (auto, just_in_out, stairway, stairway_fixed)");
+                              "' (auto, just_in_out, stairway, stairway_fixed, optimal)");
 }
 
 CampaignSpec LoadCampaignSpec(const std::string& path) {

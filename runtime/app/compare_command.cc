@@ -13,7 +13,7 @@
 
 #include "runtime/app/compare_run_options.h"
 #include "runtime/app/shovel_run.h"
-#include "runtime/optimal/scoop_ocp.h"
+#include "runtime/optimal/warm_scoop_solver.h"
 #include "runtime/prediction/shipped_models.h"
 
 namespace autoshovel::app {
@@ -36,49 +36,31 @@ struct CellStats {
 };
 
 // The least energy that takes what the strategy took, from its contact on the same pile, within
-// its time (optimal/scoop_ocp.h); warm-started from the previous solve through `ocp`.
+// its time (optimal/scoop_ocp.h); warm-started from the previous solve through `solver`.
 std::optional<optimal::ScoopOcpSolution> OptimalFromContact(
     const model::MachineDescription& machine, const CycleOutcome& outcome,
-    std::unique_ptr<optimal::ScoopOcp>& ocp, std::unique_ptr<optimal::ScoopModel>& model,
-    std::string* why) {
+    optimal::WarmScoopSolver& solver, std::string* why) {
   const ContactSnapshot& c = outcome.contact;
   const model::Material* material = machine.FindMaterial(c.material);
-  if (!c.valid || material == nullptr || c.profile_heights.size() < 2) {
+  if (!c.valid || material == nullptr) {
     *why = "no contact recorded";
     return std::nullopt;
   }
-  try {
-    model = std::make_unique<optimal::ScoopModel>(
-        machine, *material,
-        optimal::PileProfile(c.profile_start, c.profile_spacing, c.profile_heights));
-  } catch (const std::invalid_argument& e) {
-    *why = e.what();
-    return std::nullopt;
-  }
-  optimal::ScoopOcpOptions options;
-  // Equal fill, up to 97 % of the rated capacity: the smooth intake closes over the last 3 %.
-  options.target_volume = std::min(outcome.record.payload_m3, 0.97 * model->heaped_capacity());
-  options.max_time = outcome.record.time_s.crowd + outcome.record.time_s.scoop;
-  options.min_time = std::min(1.0, 0.5 * options.max_time);
-  if (!ocp) {
-    ocp = std::make_unique<optimal::ScoopOcp>(*model, options);
-  } else {
-    ocp->set_model(*model);
-    ocp->set_options(options);
-  }
-  optimal::ScoopStart start;
-  start.speed = std::max(c.speed, 0.0);
-  start.q = c.q;
-  start.volume = std::min(c.payload_volume, options.target_volume);
-  optimal::ScoopOcpSolution solution = ocp->Solve(start);
-  if (!solution.ok) *why = solution.status + " (worst: " + solution.worst_constraint + ")";
-  return solution;
+  optimal::ContactProblem problem;
+  problem.speed = c.speed;
+  problem.q = c.q;
+  problem.payload_volume = c.payload_volume;
+  problem.profile_start = c.profile_start;
+  problem.profile_spacing = c.profile_spacing;
+  problem.profile_heights = c.profile_heights;
+  problem.target_volume = outcome.record.payload_m3;
+  problem.max_time = outcome.record.time_s.crowd + outcome.record.time_s.scoop;
+  return solver.Solve(machine, *material, problem, why);
 }
 
 // `warned`: the warnings already printed (a model trained on another machine is said once).
 CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
-                  std::set<std::string>& warned,
-                  std::unique_ptr<optimal::ScoopOcp>* ocp = nullptr) {
+                  std::set<std::string>& warned, optimal::WarmScoopSolver* solver = nullptr) {
   CellStats c;
   std::vector<std::pair<std::string, int>> counts;
   for (int t = 1; t <= trials; ++t) {
@@ -105,11 +87,10 @@ CellStats RunCell(ShovelRunOptions options, int trials, std::ostream& err,
     c.scoop_time += r.time_s.scoop;
     c.scoop_energy += r.energy_kj.scoop;
     c.trigger_after_contact += out.scoop.trigger_after_contact;
-    if (ocp != nullptr) {
-      std::unique_ptr<optimal::ScoopModel> model;
+    if (solver != nullptr) {
       std::string why;
       const std::optional<optimal::ScoopOcpSolution> best =
-          OptimalFromContact(job.machine(), out, *ocp, model, &why);
+          OptimalFromContact(job.machine(), out, *solver, &why);
       if (best && best->ok) {
         ++c.optimal_solved;
         c.optimal_energy += best->energy / 1e3;
@@ -286,7 +267,7 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       << (o.optimum ? " optimum kJ | gap % | solved | solve s |" : "")
       << "\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
       << (o.optimum ? " --- | --- | --- | --- |" : "") << "\n";
-  std::unique_ptr<optimal::ScoopOcp> ocp;  // one solver: each solve warm-starts the next
+  optimal::WarmScoopSolver solver;  // one solver: each solve warm-starts the next
   for (const Row& row : rows) {
     for (const char* bin : {"bin_1", "bin_4"}) {
       ShovelRunOptions options = Base(o);
@@ -295,7 +276,7 @@ int Table5(const CompareOptions& o, std::ostream& out, std::ostream& err) {
       options.trigger = row.trigger;
       options.policy = row.policy;
       options.stairway_steps = 3;
-      const CellStats c = RunCell(options, o.trials, err, warned, o.optimum ? &ocp : nullptr);
+      const CellStats c = RunCell(options, o.trials, err, warned, o.optimum ? &solver : nullptr);
       const int m = std::string(bin) == "bin_1" ? 0 : 1;
       char line[500];
       std::snprintf(

@@ -20,7 +20,7 @@
 #include "runtime/control/path_follower.h"
 #include "runtime/control/speed_pid.h"
 #include "runtime/core/strings.h"
-#include "runtime/optimal/scoop_ocp.h"
+#include "runtime/optimal/warm_scoop_solver.h"
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/machine_footprint.h"
 #include "runtime/perception/map_render.h"
@@ -166,10 +166,8 @@ const ShovelRunOptions& Validated(const ShovelRunOptions& o) {
 
 struct ShovelJob::State {
   ShovelRunOptions options;
-  // ScoopPolicy::kOptimal: one solver for the run, so that each plan warm-starts from the last,
-  // and the model of the pile it last planned on.
-  std::unique_ptr<optimal::ScoopModel> optimal_model;
-  std::unique_ptr<optimal::ScoopOcp> optimal_ocp;
+  // ScoopPolicy::kOptimal: one solver for the run, so that each plan warm-starts from the last.
+  optimal::WarmScoopSolver optimal_solver;
   plant::ScenarioWithMachine setup;
   std::vector<std::string> site_names;
   std::vector<Site> sites;
@@ -390,51 +388,33 @@ CycleOutcome ShovelJob::RunCycle(int index, const std::filesystem::path& figures
 namespace {
 
 // ScoopPolicy::kOptimal's planner: the optimal-control scoop (runtime/optimal) on the pile the
-// map saw, to V_t (up to 97 % of capacity: the smooth intake closes over the last 3 %) within
-// `max_time`, warm-started from the run's last plan.
-std::optional<control::PlannedScoop> PlanOptimalScoop(std::unique_ptr<optimal::ScoopModel>& model,
-                                                      std::unique_ptr<optimal::ScoopOcp>& ocp,
+// map saw, to V_t within `max_time`, warm-started from the run's last plan.
+std::optional<control::PlannedScoop> PlanOptimalScoop(optimal::WarmScoopSolver& solver,
                                                       const model::MachineDescription& machine,
                                                       const model::Material& material,
                                                       const control::ScoopPlanRequest& request,
                                                       double max_time, std::string* why) {
-  try {
-    model = std::make_unique<optimal::ScoopModel>(
-        machine, material,
-        optimal::PileProfile(0.0, request.profile_spacing, request.profile_heights));
-  } catch (const std::invalid_argument& e) {
-    *why = e.what();
-    return std::nullopt;
-  }
-  optimal::ScoopOcpOptions options;
-  options.target_volume = std::min(request.target_volume, 0.97 * model->heaped_capacity());
-  options.max_time = max_time;
-  options.min_time = std::min(1.0, 0.5 * max_time);
-  if (!ocp) {
-    ocp = std::make_unique<optimal::ScoopOcp>(*model, options);
-  } else {
-    ocp->set_model(*model);
-    ocp->set_options(options);
-  }
-  optimal::ScoopStart start;
-  start.speed = request.speed;
-  start.q = {request.q_boom, request.q_bucket};
-  start.volume = std::min(request.payload_volume, options.target_volume);
-  const optimal::ScoopOcpSolution solution = ocp->Solve(start);
-  if (!solution.ok) {
-    *why = solution.status + " (worst: " + solution.worst_constraint + ")";
-    return std::nullopt;
-  }
+  optimal::ContactProblem problem;
+  problem.speed = request.speed;
+  problem.q = {request.q_boom, request.q_bucket};
+  problem.payload_volume = request.payload_volume;
+  problem.profile_spacing = request.profile_spacing;
+  problem.profile_heights = request.profile_heights;
+  problem.target_volume = request.target_volume;
+  problem.max_time = max_time;
+  const std::optional<optimal::ScoopOcpSolution> solution =
+      solver.Solve(machine, material, problem, why);
+  if (!solution || !solution->ok) return std::nullopt;
   control::PlannedScoop plan;
-  plan.time = solution.time_at;
-  for (const auto& x : solution.state) {
+  plan.time = solution->time_at;
+  for (const auto& x : solution->state) {
     plan.speed.push_back(x[optimal::kV]);
     plan.q_boom.push_back(x[optimal::kQ]);
     plan.q_bucket.push_back(x[optimal::kQ + 1]);
   }
-  plan.energy = solution.energy;
-  plan.volume = solution.volume;
-  plan.solve_seconds = solution.solve_seconds;
+  plan.energy = solution->energy;
+  plan.volume = solution->volume;
+  plan.solve_seconds = solution->solve_seconds;
   return plan;
 }
 
@@ -1127,8 +1107,7 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
         const double max_time = o.optimal_max_time;
         scoop->SetPlanner([&st, &machine, material, max_time](
                               const control::ScoopPlanRequest& request, std::string* why) {
-          return PlanOptimalScoop(st.optimal_model, st.optimal_ocp, machine, *material, request,
-                                  max_time, why);
+          return PlanOptimalScoop(st.optimal_solver, machine, *material, request, max_time, why);
         });
       }
       scoop->Start(machine_io);
@@ -1228,7 +1207,10 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
     plant.Advance(1.0 / o.control_rate);
     if (scoop && scoop->phase_name() != last_phase) {
       last_phase = scoop->phase_name();
-      if (last_phase == "crowd" && !out.contact.valid) out.contact = SnapshotAtContact(plant, rec);
+      // Contact: the crowd begins (a planned scoop goes from contact straight to its scoop).
+      if ((last_phase == "crowd" || last_phase == "scoop") && !out.contact.valid) {
+        out.contact = SnapshotAtContact(plant, rec);
+      }
       if (last_phase != "approach" && last_phase != "done") {
         say(last_phase + " at t = " + Fixed(plant.time() - t0, 2) + " s");
       }

@@ -155,8 +155,7 @@ ScoopModel::ScoopModel(const model::MachineDescription& machine, const model::Ma
 }
 
 template <typename T>
-void ScoopModel::Tip(const T* q, const T& s, T* tip_x, T* tip_z, T* bucket_angle) const {
-  const generated::TemplatedArm<T>* arm = generated::FindTemplatedArm<T>(machine_name_);
+void ScoopModel::ArmPose(const T* q, T* pose, T* d_pose) const {
   T angles[8] = {};
   T params[8] = {};
   for (std::size_t k = 0; k < params_.size(); ++k) params[k] = T(params_[k]);
@@ -166,9 +165,14 @@ void ScoopModel::Tip(const T* q, const T& s, T* tip_x, T* tip_z, T* bucket_angle
     phi = phi + q[k];
     angles[k + 1] = phi - params_[kJoints + k];
   }
+  generated::FindTemplatedArm<T>(machine_name_)->kinematics(angles, params, pose, d_pose);
+}
+
+template <typename T>
+void ScoopModel::Tip(const T* q, const T& s, T* tip_x, T* tip_z, T* bucket_angle) const {
   T pose[4];
   T d_pose[4 * 8];
-  arm->kinematics(angles, params, pose, d_pose);
+  ArmPose(q, pose, d_pose);
   *tip_x = s + pose[0];
   *tip_z = pose[2];
   *bucket_angle = pose[3];
@@ -194,17 +198,9 @@ void ScoopModel::EvaluateDetailed(const T* x, const T* u, T* xdot, T* path, T* e
   const T payload = density_ * volume;
 
   // Kinematics and its Jacobian in the joints: ∂/∂q_j = Σ_{k ≥ j} ∂/∂θ_k (θ_k sums q up to k).
-  T angles[8] = {};
-  T params[8] = {};
-  for (std::size_t k = 0; k < params_.size(); ++k) params[k] = T(params_[k]);
-  T phi(0.0);
-  for (int k = 0; k < kJoints; ++k) {
-    phi = phi + q[k];
-    angles[k + 1] = phi - params_[kJoints + k];
-  }
   T pose[4];
   T d_pose[4 * 8];
-  arm->kinematics(angles, params, pose, d_pose);
+  ArmPose(q, pose, d_pose);
   T jx[kJoints], jz[kJoints], jphi[kJoints];
   for (int j = 0; j < kJoints; ++j) {
     jx[j] = jz[j] = jphi[j] = T(0.0);

@@ -135,6 +135,9 @@ class ScoopModel {
   const double* link_params() const { return params_.data(); }
 
  private:
+  /// The generated kinematics at joints q: pose [x, y, z, φ] and ∂pose/∂angles (4 × angles).
+  template <typename T>
+  void ArmPose(const T* q, T* pose, T* d_pose) const;
   /// Evaluate, and with `extras` (12 values) the probe's quantities in ScoopModelProbe order.
   template <typename T>
   void EvaluateDetailed(const T* x, const T* u, T* xdot, T* path, T* extras) const;

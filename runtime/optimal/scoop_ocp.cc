@@ -59,28 +59,31 @@ const char* StatusText(Ipopt::ApplicationReturnStatus status) {
 
 }  // namespace
 
-std::array<double, kStates> ScoopOcpSolution::StateAt(double t) const {
-  std::array<double, kStates> out{};
-  if (time_at.empty()) return out;
-  if (t <= time_at.front()) return state.front();
-  if (t >= time_at.back()) return state.back();
-  const auto it = std::upper_bound(time_at.begin(), time_at.end(), t);
-  const std::size_t k = static_cast<std::size_t>(it - time_at.begin()) - 1;
-  const double w = (t - time_at[k]) / std::max(time_at[k + 1] - time_at[k], 1e-12);
-  for (int i = 0; i < kStates; ++i) out[i] = (1 - w) * state[k][i] + w * state[k + 1][i];
+namespace {
+
+// Linear between the nodes, held at the ends.
+template <std::size_t N>
+std::array<double, N> Interpolate(const std::vector<double>& time,
+                                  const std::vector<std::array<double, N>>& values, double t) {
+  if (time.empty()) return {};
+  if (t <= time.front()) return values.front();
+  if (t >= time.back()) return values.back();
+  const auto it = std::upper_bound(time.begin(), time.end(), t);
+  const std::size_t k = static_cast<std::size_t>(it - time.begin()) - 1;
+  const double w = (t - time[k]) / std::max(time[k + 1] - time[k], 1e-12);
+  std::array<double, N> out{};
+  for (std::size_t i = 0; i < N; ++i) out[i] = (1 - w) * values[k][i] + w * values[k + 1][i];
   return out;
 }
 
+}  // namespace
+
+std::array<double, kStates> ScoopOcpSolution::StateAt(double t) const {
+  return Interpolate(time_at, state, t);
+}
+
 std::array<double, kControls> ScoopOcpSolution::ControlAt(double t) const {
-  std::array<double, kControls> out{};
-  if (time_at.empty()) return out;
-  if (t <= time_at.front()) return control.front();
-  if (t >= time_at.back()) return control.back();
-  const auto it = std::upper_bound(time_at.begin(), time_at.end(), t);
-  const std::size_t k = static_cast<std::size_t>(it - time_at.begin()) - 1;
-  const double w = (t - time_at[k]) / std::max(time_at[k + 1] - time_at[k], 1e-12);
-  for (int i = 0; i < kControls; ++i) out[i] = (1 - w) * control[k][i] + w * control[k + 1][i];
-  return out;
+  return Interpolate(time_at, control, t);
 }
 
 struct ScoopOcp::WarmStart {

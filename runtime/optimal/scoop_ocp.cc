@@ -283,22 +283,12 @@ class ScoopOcp::Nlp : public Ipopt::TNLP {
     }
     // Trapezoids: both nodes and T₂ as Jet variables.
     for (int k = 0; k + 1 < nodes_; ++k) {
-      BlockJet a[kNodeVariables], b[kNodeVariables];
-      for (int i = 0; i < kNodeVariables; ++i) {
-        a[i] = BlockJet(z[k * kNodeVariables + i] * Scale(i), i);
-        a[i].v *= Scale(i);
-        b[i] = BlockJet(z[(k + 1) * kNodeVariables + i] * Scale(i), kNodeVariables + i);
-        b[i].v *= Scale(i);
-      }
-      const BlockJet duration(z[n_ - 1], kBlock - 1);
-      BlockJet fa[kStates], fb[kStates], path[kNumPath];
-      model_.Evaluate(a, a + kStates, fa, path);
-      model_.Evaluate(b, b + kStates, fb, path);
-      const BlockJet h = k < o_.delay_intervals ? BlockJet(dead_time_ / o_.delay_intervals)
-                                                : duration / double(o_.intervals);
+      double w[kBlock];
+      for (int c = 0; c < kBlock; ++c) w[c] = z[BlockIndex(k, c)];
+      BlockJet defects[kStates];
+      BlockDefects(k, w, defects);
       for (int i = 0; i < kStates; ++i) {
-        const BlockJet defect = (b[i] - a[i] - 0.5 * h * (fa[i] + fb[i])) / state_scale_[i];
-        for (int c = 0; c < kBlock; ++c) values[e++] = defect.v[c];
+        for (int c = 0; c < kBlock; ++c) values[e++] = defects[i].v[c];
       }
     }
     for (int k = 0; k < nodes_; ++k) {
@@ -511,8 +501,8 @@ class ScoopOcp::Nlp : public Ipopt::TNLP {
   int BlockIndex(int k, int c) const {
     return c < 2 * kNodeVariables ? k * kNodeVariables + c : n_ - 1;
   }
-  // ∇ Σ_i λ_i defect_i over a trapezoid's scaled variables w (exact, by Jet).
-  void BlockGradient(int k, const double* w, const double* weights, double* gradient) const {
+  // A trapezoid's scaled defects as Jets over its scaled variables w (two nodes, then T₂).
+  void BlockDefects(int k, const double* w, BlockJet* defects) const {
     BlockJet a[kNodeVariables], b[kNodeVariables];
     for (int i = 0; i < kNodeVariables; ++i) {
       a[i] = BlockJet(w[i] * Scale(i), i);
@@ -526,10 +516,16 @@ class ScoopOcp::Nlp : public Ipopt::TNLP {
     model_.Evaluate(b, b + kStates, fb, path);
     const BlockJet h = k < o_.delay_intervals ? BlockJet(dead_time_ / o_.delay_intervals)
                                               : duration / double(o_.intervals);
-    BlockJet sum(0.0);
     for (int i = 0; i < kStates; ++i) {
-      sum += weights[i] * (b[i] - a[i] - 0.5 * h * (fa[i] + fb[i])) / state_scale_[i];
+      defects[i] = (b[i] - a[i] - 0.5 * h * (fa[i] + fb[i])) / state_scale_[i];
     }
+  }
+  // ∇ Σ_i λ_i defect_i over a trapezoid's scaled variables w (exact, by Jet).
+  void BlockGradient(int k, const double* w, const double* weights, double* gradient) const {
+    BlockJet defects[kStates];
+    BlockDefects(k, w, defects);
+    BlockJet sum(0.0);
+    for (int i = 0; i < kStates; ++i) sum += weights[i] * defects[i];
     for (int c = 0; c < kBlock; ++c) gradient[c] = sum.v[c];
   }
   // ∇ Σ_p λ_p path_p / scale_p over a node's scaled variables.

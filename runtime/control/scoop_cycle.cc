@@ -358,6 +358,19 @@ double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
   }
 }
 
+void ScoopCycle::EndScoopPhase(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
+  rt.result.feedback_volume = rt.v1;
+  rt.result.payload_after_scoop = machine.PayloadVolume();
+  EnterPhase(machine, Phase::kLevel, s, rt);
+  rt.hold_attitude = level_attitude_;
+  rt.arrived_at = NAN;
+}
+
+void ScoopCycle::ScoopTimedOut(Runtime& rt) const {
+  rt.result.failure = "scoop not complete within " + std::to_string(options_.max_scoop) + " s";
+  rt.phase = Phase::kDone;
+}
+
 void ScoopCycle::StartPlan(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
   ScoopPlanRequest request;
   request.speed = std::max(s.speed, 0.0);
@@ -501,16 +514,10 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
         // The plan ends at rest: once its time is over and the joints have had the valves'
         // delay to follow, the scoop is over.
         if (s.time - rt.plan_start >= rt.plan->time.back() + plan_lead_) {
-          rt.result.feedback_volume = rt.v1;
-          rt.result.payload_after_scoop = machine.PayloadVolume();
           rt.result.payload_at_actions.push_back(machine.PayloadVolume());
-          EnterPhase(machine, Phase::kLevel, s, rt);
-          rt.hold_attitude = level_attitude_;
-          rt.arrived_at = NAN;
+          EndScoopPhase(machine, s, rt);
         } else if (elapsed > options_.max_scoop) {
-          rt.result.failure =
-              "scoop not complete within " + std::to_string(options_.max_scoop) + " s";
-          rt.phase = Phase::kDone;
+          ScoopTimedOut(rt);
         }
         return;
       }
@@ -550,18 +557,12 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
             rt.hold_attitude = std::min(s.q_boom + rt.targets.bucket, level_attitude_);
           }
         } else {
-          rt.result.feedback_volume = rt.v1;
           rt.result.atomic_actions = rt.sequencer->actions();
           rt.result.stairway_steps = rt.sequencer->steps();
-          rt.result.payload_after_scoop = machine.PayloadVolume();
-          EnterPhase(machine, Phase::kLevel, s, rt);
-          rt.hold_attitude = level_attitude_;
-          rt.arrived_at = NAN;
+          EndScoopPhase(machine, s, rt);
         }
       } else if (elapsed > options_.max_scoop) {
-        rt.result.failure =
-            "scoop not complete within " + std::to_string(options_.max_scoop) + " s";
-        rt.phase = Phase::kDone;
+        ScoopTimedOut(rt);
       }
       return;
     }

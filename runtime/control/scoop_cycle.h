@@ -309,6 +309,10 @@ class ScoopCycle {
   struct Runtime;
   void Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
   double ComputeV2(const Proprioception& s, double v1, Runtime& rt);
+  /// The scoop phase is over (its actions or its plan): record what the bucket holds, level.
+  void EndScoopPhase(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
+  /// The scoop phase ran past ScoopCycleOptions::max_scoop: the cycle fails.
+  void ScoopTimedOut(Runtime& rt) const;
   /// ScoopPolicy::kOptimal at contact: asks the planner and starts tracking its plan.
   void StartPlan(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
   void EnterPhase(ScoopMachine& machine, Phase phase, const Proprioception& s, Runtime& rt);

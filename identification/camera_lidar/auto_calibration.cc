@@ -5,7 +5,10 @@
 #include <cmath>
 #include <nlopt.hpp>
 #include <numbers>
+#include <opencv2/imgproc.hpp>
 #include <random>
+
+#include "identification/camera_lidar/depth_edges.h"
 
 namespace autoshovel::identification {
 
@@ -36,14 +39,79 @@ struct Problem {
   }
 };
 
+// MaskPreparationOptions: large masks keep a band inside their boundary.
+void TrimToEdgeBands(MaskSet& set, const MaskPreparationOptions& options) {
+  const double image_area = static_cast<double>(set.width) * set.height;
+  for (cv::Mat& mask : set.masks) {
+    const double area = cv::countNonZero(mask);
+    if (area < options.edge_band_min_fraction * image_area || area <= 0) continue;
+    const double margin = options.edge_band_base + image_area / area;
+    cv::Mat distance;
+    cv::distanceTransform(mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    mask.setTo(0, distance > margin);
+  }
+}
+
+// Distance to the nearest boundary of any mask (ScoreFrame::boundary_distance) [px].
+cv::Mat BoundaryDistance(const MaskSet& set) {
+  cv::Mat boundary(set.height, set.width, CV_8U, cv::Scalar(0));
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
+  for (const cv::Mat& mask : set.masks) {
+    cv::Mat gradient;
+    cv::morphologyEx(mask, gradient, cv::MORPH_GRADIENT, kernel);
+    boundary |= gradient;
+  }
+  cv::Mat distance;
+  cv::distanceTransform(boundary == 0, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  return distance;
+}
+
+// Up to four masks per pixel, smallest first (ScoreFrame::mask_layers).
+cv::Mat MaskLayers(const MaskSet& set) {
+  cv::Mat layers(set.height, set.width, CV_32SC4, cv::Scalar(0, 0, 0, 0));
+  std::vector<std::size_t> order(set.masks.size());
+  std::vector<int> area(set.masks.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = i;
+    area[i] = cv::countNonZero(set.masks[i]);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return area[a] < area[b]; });
+  for (const std::size_t k : order) {
+    const cv::Mat& mask = set.masks[k];
+    for (int v = 0; v < set.height; ++v) {
+      const std::uint8_t* in = mask.ptr<std::uint8_t>(v);
+      cv::Vec4i* out = layers.ptr<cv::Vec4i>(v);
+      for (int u = 0; u < set.width; ++u) {
+        if (in[u] == 0) continue;
+        for (int c = 0; c < 4; ++c) {
+          if (out[u][c] == 0) {
+            out[u][c] = static_cast<int>(k) + 1;
+            break;
+          }
+        }
+      }
+    }
+  }
+  return layers;
+}
+
 }  // namespace
 
 ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& masks,
-                             const CameraIntrinsics& intrinsics, const Eigen::Vector3d& up_lidar,
-                             std::size_t max_points, const CloudFeatureOptions& feature_options) {
+                             const CameraIntrinsics& intrinsics,
+                             const std::optional<Eigen::Vector3d>& up_lidar, std::size_t max_points,
+                             const CloudFeatureOptions& feature_options,
+                             const MaskPreparationOptions& mask_options) {
   ScoreFrame frame;
   frame.K = intrinsics.K.cast<float>();
-  const MaskSet undistorted = UndistortMasks(masks, intrinsics);
+  MaskSet undistorted = UndistortMasks(masks, intrinsics);
+  frame.boundary_distance = BoundaryDistance(undistorted);
+  if (mask_options.edge_band_min_fraction > 0) TrimToEdgeBands(undistorted, mask_options);
+  frame.mask_layers = MaskLayers(undistorted);
+  for (const cv::Mat& mask : undistorted.masks) {
+    frame.mask_full_area.push_back(cv::countNonZero(mask));
+  }
   frame.mask_labels = MaskLabelImage(undistorted);
   frame.num_masks = static_cast<int>(undistorted.masks.size());
   frame.mask_area.assign(frame.num_masks, 0.0);
@@ -70,6 +138,14 @@ ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& ma
   }
   const double n = std::max<double>(1, static_cast<double>(keep.size()));
   frame.reflectivity_variance = std::max(1e-12, sum2 / n - (sum / n) * (sum / n));
+  {
+    const DepthEdges edges = FindDepthEdges(frame.points);
+    for (std::size_t i = 0; i < edges.weight.size(); ++i) {
+      if (edges.weight[i] <= 0) continue;
+      frame.edge_weight.push_back(edges.weight[i]);
+      frame.edge_points.push_back(edges.silhouette[i]);
+    }
+  }
   const CloudFeatures features = ComputeCloudFeatures(frame.points, up_lidar, feature_options);
   frame.normals = features.normals;
   frame.segment = features.segment;
@@ -130,6 +206,78 @@ Eigen::Isometry3d Optimise(const std::vector<ScoreFrame>& frames, const Eigen::I
   return problem.Pose(x);
 }
 
+// AutoCalibrationOptions::coarse_samples: shrinking random search, from half ranges `rotation`
+// [rad] and `translation` [m], for `rounds` rounds. The first round samples
+// `coarse_first_round_factor` times as many poses around the start and keeps the best
+// `coarse_candidates` (the start among them); each candidate is then refined on its own, and the
+// best at the end wins: one sample landing on a spurious maximum in the first round can no
+// longer pull the whole search away from a basin another sample found.
+Eigen::Isometry3d CoarseSearch(const std::vector<ScoreFrame>& frames, const Eigen::Isometry3d& T0,
+                               const AutoCalibrationOptions& options, double rotation,
+                               double translation, int rounds, AutoCalibrationResult& result) {
+  std::mt19937_64 rng(options.coarse_seed + static_cast<unsigned>(result.coarse_rounds));
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const bool rotate = options.lock != Lock::kRotation;
+  const bool translate = options.lock != Lock::kTranslation;
+  auto sample = [&](const Eigen::Isometry3d& centre, double r, double t) {
+    Eigen::Vector3d w = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      if (rotate) w[i] = r * unit(rng);
+      if (translate) v[i] = t * unit(rng);
+    }
+    return Perturb(centre, w, v);
+  };
+  auto score = [&](const Eigen::Isometry3d& T) {
+    ++result.evaluations;
+    return ConsistencyScore(frames, T, options.score).rho;
+  };
+  if (rounds <= 0) return T0;
+  // Round 1: many samples, the best few kept.
+  std::vector<std::pair<double, Eigen::Isometry3d>> pool{{score(T0), T0}};
+  const int first = options.coarse_samples * std::max(1, options.coarse_first_round_factor);
+  for (int k = 0; k < first; ++k) {
+    const Eigen::Isometry3d T = sample(T0, rotation, translation);
+    pool.emplace_back(score(T), T);
+  }
+  const std::size_t keep =
+      std::min(pool.size(), static_cast<std::size_t>(std::max(1, options.coarse_candidates)));
+  std::partial_sort(pool.begin(), pool.begin() + static_cast<std::ptrdiff_t>(keep), pool.end(),
+                    [](const auto& a, const auto& b) { return a.first > b.first; });
+  pool.resize(keep);
+  ++result.coarse_rounds;
+  // Later rounds: each candidate refined around itself.
+  for (int round = 1; round < rounds; ++round) {
+    rotation *= options.coarse_shrink;
+    translation *= options.coarse_shrink;
+    for (auto& [best_value, best] : pool) {
+      const Eigen::Isometry3d centre = best;
+      for (int k = 0; k < options.coarse_samples; ++k) {
+        const Eigen::Isometry3d T = sample(centre, rotation, translation);
+        const double value = score(T);
+        if (value > best_value) {
+          best_value = value;
+          best = T;
+        }
+      }
+    }
+    ++result.coarse_rounds;
+  }
+  return std::max_element(pool.begin(), pool.end(),
+                          [](const auto& a, const auto& b) { return a.first < b.first; })
+      ->second;
+}
+
+// Rounds from coarse_rotation down to coarse_min_rotation.
+int CoarseRounds(const AutoCalibrationOptions& options) {
+  if (options.coarse_samples <= 0 || !(options.coarse_shrink > 0 && options.coarse_shrink < 1) ||
+      !(options.coarse_rotation >= options.coarse_min_rotation)) {
+    return 0;
+  }
+  return 1 + static_cast<int>(
+                 std::floor(std::log(options.coarse_min_rotation / options.coarse_rotation) /
+                            std::log(options.coarse_shrink)));
+}
+
 }  // namespace
 
 AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& input_frames,
@@ -149,6 +297,41 @@ AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& input_frames,
   const std::vector<ScoreFrame>& frames = marked.empty() ? input_frames : marked;
   result.initial = ConsistencyScore(frames, T0, options.score);
   Eigen::Isometry3d T = T0;
+  const int rounds = CoarseRounds(options);
+  if (options.staged && options.lock == Lock::kNone) {
+    // (1) Rotation, translation held.
+    AutoCalibrationOptions rotation = options;
+    rotation.lock = Lock::kTranslation;
+    T = CoarseSearch(frames, T, rotation, options.coarse_rotation, 0.0, rounds, result);
+    T = Optimise(frames, T, Lock::kTranslation, 1.0, rotation, result);
+    result.T_rotation_stage = T;
+    result.after_coarse = ConsistencyScore(frames, T, options.score);
+    // (2) All six from there: translation over its whole range, rotation only finely.
+    Eigen::Isometry3d T_full = CoarseSearch(frames, T, options, 2 * options.coarse_min_rotation,
+                                            options.coarse_translation, rounds, result);
+    T_full = Optimise(frames, T_full, Lock::kNone, options.second_stage_scale, options, result);
+    // (3) Kept only where the scene carries the gain.
+    result.translation_gain =
+        CompareScores(result.after_coarse, ConsistencyScore(frames, T_full, options.score));
+    result.translation_kept =
+        result.translation_gain.gain >
+        options.translation_significance * result.translation_gain.standard_error;
+    // Not carried: a local refinement of all six from the rotation stage instead (the seed's
+    // Nelder–Mead simplex, 1° and 4 cm), so translation moves only as far as its own basin.
+    result.T_lidar_camera =
+        result.translation_kept
+            ? T_full
+            : Optimise(frames, T, Lock::kNone, options.second_stage_scale, options, result);
+    result.final = ConsistencyScore(frames, result.T_lidar_camera, options.score);
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+  if (rounds > 0) {
+    T = CoarseSearch(frames, T0, options, options.coarse_rotation, options.coarse_translation,
+                     rounds, result);
+  }
+  result.after_coarse = ConsistencyScore(frames, T, options.score);
   if (options.rotation_first && options.lock == Lock::kNone) {
     T = Optimise(frames, T, Lock::kTranslation, 1.0, options, result);
     T = Optimise(frames, T, Lock::kNone, options.second_stage_scale, options, result);
@@ -180,7 +363,12 @@ std::vector<ScoreSlice> ScoreSurface(const std::vector<ScoreFrame>& frames,
         t[k - 3] = offset;
       }
       slice.offsets.push_back(offset);
-      slice.rho.push_back(ConsistencyScore(frames, Perturb(T, w, t), options).rho);
+      const ScoreBreakdown b = ConsistencyScore(frames, Perturb(T, w, t), options);
+      slice.rho.push_back(b.rho);
+      slice.reflectivity.push_back(b.reflectivity);
+      slice.normal.push_back(b.normal);
+      slice.segmentation.push_back(b.segmentation);
+      slice.size.push_back(b.size);
     }
     slices.push_back(slice);
   }

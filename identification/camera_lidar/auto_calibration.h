@@ -22,6 +22,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,22 +50,69 @@ struct AutoCalibrationOptions {
   bool rotation_first = false;       ///< 3-DOF rotation run first, then 6 DOF
   double second_stage_scale = 0.5;   ///< simplex of the 6-DOF stage after rotation_first
   double unsupported_density = 0.1;  ///< > 0: MarkUnsupportedMasks at T0 with this fraction
+  /// A start 3° off lies outside the basin Nelder–Mead's 1° simplex can see (the score is
+  /// flat or multimodal there on real scenes), so a coarse search comes first: rounds of
+  /// `coarse_samples` random poses (a fixed seed: runs repeat) within ±range of the best so far,
+  /// the range shrinking by `coarse_shrink` per round from `coarse_rotation` / `coarse_translation`
+  /// until the rotation range is below `coarse_min_rotation`; the start is always a candidate, so
+  /// the search never ends worse than it began, and the sampling is symmetric about the current
+  /// best, so the result does not depend on the sign of the start's error. 0 samples: off (the
+  /// seed's plain Nelder–Mead). CalibAnything searches the same way, without the simplex after.
+  int coarse_samples = 100;
+  double coarse_rotation = 0.07;       ///< first round's half range [rad] (4°)
+  double coarse_translation = 0.12;    ///< [m]
+  double coarse_shrink = 0.6;          ///< range factor per round [-]
+  double coarse_min_rotation = 0.005;  ///< last round's half range [rad] (0.3°)
+  unsigned coarse_seed = 1;
+  int coarse_first_round_factor = 4;  ///< the first round samples this many times more [-]
+  int coarse_candidates = 3;          ///< poses kept after the first round and refined [-]
+  /// Rotation before translation, and translation only where the scene supports it (our
+  /// departure, docs/camera_lidar_calibration.md). On real scenes most structure is far: a
+  /// rotation moves every point by f·δθ, a translation only near ones by f·δt/Z, so ρ is sharp
+  /// in rotation and nearly flat in translation, and a free 6-DOF search drifts along the flat
+  /// directions (tens of centimetres on the CalibAnything scenes). With `staged`: (1) coarse
+  /// search and Nelder–Mead over rotation, translation held; (2) the same over all six, from
+  /// there; (3) the result of (2) is kept only when its gain over (1) is at least
+  /// `translation_significance` standard errors over the masks (CompareScores); else a local
+  /// Nelder–Mead over all six from (1) (half the seed's simplex) is the result, so that
+  /// translation moves only within its own basin, not across a flat score.
+  bool staged = true;
+  double translation_significance = 2.0;
 };
 
 struct AutoCalibrationResult {
   Eigen::Isometry3d T_lidar_camera = Eigen::Isometry3d::Identity();
   ScoreBreakdown initial, final;
   int evaluations = 0;
-  int runs = 0;  ///< Nelder–Mead runs (1 + restarts)
+  int runs = 0;                 ///< Nelder–Mead runs (1 + restarts)
+  int coarse_rounds = 0;        ///< rounds of the coarse search
+  ScoreBreakdown after_coarse;  ///< the score where the coarse search ended
+  /// `staged`: the rotation stage's result, and the translation stage's gain over it.
+  Eigen::Isometry3d T_rotation_stage = Eigen::Isometry3d::Identity();
+  ScoreGain translation_gain;
+  bool translation_kept = true;
   double seconds = 0;
 };
 
+/// How masks are prepared for the score (our departures, docs/camera_lidar_calibration.md).
+struct MaskPreparationOptions {
+  /// Masks covering at least this share of the image keep only a band inside their boundary,
+  /// `edge_band_base` + W·H/area px wide (the rule of CalibAnything's mask preprocessing): the
+  /// interior of a large mask (road, sky, a wall) holds most of its points but moves with no
+  /// small pose change, so it only dilutes the score's sensitivity to the edges. 0: off.
+  double edge_band_min_fraction = 0;
+  double edge_band_base = 30;  ///< [px]
+};
+
 /// Prepares one frame: undistorts the masks, computes normals and segment classes (PCL),
-/// the cloud's reflectivity variance. `up_lidar`: gravity up in the LiDAR frame (nominal).
+/// the cloud's reflectivity variance. `up_lidar`: gravity up in the LiDAR frame (nominal), when
+/// known (a machine's description); without it the cloud is segmented without an up axis.
 /// `max_points` > 0 subsamples the cloud first (deterministic), bounding memory and time.
 ScoreFrame PrepareScoreFrame(const sensors::PointCloud& cloud, const MaskSet& masks,
-                             const CameraIntrinsics& intrinsics, const Eigen::Vector3d& up_lidar,
-                             std::size_t max_points = 0, const CloudFeatureOptions& features = {});
+                             const CameraIntrinsics& intrinsics,
+                             const std::optional<Eigen::Vector3d>& up_lidar,
+                             std::size_t max_points = 0, const CloudFeatureOptions& features = {},
+                             const MaskPreparationOptions& mask_options = {});
 
 AutoCalibrationResult AutoCalibrate(const std::vector<ScoreFrame>& frames,
                                     const Eigen::Isometry3d& T0,
@@ -75,6 +123,9 @@ struct ScoreSlice {
   std::string parameter;  ///< "rot_x" … "rot_z" [deg], "x" … "z" [m]
   std::vector<double> offsets;
   std::vector<double> rho;
+  /// The terms at each offset (ScoreBreakdown's ω_i-weighted means): reflectivity F_R, normals
+  /// F_N, classes F_S and the size factor f(|P_i|).
+  std::vector<double> reflectivity, normal, segmentation, size;
 };
 std::vector<ScoreSlice> ScoreSurface(const std::vector<ScoreFrame>& frames,
                                      const Eigen::Isometry3d& T, const ScoreOptions& options,

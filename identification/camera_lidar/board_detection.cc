@@ -72,6 +72,32 @@ BoardImageDetection DetectBoardInImage(const cv::Mat& image) {
   return out;
 }
 
+Eigen::Isometry3d PoseFromPnP(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Isometry3d T_optical_lidar = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T_optical_lidar.linear()(r, c) = R.at<double>(r, c);
+    T_optical_lidar.translation()(r) = tvec.at<double>(r);
+  }
+  return T_optical_lidar;
+}
+
+double ReprojectionResiduals(const std::vector<cv::Point3d>& object,
+                             const std::vector<cv::Point2d>& pixels, const Eigen::Matrix3d& K,
+                             const Eigen::Isometry3d& T_optical_lidar,
+                             std::vector<Eigen::Vector2d>& residuals) {
+  double sum = 0;
+  for (std::size_t i = 0; i < object.size(); ++i) {
+    const Eigen::Vector3d p =
+        T_optical_lidar * Eigen::Vector3d(object[i].x, object[i].y, object[i].z);
+    const Eigen::Vector2d uv(K(0, 0) * p.x() / p.z() + K(0, 2), K(1, 1) * p.y() / p.z() + K(1, 2));
+    residuals.push_back(Eigen::Vector2d(pixels[i].x, pixels[i].y) - uv);
+    sum += residuals.back().squaredNorm();
+  }
+  return object.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(object.size()));
+}
+
 BoardCalibration SolveBoardPnP(const std::vector<BoardObservation>& observations,
                                const Eigen::Matrix3d& K) {
   BoardCalibration out;
@@ -98,23 +124,9 @@ BoardCalibration SolveBoardPnP(const std::vector<BoardObservation>& observations
     return out;
   }
   cv::solvePnPRefineLM(object, pixels, camera, cv::noArray(), rvec, tvec);
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Isometry3d T_optical_lidar = Eigen::Isometry3d::Identity();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) T_optical_lidar.linear()(r, c) = R.at<double>(r, c);
-    T_optical_lidar.translation()(r) = tvec.at<double>(r);
-  }
+  const Eigen::Isometry3d T_optical_lidar = PoseFromPnP(rvec, tvec);
   out.T_lidar_camera = CameraInLidarFromOptical(T_optical_lidar);
-  double sum = 0;
-  for (std::size_t i = 0; i < object.size(); ++i) {
-    const Eigen::Vector3d p =
-        T_optical_lidar * Eigen::Vector3d(object[i].x, object[i].y, object[i].z);
-    const Eigen::Vector2d uv(K(0, 0) * p.x() / p.z() + K(0, 2), K(1, 1) * p.y() / p.z() + K(1, 2));
-    out.residuals.push_back(Eigen::Vector2d(pixels[i].x, pixels[i].y) - uv);
-    sum += out.residuals.back().squaredNorm();
-  }
-  out.reprojection_rms = std::sqrt(sum / static_cast<double>(object.size()));
+  out.reprojection_rms = ReprojectionResiduals(object, pixels, K, T_optical_lidar, out.residuals);
   out.ok = true;
   return out;
 }

@@ -42,6 +42,16 @@ struct BoardCalibration {
   int boards = 0;
 };
 
+/// The pose cv::solvePnP returns (Rodrigues vector, translation) as T_optical_lidar.
+Eigen::Isometry3d PoseFromPnP(const cv::Mat& rvec, const cv::Mat& tvec);
+
+/// Detected pixels minus their projection through K and T_optical_lidar, appended to
+/// `residuals` [px]; returns their RMS.
+double ReprojectionResiduals(const std::vector<cv::Point3d>& object,
+                             const std::vector<cv::Point2d>& pixels, const Eigen::Matrix3d& K,
+                             const Eigen::Isometry3d& T_optical_lidar,
+                             std::vector<Eigen::Vector2d>& residuals);
+
 BoardCalibration SolveBoardPnP(const std::vector<BoardObservation>& observations,
                                const Eigen::Matrix3d& K);
 

@@ -17,8 +17,46 @@
 
 namespace autoshovel::identification {
 
+namespace {
+
+// Planes off the cloud one after the other (no up axis): label[i] = plane index + 1 or 0.
+int ExtractPlanes(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud,
+                  const CloudFeatureOptions& options, std::vector<int>& label) {
+  const std::size_t n = cloud->size();
+  label.assign(n, 0);
+  const std::size_t min_points = std::max<std::size_t>(
+      50, static_cast<std::size_t>(options.min_plane_fraction * static_cast<double>(n)));
+  pcl::SACSegmentation<pcl::PointXYZ> sac;  // random = false: a fixed seed
+  sac.setOptimizeCoefficients(true);
+  sac.setModelType(pcl::SACMODEL_PLANE);
+  sac.setMethodType(pcl::SAC_RANSAC);
+  sac.setDistanceThreshold(options.plane_threshold);
+  sac.setMaxIterations(300);
+  sac.setInputCloud(cloud);
+  pcl::IndicesPtr remaining(new pcl::Indices(n));
+  for (std::size_t i = 0; i < n; ++i) (*remaining)[i] = static_cast<int>(i);
+  int planes = 0;
+  while (planes < options.max_planes && remaining->size() >= min_points) {
+    sac.setIndices(remaining);
+    pcl::PointIndices inliers;
+    pcl::ModelCoefficients plane;
+    sac.segment(inliers, plane);
+    if (inliers.indices.size() < min_points) break;
+    ++planes;
+    for (const int i : inliers.indices) label[static_cast<std::size_t>(i)] = planes;
+    pcl::IndicesPtr next(new pcl::Indices);
+    for (const int i : *remaining) {
+      if (label[static_cast<std::size_t>(i)] == 0) next->push_back(i);
+    }
+    remaining = next;
+  }
+  return planes;
+}
+
+}  // namespace
+
 CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
-                                   const Eigen::Vector3d& up_lidar,
+                                   const std::optional<Eigen::Vector3d>& up_axis,
                                    const CloudFeatureOptions& options) {
   CloudFeatures features;
   const std::size_t n = points.size();
@@ -46,6 +84,21 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
     }
   }
 
+  std::vector<char> is_ground(n, 0);
+  int next = 1;
+  if (!up_axis) {
+    // No up axis: planes are classes 1..P, the rest is clustered after them (header).
+    std::vector<int> plane_label;
+    const int planes = ExtractPlanes(cloud, options, plane_label);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (plane_label[i] > 0) {
+        features.segment[i] = plane_label[i];
+        is_ground[i] = 3;  // taken: not clustered below
+      }
+    }
+    next = planes + 1;
+  }
+  const Eigen::Vector3d up_lidar = up_axis.value_or(Eigen::Vector3d::UnitZ());
   // Ground: the largest plane within ground_max_tilt of horizontal.
   pcl::SACSegmentation<pcl::PointXYZ> sac;  // random = false: a fixed seed
   sac.setOptimizeCoefficients(true);
@@ -58,8 +111,7 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
   sac.setInputCloud(cloud);
   pcl::PointIndices ground;
   pcl::ModelCoefficients plane;
-  sac.segment(ground, plane);
-  std::vector<char> is_ground(n, 0);
+  if (up_axis) sac.segment(ground, plane);
   features.ground_points = 0;
   if (plane.values.size() == 4) {
     Eigen::Vector3f normal(plane.values[0], plane.values[1], plane.values[2]);
@@ -151,7 +203,6 @@ CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points,
     rest->push_back(q);
     rest_index.push_back(static_cast<int>(i));
   }
-  int next = 1;
   std::vector<int> label(rest->size(), -1);
   if (!rest->empty()) {
     const float cos_max = static_cast<float>(std::cos(options.cluster_normal_angle));

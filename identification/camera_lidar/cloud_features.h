@@ -30,9 +30,18 @@
 //   wall, and on noise-free clouds k = 12 moved the optimum 2 cm down; so a clean cloud gets
 //   k = 1. In the simulated yard k = 11 and the 6-DOF optimum moved from 22–28 mm to 10–15 mm
 //   off the truth (docs/camera_lidar_calibration.md).
+//
+// Without an up axis (a standalone rig: no description says how the LiDAR is mounted, and real
+// scenes need not have a dominant floor), the classes are planes and clusters instead: RANSAC
+// planes are taken off the cloud one after the other, largest first, while one still holds
+// `min_plane_fraction` of the points (at most `max_planes`), each a class; the rest is clustered
+// as above. The public CalibAnything implementation segments the same way (plane extraction,
+// then Euclidean clusters); it needs no notion of gravity, so a sloped, cluttered or
+// wall-dominated scene is segmented as well as a yard.
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 namespace autoshovel::identification {
@@ -48,6 +57,9 @@ struct CloudFeatureOptions {
   int min_cluster_points = 20;               ///< smaller clusters are "unclustered" [-]
   double ground_noise_sigmas = 5;            ///< smooth until this many σ fit the ground band [-]
   int max_ground_smoothing_neighbours = 32;  ///< cap on k of the height smoothing [-]
+  double plane_threshold = 0.1;              ///< no up axis: plane inlier distance [m]
+  double min_plane_fraction = 0.02;          ///< no up axis: a plane holds this share [-]
+  int max_planes = 12;                       ///< no up axis: planes taken off at most [-]
 };
 
 struct CloudFeatures {
@@ -59,9 +71,10 @@ struct CloudFeatures {
   int ground_smoothing_neighbours = 1;  ///< k the heights were averaged over (1: none) [-]
 };
 
-/// `up_lidar`: the gravity-up axis in the LiDAR frame (from the description's mounting pose).
+/// `up_lidar`: the gravity-up axis in the LiDAR frame (from the description's mounting pose);
+/// nullopt: planes and clusters (above).
 CloudFeatures ComputeCloudFeatures(const std::vector<Eigen::Vector3f>& points_lidar,
-                                   const Eigen::Vector3d& up_lidar,
+                                   const std::optional<Eigen::Vector3d>& up_lidar,
                                    const CloudFeatureOptions& options = {});
 
 }  // namespace autoshovel::identification

@@ -73,18 +73,34 @@ struct ScoreOptions {
   double zbuffer_margin = 0.3;        ///< nearer by more than this (+ relative): hidden [m]
   double zbuffer_relative = 0.05;     ///< of the hidden point's neighbour's depth [-]
   bool subpixel = true;               ///< area (bilinear) mask lookup instead of nearest pixel
+  /// Every mask containing a point's pixel gets the point (SAM's masks overlap: a part inside
+  /// its whole), as CalibAnything scores; false: only the smallest mask at the pixel.
+  bool overlapping_masks = false;
+  /// F_N from squared cosines, sign-free: (‖Σ w n nᵀ‖²_F − Σ w²) / ((Σ w)² − Σ w²), 1 for a
+  /// plane, 1/3 for random orientations; false: the oriented ⟨n_p, n_p'⟩ of the seed.
+  bool unoriented_normals = true;
+  /// The edge term (our extension, depth_edges.h): ρ = Eq. (7) + w_E J_E with
+  /// J_E = Σ X_i E(u_i) / Σ X_i over the depth-edge points in the image, E(u) =
+  /// exp(−d(u)² / 2σ²) and d the distance to the nearest mask boundary [px]. 0: the seed's ρ.
+  double weight_edges = 0;
+  double edge_sigma_px = 4;  ///< σ of E [px]
 };
 
 /// One frame prepared for scoring: masks undistorted into a label image, points with attributes.
 struct ScoreFrame {
   Eigen::Matrix3f K = Eigen::Matrix3f::Identity();  ///< pinhole of the undistorted image [px]
   cv::Mat mask_labels;  ///< CV_32S, 0 outside every mask, k + 1 in mask k (MaskLabelImage)
+  cv::Mat mask_layers;  ///< CV_32SC4: up to 4 masks per pixel (k + 1, smallest first), 0 none
   int num_masks = 0;
-  std::vector<double> mask_area;         ///< pixels of each mask in mask_labels
-  std::vector<Eigen::Vector3f> points;   ///< LiDAR frame [m]
-  std::vector<float> reflectivity;       ///< as read (any scale)
-  std::vector<Eigen::Vector3f> normals;  ///< unit, LiDAR frame
-  std::vector<int> segment;              ///< class per point, in [0, num_segments)
+  std::vector<double> mask_area;             ///< pixels of each mask in mask_labels
+  std::vector<double> mask_full_area;        ///< pixels of each mask itself (overlaps included)
+  std::vector<Eigen::Vector3f> points;       ///< LiDAR frame [m]
+  std::vector<float> reflectivity;           ///< as read (any scale)
+  std::vector<Eigen::Vector3f> normals;      ///< unit, LiDAR frame
+  std::vector<float> edge_weight;            ///< X_i of depth_edges.h (empty: no edge term)
+  std::vector<Eigen::Vector3f> edge_points;  ///< the silhouette positions of those with X_i > 0
+  cv::Mat boundary_distance;                 ///< CV_32F: distance to the nearest mask boundary [px]
+  std::vector<int> segment;                  ///< class per point, in [0, num_segments)
   int num_segments = 2;
   double reflectivity_variance = 1;     ///< over the whole cloud
   double ground_noise = 0;              ///< floor height σ the classes were made with [m]
@@ -101,17 +117,32 @@ struct MaskScore {
 };
 
 struct ScoreBreakdown {
-  double rho = 0;      ///< Eq. (7)
-  int masks_used = 0;  ///< with |P_i| ≥ min_points
+  double rho = 0;          ///< the objective: Eq. (7) + w_E J_E
+  double consistency = 0;  ///< Eq. (7) alone
+  double edges = 0;        ///< J_E
+  int masks_used = 0;      ///< with |P_i| ≥ min_points
   long points_in_masks = 0;
   double reflectivity = 0, normal = 0, segmentation = 0;  ///< ω_i-weighted means of F_R, F_N, F_S
-  std::vector<MaskScore> masks;                           ///< the masks used
+  double size = 0;                                        ///< ω_i-weighted mean of f(|P_i|)
+  double total_points = 0;  ///< Σ_j |P_j| of Eq. (7) (with misplaced and counted skipped points)
+  std::vector<MaskScore> masks;  ///< the masks used
 };
 
 /// Flags the masks whose point density at T (points per pixel, area lookup) is below `fraction`
 /// of the frame's mean over its masks (our extension, the sky term above).
 void MarkUnsupportedMasks(std::vector<ScoreFrame>& frames, const Eigen::Isometry3d& T_lidar_camera,
                           double fraction);
+
+/// How much `b` scores above `a`, and whether the scene agrees: the gain of Eq. (7) is a sum of
+/// per-mask changes Δ_i = ω_i ε_i(b) − ω_i ε_i(a) (our extension); its standard error over masks,
+/// sqrt(M/(M−1) Σ (Δ_i − Δ̄)²), is what a bootstrap resampling of the masks would give. A gain a
+/// few standard errors large is carried by the scene; one that one or two masks make is not.
+struct ScoreGain {
+  double gain = 0;            ///< Σ Δ_i (Eq. (7) part of ρ_b − ρ_a)
+  double standard_error = 0;  ///< over the masks
+  int masks = 0;              ///< M: masks used at a or b
+};
+ScoreGain CompareScores(const ScoreBreakdown& a, const ScoreBreakdown& b);
 
 ScoreBreakdown ConsistencyScore(const std::vector<ScoreFrame>& frames,
                                 const Eigen::Isometry3d& T_lidar_camera,

@@ -20,15 +20,33 @@ cv::Mat RenderProjection(const cv::Mat& image, const std::vector<Eigen::Vector3f
   for (int i = 0; i < 256; ++i) ramp.at<std::uint8_t>(0, i) = static_cast<std::uint8_t>(255 - i);
   cv::applyColorMap(ramp, colours, cv::COLORMAP_JET);
   const Eigen::Isometry3d T = OpticalFromLidar(T_lidar_camera);
+  const int radius = std::max(1, static_cast<int>(std::lround(out.cols / 640.0)));
   for (const auto& p : points_lidar) {
     Eigen::Vector2d uv;
     double depth = 0;
     if (!ProjectPoint(K, out.cols, out.rows, T, p.cast<double>(), uv, depth)) continue;
     const int index = std::clamp(static_cast<int>(255.0 * depth / max_depth), 0, 255);
-    out.at<cv::Vec3b>(static_cast<int>(std::lround(uv.y())),
-                      static_cast<int>(std::lround(uv.x()))) = colours.at<cv::Vec3b>(0, index);
+    const cv::Vec3b c = colours.at<cv::Vec3b>(0, index);
+    // Dots sized for the image: 1 px per 640 px of width (3 px at 1920), so that a full-size
+    // picture shows the points and a thumbnail still does.
+    cv::circle(out, {static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y()))},
+               radius, cv::Scalar(c[0], c[1], c[2]), cv::FILLED, cv::LINE_8);
   }
   return out;
+}
+
+cv::Mat RenderEdges(const cv::Mat& image, const ScoreFrame& frame,
+                    const Eigen::Isometry3d& T_lidar_camera, double max_depth) {
+  cv::Mat out = image.channels() == 3 ? image * 0.5 : cv::Mat();
+  if (out.empty()) {
+    cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
+    out *= 0.5;
+  }
+  if (!frame.boundary_distance.empty() && frame.boundary_distance.size() == out.size()) {
+    out.setTo(cv::Scalar(255, 255, 255), frame.boundary_distance < 1.0f);
+  }
+  return RenderProjection(out, frame.edge_points, frame.K.cast<double>(), T_lidar_camera,
+                          max_depth);
 }
 
 void WriteBeforeAfterPng(const std::string& path, const cv::Mat& image,

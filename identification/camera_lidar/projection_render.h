@@ -17,6 +17,12 @@ cv::Mat RenderProjection(const cv::Mat& image, const std::vector<Eigen::Vector3f
                          const Eigen::Matrix3d& K, const Eigen::Isometry3d& T_lidar_camera,
                          double max_depth = 30.0);
 
+/// The image darkened, the mask boundaries (distance < 1 px) white and the depth-edge points
+/// (ScoreFrame::edge_weight > 0) projected through T, coloured by depth: how the edge term sees
+/// the frame.
+cv::Mat RenderEdges(const cv::Mat& image, const ScoreFrame& frame,
+                    const Eigen::Isometry3d& T_lidar_camera, double max_depth = 30.0);
+
 /// Before | after, titled; written to `path` (PNG). Throws std::runtime_error when it cannot.
 void WriteBeforeAfterPng(const std::string& path, const cv::Mat& image,
                          const std::vector<Eigen::Vector3f>& points_lidar, const Eigen::Matrix3d& K,

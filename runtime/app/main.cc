@@ -199,14 +199,23 @@ int main(int argc, char** argv) {
   CLI::App* camera_lidar_cmd = calibrate_cmd->add_subcommand(
       "camera-lidar",
       "Camera-LiDAR extrinsic: board PnP, then the online consistency score (Algorithm 1)");
-  camera_lidar_cmd->add_option("--machine", camera_lidar.machine, "Machine name or description")
-      ->required();
+  camera_lidar_cmd->add_option(
+      "--machine", camera_lidar.machine,
+      "Machine name or description; without it a standalone rig (intrinsics and start from "
+      "--calib, --intrinsics, --initial-matrix)");
   camera_lidar_cmd->add_option("--lidar", camera_lidar.lidar, "The LiDAR beside the camera")
       ->capture_default_str();
   camera_lidar_cmd->add_option("--frames", camera_lidar.frames,
                                "Folder of NAME.png/jpg + NAME.pcd/bin pairs");
   camera_lidar_cmd->add_option("--pair", camera_lidar.pairs,
                                "IMAGE,CLOUD (repeatable), instead of --frames");
+  camera_lidar_cmd->add_option(
+      "--scene", camera_lidar.scenes,
+      "CalibAnything-style scene folder (repeatable; several are fused): one image + one "
+      "cloud, masks/ of binary PNGs, calib.txt");
+  camera_lidar_cmd->add_option("--calib", camera_lidar.calib,
+                               "calib.txt: K: (3x3), D: (k1 k2 p1 p2 [k3]), T: (3x4 LiDAR -> "
+                               "camera optical, the start); default: the first scene's");
   camera_lidar_cmd->add_option("--intrinsics", camera_lidar.intrinsics,
                                "camera_info YAML (K, D; default <root>/intrinsics.yaml, else the "
                                "description's pinhole)");
@@ -218,15 +227,58 @@ int main(int argc, char** argv) {
                                "Board views and board.yaml for the initial calibration (step 1)");
   camera_lidar_cmd
       ->add_option("--initial", camera_lidar.initial,
-                   "T_lidar_camera start: x y z [m] roll pitch yaw [deg]")
+                   "Start as the camera body pose in the LiDAR frame (body: x forward, y left, "
+                   "z up): x y z [m] roll pitch yaw [deg], R = Rz(yaw) Ry(pitch) Rx(roll)")
       ->check(autoshovel::app::FiniteIn(-1e3, 1e3))
       ->expected(6)
       ->delimiter(',');
+  camera_lidar_cmd->add_option("--initial-matrix", camera_lidar.initial_matrix,
+                               "Start as a LiDAR -> camera optical matrix (3x4 or 4x4, "
+                               "row-major; or a calib.txt)");
+  camera_lidar_cmd->add_option(
+      "--correspondences", camera_lidar.correspondences,
+      "Board step from picked corners: a file of lines 'u v x y z' (raw image pixel, LiDAR "
+      "point), or IMAGE_FILE,LIDAR_FILE with lines 'u v' and 'x y z'; PnP with RANSAC gives "
+      "the start");
+  camera_lidar_cmd
+      ->add_option("--perturb", camera_lidar.perturb,
+                   "Offset the start: roll pitch yaw [deg] x y z [m], T_start * dT with dT = "
+                   "[Rz(yaw) Ry(pitch) Rx(roll) | xyz] (CalibAnything's test protocol); errors "
+                   "are then reported against the unperturbed start")
+      ->check(autoshovel::app::FiniteIn(-180, 180))
+      ->expected(6)
+      ->delimiter(',');
+  camera_lidar_cmd->add_option("--reference", camera_lidar.reference,
+                               "Extrinsic (matrix or calib.txt) to report errors against, as "
+                               "the rotation and translation of T_ref * T_est^-1");
+  camera_lidar_cmd->add_option("--extrinsic-out", camera_lidar.extrinsic_out,
+                               "The result as a 4x4 LiDAR -> camera optical matrix (default: "
+                               "next to the overlay)");
+  camera_lidar_cmd->add_option("--slices-png", camera_lidar.slices_png,
+                               "Score slices around the result per axis (and a table of where "
+                               "each term peaks)");
+  camera_lidar_cmd->add_flag("--evaluate-only", camera_lidar.evaluate_only,
+                             "Score the start and its slices; no optimisation");
+  camera_lidar_cmd->add_flag(
+      "--protocol", camera_lidar.protocol,
+      "Robustness check instead of a calibration: from the reference (--reference, else the "
+      "start) perturbed by +/-R deg per axis (8 sign patterns) and by +/-R deg with +/-T m (8 "
+      "more), and from the reference itself; prints each run's error and the median and worst");
+  camera_lidar_cmd
+      ->add_option("--protocol-rotation", camera_lidar.protocol_rotation, "R of --protocol [deg]")
+      ->check(autoshovel::app::FiniteIn(0, 30))
+      ->capture_default_str();
+  camera_lidar_cmd
+      ->add_option("--protocol-translation", camera_lidar.protocol_translation,
+                   "T of --protocol [m]")
+      ->check(autoshovel::app::FiniteIn(0, 2))
+      ->capture_default_str();
   camera_lidar_cmd->add_option("--lock", camera_lidar.lock, "Hold rotation or translation fixed")
       ->check(CLI::IsMember({"rotation", "translation"}));
   camera_lidar_cmd
       ->add_option("--max-points", camera_lidar.max_points,
-                   "Points per frame kept (bounds memory on dense clouds)")
+                   "Points per frame read (a random subset beyond; bounds memory on dense "
+                   "clouds); the camera's view is cut out of them")
       ->check(autoshovel::app::IntegerIn(100, 100000000))
       ->capture_default_str();
   camera_lidar_cmd->add_option("-o,--overlay", camera_lidar.overlay, "Overlay to write");
@@ -234,7 +286,8 @@ int main(int argc, char** argv) {
   camera_lidar_cmd->add_option("--residuals-png", camera_lidar.residuals_png,
                                "Score surface and board residuals");
   camera_lidar_cmd->add_option("--simulate", camera_lidar.simulate,
-                               "Write a simulated data set (board and yard frames) here and stop");
+                               "Write a simulated data set here and stop: board and yard frames "
+                               "with --machine, else a street scene in the --scene layout");
   camera_lidar_cmd->add_option("--seed", camera_lidar.seed, "Seed of --simulate")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
@@ -774,12 +827,6 @@ int main(int argc, char** argv) {
     }
     if (*camera_lidar_cmd) {
       camera_lidar.models_dir = models_dir;
-      if (camera_lidar.frames.empty() && camera_lidar.pairs.empty() &&
-          camera_lidar.simulate.empty()) {
-        std::cerr << "autoshovel calibrate camera-lidar: give --frames DIR or --pair IMAGE,CLOUD "
-                     "(or --simulate DIR)\n";
-        return 2;
-      }
       return autoshovel::identification::RunCalibrateCameraLidar(camera_lidar, std::cout,
                                                                  std::cerr);
     }

@@ -25,6 +25,7 @@
 #include "identification/camera_lidar/image_header.h"
 #include "identification/camera_lidar/mask_io.h"
 #include "identification/camera_lidar/point_cloud_io.h"
+#include "identification/camera_lidar/rig_files.h"
 #include "identification/hydraulics/log_reader.h"
 #include "identification/weights/demonstration_store.h"
 #include "runtime/app/campaign/campaign_spec.h"
@@ -153,6 +154,9 @@ const std::map<std::string, ReadFn>& Readers() {
          planning::ReadShovelWeights(p, config);
        }},
       {"camera_info", [](const std::string& p) { identification::ReadCameraInfoYaml(p); }},
+      {"calib_txt", [](const std::string& p) { identification::ReadCalibTxt(p); }},
+      {"extrinsic", [](const std::string& p) { identification::ReadExtrinsic(p); }},
+      {"correspondences", [](const std::string& p) { identification::ReadCorrespondences(p); }},
       {"image_header", [](const std::string& p) { identification::ReadImageHeader(p); }},
       {"log_format", [](const std::string& p) { identification::ReadLogFormatYaml(p); }},
       {"hydraulic_log",
@@ -234,6 +238,7 @@ TEST_P(BadInput, EveryFixtureIsRefusedWithItsLocatedMessageAndLeftUntouched) {
 INSTANTIATE_TEST_SUITE_P(Readers, BadInput,
                          ::testing::Values("description", "material", "overlay", "scenario",
                                            "campaign_spec", "shovel_weights", "camera_info",
+                                           "calib_txt", "extrinsic", "correspondences",
                                            "log_format", "hydraulic_log", "arm_calibration", "pcd",
                                            "kitti_bin", "masks", "image_header", "onnx", "svr",
                                            "model_provenance", "demonstrations"),

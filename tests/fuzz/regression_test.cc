@@ -19,6 +19,7 @@
 #include "identification/calibration/arm_calibration_csv.h"
 #include "identification/camera_lidar/image_header.h"
 #include "identification/camera_lidar/point_cloud_io.h"
+#include "identification/camera_lidar/rig_files.h"
 #include "identification/hydraulics/log_reader.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
@@ -134,6 +135,25 @@ TEST(FuzzRegressions, Pcd) {
 TEST(FuzzRegressions, ImageHeader) {
   ExpectBothKinds(CheckTarget("image_header", [](const std::string& path) {
     return Refusal([&] { identification::ReadImageHeader(path); });
+  }));
+}
+
+// The standalone rig's text files (fuzz_calib_txt, fuzz_extrinsic, fuzz_correspondences).
+TEST(FuzzRegressions, CalibTxt) {
+  ExpectBothKinds(CheckTarget("calib_txt", [](const std::string& path) {
+    return Refusal([&] { identification::ReadCalibTxt(path); });
+  }));
+}
+
+TEST(FuzzRegressions, Extrinsic) {
+  ExpectBothKinds(CheckTarget("extrinsic", [](const std::string& path) {
+    return Refusal([&] { identification::ReadExtrinsic(path); });
+  }));
+}
+
+TEST(FuzzRegressions, Correspondences) {
+  ExpectBothKinds(CheckTarget("correspondences", [](const std::string& path) {
+    return Refusal([&] { identification::ReadCorrespondences(path); });
   }));
 }
 

@@ -20,6 +20,7 @@
 #include "runtime/app/compare_command.h"
 #include "runtime/app/describe_command.h"
 #include "runtime/app/energy_audit_command.h"
+#include "runtime/app/map_cloud_command.h"
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
@@ -158,8 +159,40 @@ int main(int argc, char** argv) {
   CLI::App* map_cmd = app.add_subcommand(
       "map",
       "Build the semantic elevation map from a scenario's start pose (simulated LiDARs and "
-      "camera) and draw its six layers");
-  map_cmd->add_option("scenario", map.scenario, "Scenario name or .yaml path")->required();
+      "camera) and draw its six layers; or, with --cloud, map your own scans and measure the "
+      "heaps on them");
+  autoshovel::app::MapCloudOptions map_cloud;
+  map_cmd->add_option("scenario", map.scenario, "Scenario name or .yaml path (or give --cloud)");
+  map_cmd->add_option(
+      "--cloud", map_cloud.clouds,
+      "A scan to map (repeatable): .pcd (ascii, binary, binary_compressed, any "
+      "extra fields) or KITTI .bin, in any frame: the floor is found from the data");
+  map_cmd
+      ->add_option("--pose", map_cloud.poses,
+                   "Per --cloud (all or none): the scanner's x y z [m] roll pitch yaw [deg] in "
+                   "the first cloud's frame, R = Rz(yaw) Ry(pitch) Rx(roll)")
+      ->check(autoshovel::app::FiniteIn(-1e5, 1e5))
+      ->delimiter(',');
+  map_cmd->add_option("--cell", map_cloud.cell, "Cell edge [m] (default: the extent / 250)")
+      ->check(autoshovel::app::FiniteIn(0.001, 10));
+  map_cmd->add_option("--up", map_cloud.up, "Gravity up in the first cloud's frame: x y z")
+      ->check(autoshovel::app::FiniteIn(-1, 1))
+      ->expected(3)
+      ->delimiter(',');
+  map_cmd
+      ->add_option("--alpha-d", map_cloud.alpha_d,
+                   "Sensor noise: range variance = alpha_d * distance^2 (Eq. 8)")
+      ->check(autoshovel::app::FiniteIn(1e-12, 1))
+      ->capture_default_str();
+  map_cmd
+      ->add_option("--min-heap-height", map_cloud.min_heap_height,
+                   "Cells this high above the floor form heaps [m] (default: 4 sigma of the "
+                   "floor's noise, at least 1 cm)")
+      ->check(autoshovel::app::FiniteIn(0, 100));
+  map_cmd
+      ->add_option("--output-dir", map_cloud.output,
+                   "--cloud: folder for heaps.csv, elevation.png, uncertainty.png, heaps.png")
+      ->capture_default_str();
   map_cmd->add_option("-o,--png", map.png, "Six-layer picture")->capture_default_str();
   map_cmd->add_option("--lighting", map.lighting, "normal, bright or dim (default: scenario's)");
   map_cmd->add_option("--frames", map.frames, "LiDAR frames per sensor")
@@ -839,6 +872,13 @@ int main(int argc, char** argv) {
         return 2;
       }
       return autoshovel::identification::RunIdentifyHydraulics(hydraulics, std::cout, std::cerr);
+    }
+    if (*map_cmd && !map_cloud.clouds.empty()) {
+      return autoshovel::app::RunMapCloud(map_cloud, std::cout, std::cerr);
+    }
+    if (*map_cmd && map.scenario.empty()) {
+      std::cerr << "autoshovel map: give a scenario, or --cloud FILE for your own scans\n";
+      return 2;
     }
     if (*map_cmd) {
       map.models_dir = models_dir;

@@ -1,0 +1,228 @@
+// The PCL translation unit of the scan's ground and walls (PCL headers stay out of headers).
+#include "runtime/perception/scan/scan_ground.h"
+
+#include <pcl/ModelCoefficients.h>
+#include <pcl/console/print.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/sample_consensus/method_types.h>
+#include <pcl/sample_consensus/model_types.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace autoshovel::perception {
+
+namespace {
+
+// Least-squares plane through `points[i]` for i in `indices`; normal oriented like `hint`.
+ScanPlane Refit(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
+                const Eigen::Vector3d& hint) {
+  ScanPlane plane;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const int i : indices) mean += points[static_cast<std::size_t>(i)];
+  mean /= static_cast<double>(std::max<std::size_t>(1, indices.size()));
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const int i : indices) {
+    const Eigen::Vector3d d = points[static_cast<std::size_t>(i)] - mean;
+    scatter += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  plane.normal = eig.eigenvectors().col(0);
+  if (plane.normal.dot(hint) < 0) plane.normal = -plane.normal;
+  plane.offset = plane.normal.dot(mean);
+  plane.inliers = static_cast<int>(indices.size());
+  std::vector<double> distances;
+  for (const int i : indices) {
+    distances.push_back(
+        std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset));
+  }
+  if (!distances.empty()) {
+    auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+    std::nth_element(distances.begin(), middle, distances.end());
+    plane.noise = 1.4826 * *middle;
+  }
+  return plane;
+}
+
+// The largest plane among `remaining` (RANSAC), its inliers in `inliers`. RANSAC runs on at
+// most 40 000 of them (evenly strided: a plane holding 5 % of a scan still has 2 000 there);
+// the inliers are then every remaining point within `threshold` of its plane.
+bool LargestPlane(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud,
+                  const pcl::IndicesPtr& remaining, double threshold, std::vector<int>& inliers) {
+  constexpr std::size_t kSample = 40000;
+  pcl::IndicesPtr sample = remaining;
+  if (remaining->size() > kSample) {
+    sample.reset(new pcl::Indices);
+    const std::size_t stride = (remaining->size() + kSample - 1) / kSample;
+    for (std::size_t k = 0; k < remaining->size(); k += stride) sample->push_back((*remaining)[k]);
+  }
+  pcl::SACSegmentation<pcl::PointXYZ> sac;  // random = false: a fixed seed
+  sac.setOptimizeCoefficients(true);
+  sac.setModelType(pcl::SACMODEL_PLANE);
+  sac.setMethodType(pcl::SAC_RANSAC);
+  sac.setDistanceThreshold(threshold);
+  sac.setMaxIterations(500);
+  sac.setInputCloud(cloud);
+  sac.setIndices(sample);
+  pcl::PointIndices found;
+  pcl::ModelCoefficients coefficients;
+  sac.segment(found, coefficients);
+  inliers.clear();
+  if (coefficients.values.size() != 4 || found.indices.empty()) return false;
+  Eigen::Vector4d plane(coefficients.values[0], coefficients.values[1], coefficients.values[2],
+                        coefficients.values[3]);
+  plane /= plane.head<3>().norm();
+  for (const int i : *remaining) {
+    const auto& p = (*cloud)[static_cast<std::size_t>(i)];
+    if (std::abs(plane.x() * p.x + plane.y() * p.y + plane.z() * p.z + plane.w()) < threshold) {
+      inliers.push_back(i);
+    }
+  }
+  return !inliers.empty();
+}
+
+}  // namespace
+
+ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
+                          const Eigen::Vector3d& scanner_origin, const ScanGroundOptions& options) {
+  ScanGround ground;
+  if (points.size() < 100) {
+    ground.failure = "too few points (" + std::to_string(points.size()) + ") to find a floor";
+    return ground;
+  }
+  Eigen::Vector3d lo = points.front(), hi = points.front();
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = (hi - lo).norm();
+  ground.threshold =
+      options.threshold > 0 ? options.threshold : std::clamp(0.005 * extent, 0.005, 0.05);
+  // RANSAC on a scan meets degenerate samples by the thousand; PCL warns about each one.
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  cloud->reserve(points.size());
+  for (const auto& p : points) {
+    cloud->emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                        static_cast<float>(p.z()));
+  }
+
+  // The floor: among the largest planes (taken off one after the other), the one with the
+  // scene above it. A heap that covers most of a bin's floor offers a large, gently sloping
+  // plane of its own, with the floor and the walls' feet below it; the floor has (almost)
+  // everything on its scanner side. With `up` given, planes steeper than 30° to it are walls.
+  struct Candidate {
+    ScanPlane plane;
+    std::vector<int> inliers;
+    double above = 0;  // share of all points on the plane or on its upper side
+  };
+  std::vector<Candidate> candidates;
+  std::vector<char> taken(points.size(), 0);
+  for (int attempt = 0; attempt < options.floor_candidates; ++attempt) {
+    pcl::IndicesPtr remaining(new pcl::Indices);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!taken[i]) remaining->push_back(static_cast<int>(i));
+    }
+    std::vector<int> inliers;
+    if (remaining->size() < options.min_ground_fraction * static_cast<double>(points.size()) ||
+        !LargestPlane(cloud, remaining, ground.threshold, inliers) ||
+        inliers.size() < options.min_ground_fraction * static_cast<double>(points.size())) {
+      break;
+    }
+    for (const int i : inliers) taken[static_cast<std::size_t>(i)] = 1;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const int i : inliers) centroid += points[static_cast<std::size_t>(i)];
+    centroid /= static_cast<double>(inliers.size());
+    const Eigen::Vector3d hint = options.up.value_or(scanner_origin - centroid);
+    ScanPlane plane = Refit(points, inliers, hint);
+    std::vector<int> close;
+    for (const int i : inliers) {
+      if (std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset) <
+          0.5 * ground.threshold) {
+        close.push_back(i);
+      }
+    }
+    if (close.size() >= 3) plane = Refit(points, close, hint);
+    plane.inliers = static_cast<int>(inliers.size());
+    if (options.up && plane.normal.dot(options.up->normalized()) < std::cos(0.5236)) continue;
+    Candidate c{plane, inliers, 0};
+    long above = 0;
+    for (const auto& p : points) {
+      above += plane.normal.dot(p) - plane.offset > -2 * ground.threshold ? 1 : 0;
+    }
+    c.above = static_cast<double>(above) / static_cast<double>(points.size());
+    candidates.push_back(std::move(c));
+  }
+  // The largest candidate with the scene standing on it; failing that, the one with the most
+  // of the scene above it (a heap covering the whole floor leaves no plane below everything).
+  const Candidate* chosen = nullptr;
+  for (const Candidate& c : candidates) {
+    if (c.above < options.floor_min_above) continue;
+    if (chosen == nullptr || c.plane.inliers > chosen->plane.inliers) chosen = &c;
+  }
+  if (chosen == nullptr) {
+    for (const Candidate& c : candidates) {
+      if (chosen == nullptr || c.above > chosen->above) chosen = &c;
+    }
+  }
+  if (chosen != nullptr) {
+    ground.floor = chosen->plane;
+    ground.ok = true;
+  }
+  if (!ground.ok) {
+    ground.failure = "no floor: no plane holds " +
+                     std::to_string(static_cast<int>(100 * options.min_ground_fraction)) +
+                     " % of the " + std::to_string(points.size()) +
+                     " points; scan some ground around the heap, or give --reference "
+                     "(a scan of the empty place)";
+    return ground;
+  }
+  const std::vector<int>& inliers = chosen->inliers;
+  // The ground frame: z along the floor normal; x the scanner's direction of view projected on
+  // the floor (so the pictures look the way the scanner looked); origin below the floor's centroid.
+  const Eigen::Vector3d z = ground.floor.normal;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const int i : inliers) centroid += points[static_cast<std::size_t>(i)];
+  centroid /= static_cast<double>(inliers.size());
+  Eigen::Vector3d view = centroid - scanner_origin;
+  view -= view.dot(z) * z;
+  if (view.norm() < 1e-6) view = z.unitOrthogonal();
+  const Eigen::Vector3d x = view.normalized(), y = z.cross(x);
+  Eigen::Matrix3d R_scan_ground;
+  R_scan_ground << x, y, z;
+  const Eigen::Vector3d origin = centroid - (z.dot(centroid) - ground.floor.offset) * z;
+  Eigen::Isometry3d T_scan_ground = Eigen::Isometry3d::Identity();
+  T_scan_ground.linear() = R_scan_ground;
+  T_scan_ground.translation() = origin;
+  ground.T_ground_scan = T_scan_ground.inverse();
+
+  // Walls: further large planes, steep to the floor.
+  std::fill(taken.begin(), taken.end(), 0);
+  for (const int i : inliers) taken[static_cast<std::size_t>(i)] = 1;
+  for (int k = 0; k < options.max_walls; ++k) {
+    pcl::IndicesPtr next(new pcl::Indices);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!taken[i]) next->push_back(static_cast<int>(i));
+    }
+    if (next->size() < options.min_plane_fraction * static_cast<double>(points.size())) break;
+    std::vector<int> wall_inliers;
+    if (!LargestPlane(cloud, next, ground.threshold, wall_inliers)) break;
+    if (wall_inliers.size() < options.min_plane_fraction * static_cast<double>(points.size())) {
+      break;
+    }
+    for (const int i : wall_inliers) taken[static_cast<std::size_t>(i)] = 1;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const int i : wall_inliers) c += points[static_cast<std::size_t>(i)];
+    c /= static_cast<double>(wall_inliers.size());
+    const ScanPlane wall = Refit(points, wall_inliers, scanner_origin - c);
+    if (std::acos(std::min(1.0, std::abs(wall.normal.dot(z)))) >= options.wall_min_tilt) {
+      ground.walls.push_back(wall);
+    }
+  }
+  return ground;
+}
+
+}  // namespace autoshovel::perception

@@ -1,0 +1,111 @@
+// A user's own scans into the map (issue 43, runtime/perception/scan/): synthetic scans of a
+// heap of known volume, taken the way a handheld or tripod LiDAR records them (the scanner's
+// frame with z along its range axis, the floor tilted in it, range noise), must give that
+// volume back.
+#include "runtime/perception/scan/scan_map.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace autoshovel::perception {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A cone heap of radius R and height H on the floor z = 0 (world, z up), around the origin.
+struct ConeHeap {
+  double radius = 1.0, height = 0.6;
+  double Surface(double x, double y) const {
+    return std::max(0.0, height * (1.0 - std::hypot(x, y) / radius));
+  }
+  double Volume() const { return kPi * radius * radius * height / 3.0; }
+};
+
+// Scans the heightfield from `scanner` (world) over a grid of directions around `target`,
+// returning points in the scanner's frame: z along the line of sight to the target (the range
+// axis), x to its right, as a Livox-style scanner writes them.
+ScanCloud Scan(const ConeHeap& heap, const Eigen::Vector3d& scanner, const Eigen::Vector3d& target,
+               unsigned seed, Eigen::Isometry3d& T_world_scanner) {
+  const Eigen::Vector3d z = (target - scanner).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  T_world_scanner = Eigen::Isometry3d::Identity();
+  T_world_scanner.linear() << x, y, z;
+  T_world_scanner.translation() = scanner;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  ScanCloud scan;
+  for (double a = -0.45; a <= 0.45; a += 0.0025) {
+    for (double b = -0.35; b <= 0.35; b += 0.0025) {
+      const Eigen::Vector3d d = (z + a * x + b * y).normalized();
+      // March to the first crossing of the heightfield, then bisect.
+      double t0 = 0, t1 = 0;
+      bool hit = false;
+      for (double t = 0.05; t < 20; t += 0.01) {
+        const Eigen::Vector3d p = scanner + t * d;
+        if (p.z() <= heap.Surface(p.x(), p.y())) {
+          t0 = t - 0.01;
+          t1 = t;
+          hit = true;
+          break;
+        }
+      }
+      if (!hit) continue;
+      for (int i = 0; i < 30; ++i) {
+        const double t = 0.5 * (t0 + t1);
+        const Eigen::Vector3d p = scanner + t * d;
+        (p.z() <= heap.Surface(p.x(), p.y()) ? t1 : t0) = t;
+      }
+      const Eigen::Vector3d p_world = scanner + (t1 + noise(rng)) * d;
+      sensors::LidarPoint point;
+      point.p_sensor = (T_world_scanner.inverse() * p_world).cast<float>();
+      scan.cloud.points.push_back(point);
+    }
+  }
+  return scan;
+}
+
+TEST(ScanMap, TwoScansOfAConeGiveItsVolume) {
+  const ConeHeap heap;
+  Eigen::Isometry3d T_world_a, T_world_b;
+  ScanCloud a = Scan(heap, {-3.5, 0.3, 2.2}, {0, 0, 0.2}, 1, T_world_a);
+  ScanCloud b = Scan(heap, {3.2, -0.6, 2.4}, {0, 0, 0.2}, 2, T_world_b);
+  // The second scanner's pose in the first's frame, as a user's --pose gives it.
+  b.T_first_scan = T_world_a.inverse() * T_world_b;
+  const ScanMap map = BuildScanMap({a, b});
+  ASSERT_TRUE(map.ok) << map.failure;
+  // The floor is found facing up in the world (the scans' frames are tilted 30°).
+  const Eigen::Vector3d up_world = T_world_a.linear() * map.ground.floor.normal;
+  EXPECT_GT(up_world.z(), std::cos(0.5 * kPi / 180)) << up_world.transpose();
+  ASSERT_FALSE(map.heaps.empty());
+  const Heap& h = map.heaps.front();
+  std::printf("cone: %.4f m^3 (+/- %.4f, filled %.4f) against %.4f; peak %.3f m; %zu heaps\n",
+              h.volume, h.volume_sigma, h.filled_volume, heap.Volume(), h.peak, map.heaps.size());
+  // Within 3 % (issue 43); the skirt below the heap threshold (1 cm) is a part of the error.
+  EXPECT_NEAR(h.volume, heap.Volume(), 0.03 * heap.Volume());
+  EXPECT_NEAR(h.peak, heap.height, 0.02);
+  EXPECT_GT(h.volume_sigma, 0.0);
+  EXPECT_LT(h.volume_sigma, 0.05 * heap.Volume());
+}
+
+TEST(ScanMap, ACloudWithoutAFloorIsToldSo) {
+  // Points on a sphere only: no plane holds 5 % of them.
+  ScanCloud ball;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    Eigen::Vector3d p(n(rng), n(rng), n(rng));
+    sensors::LidarPoint point;
+    point.p_sensor = (Eigen::Vector3d(0, 0, 5) + 0.5 * p.normalized()).cast<float>();
+    ball.cloud.points.push_back(point);
+  }
+  const ScanMap map = BuildScanMap({ball});
+  EXPECT_FALSE(map.ok);
+  EXPECT_NE(map.failure.find("no floor"), std::string::npos) << map.failure;
+}
+
+}  // namespace
+}  // namespace autoshovel::perception

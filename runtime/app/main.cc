@@ -173,6 +173,9 @@ int main(int argc, char** argv) {
                    "the first cloud's frame, R = Rz(yaw) Ry(pitch) Rx(roll)")
       ->check(autoshovel::app::FiniteIn(-1e5, 1e5))
       ->delimiter(',');
+  map_cmd->add_option("--reference", map_cloud.references,
+                      "A scan of the same place empty, from the same scanner pose (repeatable): "
+                      "heaps are measured above it, not above the floor plane");
   map_cmd->add_option("--cell", map_cloud.cell, "Cell edge [m] (default: the extent / 250)")
       ->check(autoshovel::app::FiniteIn(0.001, 10));
   map_cmd->add_option("--up", map_cloud.up, "Gravity up in the first cloud's frame: x y z")

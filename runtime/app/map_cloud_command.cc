@@ -76,6 +76,15 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
       if (!options.poses.empty()) c.T_first_scan = PoseOf(&options.poses[6 * k]);
       clouds.push_back(std::move(c));
     }
+    std::vector<perception::ScanCloud> references;
+    for (const std::string& path : options.references) {
+      perception::ScanCloud c;
+      c.name = path;
+      identification::PointCloudReadStats stats;
+      c.cloud = identification::ReadPointCloud(path, options.max_points, &stats);
+      non_finite += stats.non_finite;
+      references.push_back(std::move(c));
+    }
     const double read_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     perception::ScanMapOptions map_options;
@@ -85,7 +94,8 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
     if (!options.up.empty()) {
       map_options.ground.up = Eigen::Vector3d(options.up[0], options.up[1], options.up[2]);
     }
-    const perception::ScanMap map = perception::BuildScanMap(clouds, map_options);
+    const perception::ScanMap map =
+        perception::BuildScanMap(clouds, map_options, references.empty() ? nullptr : &references);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!map.ok) {
@@ -110,8 +120,9 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
                   1e3 * map.ground.threshold, 1e3 * floor.noise, map.ground.walls.size());
     out << line;
     std::snprintf(line, sizeof line,
-                  "  points stand %.3f to %.3f m above the floor (1st to 99th percentile)\n",
-                  map.height_low, map.height_high);
+                  "  points stand %.3f to %.3f m above the floor (1st to 99th percentile)%s\n",
+                  map.height_low, map.height_high,
+                  references.empty() ? "" : "; heights are measured above the reference scan");
     out << line;
     const perception::GridMap& grid = map.map.map();
     std::snprintf(line, sizeof line,

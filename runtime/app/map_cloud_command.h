@@ -16,6 +16,9 @@ struct MapCloudOptions {
   /// Per cloud, optionally: x y z [m] roll pitch yaw [deg] of the scanner in the first cloud's
   /// frame, R = Rz(yaw) Ry(pitch) Rx(roll); all clouds or none (6 values each).
   std::vector<double> poses;
+  /// Scans of the same place empty, in the first cloud's frame (the scanner not moved): heaps
+  /// are measured above them instead of above the floor plane.
+  std::vector<std::string> references;
   double cell = 0;                  ///< [m]; 0: from the data
   std::vector<double> up;           ///< gravity up in the first cloud's frame (3 values), if known
   double alpha_d = 4e-6;            ///< σp² = α_d d²

@@ -91,6 +91,27 @@ TEST(ScanMap, TwoScansOfAConeGiveItsVolume) {
   EXPECT_LT(h.volume_sigma, 0.05 * heap.Volume());
 }
 
+// --reference: a scan of the place empty, from the same scanner pose, and one with the heap;
+// the heap is what the second holds above the first.
+TEST(ScanMap, AboveAReferenceScanOfTheEmptyPlace) {
+  const ConeHeap heap;
+  ConeHeap flat;
+  flat.height = 0;
+  Eigen::Isometry3d T_world_scanner;
+  const ScanCloud full = Scan(heap, {-3.0, 0.4, 2.6}, {0, 0, 0.2}, 4, T_world_scanner);
+  const ScanCloud empty = Scan(flat, {-3.0, 0.4, 2.6}, {0, 0, 0.2}, 5, T_world_scanner);
+  const std::vector<ScanCloud> reference{empty};
+  const ScanMap map = BuildScanMap({full}, {}, &reference);
+  ASSERT_TRUE(map.ok) << map.failure;
+  ASSERT_FALSE(map.heaps.empty());
+  const Heap& h = map.heaps.front();
+  std::printf("cone above the empty scan: %.4f m^3 (filled %.4f) against %.4f\n", h.volume,
+              h.filled_volume, heap.Volume());
+  // One side only: the far side of the cone is hidden and filled (Eq. 9) from the near one.
+  EXPECT_NEAR(h.volume, heap.Volume(), 0.10 * heap.Volume());
+  EXPECT_GT(h.filled_volume, 0.0);
+}
+
 TEST(ScanMap, ACloudWithoutAFloorIsToldSo) {
   // Points on a sphere only: no plane holds 5 % of them.
   ScanCloud ball;

@@ -99,20 +99,17 @@ std::vector<Heap> FindHeaps(GridMap& map, double min_height, int min_cells, doub
   return heaps;
 }
 
-}  // namespace
-
-ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions& options) {
-  ScanMap out;
-  // Points at the scanner's own origin are "no return" (Livox drivers and CloudCompare exports
-  // write them as 0 0 0): dropped and counted, so that they neither form a "plane" through the
-  // origin nor a spike in the map.
+// Points at the scanner's own origin are "no return" (Livox drivers and CloudCompare exports
+// write them as 0 0 0): dropped and counted, so that they neither form a "plane" through the
+// origin nor a spike in the map. Appends the kept points, in the first cloud's frame.
+std::vector<ScanCloud> KeepReturns(const std::vector<ScanCloud>& clouds, long& at_origin,
+                                   std::vector<Eigen::Vector3d>& points) {
   std::vector<ScanCloud> kept = clouds;
-  std::vector<Eigen::Vector3d> points;
   for (ScanCloud& c : kept) {
     std::vector<sensors::LidarPoint> returns;
     for (const auto& p : c.cloud.points) {
       if (p.p_sensor.squaredNorm() < kNoReturn * kNoReturn) {
-        ++out.points_at_origin;
+        ++at_origin;
         continue;
       }
       returns.push_back(p);
@@ -120,24 +117,47 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
     }
     c.cloud.points = std::move(returns);
   }
+  return kept;
+}
+
+}  // namespace
+
+ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions& options,
+                     const std::vector<ScanCloud>* reference) {
+  ScanMap out;
+  std::vector<Eigen::Vector3d> points, reference_points;
+  const std::vector<ScanCloud> kept = KeepReturns(clouds, out.points_at_origin, points);
+  std::vector<ScanCloud> kept_reference;
+  if (reference != nullptr) {
+    kept_reference = KeepReturns(*reference, out.points_at_origin, reference_points);
+  }
   out.points = static_cast<long>(points.size());
   if (kept.empty() || points.empty()) {
     out.failure = "no points";
     return out;
   }
-  out.ground = FindScanGround(points, clouds.front().T_first_scan.translation(), options.ground);
+  if (reference != nullptr && reference_points.empty()) {
+    out.failure = "the reference scan has no points";
+    return out;
+  }
+  // The floor: of the empty place when there is one (the heap hides it in the scan).
+  const std::vector<Eigen::Vector3d>& floor_points = reference ? reference_points : points;
+  out.ground =
+      FindScanGround(floor_points, clouds.front().T_first_scan.translation(), options.ground);
   if (!out.ground.ok) {
-    out.failure = out.ground.failure;
+    out.failure = (reference ? "reference: " : "") + out.ground.failure;
     return out;
   }
   // The map's extent and cell from the data in the floor's frame.
   Eigen::Vector2d lo(std::numeric_limits<double>::infinity(),
                      std::numeric_limits<double>::infinity());
   Eigen::Vector2d hi = -lo;
-  for (const auto& p : points) {
-    const Eigen::Vector3d g = out.ground.T_ground_scan * p;
-    lo = lo.cwiseMin(g.head<2>());
-    hi = hi.cwiseMax(g.head<2>());
+  for (const std::vector<Eigen::Vector3d>* set : {&points, &reference_points}) {
+    for (const auto& p : *set) {
+      const Eigen::Vector3d g = out.ground.T_ground_scan * p;
+      lo = lo.cwiseMin(g.head<2>());
+      hi = hi.cwiseMax(g.head<2>());
+    }
   }
   {
     std::vector<double> heights;
@@ -162,24 +182,46 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
   // A scan is a snapshot: nothing moved between its returns, so no ray needs to clear the
   // cells it passes under (the loader's map clears for the bucket and for dynamic obstacles).
   config.clearing_stride = 0;
-  out.map = ElevationMap(config, 0.5 * (lo + hi));
-  for (const ScanCloud& c : kept) {
-    sensors::PointCloud cloud = c.cloud;
-    cloud.stamp = 0;
-    const MapUpdateStats stats =
-        out.map.Update(cloud, out.ground.T_ground_scan * c.T_first_scan, 0);
-    out.points_used += stats.fused;
+  auto build = [&](const std::vector<ScanCloud>& set, ElevationMap& map, long& used) {
+    map = ElevationMap(config, 0.5 * (lo + hi));
+    for (const ScanCloud& c : set) {
+      sensors::PointCloud cloud = c.cloud;
+      cloud.stamp = 0;
+      used += map.Update(cloud, out.ground.T_ground_scan * c.T_first_scan, 0).fused;
+    }
+    return map.FillHoles();
+  };
+  out.cells_filled = build(kept, out.map, out.points_used);
+  GridMap& grid = out.map.map();
+  double floor_sigma = out.ground.floor.noise / std::sqrt(std::max(1, out.ground.floor.inliers));
+  if (reference != nullptr) {
+    // Heights above the empty place instead of above the floor plane: the difference where both
+    // scans know the cell, with the variances added; the floor plane's error cancels.
+    ElevationMap empty;
+    long unused = 0;
+    build(kept_reference, empty, unused);
+    const GridMap& ref = empty.map();
+    grid.Add("reference");
+    for (GridMap::Iterator it(grid); !it.done(); ++it) {
+      const float h_ref = ref.at("elevation", *it);
+      grid.at("reference", *it) = h_ref;
+      float& h = grid.at("elevation", *it);
+      if (!std::isfinite(h) || !std::isfinite(h_ref)) {
+        h = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      h -= h_ref;
+      grid.at("variance", *it) += ref.at("variance", *it);
+      if (ref.at("filled", *it) > 0) grid.at("filled", *it) = 1;
+    }
+    floor_sigma = 0;
   }
-  out.cells_filled = out.map.FillHoles();
-  const GridMap& grid = out.map.map();
   for (GridMap::Iterator it(grid); !it.done(); ++it) {
     out.cells_observed += grid.at("observed", *it) > 0 ? 1 : 0;
   }
-  const double floor_sigma =
-      out.ground.floor.noise / std::sqrt(std::max(1, out.ground.floor.inliers));
   out.min_heap_height = options.min_heap_height > 0 ? options.min_heap_height
                                                     : std::max(0.01, 4 * out.ground.floor.noise);
-  out.heaps = FindHeaps(out.map.map(), out.min_heap_height, options.min_heap_cells, floor_sigma);
+  out.heaps = FindHeaps(grid, out.min_heap_height, options.min_heap_cells, floor_sigma);
   out.ok = true;
   return out;
 }

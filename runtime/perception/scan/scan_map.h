@@ -65,6 +65,10 @@ struct ScanMap {
   double min_heap_height = 0;
 };
 
-ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions& options = {});
+/// `reference`: scans of the same place empty (the same frame as the first cloud, or placed by
+/// their own T_first_scan): the floor is found on them, and heights are measured above them —
+/// the heap is what the scans hold and the reference does not, on cells both know.
+ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions& options = {},
+                     const std::vector<ScanCloud>* reference = nullptr);
 
 }  // namespace autoshovel::perception

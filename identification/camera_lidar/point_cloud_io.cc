@@ -16,6 +16,7 @@
 #include <sstream>
 #include <vector>
 
+#include "identification/camera_lidar/ply_io.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/file_output.h"
 #include "runtime/core/input_file.h"
@@ -403,7 +404,12 @@ sensors::PointCloud ReadPointCloud(const std::string& path, std::size_t max_poin
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".pcd") return ReadPcd(path, max_points, out);
   if (ext == ".bin") return ReadKittiBin(path, max_points, out);
-  Fail(path, 0, "", "unknown point cloud format '" + ext + "' (expected .pcd or .bin)");
+  if (ext == ".ply") {
+    sensors::PointCloud cloud = ReadPly(path, out);
+    Reduce(cloud.points, max_points);
+    return cloud;
+  }
+  Fail(path, 0, "", "unknown point cloud format '" + ext + "' (expected .pcd, .ply or .bin)");
 }
 
 void WritePcd(const std::string& path, const sensors::PointCloud& cloud, PcdEncoding encoding) {

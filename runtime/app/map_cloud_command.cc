@@ -8,9 +8,11 @@
 #include <ostream>
 #include <sstream>
 
+#include "identification/camera_lidar/ply_io.h"
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/file_output.h"
+#include "runtime/perception/scan/geotiff_export.h"
 #include "runtime/perception/scan/scan_map.h"
 #include "runtime/perception/scan/scan_render.h"
 
@@ -154,7 +156,21 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
     perception::LayerPicture heaps{"heap", "heaps", ""};
     heaps.categorical = true;
     perception::WriteLayerPng(options.output + "/heaps.png", grid, heaps);
-    out << "wrote " << options.output << "/heaps.csv, elevation.png, uncertainty.png, heaps.png\n";
+    perception::WriteGeoTiff(options.output + "/map.tif", grid);
+    sensors::PointCloud centres;  // the map's cells as points, for CloudCompare
+    for (perception::GridMap::Iterator it(grid); !it.done(); ++it) {
+      const float h = grid.at("elevation", *it);
+      if (!std::isfinite(h)) continue;
+      sensors::LidarPoint p;
+      const Eigen::Vector2d xy = grid.PositionOf(*it);
+      p.p_sensor = Eigen::Vector3f(static_cast<float>(xy.x()), static_cast<float>(xy.y()), h);
+      p.intensity = grid.at("filled", *it) > 0 ? 0.f : 1.f;  // 1 measured, 0 filled
+      centres.points.push_back(p);
+    }
+    identification::WritePly(options.output + "/map.ply", centres);
+    out << "wrote " << options.output
+        << "/heaps.csv, elevation.png, uncertainty.png, heaps.png, map.tif (GeoTIFF: height, "
+           "sigma, filled), map.ply (cell centres; intensity 1 measured, 0 filled)\n";
     return 0;
   } catch (const core::InputError& e) {
     err << e.what() << "\n";

@@ -169,6 +169,7 @@ const std::map<std::string, ReadFn>& Readers() {
        }},
       {"pcd", [](const std::string& p) { identification::ReadPointCloud(p); }},
       {"kitti_bin", [](const std::string& p) { identification::ReadPointCloud(p); }},
+      {"ply", [](const std::string& p) { identification::ReadPointCloud(p); }},
       {"masks",
        [](const std::string& p) { identification::ReadMasks(p, kMaskWidth, kMaskHeight); }},
       {"onnx", [](const std::string& p) { perception::Segmenter segmenter(p); }},
@@ -240,8 +241,8 @@ INSTANTIATE_TEST_SUITE_P(Readers, BadInput,
                                            "campaign_spec", "shovel_weights", "camera_info",
                                            "calib_txt", "extrinsic", "correspondences",
                                            "log_format", "hydraulic_log", "arm_calibration", "pcd",
-                                           "kitti_bin", "masks", "image_header", "onnx", "svr",
-                                           "model_provenance", "demonstrations"),
+                                           "kitti_bin", "ply", "masks", "image_header", "onnx",
+                                           "svr", "model_provenance", "demonstrations"),
                          [](const auto& param_info) { return param_info.param; });
 
 // Every reader folder is exercised by the test above.

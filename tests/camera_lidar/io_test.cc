@@ -11,6 +11,7 @@
 
 #include "identification/camera_lidar/camera_model.h"
 #include "identification/camera_lidar/mask_io.h"
+#include "identification/camera_lidar/ply_io.h"
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "runtime/core/diagnostics.h"
 
@@ -38,6 +39,35 @@ sensors::PointCloud RandomCloud(int n) {
     cloud.points.push_back(p);
   }
   return cloud;
+}
+
+// PLY (issue 43): our binary little-endian writer read back, and a big-endian file of doubles
+// with a ushort intensity written byte by byte.
+TEST(PointCloudIo, PlyRoundTripAndOtherTypesAndByteOrders) {
+  const std::string dir = TempDir("ply");
+  const sensors::PointCloud cloud = RandomCloud(300);
+  WritePly(dir + "/cloud.ply", cloud);
+  const sensors::PointCloud back = ReadPointCloud(dir + "/cloud.ply");
+  ASSERT_EQ(back.points.size(), cloud.points.size());
+  for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+    EXPECT_EQ(back.points[i].p_sensor, cloud.points[i].p_sensor);
+    EXPECT_EQ(back.points[i].intensity, cloud.points[i].intensity);
+  }
+  std::string bytes =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty double x\n"
+      "property double y\nproperty double z\nproperty ushort intensity\nend_header\n";
+  auto big = [&](const void* p, int n) {
+    for (int k = n - 1; k >= 0; --k) bytes.push_back(static_cast<const char*>(p)[k]);
+  };
+  const double xyz[3] = {1.25, -2.5, 3.75};
+  for (const double v : xyz) big(&v, 8);
+  const std::uint16_t intensity = 513;
+  big(&intensity, 2);
+  std::ofstream(dir + "/big.ply", std::ios::binary) << bytes;
+  const sensors::PointCloud one = ReadPointCloud(dir + "/big.ply");
+  ASSERT_EQ(one.points.size(), 1u);
+  EXPECT_EQ(one.points[0].p_sensor, Eigen::Vector3f(1.25f, -2.5f, 3.75f));
+  EXPECT_EQ(one.points[0].intensity, 513.0f);
 }
 
 TEST(PointCloudIo, PcdInEveryEncodingAndKittiBinRoundTrip) {

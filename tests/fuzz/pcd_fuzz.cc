@@ -1,6 +1,7 @@
 // Fuzz target: the PCD reader (identification/camera_lidar/point_cloud_io.h): the project's
 // header check, then pcl::io's decoding of ascii, binary and binary_compressed data. Its only
 // documented refusal is core::InputError. A point bound exercises the sampling after decoding.
+// Built a second time as fuzz_ply with CLOUD_EXTENSION ".ply": the PLY reader (ply_io.h).
 #include <pcl/console/print.h>
 
 #include <cstddef>
@@ -19,7 +20,10 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace autoshovel;
-  const std::string path = fuzz::WriteInput(data, size, ".pcd");
+#ifndef CLOUD_EXTENSION
+#define CLOUD_EXTENSION ".pcd"
+#endif
+  const std::string path = fuzz::WriteInput(data, size, CLOUD_EXTENSION);
   try {
     identification::ReadPointCloud(path, /*max_points=*/64);
   } catch (const core::InputError& e) {

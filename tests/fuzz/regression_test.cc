@@ -132,6 +132,12 @@ TEST(FuzzRegressions, Pcd) {
   }));
 }
 
+TEST(FuzzRegressions, Ply) {
+  ExpectBothKinds(CheckTarget("ply", [](const std::string& path) {
+    return Refusal([&] { identification::ReadPointCloud(path, /*max_points=*/64); });
+  }));
+}
+
 TEST(FuzzRegressions, ImageHeader) {
   ExpectBothKinds(CheckTarget("image_header", [](const std::string& path) {
     return Refusal([&] { identification::ReadImageHeader(path); });

@@ -4,11 +4,16 @@
 // volume back.
 #include "runtime/perception/scan/scan_map.h"
 
+#include <gdal_priv.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <numbers>
 #include <random>
+
+#include "runtime/perception/scan/geotiff_export.h"
 
 namespace autoshovel::perception {
 namespace {
@@ -110,6 +115,46 @@ TEST(ScanMap, AboveAReferenceScanOfTheEmptyPlace) {
   // One side only: the far side of the cone is hidden and filled (Eq. 9) from the near one.
   EXPECT_NEAR(h.volume, heap.Volume(), 0.10 * heap.Volume());
   EXPECT_GT(h.filled_volume, 0.0);
+}
+
+// The GeoTIFF export: heights, sigma and the filled flag at the right cells, row 0 north, the
+// geotransform placing cell centres where the grid does; NaN where nothing is known.
+TEST(ScanMap, GeoTiffHoldsTheMapWhereTheGridHasIt) {
+  GridMap map(0.5, {3.0, 2.0}, {10.0, -4.0});
+  map.Add("elevation");
+  map.Add("variance");
+  map.Add("filled", 0.f);
+  const Index cell(1, 3);  // x = 8.75 + 0.5, y = −5 + 1.75
+  map.at("elevation", cell) = 0.42f;
+  map.at("variance", cell) = 0.0009f;
+  map.at("filled", cell) = 1.f;
+  const std::string path = (std::filesystem::temp_directory_path() / "scan_map_test.tif").string();
+  WriteGeoTiff(path, map);
+  GDALAllRegister();
+  std::unique_ptr<GDALDataset> data(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(data);
+  ASSERT_EQ(data->GetRasterXSize(), 6);
+  ASSERT_EQ(data->GetRasterYSize(), 4);
+  double t[6];
+  data->GetGeoTransform(t);
+  // The centre of pixel (column 1, row 4 − 1 − 3 = 0) is the grid's cell centre.
+  const Eigen::Vector2d centre = map.PositionOf(cell);
+  EXPECT_NEAR(t[0] + 1.5 * t[1], centre.x(), 1e-9);
+  EXPECT_NEAR(t[3] + 0.5 * t[5], centre.y(), 1e-9);
+  float v[3];
+  for (int band = 1; band <= 3; ++band) {
+    ASSERT_EQ(data->GetRasterBand(band)->RasterIO(GF_Read, 1, 0, 1, 1, &v[band - 1], 1, 1,
+                                                  GDT_Float32, 0, 0),
+              CE_None);
+  }
+  EXPECT_FLOAT_EQ(v[0], 0.42f);
+  EXPECT_NEAR(v[1], 0.03f, 1e-6);
+  EXPECT_FLOAT_EQ(v[2], 1.f);
+  float unknown = 0;
+  ASSERT_EQ(
+      data->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 1, 1, &unknown, 1, 1, GDT_Float32, 0, 0),
+      CE_None);
+  EXPECT_TRUE(std::isnan(unknown));
 }
 
 TEST(ScanMap, ACloudWithoutAFloorIsToldSo) {

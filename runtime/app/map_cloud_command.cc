@@ -98,8 +98,6 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
     }
     const perception::ScanMap map =
         perception::BuildScanMap(clouds, map_options, references.empty() ? nullptr : &references);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!map.ok) {
       err << kCommand << ": " << options.clouds.front() << ": " << map.failure << "\n";
       return 2;
@@ -111,8 +109,9 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
     if (map.points_at_origin > 0) {
       out << " (" << map.points_at_origin << " at the scanner's origin: no return, dropped)";
     }
-    std::snprintf(line, sizeof line, ", %ld fused; read %.2f s, mapped %.2f s\n", map.points_used,
-                  read_seconds, seconds - read_seconds);
+    std::snprintf(
+        line, sizeof line, ", %ld fused; read %.2f s, floor %.2f s, map %.2f s, heaps %.2f s\n",
+        map.points_used, read_seconds, map.seconds_floor, map.seconds_map, map.seconds_heaps);
     out << line;
     const perception::ScanPlane& floor = map.ground.floor;
     std::snprintf(line, sizeof line,

@@ -48,11 +48,11 @@ ScanPlane Refit(const std::vector<Eigen::Vector3d>& points, const std::vector<in
 }
 
 // The largest plane among `remaining` (RANSAC), its inliers in `inliers`. RANSAC runs on at
-// most 40 000 of them (evenly strided: a plane holding 5 % of a scan still has 2 000 there);
+// most 10 000 of them (evenly strided: a plane holding 5 % of a scan still has 500 there);
 // the inliers are then every remaining point within `threshold` of its plane.
 bool LargestPlane(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud,
                   const pcl::IndicesPtr& remaining, double threshold, std::vector<int>& inliers) {
-  constexpr std::size_t kSample = 40000;
+  constexpr std::size_t kSample = 10000;
   pcl::IndicesPtr sample = remaining;
   if (remaining->size() > kSample) {
     sample.reset(new pcl::Indices);

@@ -1,6 +1,7 @@
 #include "runtime/perception/scan/scan_map.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -141,6 +142,11 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
     return out;
   }
   // The floor: of the empty place when there is one (the heap hides it in the scan).
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  auto stage = Clock::now();
   const std::vector<Eigen::Vector3d>& floor_points = reference ? reference_points : points;
   out.ground =
       FindScanGround(floor_points, clouds.front().T_first_scan.translation(), options.ground);
@@ -148,6 +154,8 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
     out.failure = (reference ? "reference: " : "") + out.ground.failure;
     return out;
   }
+  out.seconds_floor = since(stage);
+  stage = Clock::now();
   // The map's extent and cell from the data in the floor's frame.
   Eigen::Vector2d lo(std::numeric_limits<double>::infinity(),
                      std::numeric_limits<double>::infinity());
@@ -219,9 +227,12 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
   for (GridMap::Iterator it(grid); !it.done(); ++it) {
     out.cells_observed += grid.at("observed", *it) > 0 ? 1 : 0;
   }
+  out.seconds_map = since(stage);
+  stage = Clock::now();
   out.min_heap_height = options.min_heap_height > 0 ? options.min_heap_height
                                                     : std::max(0.01, 4 * out.ground.floor.noise);
   out.heaps = FindHeaps(grid, out.min_heap_height, options.min_heap_cells, floor_sigma);
+  out.seconds_heaps = since(stage);
   out.ok = true;
   return out;
 }

@@ -62,6 +62,7 @@ struct ScanMap {
   long points = 0, points_used = 0, cells_observed = 0, cells_filled = 0;
   long points_at_origin = 0;               ///< 0 0 0 "no return" points dropped
   double height_low = 0, height_high = 0;  ///< 1st and 99th percentile above the floor [m]
+  double seconds_floor = 0, seconds_map = 0, seconds_heaps = 0;  ///< where the time went
   double min_heap_height = 0;
 };
 

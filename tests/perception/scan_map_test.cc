@@ -13,6 +13,7 @@
 #include <numbers>
 #include <random>
 
+#include "identification/camera_lidar/point_cloud_io.h"
 #include "runtime/perception/scan/geotiff_export.h"
 
 namespace autoshovel::perception {
@@ -155,6 +156,35 @@ TEST(ScanMap, GeoTiffHoldsTheMapWhereTheGridHasIt) {
       data->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 1, 1, &unknown, 1, 1, GDT_Float32, 0, 0),
       CE_None);
   EXPECT_TRUE(std::isnan(unknown));
+}
+
+// Real scans (tests/data/pile_scans/README.md): balls in a box above a scan of the empty box,
+// the scanner's frame with z along its range axis. Three times the balls hold more than twice
+// the volume, and 25 balls hold some.
+TEST(ScanMap, RealScansOfBallsInABoxGrowWithTheBalls) {
+  const std::string dir = std::string(AUTOSHOVEL_SOURCE_DIR) + "/tests/data/pile_scans/";
+  auto read = [&](const std::string& name) {
+    ScanCloud c;
+    c.name = name;
+    c.cloud = identification::ReadPointCloud(dir + name);
+    return c;
+  };
+  const std::vector<ScanCloud> empty{read("empty_box.pcd")};
+  ScanMapOptions options;
+  options.cell = 0.01;  // 12 000 points over 0.5 m x 0.4 m
+  const ScanMap few = BuildScanMap({read("balls_25.pcd")}, options, &empty);
+  const ScanMap many = BuildScanMap({read("balls_75.pcd")}, options, &empty);
+  ASSERT_TRUE(few.ok) << few.failure;
+  ASSERT_TRUE(many.ok) << many.failure;
+  auto total = [](const ScanMap& m) {
+    double v = 0;
+    for (const Heap& h : m.heaps) v += h.volume;
+    return v;
+  };
+  std::printf("25 balls %.5f m^3, 75 balls %.5f m^3\n", total(few), total(many));
+  EXPECT_GT(total(few), 0.001);  // 25 balls of ≈ 6 cm under their surface: ≈ 2.5 litres
+  EXPECT_GT(total(many), 2.0 * total(few));
+  EXPECT_LT(total(many), 4.0 * total(few));
 }
 
 TEST(ScanMap, ACloudWithoutAFloorIsToldSo) {

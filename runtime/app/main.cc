@@ -173,6 +173,9 @@ int main(int argc, char** argv) {
                    "the first cloud's frame, R = Rz(yaw) Ry(pitch) Rx(roll)")
       ->check(autoshovel::app::FiniteIn(-1e5, 1e5))
       ->delimiter(',');
+  map_cmd->add_option("--poses", map_cloud.poses_file,
+                      "Poses of a sequence: lines 'name x y z roll pitch yaw' (the cloud's file "
+                      "name; metres, degrees) in the first cloud's frame");
   map_cmd->add_option("--reference", map_cloud.references,
                       "A scan of the same place empty, from the same scanner pose (repeatable): "
                       "heaps are measured above it, not above the floor plane");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <ostream>
 #include <sstream>
@@ -14,22 +15,15 @@
 #include "runtime/core/file_output.h"
 #include "runtime/perception/scan/geotiff_export.h"
 #include "runtime/perception/scan/scan_map.h"
+#include "runtime/perception/scan/scan_poses.h"
 #include "runtime/perception/scan/scan_render.h"
 
 namespace autoshovel::app {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 Eigen::Isometry3d PoseOf(const double* v) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(v[5] * kDeg, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(v[4] * kDeg, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(v[3] * kDeg, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-  return T;
+  return perception::PoseFromXyzRpyDegrees(v[0], v[1], v[2], v[3], v[4], v[5]);
 }
 
 void WriteHeapsCsv(const std::string& path, const perception::ScanMap& map) {
@@ -61,6 +55,21 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
           << options.poses.size() << " values for " << options.clouds.size() << " clouds\n";
       return 2;
     }
+    if (!options.poses.empty() && !options.poses_file.empty()) {
+      err << kCommand << ": give --pose or --poses, not both\n";
+      return 2;
+    }
+    std::map<std::string, Eigen::Isometry3d> pose_by_name;
+    if (!options.poses_file.empty()) {
+      pose_by_name = perception::ReadScanPoses(options.poses_file);
+      for (const std::string& cloud : options.clouds) {
+        const std::string name = std::filesystem::path(cloud).filename().string();
+        if (pose_by_name.count(name) == 0) {
+          err << options.poses_file << ": no pose for the cloud '" << name << "'\n";
+          return 2;
+        }
+      }
+    }
     if (!options.up.empty() && options.up.size() != 3) {
       err << kCommand << ": --up needs 3 values (x y z)\n";
       return 2;
@@ -76,6 +85,9 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
       c.cloud = identification::ReadPointCloud(c.name, options.max_points, &stats);
       non_finite += stats.non_finite;
       if (!options.poses.empty()) c.T_first_scan = PoseOf(&options.poses[6 * k]);
+      if (!pose_by_name.empty()) {
+        c.T_first_scan = pose_by_name.at(std::filesystem::path(c.name).filename().string());
+      }
       clouds.push_back(std::move(c));
     }
     std::vector<perception::ScanCloud> references;

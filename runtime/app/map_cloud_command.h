@@ -16,6 +16,7 @@ struct MapCloudOptions {
   /// Per cloud, optionally: x y z [m] roll pitch yaw [deg] of the scanner in the first cloud's
   /// frame, R = Rz(yaw) Ry(pitch) Rx(roll); all clouds or none (6 values each).
   std::vector<double> poses;
+  std::string poses_file;  ///< or a poses file (scan_poses.h): a line per cloud, by file name
   /// Scans of the same place empty, in the first cloud's frame (the scanner not moved): heaps
   /// are measured above them instead of above the floor plane.
   std::vector<std::string> references;

@@ -31,6 +31,7 @@
 #include "runtime/app/campaign/campaign_spec.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
+#include "runtime/perception/scan/scan_poses.h"
 #include "runtime/perception/segmentation.h"
 #include "runtime/planning/shovel_weights_file.h"
 #include "runtime/plant/scenario.h"
@@ -170,6 +171,7 @@ const std::map<std::string, ReadFn>& Readers() {
       {"pcd", [](const std::string& p) { identification::ReadPointCloud(p); }},
       {"kitti_bin", [](const std::string& p) { identification::ReadPointCloud(p); }},
       {"ply", [](const std::string& p) { identification::ReadPointCloud(p); }},
+      {"scan_poses", [](const std::string& p) { perception::ReadScanPoses(p); }},
       {"masks",
        [](const std::string& p) { identification::ReadMasks(p, kMaskWidth, kMaskHeight); }},
       {"onnx", [](const std::string& p) { perception::Segmenter segmenter(p); }},
@@ -241,8 +243,9 @@ INSTANTIATE_TEST_SUITE_P(Readers, BadInput,
                                            "campaign_spec", "shovel_weights", "camera_info",
                                            "calib_txt", "extrinsic", "correspondences",
                                            "log_format", "hydraulic_log", "arm_calibration", "pcd",
-                                           "kitti_bin", "ply", "masks", "image_header", "onnx",
-                                           "svr", "model_provenance", "demonstrations"),
+                                           "kitti_bin", "ply", "scan_poses", "masks",
+                                           "image_header", "onnx", "svr", "model_provenance",
+                                           "demonstrations"),
                          [](const auto& param_info) { return param_info.param; });
 
 // Every reader folder is exercised by the test above.

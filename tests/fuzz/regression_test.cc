@@ -23,6 +23,7 @@
 #include "identification/hydraulics/log_reader.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
+#include "runtime/perception/scan/scan_poses.h"
 #include "runtime/results/results_db.h"
 #include "tests/fuzz/hydraulic_log_formats.h"
 #include "tests/fuzz/refusal.h"
@@ -135,6 +136,12 @@ TEST(FuzzRegressions, Pcd) {
 TEST(FuzzRegressions, Ply) {
   ExpectBothKinds(CheckTarget("ply", [](const std::string& path) {
     return Refusal([&] { identification::ReadPointCloud(path, /*max_points=*/64); });
+  }));
+}
+
+TEST(FuzzRegressions, ScanPoses) {
+  ExpectBothKinds(CheckTarget("scan_poses", [](const std::string& path) {
+    return Refusal([&] { perception::ReadScanPoses(path); });
   }));
 }
 

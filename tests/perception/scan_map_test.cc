@@ -15,6 +15,7 @@
 
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "runtime/perception/scan/geotiff_export.h"
+#include "runtime/perception/scan/scan_poses.h"
 
 namespace autoshovel::perception {
 namespace {
@@ -185,6 +186,33 @@ TEST(ScanMap, RealScansOfBallsInABoxGrowWithTheBalls) {
   EXPECT_GT(total(few), 0.001);  // 25 balls of ≈ 6 cm under their surface: ≈ 2.5 litres
   EXPECT_GT(total(many), 2.0 * total(few));
   EXPECT_LT(total(many), 4.0 * total(few));
+}
+
+// A poses file places the second station as --pose does: the same volume as the test above.
+TEST(ScanMap, APosesFilePlacesTheStations) {
+  const ConeHeap heap;
+  Eigen::Isometry3d T_world_a, T_world_b;
+  ScanCloud a = Scan(heap, {-3.5, 0.3, 2.2}, {0, 0, 0.2}, 1, T_world_a);
+  ScanCloud b = Scan(heap, {3.2, -0.6, 2.4}, {0, 0, 0.2}, 2, T_world_b);
+  const Eigen::Isometry3d T_a_b = T_world_a.inverse() * T_world_b;
+  const Eigen::Vector3d t = T_a_b.translation();
+  // Roll, pitch, yaw of R = Rz Ry Rx, in degrees.
+  const Eigen::Matrix3d& R = T_a_b.linear();
+  const double pitch = std::asin(-R(2, 0)) * 180 / kPi;
+  const double roll = std::atan2(R(2, 1), R(2, 2)) * 180 / kPi;
+  const double yaw = std::atan2(R(1, 0), R(0, 0)) * 180 / kPi;
+  char text[256];
+  std::snprintf(
+      text, sizeof text,
+      "name,x,y,z,roll,pitch,yaw\na.pcd,0,0,0,0,0,0\nb.pcd,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", t.x(),
+      t.y(), t.z(), roll, pitch, yaw);
+  const auto poses = ParseScanPoses(text, "poses.csv");
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_LT((poses.at("b.pcd").matrix() - T_a_b.matrix()).cwiseAbs().maxCoeff(), 1e-6);
+  b.T_first_scan = poses.at("b.pcd");
+  const ScanMap map = BuildScanMap({a, b});
+  ASSERT_TRUE(map.ok) << map.failure;
+  EXPECT_NEAR(map.heaps.front().volume, heap.Volume(), 0.03 * heap.Volume());
 }
 
 TEST(ScanMap, ACloudWithoutAFloorIsToldSo) {

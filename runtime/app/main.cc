@@ -24,6 +24,7 @@
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
 #include "runtime/app/scenario_command.h"
+#include "runtime/app/shovel_job/shovel_cycle.h"
 #include "runtime/app/shovel_run.h"
 #include "runtime/app/train_segmentation.h"
 #include "runtime/app/truck_loading/truck_loading_job.h"
@@ -89,6 +90,14 @@ int main(int argc, char** argv) {
                          "List the values marked as estimated");
   describe_cmd->add_option("--overlay", describe.overlays,
                            "Apply identified values (calibrate/identify output), in order");
+
+  std::string architecture_output;
+  CLI::App* architecture_cmd = app.add_subcommand(
+      "architecture",
+      "Print the main job's components, the executive's tasks and rates and the data flowing "
+      "between them as Graphviz DOT (docs/architecture.md; `| dot -Tsvg > arch.svg`)");
+  architecture_cmd->add_option("-o,--output", architecture_output,
+                               "Write to FILE (default: stdout)");
 
   std::vector<std::string> gen_descriptions;
   std::string gen_output = "generated", gen_materials;
@@ -825,6 +834,21 @@ int main(int argc, char** argv) {
       return autoshovel::app::RunShovelCommand(run, run_out, std::cout, std::cerr);
     }
 
+    if (*architecture_cmd) {
+      const std::string dot =
+          autoshovel::app::ShovelJobArchitectureDot(autoshovel::app::ShovelRunOptions{});
+      if (architecture_output.empty()) {
+        std::cout << dot;
+        return 0;
+      }
+      try {
+        autoshovel::core::WriteFileAtomically(architecture_output, dot);
+      } catch (const autoshovel::core::OutputError& e) {
+        std::cerr << "autoshovel architecture: " << e.what() << "\n";
+        return 1;
+      }
+      return 0;
+    }
     if (*describe_cmd) {
       describe.models_dir = models_dir;
       return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);

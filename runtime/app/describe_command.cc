@@ -129,25 +129,8 @@ void PrintSpecSheet(const model::MachineDescription& m, std::ostream& out) {
       << '\n';
 }
 
-}  // namespace
-
-int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream& err) {
-  model::MachineDescription m;
-  try {
-    model::LoadOptions load;
-    load.overlays = options.overlays;
-    load.models_dir = options.models_dir;
-    m = model::LoadMachineDescription(
-        model::ResolveMachineDescription(options.machine, options.models_dir), load);
-  } catch (const core::InputError& e) {
-    for (const auto& d : e.diagnostics()) err << d.ToString() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    err << "autoshovel describe: " << e.what() << '\n';
-    return 1;
-  }
-  const model::MachineSummary s = model::Summarize(m);
-
+// The machine, its description file, the code it runs on, overlays and plausibility.
+void PrintIdentity(const model::MachineDescription& m, bool show_estimated, std::ostream& out) {
   out << m.name << " — " << model::ToString(m.kind) << ", " << model::ToString(m.drive)
       << " drive\n";
   out << "  description   " << m.source_file << "\n  sha256        " << m.sha256 << '\n';
@@ -176,11 +159,14 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
       << '\n';
   for (const core::Diagnostic& warning : m.warnings) out << "    " << warning.ToString() << '\n';
   out << "  estimated     " << m.estimated.size() << " values"
-      << (options.show_estimated ? ":" : " (--estimated lists them)") << '\n';
-  if (options.show_estimated) {
+      << (show_estimated ? ":" : " (--estimated lists them)") << '\n';
+  if (show_estimated) {
     for (const auto& path : m.estimated) out << "                  " << path << '\n';
   }
+}
 
+// Links, joints and what drives them.
+void PrintArm(const model::MachineDescription& m, std::ostream& out) {
   out << "\nArm (frame M at " << Fixed(m.arm_pivot.x(), 3) << ", " << Fixed(m.arm_pivot.y(), 3)
       << " m in the base frame)\n";
   for (const auto& link : m.links) {
@@ -215,7 +201,10 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
     out << "            " << a.name << ": " << a.base_mount.body << " -> " << a.rod_mount.body
         << (own ? "" : " (moves with every joint from the chassis to " + a.joint + ")") << '\n';
   }
+}
 
+void PrintReach(const model::MachineDescription& m, const model::MachineSummary& s,
+                std::ostream& out) {
   out << "\nReach and heights (bucket tip B, base frame, ground at z = 0)\n";
   out << "  max reach                 " << Fixed(s.max_reach, 2) << " m from the base origin\n";
   out << "  max reach at ground level " << Fixed(s.max_reach_at_ground, 2) << " m\n";
@@ -239,7 +228,9 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
       << " m, z " << Fixed(s.tip_z_min, 2) << " .. " << Fixed(s.tip_z_max, 2)
       << " m ('#' reachable, '-' ground)\n";
   for (const auto& row : s.workspace_map) out << "  |" << row << "|\n";
+}
 
+void PrintCylinders(const model::MachineSummary& s, std::ostream& out) {
   out << "\nCylinders over the joint range (stroke used vs available)\n";
   for (const auto& a : s.actuators) {
     if (a.is_motor) {
@@ -278,6 +269,9 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
         << Fixed(a.lever_min, 3) << " .. " << Fixed(a.lever_max, 3) << " m/rad; delay "
         << Fixed(a.transport_delay, 2) << " s\n";
   }
+}
+
+void PrintValvesAndSensors(const model::MachineDescription& m, std::ostream& out) {
   out << "\nValves (`autoshovel identify hydraulics` identifies these)\n";
   for (const model::Actuator& a : m.hydraulics.actuators) {
     out << "  " << std::left << std::setw(17) << a.name << std::right << " dead zone "
@@ -297,6 +291,10 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
     out << "  " << std::left << std::setw(17) << lidar.name << std::right << " "
         << pose_text(lidar.pose) << '\n';
   }
+}
+
+void PrintCarryAndBucket(const model::MachineDescription& m, const model::MachineSummary& s,
+                         std::ostream& out) {
   out << "\nCarry pose (" << s.carry_pose_definition << "):";
   for (double q : s.carry_pose) out << ' ' << Fixed(Deg(q), 1);
   out << " deg\n";
@@ -316,6 +314,33 @@ int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream&
       << "  rated capacity of " << m.bucket.design_material << "  "
       << Fixed(s.payload_at_rated_capacity, 0) << " kg (rated load "
       << Fixed(m.bucket.rated_load, 0) << " kg)\n";
+}
+
+}  // namespace
+
+int RunDescribe(const DescribeOptions& options, std::ostream& out, std::ostream& err) {
+  model::MachineDescription m;
+  try {
+    model::LoadOptions load;
+    load.overlays = options.overlays;
+    load.models_dir = options.models_dir;
+    m = model::LoadMachineDescription(
+        model::ResolveMachineDescription(options.machine, options.models_dir), load);
+  } catch (const core::InputError& e) {
+    for (const auto& d : e.diagnostics()) err << d.ToString() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    err << "autoshovel describe: " << e.what() << '\n';
+    return 1;
+  }
+  const model::MachineSummary s = model::Summarize(m);
+
+  PrintIdentity(m, options.show_estimated, out);
+  PrintArm(m, out);
+  PrintReach(m, s, out);
+  PrintCylinders(s, out);
+  PrintValvesAndSensors(m, out);
+  PrintCarryAndBucket(m, s, out);
   if (m.kind == model::MachineKind::kWheelLoader) {
     try {
       PrintSpecSheet(m, out);

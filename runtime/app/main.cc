@@ -5,7 +5,9 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -64,687 +66,946 @@ int FinishOutput(int status) {
   return status;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"autoshovel — autonomous wheel-loader shoveling and excavator truck loading"};
-  app.require_subcommand(1);
+// The folders every command reads, set by the top-level options (read once parsed).
+struct Globals {
   std::string models_dir = AUTOSHOVEL_DEFAULT_MODELS_DIR;
-  app.add_option("--models", models_dir, "Folder of machine descriptions and materials")
-      ->capture_default_str();
   std::string materials_dir;
-  app.add_option("--materials", materials_dir,
-                 "Material folder for every description loaded (default: <description "
-                 "dir>/../materials, then <models>/materials)");
-  // --models and --materials may also follow the subcommand (`describe FILE --materials DIR`).
-  app.fallthrough();
+};
 
-  autoshovel::app::DescribeOptions describe;
-  CLI::App* describe_cmd = app.add_subcommand(
+// A leaf subcommand: the parser's node, and what runs when it was the one given. Each Add*
+// function below registers one, its options held in a struct the runner shares.
+struct Command {
+  CLI::App* cli = nullptr;
+  std::function<int()> run;
+};
+
+Command AddDescribe(CLI::App& app, const Globals& g) {
+  struct Cli {
+    autoshovel::app::DescribeOptions describe;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "describe",
       "Print the derived quantities of a machine (reach, dump height, workspace, "
       "cylinder strokes, lever arms)");
-  describe_cmd->add_option("machine", describe.machine, "Machine name or description file")
-      ->required();
-  describe_cmd->add_flag("--estimated", describe.show_estimated,
-                         "List the values marked as estimated");
-  describe_cmd->add_option("--overlay", describe.overlays,
-                           "Apply identified values (calibrate/identify output), in order");
+  cmd->add_option("machine", c->describe.machine, "Machine name or description file")->required();
+  cmd->add_flag("--estimated", c->describe.show_estimated, "List the values marked as estimated");
+  cmd->add_option("--overlay", c->describe.overlays,
+                  "Apply identified values (calibrate/identify output), in order");
+  return {cmd, [c, &g]() -> int {
+            c->describe.models_dir = g.models_dir;
+            return autoshovel::app::RunDescribe(c->describe, std::cout, std::cerr);
+          }};
+}
 
-  std::string architecture_output;
-  CLI::App* architecture_cmd = app.add_subcommand(
+Command AddArchitecture(CLI::App& app, const Globals&) {
+  struct Cli {
+    std::string architecture_output;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "architecture",
       "Print the main job's components, the executive's tasks and rates and the data flowing "
       "between them as Graphviz DOT (docs/architecture.md; `| dot -Tsvg > arch.svg`)");
-  architecture_cmd->add_option("-o,--output", architecture_output,
-                               "Write to FILE (default: stdout)");
+  cmd->add_option("-o,--output", c->architecture_output, "Write to FILE (default: stdout)");
+  return {cmd, [c]() -> int {
+            const std::string dot =
+                autoshovel::app::ShovelJobArchitectureDot(autoshovel::app::ShovelRunOptions{});
+            if (c->architecture_output.empty()) {
+              std::cout << dot;
+              return 0;
+            }
+            try {
+              autoshovel::core::WriteFileAtomically(c->architecture_output, dot);
+            } catch (const autoshovel::core::OutputError& e) {
+              std::cerr << "autoshovel architecture: " << e.what() << "\n";
+              return 1;
+            }
+            return 0;
+          }};
+}
 
-  std::vector<std::string> gen_descriptions;
-  std::string gen_output = "generated", gen_materials;
-  CLI::App* gen_cmd = app.add_subcommand(
+Command AddGen(CLI::App& app, const Globals& g) {
+  struct Cli {
+    std::vector<std::string> gen_descriptions;
+    std::string gen_output = "generated", gen_materials;
+    bool gen_no_compile = false;
+    std::string gen_cache;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "gen",
       "Validate machine descriptions, generate their C++ (kinematics, calibration residuals, "
       "plant right-hand sides) and compile it into a machine library that every --machine "
       "loads: no rebuild");
-  gen_cmd->add_option("descriptions", gen_descriptions, "Description files (.yaml)")->required();
-  gen_cmd->add_option("-o,--output", gen_output, "Output folder (gets <machine>/, registry)")
+  cmd->add_option("descriptions", c->gen_descriptions, "Description files (.yaml)")->required();
+  cmd->add_option("-o,--output", c->gen_output, "Output folder (gets <machine>/, registry)")
       ->capture_default_str();
-  gen_cmd->add_option("--materials", gen_materials,
-                      "Material folder (default: <description dir>/../materials)");
-  bool gen_no_compile = false;
-  std::string gen_cache;
-  gen_cmd->add_flag("--no-compile", gen_no_compile,
-                    "Only generate: do not compile the machine library that lets every command "
-                    "use the machine without rebuilding autoshovel");
-  gen_cmd->add_option("--cache", gen_cache,
-                      "Machine library cache (default: $AUTOSHOVEL_MACHINE_CACHE, else "
-                      "${XDG_CACHE_HOME:-~/.cache}/autoshovel/machines)");
+  cmd->add_option("--materials", c->gen_materials,
+                  "Material folder (default: <description dir>/../materials)");
+  cmd->add_flag("--no-compile", c->gen_no_compile,
+                "Only generate: do not compile the machine library that lets every command "
+                "use the machine without rebuilding autoshovel");
+  cmd->add_option("--cache", c->gen_cache,
+                  "Machine library cache (default: $AUTOSHOVEL_MACHINE_CACHE, else "
+                  "${XDG_CACHE_HOME:-~/.cache}/autoshovel/machines)");
+  return {
+      cmd, [c, &g]() -> int {
+        std::string materials = c->gen_materials.empty() ? g.materials_dir : c->gen_materials;
+        if (materials.empty()) {
+          // The generator takes one material folder: the descriptions' own when they have one, else
+          // the models folder's (a description written outside models/ finds the shipped
+          // materials).
+          bool own = false;
+          for (const std::string& d : c->gen_descriptions) {
+            std::error_code error;
+            own = own || std::filesystem::is_directory(
+                             std::filesystem::path(d).parent_path() / ".." / "materials", error);
+          }
+          if (!own) materials = g.models_dir + "/materials";
+        }
+        std::vector<std::string> arguments{"-o", c->gen_output};
+        if (!materials.empty()) arguments.insert(arguments.end(), {"--materials", materials});
+        if (!c->gen_no_compile) {
+          // The library must be loadable by this very binary: gen checks its ABI tag now.
+          arguments.insert(arguments.end(),
+                           {"--compile", "--expect-abi", autoshovel::machines::RunningAbiTag()});
+        }
+        if (!c->gen_cache.empty()) arguments.insert(arguments.end(), {"--cache", c->gen_cache});
+        arguments.insert(arguments.end(), c->gen_descriptions.begin(), c->gen_descriptions.end());
+        return RunGenerator(arguments);
+      }};
+}
 
-  autoshovel::app::PlantStepOptions step;
-  CLI::App* plant_cmd = app.add_subcommand("plant", "Experiments on the simulated machine");
-  plant_cmd->require_subcommand(1);
-  CLI::App* step_cmd = plant_cmd->add_subcommand(
+Command AddPlantStep(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::app::PlantStepOptions step;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "step",
       "Valve step (or chirp) on one actuator; CSV t,command,spool,pressure,joint_angle,"
       "joint_rate for hydraulic identification");
-  step_cmd->add_option("--machine", step.machine, "Machine name or description file")->required();
-  step_cmd->add_option("--actuator", step.actuator, "Actuator name")->capture_default_str();
-  step_cmd->add_option("--amplitude", step.amplitude, "Valve duty of the step, in [-1, 1]")
+  cmd->add_option("--machine", c->step.machine, "Machine name or description file")->required();
+  cmd->add_option("--actuator", c->step.actuator, "Actuator name")->capture_default_str();
+  cmd->add_option("--amplitude", c->step.amplitude, "Valve duty of the step, in [-1, 1]")
       ->check(autoshovel::app::FiniteIn(-1, 1))
       ->capture_default_str();
-  step_cmd->add_flag("--chirp", step.chirp, "Linear frequency sweep instead of a step");
-  step_cmd->add_option("--f0", step.chirp_f0, "Chirp start frequency [Hz]")
+  cmd->add_flag("--chirp", c->step.chirp, "Linear frequency sweep instead of a step");
+  cmd->add_option("--f0", c->step.chirp_f0, "Chirp start frequency [Hz]")
       ->check(autoshovel::app::FiniteIn(0, 100, true))
       ->capture_default_str();
-  step_cmd->add_option("--f1", step.chirp_f1, "Chirp end frequency [Hz]")
+  cmd->add_option("--f1", c->step.chirp_f1, "Chirp end frequency [Hz]")
       ->check(autoshovel::app::FiniteIn(0, 100, true))
       ->capture_default_str();
-  step_cmd->add_option("--start", step.step_time, "Time of the step [s]")
+  cmd->add_option("--start", c->step.step_time, "Time of the step [s]")
       ->check(autoshovel::app::FiniteIn(0, 1e5))
       ->capture_default_str();
-  step_cmd->add_option("--duration", step.duration, "Length of the log [s]")
+  cmd->add_option("--duration", c->step.duration, "Length of the log [s]")
       ->check(autoshovel::app::FiniteIn(0, 1e6, true))
       ->capture_default_str();
-  step_cmd->add_option("--rate", step.sample_rate, "Control and logging rate [Hz]")
+  cmd->add_option("--rate", c->step.sample_rate, "Control and logging rate [Hz]")
       ->check(autoshovel::app::FiniteIn(1, 1e4))
       ->capture_default_str();
-  step_cmd->add_flag("--noise", step.noise, "Add data-logger sensor noise");
-  step_cmd->add_option("--seed", step.seed, "Seed of the noise")
+  cmd->add_flag("--noise", c->step.noise, "Add data-logger sensor noise");
+  cmd->add_option("--seed", c->step.seed, "Seed of the noise")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
-  step_cmd->add_option("-o,--output", step.output, "CSV file (default: standard output)");
+  cmd->add_option("-o,--output", c->step.output, "CSV file (default: standard output)");
+  return {cmd, [c, &g]() -> int {
+            c->step.models_dir = g.models_dir;
+            return autoshovel::app::RunPlantStep(c->step, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::app::ScenarioOptions scenario;
-  CLI::App* scenario_cmd = app.add_subcommand(
+Command AddScenario(CLI::App& app, const Globals& g) {
+  struct Cli {
+    autoshovel::app::ScenarioOptions scenario;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "scenario", "Load a yard scenario, list its piles and obstacles, draw its top view");
-  scenario_cmd->add_option("scenario", scenario.scenario, "Scenario name or .yaml path")
-      ->required();
-  scenario_cmd->add_option("-o,--png", scenario.png, "Write the top view to this PNG");
-  scenario_cmd->add_option("--mpp", scenario.metres_per_pixel, "Top view metres per pixel")
+  cmd->add_option("scenario", c->scenario.scenario, "Scenario name or .yaml path")->required();
+  cmd->add_option("-o,--png", c->scenario.png, "Write the top view to this PNG");
+  cmd->add_option("--mpp", c->scenario.metres_per_pixel, "Top view metres per pixel")
       ->check(autoshovel::app::FiniteIn(0.005, 10))
       ->capture_default_str();
+  return {cmd, [c, &g]() -> int {
+            c->scenario.models_dir = g.models_dir;
+            return autoshovel::app::RunScenario(c->scenario, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::app::MapOptions map;
-  CLI::App* map_cmd = app.add_subcommand(
+Command AddMap(CLI::App& app, const Globals& g) {
+  struct Cli {
+    autoshovel::app::MapOptions map;
+    autoshovel::app::MapCloudOptions map_cloud;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "map",
       "Build the semantic elevation map from a scenario's start pose (simulated LiDARs and "
       "camera) and draw its six layers; or, with --cloud, map your own scans and measure the "
       "heaps on them");
-  autoshovel::app::MapCloudOptions map_cloud;
-  map_cmd->add_option("scenario", map.scenario, "Scenario name or .yaml path (or give --cloud)");
-  map_cmd->add_option(
-      "--cloud", map_cloud.clouds,
-      "A scan to map (repeatable): .pcd (ascii, binary, binary_compressed, any "
-      "extra fields) or KITTI .bin, in any frame: the floor is found from the data");
-  map_cmd
-      ->add_option("--pose", map_cloud.poses,
-                   "Per --cloud (all or none): the scanner's x y z [m] roll pitch yaw [deg] in "
-                   "the first cloud's frame, R = Rz(yaw) Ry(pitch) Rx(roll)")
+  cmd->add_option("scenario", c->map.scenario, "Scenario name or .yaml path (or give --cloud)");
+  cmd->add_option("--cloud", c->map_cloud.clouds,
+                  "A scan to map (repeatable): .pcd (ascii, binary, binary_compressed, any "
+                  "extra fields) or KITTI .bin, in any frame: the floor is found from the data");
+  cmd->add_option("--pose", c->map_cloud.poses,
+                  "Per --cloud (all or none): the scanner's x y z [m] roll pitch yaw [deg] in "
+                  "the first cloud's frame, R = Rz(yaw) Ry(pitch) Rx(roll)")
       ->check(autoshovel::app::FiniteIn(-1e5, 1e5))
       ->delimiter(',');
-  map_cmd->add_option("--poses", map_cloud.poses_file,
-                      "Poses of a sequence: lines 'name x y z roll pitch yaw' (the cloud's file "
-                      "name; metres, degrees) in the first cloud's frame");
-  map_cmd->add_option("--reference", map_cloud.references,
-                      "A scan of the same place empty, from the same scanner pose (repeatable): "
-                      "heaps are measured above it, not above the floor plane");
-  map_cmd->add_option("--cell", map_cloud.cell, "Cell edge [m] (default: the extent / 250)")
+  cmd->add_option("--poses", c->map_cloud.poses_file,
+                  "Poses of a sequence: lines 'name x y z roll pitch yaw' (the cloud's file "
+                  "name; metres, degrees) in the first cloud's frame");
+  cmd->add_option("--reference", c->map_cloud.references,
+                  "A scan of the same place empty, from the same scanner pose (repeatable): "
+                  "heaps are measured above it, not above the floor plane");
+  cmd->add_option("--cell", c->map_cloud.cell, "Cell edge [m] (default: the extent / 250)")
       ->check(autoshovel::app::FiniteIn(0.001, 10));
-  map_cmd->add_option("--up", map_cloud.up, "Gravity up in the first cloud's frame: x y z")
+  cmd->add_option("--up", c->map_cloud.up, "Gravity up in the first cloud's frame: x y z")
       ->check(autoshovel::app::FiniteIn(-1, 1))
       ->expected(3)
       ->delimiter(',');
-  map_cmd
-      ->add_option("--alpha-d", map_cloud.alpha_d,
-                   "Sensor noise: range variance = alpha_d * distance^2 (Eq. 8)")
+  cmd->add_option("--alpha-d", c->map_cloud.alpha_d,
+                  "Sensor noise: range variance = alpha_d * distance^2 (Eq. 8)")
       ->check(autoshovel::app::FiniteIn(1e-12, 1))
       ->capture_default_str();
-  map_cmd
-      ->add_option("--min-heap-height", map_cloud.min_heap_height,
-                   "Cells this high above the floor form heaps [m] (default: 4 sigma of the "
-                   "floor's noise, at least 1 cm)")
+  cmd->add_option("--min-heap-height", c->map_cloud.min_heap_height,
+                  "Cells this high above the floor form heaps [m] (default: 4 sigma of the "
+                  "floor's noise, at least 1 cm)")
       ->check(autoshovel::app::FiniteIn(0, 100));
-  map_cmd
-      ->add_option("--output-dir", map_cloud.output,
-                   "--cloud: folder for heaps.csv, elevation.png, uncertainty.png, heaps.png")
+  cmd->add_option("--output-dir", c->map_cloud.output,
+                  "--cloud: folder for heaps.csv, elevation.png, uncertainty.png, heaps.png")
       ->capture_default_str();
-  map_cmd->add_option("-o,--png", map.png, "Six-layer picture")->capture_default_str();
-  map_cmd->add_option("--lighting", map.lighting, "normal, bright or dim (default: scenario's)");
-  map_cmd->add_option("--frames", map.frames, "LiDAR frames per sensor")
+  cmd->add_option("-o,--png", c->map.png, "Six-layer picture")->capture_default_str();
+  cmd->add_option("--lighting", c->map.lighting, "normal, bright or dim (default: scenario's)");
+  cmd->add_option("--frames", c->map.frames, "LiDAR frames per sensor")
       ->check(autoshovel::app::IntegerIn(1, 100))
       ->capture_default_str();
-  map_cmd->add_option("--advance", map.advance, "Start this far ahead of the start pose [m]")
+  cmd->add_option("--advance", c->map.advance, "Start this far ahead of the start pose [m]")
       ->check(autoshovel::app::FiniteIn(-50, 50))
       ->capture_default_str();
-  map_cmd->add_option("--segmenter", map.segmenter,
-                      "ONNX segmentation network (default: models/segmentation/yard_segmenter)");
-  map_cmd->add_flag("--truth", map.truth_labels,
-                    "Use the simulator's per-pixel labels instead of the network");
+  cmd->add_option("--segmenter", c->map.segmenter,
+                  "ONNX segmentation network (default: models/segmentation/yard_segmenter)");
+  cmd->add_flag("--truth", c->map.truth_labels,
+                "Use the simulator's per-pixel labels instead of the network");
+  return {cmd, [c, &g]() -> int {
+            if (!c->map_cloud.clouds.empty()) {
+              return autoshovel::app::RunMapCloud(c->map_cloud, std::cout, std::cerr);
+            }
+            if (c->map.scenario.empty()) {
+              std::cerr << "autoshovel map: give a scenario, or --cloud FILE for your own scans\n";
+              return 2;
+            }
+            c->map.models_dir = g.models_dir;
+            return autoshovel::app::RunMap(c->map, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::identification::CalibrateArmOptions calibrate_arm;
-  CLI::App* calibrate_cmd = app.add_subcommand("calibrate", "Calibrate a machine from data");
-  calibrate_cmd->require_subcommand(1);
-  CLI::App* arm_cmd = calibrate_cmd->add_subcommand(
+Command AddCalibrateArm(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::identification::CalibrateArmOptions calibrate_arm;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "arm", "Arm kinematic calibration (l_k, alpha_k) from IMU angles and tip displacements");
-  arm_cmd->add_option("data", calibrate_arm.data, "Measurement CSV (see --help of the format)");
-  arm_cmd->add_option("--machine", calibrate_arm.machine, "Machine name or description")
-      ->required();
-  arm_cmd
-      ->add_option("--initial", calibrate_arm.initial,
-                   "Start: lengths [m] then offsets [deg] (default: the description's)")
+  cmd->add_option("data", c->calibrate_arm.data, "Measurement CSV (see --help of the format)");
+  cmd->add_option("--machine", c->calibrate_arm.machine, "Machine name or description")->required();
+  cmd->add_option("--initial", c->calibrate_arm.initial,
+                  "Start: lengths [m] then offsets [deg] (default: the description's)")
       ->check(autoshovel::app::FiniteIn(-1e3, 1e3))
       ->delimiter(',');
-  arm_cmd->add_option("-o,--overlay", calibrate_arm.overlay, "Overlay to write");
-  arm_cmd->add_option("--png", calibrate_arm.png,
-                      "Residual chart to write (default: <overlay>.png)");
-  arm_cmd->add_option("--simulate", calibrate_arm.simulate,
-                      "Write a simulated measurement file (7 poses, seed's noise) and stop");
-  arm_cmd->add_option("--seed", calibrate_arm.seed, "Seed of --simulate")
+  cmd->add_option("-o,--overlay", c->calibrate_arm.overlay, "Overlay to write");
+  cmd->add_option("--png", c->calibrate_arm.png,
+                  "Residual chart to write (default: <overlay>.png)");
+  cmd->add_option("--simulate", c->calibrate_arm.simulate,
+                  "Write a simulated measurement file (7 poses, seed's noise) and stop");
+  cmd->add_option("--seed", c->calibrate_arm.seed, "Seed of --simulate")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
+  return {
+      cmd, [c, &g]() -> int {
+        c->calibrate_arm.models_dir = g.models_dir;
+        if (c->calibrate_arm.data.empty() && c->calibrate_arm.simulate.empty()) {
+          std::cerr << "autoshovel calibrate arm: give a measurement CSV (or --simulate FILE)\n";
+          return 2;
+        }
+        return autoshovel::identification::RunCalibrateArm(c->calibrate_arm, std::cout, std::cerr);
+      }};
+}
 
-  autoshovel::identification::CalibrateCameraLidarOptions camera_lidar;
-  CLI::App* camera_lidar_cmd = calibrate_cmd->add_subcommand(
+Command AddCalibrateCameraLidar(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::identification::CalibrateCameraLidarOptions camera_lidar;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "camera-lidar",
       "Camera-LiDAR extrinsic: board PnP, then the online consistency score (Algorithm 1)");
-  camera_lidar_cmd->add_option(
-      "--machine", camera_lidar.machine,
+  cmd->add_option(
+      "--machine", c->camera_lidar.machine,
       "Machine name or description; without it a standalone rig (intrinsics and start from "
       "--calib, --intrinsics, --initial-matrix)");
-  camera_lidar_cmd->add_option("--lidar", camera_lidar.lidar, "The LiDAR beside the camera")
+  cmd->add_option("--lidar", c->camera_lidar.lidar, "The LiDAR beside the camera")
       ->capture_default_str();
-  camera_lidar_cmd->add_option("--frames", camera_lidar.frames,
-                               "Folder of NAME.png/jpg + NAME.pcd/bin pairs");
-  camera_lidar_cmd->add_option("--pair", camera_lidar.pairs,
-                               "IMAGE,CLOUD (repeatable), instead of --frames");
-  camera_lidar_cmd->add_option(
-      "--scene", camera_lidar.scenes,
+  cmd->add_option("--frames", c->camera_lidar.frames,
+                  "Folder of NAME.png/jpg + NAME.pcd/bin pairs");
+  cmd->add_option("--pair", c->camera_lidar.pairs, "IMAGE,CLOUD (repeatable), instead of --frames");
+  cmd->add_option(
+      "--scene", c->camera_lidar.scenes,
       "CalibAnything-style scene folder (repeatable; several are fused): one image + one "
       "cloud, masks/ of binary PNGs, calib.txt");
-  camera_lidar_cmd->add_option("--calib", camera_lidar.calib,
-                               "calib.txt: K: (3x3), D: (k1 k2 p1 p2 [k3]), T: (3x4 LiDAR -> "
-                               "camera optical, the start); default: the first scene's");
-  camera_lidar_cmd->add_option("--intrinsics", camera_lidar.intrinsics,
-                               "camera_info YAML (K, D; default <root>/intrinsics.yaml, else the "
-                               "description's pinhole)");
-  camera_lidar_cmd->add_option(
-      "--masks", camera_lidar.masks,
-      "Per-frame masks: NAME/ (binary PNGs), NAME.png (labels) or NAME.json "
-      "(COCO RLE); 'none': built-in segmenter");
-  camera_lidar_cmd->add_option("--board", camera_lidar.board,
-                               "Board views and board.yaml for the initial calibration (step 1)");
-  camera_lidar_cmd
-      ->add_option("--initial", camera_lidar.initial,
-                   "Start as the camera body pose in the LiDAR frame (body: x forward, y left, "
-                   "z up): x y z [m] roll pitch yaw [deg], R = Rz(yaw) Ry(pitch) Rx(roll)")
+  cmd->add_option("--calib", c->camera_lidar.calib,
+                  "calib.txt: K: (3x3), D: (k1 k2 p1 p2 [k3]), T: (3x4 LiDAR -> "
+                  "camera optical, the start); default: the first scene's");
+  cmd->add_option("--intrinsics", c->camera_lidar.intrinsics,
+                  "camera_info YAML (K, D; default <root>/intrinsics.yaml, else the "
+                  "description's pinhole)");
+  cmd->add_option("--masks", c->camera_lidar.masks,
+                  "Per-frame masks: NAME/ (binary PNGs), NAME.png (labels) or NAME.json "
+                  "(COCO RLE); 'none': built-in segmenter");
+  cmd->add_option("--board", c->camera_lidar.board,
+                  "Board views and board.yaml for the initial calibration (step 1)");
+  cmd->add_option("--initial", c->camera_lidar.initial,
+                  "Start as the camera body pose in the LiDAR frame (body: x forward, y left, "
+                  "z up): x y z [m] roll pitch yaw [deg], R = Rz(yaw) Ry(pitch) Rx(roll)")
       ->check(autoshovel::app::FiniteIn(-1e3, 1e3))
       ->expected(6)
       ->delimiter(',');
-  camera_lidar_cmd->add_option("--initial-matrix", camera_lidar.initial_matrix,
-                               "Start as a LiDAR -> camera optical matrix (3x4 or 4x4, "
-                               "row-major; or a calib.txt)");
-  camera_lidar_cmd->add_option(
-      "--correspondences", camera_lidar.correspondences,
+  cmd->add_option("--initial-matrix", c->camera_lidar.initial_matrix,
+                  "Start as a LiDAR -> camera optical matrix (3x4 or 4x4, "
+                  "row-major; or a calib.txt)");
+  cmd->add_option(
+      "--correspondences", c->camera_lidar.correspondences,
       "Board step from picked corners: a file of lines 'u v x y z' (raw image pixel, LiDAR "
       "point), or IMAGE_FILE,LIDAR_FILE with lines 'u v' and 'x y z'; PnP with RANSAC gives "
       "the start");
-  camera_lidar_cmd
-      ->add_option("--perturb", camera_lidar.perturb,
-                   "Offset the start: roll pitch yaw [deg] x y z [m], T_start * dT with dT = "
-                   "[Rz(yaw) Ry(pitch) Rx(roll) | xyz] (CalibAnything's test protocol); errors "
-                   "are then reported against the unperturbed start")
+  cmd->add_option("--perturb", c->camera_lidar.perturb,
+                  "Offset the start: roll pitch yaw [deg] x y z [m], T_start * dT with dT = "
+                  "[Rz(yaw) Ry(pitch) Rx(roll) | xyz] (CalibAnything's test protocol); errors "
+                  "are then reported against the unperturbed start")
       ->check(autoshovel::app::FiniteIn(-180, 180))
       ->expected(6)
       ->delimiter(',');
-  camera_lidar_cmd->add_option("--reference", camera_lidar.reference,
-                               "Extrinsic (matrix or calib.txt) to report errors against, as "
-                               "the rotation and translation of T_ref * T_est^-1");
-  camera_lidar_cmd->add_option("--extrinsic-out", camera_lidar.extrinsic_out,
-                               "The result as a 4x4 LiDAR -> camera optical matrix (default: "
-                               "next to the overlay)");
-  camera_lidar_cmd->add_option("--slices-png", camera_lidar.slices_png,
-                               "Score slices around the result per axis (and a table of where "
-                               "each term peaks)");
-  camera_lidar_cmd->add_flag("--evaluate-only", camera_lidar.evaluate_only,
-                             "Score the start and its slices; no optimisation");
-  camera_lidar_cmd->add_flag(
-      "--protocol", camera_lidar.protocol,
+  cmd->add_option("--reference", c->camera_lidar.reference,
+                  "Extrinsic (matrix or calib.txt) to report errors against, as "
+                  "the rotation and translation of T_ref * T_est^-1");
+  cmd->add_option("--extrinsic-out", c->camera_lidar.extrinsic_out,
+                  "The result as a 4x4 LiDAR -> camera optical matrix (default: "
+                  "next to the overlay)");
+  cmd->add_option("--slices-png", c->camera_lidar.slices_png,
+                  "Score slices around the result per axis (and a table of where "
+                  "each term peaks)");
+  cmd->add_flag("--evaluate-only", c->camera_lidar.evaluate_only,
+                "Score the start and its slices; no optimisation");
+  cmd->add_flag(
+      "--protocol", c->camera_lidar.protocol,
       "Robustness check instead of a calibration: from the reference (--reference, else the "
       "start) perturbed by +/-R deg per axis (8 sign patterns) and by +/-R deg with +/-T m (8 "
       "more), and from the reference itself; prints each run's error and the median and worst");
-  camera_lidar_cmd
-      ->add_option("--protocol-rotation", camera_lidar.protocol_rotation, "R of --protocol [deg]")
+  cmd->add_option("--protocol-rotation", c->camera_lidar.protocol_rotation, "R of --protocol [deg]")
       ->check(autoshovel::app::FiniteIn(0, 30))
       ->capture_default_str();
-  camera_lidar_cmd
-      ->add_option("--protocol-translation", camera_lidar.protocol_translation,
-                   "T of --protocol [m]")
+  cmd->add_option("--protocol-translation", c->camera_lidar.protocol_translation,
+                  "T of --protocol [m]")
       ->check(autoshovel::app::FiniteIn(0, 2))
       ->capture_default_str();
-  camera_lidar_cmd->add_option("--lock", camera_lidar.lock, "Hold rotation or translation fixed")
+  cmd->add_option("--lock", c->camera_lidar.lock, "Hold rotation or translation fixed")
       ->check(CLI::IsMember({"rotation", "translation"}));
-  camera_lidar_cmd
-      ->add_option("--max-points", camera_lidar.max_points,
-                   "Points per frame read (a random subset beyond; bounds memory on dense "
-                   "clouds); the camera's view is cut out of them")
+  cmd->add_option("--max-points", c->camera_lidar.max_points,
+                  "Points per frame read (a random subset beyond; bounds memory on dense "
+                  "clouds); the camera's view is cut out of them")
       ->check(autoshovel::app::IntegerIn(100, 100000000))
       ->capture_default_str();
-  camera_lidar_cmd->add_option("-o,--overlay", camera_lidar.overlay, "Overlay to write");
-  camera_lidar_cmd->add_option("--png", camera_lidar.png, "Before/after projection image");
-  camera_lidar_cmd->add_option("--residuals-png", camera_lidar.residuals_png,
-                               "Score surface and board residuals");
-  camera_lidar_cmd->add_option("--simulate", camera_lidar.simulate,
-                               "Write a simulated data set here and stop: board and yard frames "
-                               "with --machine, else a street scene in the --scene layout");
-  camera_lidar_cmd->add_option("--seed", camera_lidar.seed, "Seed of --simulate")
+  cmd->add_option("-o,--overlay", c->camera_lidar.overlay, "Overlay to write");
+  cmd->add_option("--png", c->camera_lidar.png, "Before/after projection image");
+  cmd->add_option("--residuals-png", c->camera_lidar.residuals_png,
+                  "Score surface and board residuals");
+  cmd->add_option("--simulate", c->camera_lidar.simulate,
+                  "Write a simulated data set here and stop: board and yard frames "
+                  "with --machine, else a street scene in the --scene layout");
+  cmd->add_option("--seed", c->camera_lidar.seed, "Seed of --simulate")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
+  return {cmd, [c, &g]() -> int {
+            c->camera_lidar.models_dir = g.models_dir;
+            return autoshovel::identification::RunCalibrateCameraLidar(c->camera_lidar, std::cout,
+                                                                       std::cerr);
+          }};
+}
 
-  autoshovel::identification::IdentifyHydraulicsOptions hydraulics;
-  CLI::App* identify_cmd = app.add_subcommand("identify", "Identify model parameters from logs");
-  identify_cmd->require_subcommand(1);
-  CLI::App* hydraulics_cmd = identify_cmd->add_subcommand(
+Command AddIdentifyHydraulics(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::identification::IdentifyHydraulicsOptions hydraulics;
+    bool no_cross_validation = false, keep_end_stops = false;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "hydraulics",
       "Valve chain per actuator and direction from step logs: command -> pilot and pilot -> "
       "motion delays and lags, flow characteristic, stalls read from the data (--model linear: "
       "dead zone, delay, spool lag, rated flow)");
-  hydraulics_cmd->add_option("logs", hydraulics.logs,
-                             "Step or chirp logs (CSV), fitted jointly per actuator");
-  hydraulics_cmd->add_option("--machine", hydraulics.machine, "Machine name or description")
-      ->required();
-  hydraulics_cmd->add_option("--actuator", hydraulics.actuator,
-                             "Actuator name or joint (default: named by each log)");
-  hydraulics_cmd->add_option(
-      "--columns", hydraulics.columns,
+  cmd->add_option("logs", c->hydraulics.logs,
+                  "Step or chirp logs (CSV), fitted jointly per actuator");
+  cmd->add_option("--machine", c->hydraulics.machine, "Machine name or description")->required();
+  cmd->add_option("--actuator", c->hydraulics.actuator,
+                  "Actuator name or joint (default: named by each log)");
+  cmd->add_option(
+      "--columns", c->hydraulics.columns,
       "Column map time=COL,command=COL,joint_angle=COL[,spool=,pressure_a=,pressure_b=,"
       "pilot_pressure=]; COL: header name (ControlDesk: trace name, path or its last part), "
       "1-based number, or expression such as 'Boom_up_duty - Boom_dn_duty', '-Arm_ang + 90', "
       "'0.1*$3'");
-  hydraulics_cmd->add_option("--column-map", hydraulics.column_map,
-                             "YAML column map (columns: names or expressions as in --columns, "
-                             "units, header_lines, actuator)");
-  hydraulics_cmd->add_option("--command-units", hydraulics.command_units, "unit ([-1,1]) | percent")
+  cmd->add_option("--column-map", c->hydraulics.column_map,
+                  "YAML column map (columns: names or expressions as in --columns, "
+                  "units, header_lines, actuator)");
+  cmd->add_option("--command-units", c->hydraulics.command_units, "unit ([-1,1]) | percent")
       ->check(CLI::IsMember({"unit", "percent"}));
-  hydraulics_cmd
-      ->add_option("--spool-units", hydraulics.spool_units,
-                   "unit | percent (default: as the command)")
+  cmd->add_option("--spool-units", c->hydraulics.spool_units,
+                  "unit | percent (default: as the command)")
       ->check(CLI::IsMember({"unit", "percent"}));
-  hydraulics_cmd->add_option("--angle-units", hydraulics.angle_units, "rad | deg")
+  cmd->add_option("--angle-units", c->hydraulics.angle_units, "rad | deg")
       ->check(CLI::IsMember({"rad", "deg"}));
-  hydraulics_cmd->add_option("--pressure-units", hydraulics.pressure_units, "Pa | bar | MPa")
+  cmd->add_option("--pressure-units", c->hydraulics.pressure_units, "Pa | bar | MPa")
       ->check(CLI::IsMember({"Pa", "bar", "MPa"}));
-  hydraulics_cmd->add_option("--time-units", hydraulics.time_units, "s | ms")
+  cmd->add_option("--time-units", c->hydraulics.time_units, "s | ms")
       ->check(CLI::IsMember({"s", "ms"}));
-  hydraulics_cmd
-      ->add_option("--header-lines", hydraulics.header_lines,
-                   "Lines before the first sample (default: detected)")
+  cmd->add_option("--header-lines", c->hydraulics.header_lines,
+                  "Lines before the first sample (default: detected)")
       ->check(autoshovel::app::IntegerIn(0, 1000000));
-  hydraulics_cmd->add_option("-o,--overlay", hydraulics.overlay,
-                             "Overlay to write (default: <first log>.overlay.yaml)");
-  hydraulics_cmd->add_option("--png", hydraulics.png,
-                             "Residual figure (default: <first log>.residuals.png)");
-  bool no_cross_validation = false, keep_end_stops = false;
-  hydraulics_cmd->add_flag("--no-cross-validation", no_cross_validation,
-                           "Skip fitting on some duty levels and predicting the others");
-  hydraulics_cmd->add_flag("--keep-end-stops", keep_end_stops, "Fit samples at end stops too");
-  hydraulics_cmd
-      ->add_option("--model", hydraulics.model,
-                   "chain: pilot stage, flow characteristic, stalls from the data (default) | "
-                   "linear: dead zone + linear flow through the description's kinematics")
+  cmd->add_option("-o,--overlay", c->hydraulics.overlay,
+                  "Overlay to write (default: <first log>.overlay.yaml)");
+  cmd->add_option("--png", c->hydraulics.png,
+                  "Residual figure (default: <first log>.residuals.png)");
+  cmd->add_flag("--no-cross-validation", c->no_cross_validation,
+                "Skip fitting on some duty levels and predicting the others");
+  cmd->add_flag("--keep-end-stops", c->keep_end_stops, "Fit samples at end stops too");
+  cmd->add_option("--model", c->hydraulics.model,
+                  "chain: pilot stage, flow characteristic, stalls from the data (default) | "
+                  "linear: dead zone + linear flow through the description's kinematics")
       ->check(CLI::IsMember({"chain", "linear"}))
       ->capture_default_str();
-  hydraulics_cmd
-      ->add_option("--bootstrap", hydraulics.bootstrap,
-                   "chain: resamples of the logs for the parameter intervals (0: none)")
+  cmd->add_option("--bootstrap", c->hydraulics.bootstrap,
+                  "chain: resamples of the logs for the parameter intervals (0: none)")
       ->check(autoshovel::app::IntegerIn(0, 10000))
       ->capture_default_str();
-  hydraulics_cmd->add_option("--relief", hydraulics.relief,
-                             "chain: stall pressure override in the pressure units (default: the "
-                             "highest driving pressure of each log)");
-  hydraulics_cmd->add_option("--joint-range", hydraulics.joint_range,
-                             "chain: MIN:MAX joint angles to fit, in the angle units");
-  hydraulics_cmd->add_option("--window", hydraulics.window, "chain: T0:T1 time window to fit [s]");
-  hydraulics_cmd->add_option("--replay", hydraulics.replay,
-                             "Drive the description's plant with this overlay by the logs' "
-                             "commands and compare the angle (no fit)");
-  hydraulics_cmd->add_option("--simulate", hydraulics.simulate,
-                             "Write simulated plant logs (steps 30/60/100 % both ways, a chirp) "
-                             "into DIR and stop");
-  hydraulics_cmd
-      ->add_option("--format", hydraulics.simulate_format,
-                   "Layout of --simulate: plant (steps and a chirp) | controldesk (an excavator's "
-                   "boom and arm step tests with a known valve chain, truth.overlay.yaml)")
+  cmd->add_option("--relief", c->hydraulics.relief,
+                  "chain: stall pressure override in the pressure units (default: the "
+                  "highest driving pressure of each log)");
+  cmd->add_option("--joint-range", c->hydraulics.joint_range,
+                  "chain: MIN:MAX joint angles to fit, in the angle units");
+  cmd->add_option("--window", c->hydraulics.window, "chain: T0:T1 time window to fit [s]");
+  cmd->add_option("--replay", c->hydraulics.replay,
+                  "Drive the description's plant with this overlay by the logs' "
+                  "commands and compare the angle (no fit)");
+  cmd->add_option("--simulate", c->hydraulics.simulate,
+                  "Write simulated plant logs (steps 30/60/100 % both ways, a chirp) "
+                  "into DIR and stop");
+  cmd->add_option("--format", c->hydraulics.simulate_format,
+                  "Layout of --simulate: plant (steps and a chirp) | controldesk (an excavator's "
+                  "boom and arm step tests with a known valve chain, truth.overlay.yaml)")
       ->check(CLI::IsMember({"plant", "controldesk"}))
       ->capture_default_str();
-  hydraulics_cmd->add_option("--seed", hydraulics.seed, "Seed of --simulate")
+  cmd->add_option("--seed", c->hydraulics.seed, "Seed of --simulate")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
+  return {cmd, [c, &g]() -> int {
+            c->hydraulics.models_dir = g.models_dir;
+            c->hydraulics.cross_validate = !c->no_cross_validation;
+            c->hydraulics.exclude_end_stops = !c->keep_end_stops;
+            if (c->hydraulics.logs.empty() && c->hydraulics.simulate.empty()) {
+              std::cerr
+                  << "autoshovel identify hydraulics: give one or more logs (or --simulate DIR)\n";
+              return 2;
+            }
+            return autoshovel::identification::RunIdentifyHydraulics(c->hydraulics, std::cout,
+                                                                     std::cerr);
+          }};
+}
 
-  autoshovel::identification::TrainWeightsOptions train_weights;
-  CLI::App* train_cmd = app.add_subcommand("train", "Fit learned parts of the system to data");
-  train_cmd->require_subcommand(1);
-  CLI::App* weights_cmd = train_cmd->add_subcommand(
+Command AddTrainWeights(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::identification::TrainWeightsOptions train_weights;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "weights", "Tune the Eq. (18) shovel-point weights by CMA-ES on expert demonstrations");
-  weights_cmd->add_option("--machine", train_weights.machine, "Wheel loader name or description")
+  cmd->add_option("--machine", c->train_weights.machine, "Wheel loader name or description")
       ->capture_default_str();
-  weights_cmd->add_option("--demos", train_weights.demos, "Demonstrations database (SQLite)")
+  cmd->add_option("--demos", c->train_weights.demos, "Demonstrations database (SQLite)")
       ->capture_default_str();
-  weights_cmd
-      ->add_option("--generate", train_weights.generate,
-                   "First write this many simulated expert demonstrations to --demos "
-                   "(the seed used 482)")
+  cmd->add_option("--generate", c->train_weights.generate,
+                  "First write this many simulated expert demonstrations to --demos "
+                  "(the seed used 482)")
       ->check(autoshovel::app::IntegerIn(1, 1000000));
-  weights_cmd->add_option("--seed", train_weights.seed, "Seed of the scenes and of CMA-ES")
+  cmd->add_option("--seed", c->train_weights.seed, "Seed of the scenes and of CMA-ES")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
-  weights_cmd
-      ->add_option("-o,--out", train_weights.out, "Weights YAML to write (never overwritten)")
+  cmd->add_option("-o,--out", c->train_weights.out, "Weights YAML to write (never overwritten)")
       ->capture_default_str();
-  weights_cmd->add_option("--evaluations", train_weights.evaluations, "CMA-ES budget")
+  cmd->add_option("--evaluations", c->train_weights.evaluations, "CMA-ES budget")
       ->check(autoshovel::app::IntegerIn(10, 10000000))
       ->capture_default_str();
-  weights_cmd->add_option("--threads", train_weights.threads, "Worker threads (0: every core)")
+  cmd->add_option("--threads", c->train_weights.threads, "Worker threads (0: every core)")
       ->check(autoshovel::app::IntegerIn(0, 1024))
       ->capture_default_str();
+  return {cmd, [c, &g]() -> int {
+            c->train_weights.models_dir = g.models_dir;
+            return autoshovel::identification::RunTrainWeights(c->train_weights, std::cout,
+                                                               std::cerr);
+          }};
+}
 
-  autoshovel::predictor::RetrainOptions retrain;
-  CLI::App* retrain_cmd = train_cmd->add_subcommand(
+Command AddTrainPredictor(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::predictor::RetrainOptions retrain;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "predictor",
       "Train the penetration predictor on --machine's simulated plant, or retrain it from a "
       "campaign's crowding samples (DATABASE); writes STEM.model, .scale and .meta.yaml (the "
       "machine it was trained on)");
   CLI::Option* database_opt =
-      retrain_cmd->add_option("database", retrain.database,
-                              "results.sqlite of a campaign or a run (without it: crowding runs "
-                              "on the machine's simulated plant)");
-  retrain_cmd->add_option("-o,--out", retrain.out, "Path stem of the new model")->required();
-  retrain_cmd->add_option("--machine", retrain.machine, "Wheel loader name or description")
+      cmd->add_option("database", c->retrain.database,
+                      "results.sqlite of a campaign or a run (without it: crowding runs "
+                      "on the machine's simulated plant)");
+  cmd->add_option("-o,--out", c->retrain.out, "Path stem of the new model")->required();
+  cmd->add_option("--machine", c->retrain.machine, "Wheel loader name or description")
       ->capture_default_str();
-  retrain_cmd->add_option("--base", retrain.base,
-                          "Model to compare with (default with a database: the main job's, "
-                          "models/prediction/penetration_svr_fast; without: none)");
-  retrain_cmd->add_option("--strategy", retrain.strategy, "Samples of this scoop only, or all")
+  cmd->add_option("--base", c->retrain.base,
+                  "Model to compare with (default with a database: the main job's, "
+                  "models/prediction/penetration_svr_fast; without: none)");
+  cmd->add_option("--strategy", c->retrain.strategy, "Samples of this scoop only, or all")
       ->capture_default_str()
       ->needs(database_opt);
   // Without a database: the main job's recipe (RetrainOptions::MainJobPlantTraining).
-  retrain_cmd->add_option("--runs", retrain.plant.runs, "Plant crowding runs (1 in 5 held out)")
+  cmd->add_option("--runs", c->retrain.plant.runs, "Plant crowding runs (1 in 5 held out)")
       ->check(autoshovel::app::IntegerIn(5, 1000000))
       ->capture_default_str()
       ->excludes(database_opt);
-  retrain_cmd->add_option("--seed", retrain.plant.seed, "Seed of the plant runs")
+  cmd->add_option("--seed", c->retrain.plant.seed, "Seed of the plant runs")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str()
       ->excludes(database_opt);
-  retrain_cmd
-      ->add_option_function<double>(
-          "--attack-speed",
-          [&retrain](double v) {
-            retrain.plant.run_options.min_speed = retrain.plant.run_options.max_speed = v;
-          },
-          "Approach speed of the plant runs [m/s] (the main job's: 1.5)")
+  cmd->add_option_function<double>(
+         "--attack-speed",
+         [c](double v) {
+           c->retrain.plant.run_options.min_speed = c->retrain.plant.run_options.max_speed = v;
+         },
+         "Approach speed of the plant runs [m/s] (the main job's: 1.5)")
       ->check(autoshovel::app::FiniteIn(0.1, 5, false))
       ->excludes(database_opt);
-  retrain_cmd
-      ->add_option("--scoop-deceleration", retrain.plant.scoop_deceleration,
-                   "Fall of the speed reference once the arm moves [m/s^2] (0: release)")
+  cmd->add_option("--scoop-deceleration", c->retrain.plant.scoop_deceleration,
+                  "Fall of the speed reference once the arm moves [m/s^2] (0: release)")
       ->check(autoshovel::app::FiniteIn(0, 10))
       ->capture_default_str()
       ->excludes(database_opt);
-  retrain_cmd
-      ->add_option("--dug-face-fraction", retrain.plant.dug_face_fraction,
-                   "Share of plant runs on a face a previous scoop has dug")
+  cmd->add_option("--dug-face-fraction", c->retrain.plant.dug_face_fraction,
+                  "Share of plant runs on a face a previous scoop has dug")
       ->check(autoshovel::app::FiniteIn(0, 1))
       ->capture_default_str()
       ->excludes(database_opt);
-  retrain_cmd->add_option("--threads", retrain.threads, "0: every core")
+  cmd->add_option("--threads", c->retrain.threads, "0: every core")
       ->check(autoshovel::app::IntegerIn(0, 1024))
       ->capture_default_str();
+  return {cmd, [c, &g]() -> int {
+            c->retrain.models_dir = g.models_dir;
+            return autoshovel::predictor::RunRetrainPredictor(c->retrain, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::app::TrainSegmentationOptions segmentation;
-  CLI::App* segmentation_cmd = train_cmd->add_subcommand(
+Command AddTrainSegmentation(CLI::App& parent, const Globals& g) {
+  struct Cli {
+    autoshovel::app::TrainSegmentationOptions segmentation;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "segmentation",
       "Fine-tune the segmentation network on views rendered in a new site's yard; scores before "
       "and after on held-out views; never writes the shipped network");
-  segmentation_cmd->add_option("scenario", segmentation.scenario, "The new site's yard")
-      ->required();
-  segmentation_cmd->add_option("-o,--out", segmentation.out, "The new ONNX network")->required();
-  segmentation_cmd->add_option("--base", segmentation.base,
-                               "Network to start from (default: the shipped one)");
-  segmentation_cmd->add_option("--views", segmentation.views, "Training views to render")
+  cmd->add_option("scenario", c->segmentation.scenario, "The new site's yard")->required();
+  cmd->add_option("-o,--out", c->segmentation.out, "The new ONNX network")->required();
+  cmd->add_option("--base", c->segmentation.base,
+                  "Network to start from (default: the shipped one)");
+  cmd->add_option("--views", c->segmentation.views, "Training views to render")
       ->check(autoshovel::app::IntegerIn(1, 1000000))
       ->capture_default_str();
-  segmentation_cmd->add_option("--heldout", segmentation.heldout, "Held-out views to render")
+  cmd->add_option("--heldout", c->segmentation.heldout, "Held-out views to render")
       ->check(autoshovel::app::IntegerIn(1, 1000000))
       ->capture_default_str();
-  segmentation_cmd->add_option("--steps", segmentation.steps, "Fine-tuning steps (batch 8)")
+  cmd->add_option("--steps", c->segmentation.steps, "Fine-tuning steps (batch 8)")
       ->check(autoshovel::app::IntegerIn(1, 10000000))
       ->capture_default_str();
-  segmentation_cmd->add_option("--lr", segmentation.learning_rate, "Peak learning rate")
+  cmd->add_option("--lr", c->segmentation.learning_rate, "Peak learning rate")
       ->check(autoshovel::app::FiniteIn(0, 1, true))
       ->capture_default_str();
-  segmentation_cmd
-      ->add_option("--seed", segmentation.seed, "Training views' seed (held-out: seed + 1000)")
+  cmd->add_option("--seed", c->segmentation.seed, "Training views' seed (held-out: seed + 1000)")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
-  segmentation_cmd->add_option("--jobs", segmentation.jobs, "Threads")
+  cmd->add_option("--jobs", c->segmentation.jobs, "Threads")
       ->check(autoshovel::app::IntegerIn(1, 1024))
       ->capture_default_str();
-  segmentation_cmd->add_option("--work", segmentation.work_dir,
-                               "Folder for the rendered views and logs (default: <out>.data)");
+  cmd->add_option("--work", c->segmentation.work_dir,
+                  "Folder for the rendered views and logs (default: <out>.data)");
+  return {cmd, [c, &g]() -> int {
+            c->segmentation.models_dir = g.models_dir;
+            return autoshovel::app::RunTrainSegmentation(c->segmentation, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::app::CampaignOptions campaign;
-  std::string campaign_out;
-  CLI::App* campaign_cmd = app.add_subcommand(
+Command AddCampaign(CLI::App& app, const Globals& g) {
+  struct Cli {
+    autoshovel::app::CampaignOptions campaign;
+    std::string campaign_out;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "campaign",
       "Run a production campaign (weeks of shifts x policies) over every core, or over MPI "
       "ranks under mpirun; resumable");
-  campaign_cmd->add_option("spec", campaign.spec, "Campaign YAML (docs/campaigns.md)")->required();
-  campaign_cmd->add_option("-o,--out", campaign_out,
-                           "Campaign folder (default: runs/campaign_<name>)");
-  campaign_cmd->add_option("--workers", campaign.workers, "Worker processes (0: every core)")
+  cmd->add_option("spec", c->campaign.spec, "Campaign YAML (docs/campaigns.md)")->required();
+  cmd->add_option("-o,--out", c->campaign_out, "Campaign folder (default: runs/campaign_<name>)");
+  cmd->add_option("--workers", c->campaign.workers, "Worker processes (0: every core)")
       ->check(autoshovel::app::IntegerIn(0, 1024))
       ->capture_default_str();
-  campaign_cmd->add_flag("--resume", campaign.resume,
-                         "Continue the campaign in the folder: merge, then run what is missing");
-  campaign_cmd->add_option("--worker-index", campaign.worker_index)->group("");
-  campaign_cmd->add_option("--coordinator-pid", campaign.coordinator_pid)->group("");
-  campaign_cmd->add_option("--worker-count", campaign.worker_count)->group("");
+  cmd->add_flag("--resume", c->campaign.resume,
+                "Continue the campaign in the folder: merge, then run what is missing");
+  cmd->add_option("--worker-index", c->campaign.worker_index)->group("");
+  cmd->add_option("--coordinator-pid", c->campaign.coordinator_pid)->group("");
+  cmd->add_option("--worker-count", c->campaign.worker_count)->group("");
+  return {cmd, [c, &g]() -> int {
+            c->campaign.models_dir = g.models_dir;
+            c->campaign.out_dir = c->campaign_out;
+            return autoshovel::app::RunCampaign(c->campaign, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::app::ProductionReportOptions production;
-  std::string production_db, production_png;
-  CLI::App* report_cmd = app.add_subcommand("report", "Reports from results databases");
-  report_cmd->require_subcommand(1);
-  CLI::App* production_cmd = report_cmd->add_subcommand(
+Command AddReportProduction(CLI::App& parent, const Globals&) {
+  struct Cli {
+    autoshovel::app::ProductionReportOptions production;
+    std::string production_db, production_png;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = parent.add_subcommand(
       "production",
       "The seed's Tables 6-7 and Fig. 22 from a campaign database (adaptive vs Stairway #3)");
-  production_cmd->add_option("database", production_db, "results.sqlite of a campaign")->required();
-  production_cmd->add_option("--png", production_png,
-                             "Fig. 22 box plots (default: production_fig22.png beside it)");
-  production_cmd->add_option("--adaptive", production.adaptive_policy, "Adaptive policy's name")
+  cmd->add_option("database", c->production_db, "results.sqlite of a campaign")->required();
+  cmd->add_option("--png", c->production_png,
+                  "Fig. 22 box plots (default: production_fig22.png beside it)");
+  cmd->add_option("--adaptive", c->production.adaptive_policy, "Adaptive policy's name")
       ->capture_default_str();
-  production_cmd->add_option("--baseline", production.baseline_policy, "Baseline policy's name")
+  cmd->add_option("--baseline", c->production.baseline_policy, "Baseline policy's name")
       ->capture_default_str();
+  return {cmd, [c]() -> int {
+            c->production.database = c->production_db;
+            c->production.png = c->production_png;
+            return autoshovel::app::RunProductionReport(c->production, std::cout, std::cerr);
+          }};
+}
 
-  autoshovel::planning::SelectOptions select;
-  CLI::App* select_cmd = app.add_subcommand(
+Command AddSelect(CLI::App& app, const Globals& g) {
+  struct Cli {
+    autoshovel::planning::SelectOptions select;
+    bool no_baseline = false;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "select", "Shovel point selection (Algorithm 2) on a yard: ranked candidates and a PNG");
-  select_cmd->add_option("scenario", select.scenario, "Scenario name or path")->required();
-  select_cmd->add_option("--png", select.png, "Candidates drawn on the map")->capture_default_str();
-  select_cmd->add_flag("--truth-map", select.truth_map,
-                       "Rasterise the simulator's yard instead of perceiving it");
-  select_cmd->add_flag("--truth", select.truth_labels,
-                       "Perceive with the simulator's labels instead of the network");
-  select_cmd->add_option("--segmenter", select.segmenter, "ONNX segmentation network");
-  select_cmd->add_option("--frames", select.frames, "LiDAR frames per sensor")
+  cmd->add_option("scenario", c->select.scenario, "Scenario name or path")->required();
+  cmd->add_option("--png", c->select.png, "Candidates drawn on the map")->capture_default_str();
+  cmd->add_flag("--truth-map", c->select.truth_map,
+                "Rasterise the simulator's yard instead of perceiving it");
+  cmd->add_flag("--truth", c->select.truth_labels,
+                "Perceive with the simulator's labels instead of the network");
+  cmd->add_option("--segmenter", c->select.segmenter, "ONNX segmentation network");
+  cmd->add_option("--frames", c->select.frames, "LiDAR frames per sensor")
       ->check(autoshovel::app::IntegerIn(1, 100))
       ->capture_default_str();
-  select_cmd->add_option("--advance", select.advance, "Drive the start pose this far ahead [m]")
+  cmd->add_option("--advance", c->select.advance, "Drive the start pose this far ahead [m]")
       ->check(autoshovel::app::FiniteIn(-50, 50))
       ->capture_default_str();
-  select_cmd->add_option("--spacing", select.spacing, "Candidate spacing along the front [m]")
+  cmd->add_option("--spacing", c->select.spacing, "Candidate spacing along the front [m]")
       ->check(autoshovel::app::FiniteIn(0.05, 10))
       ->capture_default_str();
-  select_cmd
-      ->add_option("--angles", select.entry_angles_deg,
-                   "Entry headings relative to the face normal [deg]")
+  cmd->add_option("--angles", c->select.entry_angles_deg,
+                  "Entry headings relative to the face normal [deg]")
       ->check(autoshovel::app::FiniteIn(-90, 90))
       ->delimiter(',');
-  select_cmd->add_option("--safety-distance", select.safety_distance, "d_res [m]")
+  cmd->add_option("--safety-distance", c->select.safety_distance, "d_res [m]")
       ->check(autoshovel::app::FiniteIn(0, 20))
       ->capture_default_str();
-  select_cmd->add_option("--top", select.top, "Candidates listed and drawn")
+  cmd->add_option("--top", c->select.top, "Candidates listed and drawn")
       ->check(autoshovel::app::IntegerIn(1, 1000))
       ->capture_default_str();
-  select_cmd->add_option("--pile", select.pile, "Only this pile (index, largest first)")
+  cmd->add_option("--pile", c->select.pile, "Only this pile (index, largest first)")
       ->check(autoshovel::app::IntegerIn(0, 1000));
-  bool no_baseline = false;
-  select_cmd->add_flag("--no-baseline", no_baseline, "Skip the Chen et al. (2024) ranking");
+  cmd->add_flag("--no-baseline", c->no_baseline, "Skip the Chen et al. (2024) ranking");
+  return {cmd, [c, &g]() -> int {
+            c->select.models_dir = g.models_dir;
+            c->select.baseline = !c->no_baseline;
+            return autoshovel::planning::RunSelect(c->select, std::cout, std::cerr);
+          }};
+}
 
+// What `autoshovel run` parses: the main job's options, or the truck-loading job's for an
+// excavator's scenario.
+struct RunCli {
   autoshovel::app::ShovelRunOptions run;
   std::string run_faults;
   std::string run_out, run_policy = "auto", run_trigger = "predicted", run_selection = "ours";
   double run_pressure_bar = run.pressure_threshold / 1e5;
-  CLI::App* run_cmd = app.add_subcommand(
+  bool run_no_feed_forward = false;
+  bool run_no_figures = false;
+  autoshovel::app::TruckLoadingOptions truck_loading;
+  bool truck_loading_dust = false;
+};
+
+// `autoshovel run`: an excavator's scenario (truck_loading) runs the truck-loading job, passes
+// instead of cycles, until the truck is full unless --cycles is given; any other the main job.
+int RunMainJob(RunCli& c, bool cycles_given, const Globals& g) {
+  bool excavator = false;
+  try {
+    excavator =
+        autoshovel::app::TruckLoadingJob::IsTruckLoadingScenario(c.run.scenario, g.models_dir);
+  } catch (const std::exception&) {
+    // Not loadable here: the shovel job reports what is wrong with it.
+  }
+  if (excavator) {
+    autoshovel::app::TruckLoadingOptions& truck = c.truck_loading;
+    truck.scenario = c.run.scenario;
+    truck.models_dir = g.models_dir;
+    truck.seed = c.run.seed;
+    truck.figures = !c.run_no_figures;
+    if (cycles_given) truck.passes = c.run.cycles;
+    if (c.truck_loading_dust) {
+      const double azimuth = truck.truck_azimuth_deg * 3.14159265358979 / 180.0;
+      autoshovel::app::DustCloud cloud;
+      cloud.p_world_center = Eigen::Vector3d(truck.truck_radius * std::cos(azimuth),
+                                             truck.truck_radius * std::sin(azimuth), 0.5);
+      truck.dust.push_back(cloud);
+    }
+    return autoshovel::app::RunTruckLoadingCommand(truck, c.run_out, std::cout, std::cerr);
+  }
+  autoshovel::app::ShovelRunOptions& run = c.run;
+  run.models_dir = g.models_dir;
+  run.figures = !c.run_no_figures;
+  run.attitude_feed_forward = !c.run_no_feed_forward;
+  run.pressure_threshold = c.run_pressure_bar * 1e5;
+  using autoshovel::control::ScoopPolicy;
+  run.policy = c.run_policy == "auto"          ? ScoopPolicy::kAutoSelection
+               : c.run_policy == "just_in_out" ? ScoopPolicy::kJustInOut
+               : c.run_policy == "stairway"    ? ScoopPolicy::kStairway
+               : c.run_policy == "optimal"     ? ScoopPolicy::kOptimal
+                                               : ScoopPolicy::kStairwayFixed;
+  using autoshovel::app::TriggerChoice;
+  run.trigger = c.run_trigger == "predicted"    ? TriggerChoice::kPredicted
+                : c.run_trigger == "perception" ? TriggerChoice::kPerception
+                                                : TriggerChoice::kPressure;
+  run.selection = c.run_selection == "ours" ? autoshovel::app::SelectionMethod::kOurs
+                                            : autoshovel::app::SelectionMethod::kChen2024;
+  if (!c.run_faults.empty()) {
+    try {
+      run.faults = autoshovel::plant::LoadFaults(c.run_faults);
+    } catch (const std::exception& e) {
+      std::cerr << "autoshovel run: " << e.what() << "\n";
+      return 2;
+    }
+  }
+  return autoshovel::app::RunShovelCommand(run, c.run_out, std::cout, std::cerr);
+}
+
+Command AddRun(CLI::App& app, const Globals& g) {
+  using Cli = RunCli;
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "run",
       "The main job: closed-loop shoveling cycles in a simulated yard; writes a run folder with "
       "config.yaml, results.sqlite, log.txt and report.html");
-  run_cmd->add_option("scenario", run.scenario, "Scenario name or path")->capture_default_str();
-  run_cmd->add_option("--machine", run.machine,
-                      "Wheel-loader name or description (default: "
-                      "the scenario's)");
-  run_cmd->add_option("--cycles", run.cycles, "Shoveling cycles")
+  cmd->add_option("scenario", c->run.scenario, "Scenario name or path")->capture_default_str();
+  cmd->add_option("--machine", c->run.machine,
+                  "Wheel-loader name or description (default: "
+                  "the scenario's)");
+  cmd->add_option("--cycles", c->run.cycles, "Shoveling cycles")
       ->check(autoshovel::app::IntegerIn(1, 100000))
       ->capture_default_str();
-  run_cmd->add_option("--seed", run.seed, "Seed of every random draw")
+  cmd->add_option("--seed", c->run.seed, "Seed of every random draw")
       ->check(autoshovel::app::SeedRange())
       ->capture_default_str();
-  run_cmd->add_option("-o,--out", run_out, "Run folder (default: runs/<UTC timestamp>)");
-  run_cmd->add_option("--bins", run.bins, "Bins to shovel from in turn (default: all with piles)");
-  run_cmd->add_flag("--truth", run.truth_labels,
-                    "Simulator labels instead of the segmentation network");
-  run_cmd->add_option("--segmenter", run.segmenter, "ONNX segmentation network");
-  run_cmd->add_option("--predictor", run.predictor, "Penetration SVR (path without .model)");
-  run_cmd
-      ->add_option("--policy", run_policy,
-                   "auto | just_in_out | stairway | stairway_fixed | optimal")
+  cmd->add_option("-o,--out", c->run_out, "Run folder (default: runs/<UTC timestamp>)");
+  cmd->add_option("--bins", c->run.bins, "Bins to shovel from in turn (default: all with piles)");
+  cmd->add_flag("--truth", c->run.truth_labels,
+                "Simulator labels instead of the segmentation network");
+  cmd->add_option("--segmenter", c->run.segmenter, "ONNX segmentation network");
+  cmd->add_option("--predictor", c->run.predictor, "Penetration SVR (path without .model)");
+  cmd->add_option("--policy", c->run_policy,
+                  "auto | just_in_out | stairway | stairway_fixed | optimal")
       ->check(CLI::IsMember({"auto", "just_in_out", "stairway", "stairway_fixed", "optimal"}))
       ->capture_default_str();
-  run_cmd->add_option("--trigger", run_trigger, "predicted | perception | pressure")
+  cmd->add_option("--trigger", c->run_trigger, "predicted | perception | pressure")
       ->check(CLI::IsMember({"predicted", "perception", "pressure"}))
       ->capture_default_str();
-  run_cmd->add_option("--pressure-bar", run_pressure_bar, "Threshold of --trigger pressure [bar]")
+  cmd->add_option("--pressure-bar", c->run_pressure_bar, "Threshold of --trigger pressure [bar]")
       ->check(autoshovel::app::FiniteIn(0, 420, true))
       ->capture_default_str();
-  run_cmd
-      ->add_option("--scoop-deceleration", run.scoop_deceleration,
-                   "Fall of the speed reference once the scoop moves the arm [m/s^2] (the "
-                   "predictor must be trained for it: docs/scooping_control.md)")
+  cmd->add_option("--scoop-deceleration", c->run.scoop_deceleration,
+                  "Fall of the speed reference once the scoop moves the arm [m/s^2] (the "
+                  "predictor must be trained for it: docs/scooping_control.md)")
       ->check(autoshovel::app::FiniteIn(0, 10, true))
       ->capture_default_str();
-  run_cmd
-      ->add_option("--attack-speed", run.attack_speed,
-                   "Approach and crowding speed [m/s] (the predictor must be trained for it)")
+  cmd->add_option("--attack-speed", c->run.attack_speed,
+                  "Approach and crowding speed [m/s] (the predictor must be trained for it)")
       ->check(autoshovel::app::FiniteIn(0, 3, true))
       ->capture_default_str();
-  run_cmd
-      ->add_option("--target-fill", run.target_fill,
-                   "V_t as a fraction of the rated capacity: the trigger's and the adaptive "
-                   "Stairway's target")
+  cmd->add_option("--target-fill", c->run.target_fill,
+                  "V_t as a fraction of the rated capacity: the trigger's and the adaptive "
+                  "Stairway's target")
       ->check(autoshovel::app::FiniteIn(0.1, 1.5))
       ->capture_default_str();
-  bool run_no_feed_forward = false;
-  run_cmd->add_flag("--no-attitude-feed-forward", run_no_feed_forward,
-                    "Hold the bucket's attitude in the exit lift by its PID alone (no tilt "
-                    "feed-forward from the boom's demand: docs/scooping_control.md)");
-  run_cmd->add_option("--stairway-steps", run.stairway_steps, "N of Stairway #N")
+  cmd->add_flag("--no-attitude-feed-forward", c->run_no_feed_forward,
+                "Hold the bucket's attitude in the exit lift by its PID alone (no tilt "
+                "feed-forward from the boom's demand: docs/scooping_control.md)");
+  cmd->add_option("--stairway-steps", c->run.stairway_steps, "N of Stairway #N")
       ->check(autoshovel::app::IntegerIn(1, 20))
       ->capture_default_str();
-  run_cmd->add_option("--selection", run_selection, "ours | chen2024")
+  cmd->add_option("--selection", c->run_selection, "ours | chen2024")
       ->check(CLI::IsMember({"ours", "chen2024"}))
       ->capture_default_str();
-  run_cmd
-      ->add_option("--safety-distance", run.safety_distance,
-                   "Never closer to an obstacle (footprint with 0.3 m margins) [m]")
+  cmd->add_option("--safety-distance", c->run.safety_distance,
+                  "Never closer to an obstacle (footprint with 0.3 m margins) [m]")
       ->check(autoshovel::app::FiniteIn(0, 20))
       ->capture_default_str();
-  run_cmd->add_option("--d-res", run.d_res, "d_res of Eq. (14) [m]")
+  cmd->add_option("--d-res", c->run.d_res, "d_res of Eq. (14) [m]")
       ->check(autoshovel::app::FiniteIn(0, 20, true))
       ->capture_default_str();
-  run_cmd
-      ->add_option("--sure-obstacle-growth", run.sure_obstacle_growth_cells,
-                   "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
+  cmd->add_option("--sure-obstacle-growth", c->run.sure_obstacle_growth_cells,
+                  "Crowd look-ahead: grow the map's sure obstacle cells by this many cells")
       ->check(autoshovel::app::IntegerIn(0, 10))
       ->capture_default_str();
-  run_cmd
-      ->add_option("--faults", run_faults,
-                   "YAML file with a 'faults' list injected into every cycle (docs/faults.md)")
+  cmd->add_option("--faults", c->run_faults,
+                  "YAML file with a 'faults' list injected into every cycle (docs/faults.md)")
       ->check(CLI::ExistingFile);
-  run_cmd
-      ->add_option("--yard-variation", run.yard_variation,
-                   "Restock the piles up to this fraction lower (a campaign's yard_variation)")
+  cmd->add_option("--yard-variation", c->run.yard_variation,
+                  "Restock the piles up to this fraction lower (a campaign's yard_variation)")
       ->check(autoshovel::app::FiniteIn(0, 0.9))
       ->capture_default_str();
-  run_cmd->add_option("--shovel-weights", run.shovel_weights,
-                      "Eq. (18) weights YAML from `autoshovel train weights` (default: Table 1)");
-  bool run_no_figures = false;
-  run_cmd->add_flag("--no-figures", run_no_figures, "Skip the per-cycle PNGs");
-  autoshovel::app::TruckLoadingOptions truck_loading;
-  bool truck_loading_dust = false;
-  run_cmd
-      ->add_option("--dig-evaluations", truck_loading.dig_evaluations,
-                   "Excavator scenarios: plant simulations per dig plan")
+  cmd->add_option("--shovel-weights", c->run.shovel_weights,
+                  "Eq. (18) weights YAML from `autoshovel train weights` (default: Table 1)");
+  cmd->add_flag("--no-figures", c->run_no_figures, "Skip the per-cycle PNGs");
+  cmd->add_option("--dig-evaluations", c->truck_loading.dig_evaluations,
+                  "Excavator scenarios: plant simulations per dig plan")
       ->check(autoshovel::app::IntegerIn(1, 100000))
       ->capture_default_str();
-  run_cmd->add_flag(
-      "--dust", truck_loading_dust,
-      "Excavator scenarios: a dust cloud (3 m radius, visibility 16 m) over the truck");
+  cmd->add_flag("--dust", c->truck_loading_dust,
+                "Excavator scenarios: a dust cloud (3 m radius, visibility 16 m) over the truck");
+  return {cmd, [c, cmd, &g]() -> int { return RunMainJob(*c, cmd->count("--cycles") > 0, g); }};
+}
 
-  autoshovel::app::CompareOptions compare;
-  double compare_pressure_bar = compare.pressure_threshold / 1e5;
-  CLI::App* compare_cmd = app.add_subcommand(
+Command AddCompare(CLI::App& app, const Globals& g) {
+  struct Cli {
+    autoshovel::app::CompareOptions compare;
+    double compare_pressure_bar = compare.pressure_threshold / 1e5;
+    std::string compare_output;
+    bool compare_no_optimum = false;
+    bool compare_no_feed_forward = false;
+  };
+  auto c = std::make_shared<Cli>();
+  CLI::App* cmd = app.add_subcommand(
       "compare",
       "Rerun the seed's Table 4 (shovel point selection) or Table 5 (trigger and "
       "scooping strategy) in simulation, beside the seed's figures; `audit`: where a gravel "
       "and a sand scoop's energy goes");
-  compare_cmd->add_option("table", compare.table, "table4 | table5 | audit")
+  cmd->add_option("table", c->compare.table, "table4 | table5 | audit")
       ->required()
       ->check(CLI::IsMember({"table4", "table5", "audit"}));
-  compare_cmd->add_option("--machine", compare.machine,
-                          "Wheel-loader description (name or path) instead of the scenario's");
-  std::string compare_output;
-  compare_cmd->add_option("-o,--output", compare_output,
-                          "audit: folder for the stacked energy plots and per-tick CSVs");
-  compare_cmd->add_option("--trials", compare.trials, "Single-cycle runs per cell")
+  cmd->add_option("--machine", c->compare.machine,
+                  "Wheel-loader description (name or path) instead of the scenario's");
+  cmd->add_option("-o,--output", c->compare_output,
+                  "audit: folder for the stacked energy plots and per-tick CSVs");
+  cmd->add_option("--trials", c->compare.trials, "Single-cycle runs per cell")
       ->check(autoshovel::app::IntegerIn(1, 1000))
       ->capture_default_str();
-  bool compare_no_optimum = false;
-  compare_cmd->add_flag("--no-optimum", compare_no_optimum,
-                        "table5: leave out the optimal scoop beside each row (saves its solves)");
-  compare_cmd->add_flag("--network", compare.network,
-                        "Segmentation network instead of the simulator's labels");
-  compare_cmd
-      ->add_option("--scoop-deceleration", compare.scoop_deceleration,
-                   "Fall of the speed reference once the scoop moves the arm [m/s^2]")
+  cmd->add_flag("--no-optimum", c->compare_no_optimum,
+                "table5: leave out the optimal scoop beside each row (saves its solves)");
+  cmd->add_flag("--network", c->compare.network,
+                "Segmentation network instead of the simulator's labels");
+  cmd->add_option("--scoop-deceleration", c->compare.scoop_deceleration,
+                  "Fall of the speed reference once the scoop moves the arm [m/s^2]")
       ->check(autoshovel::app::FiniteIn(0, 10, true))
       ->capture_default_str();
-  compare_cmd
-      ->add_option("--attack-speed", compare.attack_speed, "Approach and crowding speed [m/s]")
+  cmd->add_option("--attack-speed", c->compare.attack_speed, "Approach and crowding speed [m/s]")
       ->check(autoshovel::app::FiniteIn(0, 3, true))
       ->capture_default_str();
-  compare_cmd
-      ->add_option("--target-fill", compare.target_fill, "V_t as a fraction of the rated capacity")
+  cmd->add_option("--target-fill", c->compare.target_fill,
+                  "V_t as a fraction of the rated capacity")
       ->check(autoshovel::app::FiniteIn(0.1, 1.5))
       ->capture_default_str();
-  bool compare_no_feed_forward = false;
-  compare_cmd->add_flag("--no-attitude-feed-forward", compare_no_feed_forward,
-                        "Hold the bucket's attitude in the exit lift by its PID alone");
-  compare_cmd->add_option("--predictor", compare.predictor,
-                          "Penetration SVR (path without .model; default: the shipped one)");
-  compare_cmd
-      ->add_option("--pressure-bar", compare_pressure_bar,
-                   "Threshold of the pressure trigger [bar]")
+  cmd->add_flag("--no-attitude-feed-forward", c->compare_no_feed_forward,
+                "Hold the bucket's attitude in the exit lift by its PID alone");
+  cmd->add_option("--predictor", c->compare.predictor,
+                  "Penetration SVR (path without .model; default: the shipped one)");
+  cmd->add_option("--pressure-bar", c->compare_pressure_bar,
+                  "Threshold of the pressure trigger [bar]")
       ->check(autoshovel::app::FiniteIn(0, 420, true))
       ->capture_default_str();
+  return {cmd, [c, &g]() -> int {
+            c->compare.models_dir = g.models_dir;
+            c->compare.pressure_threshold = c->compare_pressure_bar * 1e5;
+            c->compare.attitude_feed_forward = !c->compare_no_feed_forward;
+            c->compare.optimum = !c->compare_no_optimum;
+            if (c->compare.table == "audit") {
+              return autoshovel::app::RunEnergyAudit(c->compare, c->compare_output, std::cout,
+                                                     std::cerr);
+            }
+            return autoshovel::app::RunCompare(c->compare, std::cout, std::cerr);
+          }};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"autoshovel — autonomous wheel-loader shoveling and excavator truck loading"};
+  app.require_subcommand(1);
+  Globals g;
+  app.add_option("--models", g.models_dir, "Folder of machine descriptions and materials")
+      ->capture_default_str();
+  app.add_option("--materials", g.materials_dir,
+                 "Material folder for every description loaded (default: <description "
+                 "dir>/../materials, then <models>/materials)");
+  // --models and --materials may also follow the subcommand (`describe FILE --materials DIR`).
+  app.fallthrough();
+
+  // In the order `--help` lists them; the groups take one subcommand each.
+  std::vector<Command> commands;
+  commands.push_back(AddDescribe(app, g));
+  commands.push_back(AddArchitecture(app, g));
+  commands.push_back(AddGen(app, g));
+  CLI::App* plant = app.add_subcommand("plant", "Experiments on the simulated machine");
+  plant->require_subcommand(1);
+  commands.push_back(AddPlantStep(*plant, g));
+  commands.push_back(AddScenario(app, g));
+  commands.push_back(AddMap(app, g));
+  CLI::App* calibrate = app.add_subcommand("calibrate", "Calibrate a machine from data");
+  calibrate->require_subcommand(1);
+  commands.push_back(AddCalibrateArm(*calibrate, g));
+  commands.push_back(AddCalibrateCameraLidar(*calibrate, g));
+  CLI::App* identify = app.add_subcommand("identify", "Identify model parameters from logs");
+  identify->require_subcommand(1);
+  commands.push_back(AddIdentifyHydraulics(*identify, g));
+  CLI::App* train = app.add_subcommand("train", "Fit learned parts of the system to data");
+  train->require_subcommand(1);
+  commands.push_back(AddTrainWeights(*train, g));
+  commands.push_back(AddTrainPredictor(*train, g));
+  commands.push_back(AddTrainSegmentation(*train, g));
+  commands.push_back(AddCampaign(app, g));
+  CLI::App* report = app.add_subcommand("report", "Reports from results databases");
+  report->require_subcommand(1);
+  commands.push_back(AddReportProduction(*report, g));
+  commands.push_back(AddSelect(app, g));
+  commands.push_back(AddRun(app, g));
+  commands.push_back(AddCompare(app, g));
 
   // One line naming the command and the option for any refused command line (cli_checks.h).
   app.failure_message(autoshovel::app::FailureLine);
@@ -754,187 +1015,13 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   // Every command that loads a description searches these (model::LoadOptions).
-  autoshovel::model::SetDefaultMaterialFolders(materials_dir, models_dir);
-  if (gen_materials.empty()) gen_materials = materials_dir;
-  if (gen_materials.empty() && *gen_cmd) {
-    // The generator takes one material folder: the descriptions' own when they have one, else
-    // the models folder's (a description written outside models/ finds the shipped materials).
-    bool own = false;
-    for (const std::string& d : gen_descriptions) {
-      std::error_code error;
-      own = own || std::filesystem::is_directory(
-                       std::filesystem::path(d).parent_path() / ".." / "materials", error);
+  autoshovel::model::SetDefaultMaterialFolders(g.materials_dir, g.models_dir);
+  int status = 0;
+  for (const Command& command : commands) {
+    if (*command.cli) {
+      status = command.run();
+      break;
     }
-    if (!own) gen_materials = models_dir + "/materials";
   }
-
-  const int status = [&]() -> int {
-    if (*compare_cmd) {
-      compare.models_dir = models_dir;
-      compare.pressure_threshold = compare_pressure_bar * 1e5;
-      compare.attitude_feed_forward = !compare_no_feed_forward;
-      compare.optimum = !compare_no_optimum;
-      if (compare.table == "audit") {
-        return autoshovel::app::RunEnergyAudit(compare, compare_output, std::cout, std::cerr);
-      }
-      return autoshovel::app::RunCompare(compare, std::cout, std::cerr);
-    }
-
-    if (*run_cmd) {
-      // An excavator's scenario (truck_loading) runs the truck-loading job: passes instead of
-      // cycles, until the truck is full unless --cycles is given.
-      bool excavator = false;
-      try {
-        excavator =
-            autoshovel::app::TruckLoadingJob::IsTruckLoadingScenario(run.scenario, models_dir);
-      } catch (const std::exception&) {
-        // Not loadable here: the shovel job reports what is wrong with it.
-      }
-      if (excavator) {
-        truck_loading.scenario = run.scenario;
-        truck_loading.models_dir = models_dir;
-        truck_loading.seed = run.seed;
-        truck_loading.figures = !run_no_figures;
-        if (run_cmd->count("--cycles") > 0) truck_loading.passes = run.cycles;
-        if (truck_loading_dust) {
-          const double azimuth = truck_loading.truck_azimuth_deg * 3.14159265358979 / 180.0;
-          autoshovel::app::DustCloud cloud;
-          cloud.p_world_center =
-              Eigen::Vector3d(truck_loading.truck_radius * std::cos(azimuth),
-                              truck_loading.truck_radius * std::sin(azimuth), 0.5);
-          truck_loading.dust.push_back(cloud);
-        }
-        return autoshovel::app::RunTruckLoadingCommand(truck_loading, run_out, std::cout,
-                                                       std::cerr);
-      }
-      run.models_dir = models_dir;
-      run.figures = !run_no_figures;
-      run.attitude_feed_forward = !run_no_feed_forward;
-      run.pressure_threshold = run_pressure_bar * 1e5;
-      using autoshovel::control::ScoopPolicy;
-      run.policy = run_policy == "auto"          ? ScoopPolicy::kAutoSelection
-                   : run_policy == "just_in_out" ? ScoopPolicy::kJustInOut
-                   : run_policy == "stairway"    ? ScoopPolicy::kStairway
-                   : run_policy == "optimal"     ? ScoopPolicy::kOptimal
-                                                 : ScoopPolicy::kStairwayFixed;
-      using autoshovel::app::TriggerChoice;
-      run.trigger = run_trigger == "predicted"    ? TriggerChoice::kPredicted
-                    : run_trigger == "perception" ? TriggerChoice::kPerception
-                                                  : TriggerChoice::kPressure;
-      run.selection = run_selection == "ours" ? autoshovel::app::SelectionMethod::kOurs
-                                              : autoshovel::app::SelectionMethod::kChen2024;
-      if (!run_faults.empty()) {
-        try {
-          run.faults = autoshovel::plant::LoadFaults(run_faults);
-        } catch (const std::exception& e) {
-          std::cerr << "autoshovel run: " << e.what() << "\n";
-          return 2;
-        }
-      }
-      return autoshovel::app::RunShovelCommand(run, run_out, std::cout, std::cerr);
-    }
-
-    if (*architecture_cmd) {
-      const std::string dot =
-          autoshovel::app::ShovelJobArchitectureDot(autoshovel::app::ShovelRunOptions{});
-      if (architecture_output.empty()) {
-        std::cout << dot;
-        return 0;
-      }
-      try {
-        autoshovel::core::WriteFileAtomically(architecture_output, dot);
-      } catch (const autoshovel::core::OutputError& e) {
-        std::cerr << "autoshovel architecture: " << e.what() << "\n";
-        return 1;
-      }
-      return 0;
-    }
-    if (*describe_cmd) {
-      describe.models_dir = models_dir;
-      return autoshovel::app::RunDescribe(describe, std::cout, std::cerr);
-    }
-    if (*arm_cmd) {
-      calibrate_arm.models_dir = models_dir;
-      if (calibrate_arm.data.empty() && calibrate_arm.simulate.empty()) {
-        std::cerr << "autoshovel calibrate arm: give a measurement CSV (or --simulate FILE)\n";
-        return 2;
-      }
-      return autoshovel::identification::RunCalibrateArm(calibrate_arm, std::cout, std::cerr);
-    }
-    if (*production_cmd) {
-      production.database = production_db;
-      production.png = production_png;
-      return autoshovel::app::RunProductionReport(production, std::cout, std::cerr);
-    }
-    if (*campaign_cmd) {
-      campaign.models_dir = models_dir;
-      campaign.out_dir = campaign_out;
-      return autoshovel::app::RunCampaign(campaign, std::cout, std::cerr);
-    }
-    if (*segmentation_cmd) {
-      segmentation.models_dir = models_dir;
-      return autoshovel::app::RunTrainSegmentation(segmentation, std::cout, std::cerr);
-    }
-    if (*retrain_cmd) {
-      retrain.models_dir = models_dir;
-      return autoshovel::predictor::RunRetrainPredictor(retrain, std::cout, std::cerr);
-    }
-    if (*weights_cmd) {
-      train_weights.models_dir = models_dir;
-      return autoshovel::identification::RunTrainWeights(train_weights, std::cout, std::cerr);
-    }
-    if (*select_cmd) {
-      select.models_dir = models_dir;
-      select.baseline = !no_baseline;
-      return autoshovel::planning::RunSelect(select, std::cout, std::cerr);
-    }
-    if (*camera_lidar_cmd) {
-      camera_lidar.models_dir = models_dir;
-      return autoshovel::identification::RunCalibrateCameraLidar(camera_lidar, std::cout,
-                                                                 std::cerr);
-    }
-    if (*hydraulics_cmd) {
-      hydraulics.models_dir = models_dir;
-      hydraulics.cross_validate = !no_cross_validation;
-      hydraulics.exclude_end_stops = !keep_end_stops;
-      if (hydraulics.logs.empty() && hydraulics.simulate.empty()) {
-        std::cerr << "autoshovel identify hydraulics: give one or more logs (or --simulate DIR)\n";
-        return 2;
-      }
-      return autoshovel::identification::RunIdentifyHydraulics(hydraulics, std::cout, std::cerr);
-    }
-    if (*map_cmd && !map_cloud.clouds.empty()) {
-      return autoshovel::app::RunMapCloud(map_cloud, std::cout, std::cerr);
-    }
-    if (*map_cmd && map.scenario.empty()) {
-      std::cerr << "autoshovel map: give a scenario, or --cloud FILE for your own scans\n";
-      return 2;
-    }
-    if (*map_cmd) {
-      map.models_dir = models_dir;
-      return autoshovel::app::RunMap(map, std::cout, std::cerr);
-    }
-    if (*scenario_cmd) {
-      scenario.models_dir = models_dir;
-      return autoshovel::app::RunScenario(scenario, std::cout, std::cerr);
-    }
-    if (*step_cmd) {
-      step.models_dir = models_dir;
-      return autoshovel::app::RunPlantStep(step, std::cout, std::cerr);
-    }
-    if (*gen_cmd) {
-      std::vector<std::string> arguments{"-o", gen_output};
-      if (!gen_materials.empty()) arguments.insert(arguments.end(), {"--materials", gen_materials});
-      if (!gen_no_compile) {
-        // The library must be loadable by this very binary: gen checks its ABI tag now.
-        arguments.insert(arguments.end(),
-                         {"--compile", "--expect-abi", autoshovel::machines::RunningAbiTag()});
-      }
-      if (!gen_cache.empty()) arguments.insert(arguments.end(), {"--cache", gen_cache});
-      arguments.insert(arguments.end(), gen_descriptions.begin(), gen_descriptions.end());
-      return RunGenerator(arguments);
-    }
-    return 0;
-  }();
   return FinishOutput(status);
 }

@@ -423,187 +423,205 @@ void ScoopCycle::Decide(ScoopMachine& machine, const Proprioception& s, Runtime&
   }
   const double elapsed = s.time - rt.phase_start_time;
   switch (rt.phase) {
-    case Phase::kApproach: {
-      if (!rt.stop_request.empty()) {
-        rt.result.failure = "stopped before contact: " + rt.stop_request;
-        rt.phase = Phase::kDone;
-        return;
-      }
-      if (rt.v1 > options_.contact_volume) {
-        rt.result.contact_time = s.time;
-        rt.result.boom_pressure_at_contact = s.boom_pressure;
-        rt.contact_hinge = s.hinge_xy;
-        rt.stop.Reset();
-        if (options_.policy == ScoopPolicy::kOptimal) {
-          StartPlan(machine, s, rt);
-          return;
-        }
-        EnterPhase(machine, Phase::kCrowd, s, rt);
-      } else if (elapsed > options_.max_approach) {
-        rt.result.failure =
-            "no contact with the pile within " + std::to_string(options_.max_approach) + " s";
-        rt.phase = Phase::kDone;
-      }
-      return;
-    }
-    case Phase::kCrowd: {
-      TriggerInputs in;
-      in.v1 = rt.v1;
-      in.boom_pressure = s.boom_pressure;
-      const bool predict =
-          trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
-      rt.last_features.reset();
-      rt.last_penetration = NAN;
-      in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
-      in.intake_factor = predictor_ != nullptr ? predictor_->IntakeFactor(material_.name) : 1.0;
-      rt.last_v2 = predict ? in.v2 : NAN;
-      rt.result.intake_factor = in.intake_factor;
-      const bool fired = trigger_.Fire(in);
-      std::optional<ScoopStrategy> strategy;
-      if (options_.policy == ScoopPolicy::kAutoSelection) {
-        // Algorithm 3 with this trigger as line 7's condition.
-        const ScoopDecision decision =
-            fired ? (material_.difficult ? ScoopDecision::kStairway : ScoopDecision::kJustInOut)
-                  : SelectStrategy({.v1 = rt.v1,
-                                    .v2 = 0,
-                                    .target_volume = INFINITY,
-                                    .difficult = material_.difficult,
-                                    .stopped = stopped});
-        if (decision == ScoopDecision::kJustInOut) strategy = ScoopStrategy::kJustInOut;
-        if (decision == ScoopDecision::kStairway) strategy = ScoopStrategy::kStairway;
-      } else if (fired || stopped) {
-        strategy = options_.policy == ScoopPolicy::kJustInOut  ? ScoopStrategy::kJustInOut
-                   : options_.policy == ScoopPolicy::kStairway ? ScoopStrategy::kStairway
-                                                               : ScoopStrategy::kStairwayFixed;
-      }
-      if (strategy) {
-        ScoopResult& r = rt.result;
-        r.trigger_time = s.time;
-        r.trigger_after_contact = s.time - r.contact_time;
-        r.trigger_reason = fired                      ? trigger_.Name()
-                           : !rt.stop_request.empty() ? rt.stop_request
-                                                      : "stopped";
-        r.strategy = *strategy;
-        r.v1_at_trigger = rt.v1;
-        r.v2_at_trigger = in.v2;
-        r.predicted_tip_path = rt.last_predicted_path;
-        r.boom_pressure_at_trigger = s.boom_pressure;
-        r.has_features_at_trigger = rt.last_features.has_value();
-        if (rt.last_features) r.features_at_trigger = *rt.last_features;
-        r.predicted_travel_at_trigger = rt.last_features ? rt.last_penetration : NAN;
-        rt.trigger_hinge = s.hinge_xy;
-        rt.trigger_heading = s.heading;
-        r.travel_after_trigger = 0;
-        rt.q_bucket_at_trigger = s.q_bucket;
-        rt.q_boom_at_trigger = s.q_boom;
-        rt.sequencer.emplace(*strategy, options_.strategy, limits_);
-        rt.action.reset();
-        EnterPhase(machine, Phase::kScoop, s, rt);
-      } else if (elapsed > options_.max_crowd) {
-        rt.result.failure = "no trigger within " + std::to_string(options_.max_crowd) + " s";
-        rt.phase = Phase::kDone;
-      }
-      return;
-    }
-    case Phase::kScoop: {
-      rt.result.travel_after_trigger = std::max(
-          rt.result.travel_after_trigger,
-          (s.hinge_xy - rt.trigger_hinge)
-              .dot(Eigen::Vector2d(std::cos(rt.trigger_heading), std::sin(rt.trigger_heading))));
-      if (rt.plan) {
-        // The plan ends at rest: once its time is over and the joints have had the valves'
-        // delay to follow, the scoop is over.
-        if (s.time - rt.plan_start >= rt.plan->time.back() + plan_lead_) {
-          rt.result.payload_at_actions.push_back(machine.PayloadVolume());
-          EndScoopPhase(machine, s, rt);
-        } else if (elapsed > options_.max_scoop) {
-          ScoopTimedOut(rt);
-        }
-        return;
-      }
-      // The running action is over once arrived and paused, or timed out.
-      if (rt.action) {
-        const bool bucket = rt.action->kind == AtomicKind::kRetractBucket;
-        const double error = bucket ? rt.targets.bucket - s.q_bucket : rt.targets.boom - s.q_boom;
-        const double tolerance =
-            bucket ? options_.bucket_gains.tolerance : options_.boom_gains.tolerance;
-        if (std::isnan(rt.arrived_at) && std::abs(error) <= 2 * tolerance) rt.arrived_at = s.time;
-        const bool paused =
-            !std::isnan(rt.arrived_at) && s.time - rt.arrived_at >= rt.action->pause;
-        if (paused || s.time - rt.action_start > options_.action_timeout) rt.action.reset();
-      }
-      if (!rt.action) {
-        rt.result.payload_at_actions.push_back(machine.PayloadVolume());
-        rt.action = rt.sequence_ended
-                        ? std::nullopt
-                        : rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
-        if (rt.action) {
-          rt.result.action_names.emplace_back(ToString(rt.action->kind));
-          rt.targets = TargetsAfter(*rt.action, rt.targets, limits_);
-          rt.action_start = s.time;
-          rt.arrived_at = NAN;
-          rt.drive_eased = false;
-          // The final rack-back and lift leave the pile: stop crowding.
-          const bool final_part = rt.sequencer->strategy() == ScoopStrategy::kJustInOut ||
-                                  rt.sequencer->actions() > 2 * rt.sequencer->steps();
-          if (final_part) rt.finishing_drive = true;
-          // The exit lift holds the bucket's attitude: a Z-bar arm tips the bucket back as the
-          // boom rises (q_bucket is relative to the boom), which would pour the heap out over
-          // the back wall; a parallel-lift linkage does this mechanically. It holds the racked
-          // attitude, but no further back than the carrying one (level_attitude_): a heap is
-          // largest with the opening level (bucket_terrain.cc HoldableVolume), racked past it
-          // the bucket holds no more, and every further tip-back as it leaves the pile pours.
-          if (final_part && rt.action->kind == AtomicKind::kLiftBoom) {
-            rt.hold_attitude = std::min(s.q_boom + rt.targets.bucket, level_attitude_);
-          }
-        } else {
-          rt.result.atomic_actions = rt.sequencer->actions();
-          rt.result.stairway_steps = rt.sequencer->steps();
-          EndScoopPhase(machine, s, rt);
-        }
-      } else if (elapsed > options_.max_scoop) {
-        ScoopTimedOut(rt);
-      }
-      return;
-    }
-    case Phase::kLevel: {
-      if (std::isnan(rt.arrived_at) && std::abs(rt.hold_attitude - (s.q_boom + s.q_bucket)) <=
-                                           2 * options_.bucket_gains.tolerance) {
-        rt.arrived_at = s.time;
-      }
-      const bool held =
-          !std::isnan(rt.arrived_at) && s.time - rt.arrived_at >= options_.finishing.level_hold;
-      if (held || elapsed > options_.action_timeout) {
-        EnterPhase(machine, Phase::kShake, s, rt);
-        rt.shake_start = s.time;
-      }
-      return;
-    }
-    case Phase::kShake: {
-      // Pulses, then the valve's delay for the last one to reach the spool and die out.
-      const double pulses = options_.finishing.shake_pulses * options_.finishing.shake_pulse;
-      if (elapsed >= pulses + bucket_delay_) {
-        // Carried level (hold_attitude stays): racking back further would tip the heap out.
-        EnterPhase(machine, Phase::kRetreat, s, rt);
-      }
-      return;
-    }
-    case Phase::kRetreat: {
-      const double behind = (rt.contact_hinge - s.hinge_xy)
-                                .dot(Eigen::Vector2d(std::cos(s.heading), std::sin(s.heading)));
-      if (!rt.stopping && behind >= options_.retreat_beyond_contact) rt.stopping = true;
-      if (rt.stopping && std::abs(s.speed) < 0.05) {
-        EnterPhase(machine, Phase::kDone, s, rt);
-        rt.result.ok = true;
-      } else if (elapsed > options_.max_retreat) {
-        rt.result.failure =
-            "retreat not complete within " + std::to_string(options_.max_retreat) + " s";
-        rt.phase = Phase::kDone;
-      }
-      return;
-    }
+    case Phase::kApproach:
+      return DecideApproach(machine, s, rt, elapsed);
+    case Phase::kCrowd:
+      return DecideCrowd(machine, s, rt, elapsed, stopped);
+    case Phase::kScoop:
+      return DecideScoop(machine, s, rt, elapsed);
+    case Phase::kLevel:
+    case Phase::kShake:
+    case Phase::kRetreat:
+      return DecideFinishing(machine, s, rt, elapsed);
     case Phase::kDone:
       return;
+  }
+}
+
+// Approach: contact once V1 passes the contact volume (then the crowd, or the plan at contact).
+void ScoopCycle::DecideApproach(ScoopMachine& machine, const Proprioception& s, Runtime& rt,
+                                double elapsed) {
+  if (!rt.stop_request.empty()) {
+    rt.result.failure = "stopped before contact: " + rt.stop_request;
+    rt.phase = Phase::kDone;
+    return;
+  }
+  if (rt.v1 > options_.contact_volume) {
+    rt.result.contact_time = s.time;
+    rt.result.boom_pressure_at_contact = s.boom_pressure;
+    rt.contact_hinge = s.hinge_xy;
+    rt.stop.Reset();
+    if (options_.policy == ScoopPolicy::kOptimal) {
+      StartPlan(machine, s, rt);
+      return;
+    }
+    EnterPhase(machine, Phase::kCrowd, s, rt);
+  } else if (elapsed > options_.max_approach) {
+    rt.result.failure =
+        "no contact with the pile within " + std::to_string(options_.max_approach) + " s";
+    rt.phase = Phase::kDone;
+  }
+  return;
+}
+
+// Crowd: the trigger, and Algorithm 3's choice of strategy when it fires (or the machine stops).
+void ScoopCycle::DecideCrowd(ScoopMachine& machine, const Proprioception& s, Runtime& rt,
+                             double elapsed, bool stopped) {
+  TriggerInputs in;
+  in.v1 = rt.v1;
+  in.boom_pressure = s.boom_pressure;
+  const bool predict = trigger_.NeedsPrediction() || options_.policy == ScoopPolicy::kAutoSelection;
+  rt.last_features.reset();
+  rt.last_penetration = NAN;
+  in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
+  in.intake_factor = predictor_ != nullptr ? predictor_->IntakeFactor(material_.name) : 1.0;
+  rt.last_v2 = predict ? in.v2 : NAN;
+  rt.result.intake_factor = in.intake_factor;
+  const bool fired = trigger_.Fire(in);
+  std::optional<ScoopStrategy> strategy;
+  if (options_.policy == ScoopPolicy::kAutoSelection) {
+    // Algorithm 3 with this trigger as line 7's condition.
+    const ScoopDecision decision =
+        fired ? (material_.difficult ? ScoopDecision::kStairway : ScoopDecision::kJustInOut)
+              : SelectStrategy({.v1 = rt.v1,
+                                .v2 = 0,
+                                .target_volume = INFINITY,
+                                .difficult = material_.difficult,
+                                .stopped = stopped});
+    if (decision == ScoopDecision::kJustInOut) strategy = ScoopStrategy::kJustInOut;
+    if (decision == ScoopDecision::kStairway) strategy = ScoopStrategy::kStairway;
+  } else if (fired || stopped) {
+    strategy = options_.policy == ScoopPolicy::kJustInOut  ? ScoopStrategy::kJustInOut
+               : options_.policy == ScoopPolicy::kStairway ? ScoopStrategy::kStairway
+                                                           : ScoopStrategy::kStairwayFixed;
+  }
+  if (strategy) {
+    ScoopResult& r = rt.result;
+    r.trigger_time = s.time;
+    r.trigger_after_contact = s.time - r.contact_time;
+    r.trigger_reason = fired                      ? trigger_.Name()
+                       : !rt.stop_request.empty() ? rt.stop_request
+                                                  : "stopped";
+    r.strategy = *strategy;
+    r.v1_at_trigger = rt.v1;
+    r.v2_at_trigger = in.v2;
+    r.predicted_tip_path = rt.last_predicted_path;
+    r.boom_pressure_at_trigger = s.boom_pressure;
+    r.has_features_at_trigger = rt.last_features.has_value();
+    if (rt.last_features) r.features_at_trigger = *rt.last_features;
+    r.predicted_travel_at_trigger = rt.last_features ? rt.last_penetration : NAN;
+    rt.trigger_hinge = s.hinge_xy;
+    rt.trigger_heading = s.heading;
+    r.travel_after_trigger = 0;
+    rt.q_bucket_at_trigger = s.q_bucket;
+    rt.q_boom_at_trigger = s.q_boom;
+    rt.sequencer.emplace(*strategy, options_.strategy, limits_);
+    rt.action.reset();
+    EnterPhase(machine, Phase::kScoop, s, rt);
+  } else if (elapsed > options_.max_crowd) {
+    rt.result.failure = "no trigger within " + std::to_string(options_.max_crowd) + " s";
+    rt.phase = Phase::kDone;
+  }
+  return;
+}
+
+// Scoop: the planned trajectory's end, or the atomic actions one after another.
+void ScoopCycle::DecideScoop(ScoopMachine& machine, const Proprioception& s, Runtime& rt,
+                             double elapsed) {
+  rt.result.travel_after_trigger = std::max(
+      rt.result.travel_after_trigger,
+      (s.hinge_xy - rt.trigger_hinge)
+          .dot(Eigen::Vector2d(std::cos(rt.trigger_heading), std::sin(rt.trigger_heading))));
+  if (rt.plan) {
+    // The plan ends at rest: once its time is over and the joints have had the valves'
+    // delay to follow, the scoop is over.
+    if (s.time - rt.plan_start >= rt.plan->time.back() + plan_lead_) {
+      rt.result.payload_at_actions.push_back(machine.PayloadVolume());
+      EndScoopPhase(machine, s, rt);
+    } else if (elapsed > options_.max_scoop) {
+      ScoopTimedOut(rt);
+    }
+    return;
+  }
+  // The running action is over once arrived and paused, or timed out.
+  if (rt.action) {
+    const bool bucket = rt.action->kind == AtomicKind::kRetractBucket;
+    const double error = bucket ? rt.targets.bucket - s.q_bucket : rt.targets.boom - s.q_boom;
+    const double tolerance =
+        bucket ? options_.bucket_gains.tolerance : options_.boom_gains.tolerance;
+    if (std::isnan(rt.arrived_at) && std::abs(error) <= 2 * tolerance) rt.arrived_at = s.time;
+    const bool paused = !std::isnan(rt.arrived_at) && s.time - rt.arrived_at >= rt.action->pause;
+    if (paused || s.time - rt.action_start > options_.action_timeout) rt.action.reset();
+  }
+  if (!rt.action) {
+    rt.result.payload_at_actions.push_back(machine.PayloadVolume());
+    rt.action = rt.sequence_ended ? std::nullopt
+                                  : rt.sequencer->Next(rt.targets, rt.v1, rt.result.target_volume);
+    if (rt.action) {
+      rt.result.action_names.emplace_back(ToString(rt.action->kind));
+      rt.targets = TargetsAfter(*rt.action, rt.targets, limits_);
+      rt.action_start = s.time;
+      rt.arrived_at = NAN;
+      rt.drive_eased = false;
+      // The final rack-back and lift leave the pile: stop crowding.
+      const bool final_part = rt.sequencer->strategy() == ScoopStrategy::kJustInOut ||
+                              rt.sequencer->actions() > 2 * rt.sequencer->steps();
+      if (final_part) rt.finishing_drive = true;
+      // The exit lift holds the bucket's attitude: a Z-bar arm tips the bucket back as the
+      // boom rises (q_bucket is relative to the boom), which would pour the heap out over
+      // the back wall; a parallel-lift linkage does this mechanically. It holds the racked
+      // attitude, but no further back than the carrying one (level_attitude_): a heap is
+      // largest with the opening level (bucket_terrain.cc HoldableVolume), racked past it
+      // the bucket holds no more, and every further tip-back as it leaves the pile pours.
+      if (final_part && rt.action->kind == AtomicKind::kLiftBoom) {
+        rt.hold_attitude = std::min(s.q_boom + rt.targets.bucket, level_attitude_);
+      }
+    } else {
+      rt.result.atomic_actions = rt.sequencer->actions();
+      rt.result.stairway_steps = rt.sequencer->steps();
+      EndScoopPhase(machine, s, rt);
+    }
+  } else if (elapsed > options_.max_scoop) {
+    ScoopTimedOut(rt);
+  }
+  return;
+}
+
+// Level, shake, retreat (§6.2: levelling the bucket's upper edge, vibrating, backing out).
+void ScoopCycle::DecideFinishing(ScoopMachine& machine, const Proprioception& s, Runtime& rt,
+                                 double elapsed) {
+  if (rt.phase == Phase::kLevel) {
+    if (std::isnan(rt.arrived_at) && std::abs(rt.hold_attitude - (s.q_boom + s.q_bucket)) <=
+                                         2 * options_.bucket_gains.tolerance) {
+      rt.arrived_at = s.time;
+    }
+    const bool held =
+        !std::isnan(rt.arrived_at) && s.time - rt.arrived_at >= options_.finishing.level_hold;
+    if (held || elapsed > options_.action_timeout) {
+      EnterPhase(machine, Phase::kShake, s, rt);
+      rt.shake_start = s.time;
+    }
+    return;
+  }
+  if (rt.phase == Phase::kShake) {
+    // Pulses, then the valve's delay for the last one to reach the spool and die out.
+    const double pulses = options_.finishing.shake_pulses * options_.finishing.shake_pulse;
+    if (elapsed >= pulses + bucket_delay_) {
+      // Carried level (hold_attitude stays): racking back further would tip the heap out.
+      EnterPhase(machine, Phase::kRetreat, s, rt);
+    }
+    return;
+  }
+  const double behind = (rt.contact_hinge - s.hinge_xy)
+                            .dot(Eigen::Vector2d(std::cos(s.heading), std::sin(s.heading)));
+  if (!rt.stopping && behind >= options_.retreat_beyond_contact) rt.stopping = true;
+  if (rt.stopping && std::abs(s.speed) < 0.05) {
+    EnterPhase(machine, Phase::kDone, s, rt);
+    rt.result.ok = true;
+  } else if (elapsed > options_.max_retreat) {
+    rt.result.failure =
+        "retreat not complete within " + std::to_string(options_.max_retreat) + " s";
+    rt.phase = Phase::kDone;
   }
 }
 

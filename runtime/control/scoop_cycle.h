@@ -308,6 +308,12 @@ class ScoopCycle {
   enum class Phase { kApproach, kCrowd, kScoop, kLevel, kShake, kRetreat, kDone };
   struct Runtime;
   void Decide(ScoopMachine& machine, const Proprioception& s, Runtime& rt);
+  // Decide's phases; `elapsed`: time in the phase [s].
+  void DecideApproach(ScoopMachine& machine, const Proprioception& s, Runtime& rt, double elapsed);
+  void DecideCrowd(ScoopMachine& machine, const Proprioception& s, Runtime& rt, double elapsed,
+                   bool stopped);
+  void DecideScoop(ScoopMachine& machine, const Proprioception& s, Runtime& rt, double elapsed);
+  void DecideFinishing(ScoopMachine& machine, const Proprioception& s, Runtime& rt, double elapsed);
   double ComputeV2(const Proprioception& s, double v1, Runtime& rt);
   /// The scoop phase is over (its actions or its plan): record what the bucket holds, level.
   void EndScoopPhase(ScoopMachine& machine, const Proprioception& s, Runtime& rt);

@@ -95,6 +95,86 @@ class PiecewiseLinear {
   std::vector<double> v_;
 };
 
+// Grid (under the areas), ticks and tick labels; `x_px`, `y_px` map values to pixels.
+template <typename XPx, typename YPx>
+void DrawGridAndTicks(cv::Mat& image, double x_lo, double x_hi, double x_span, double y_hi,
+                      double y_step, int top, double plot_w, double plot_h, const XPx& x_px,
+                      const YPx& y_px) {
+  const double x_step = NiceStep(x_span);
+  const double eps_x = 1e-9 * x_step, eps_y = 1e-9 * y_step;
+  for (double x = std::ceil((x_lo - eps_x) / x_step) * x_step; x <= x_hi + eps_x; x += x_step) {
+    const cv::Point2d p(x_px(x), top + plot_h);
+    cv::line(image, cv::Point2d(p.x, top), p, kGridColor, 1);
+    cv::line(image, p, p + cv::Point2d(0, 5), kBlack, 1);
+    const std::string label = TickLabel(x, x_step);
+    const cv::Size size = TextSize(label, 0.45);
+    PutText(
+        image, label,
+        cv::Point(static_cast<int>(p.x) - size.width / 2, static_cast<int>(p.y) + 8 + size.height),
+        0.45);
+  }
+  for (double y = 0.0; y <= y_hi + eps_y; y += y_step) {
+    const cv::Point2d p(kLeft, y_px(y));
+    cv::line(image, p, cv::Point2d(kLeft + plot_w, p.y), kGridColor, 1);
+    cv::line(image, p, p - cv::Point2d(5, 0), kBlack, 1);
+    const std::string label = TickLabel(y, y_step);
+    const cv::Size size = TextSize(label, 0.45);
+    PutText(image, label,
+            cv::Point(kLeft - 8 - size.width, static_cast<int>(p.y) + size.height / 2), 0.45);
+  }
+}
+
+// Areas, column by column: pixel row r belongs to a band when its centre r + 0.5 lies in
+// [y_px(top of band), y_px(base of band)), so bands meet without gap or overlap and a band of
+// zero height covers no pixel.
+template <typename YPx>
+void DrawStack(cv::Mat& image, const cv::Rect& area, const std::vector<StackedSeries>& series,
+               const std::vector<double>& means, const std::vector<bool>& in_data,
+               const YPx& y_px) {
+  const int columns = area.width;
+  const std::size_t k_count = series.size();
+  auto first_row = [&](double y) {  // first pixel row at or below y [value]
+    return std::clamp(static_cast<int>(std::ceil(y_px(y) - 0.5)), area.y, area.y + area.height);
+  };
+  std::vector<int> line_row(columns, -1);  // of the total, per column; -1: no data
+  for (int c = 0; c < columns; ++c) {
+    if (!in_data[c]) continue;
+    double base = 0.0;
+    for (std::size_t k = 0; k < k_count; ++k) {
+      const double top_value = base + means[c * k_count + k];
+      const cv::Vec3b color(series[k].color.b, series[k].color.g, series[k].color.r);
+      for (int r = first_row(top_value); r < first_row(base); ++r) {
+        image.at<cv::Vec3b>(r, area.x + c) = color;
+      }
+      base = top_value;
+    }
+    line_row[c] = std::max(area.y, first_row(base) - 1);
+  }
+  // The total: a thin dark staircase on the pixels just above the stack, each column drawn up
+  // to one row below its neighbours' so that it is connected; it never covers an area's pixel.
+  for (int c = 0; c < columns; ++c) {
+    if (line_row[c] < 0) continue;
+    int from = line_row[c];
+    if (c > 0 && line_row[c - 1] >= 0) from = std::min(from, line_row[c - 1] + 1);
+    if (c + 1 < columns && line_row[c + 1] >= 0) from = std::min(from, line_row[c + 1] + 1);
+    for (int r = from; r <= line_row[c]; ++r) {
+      image.at<cv::Vec3b>(r, area.x + c) = kTotalColor;
+    }
+  }
+}
+
+// Legend right of the plotting area, top of the stack first, as the areas are stacked.
+void DrawLegend(cv::Mat& image, const std::vector<const StackedSeries*>& entries, int legend_x,
+                int top) {
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const int y = top + kLegendRow * static_cast<int>(i) + kLegendRow / 2;
+    const cv::Rect swatch(legend_x, y - kSwatchH / 2, kSwatchW, kSwatchH);
+    cv::rectangle(image, swatch, ToScalar(entries[i]->color), cv::FILLED);
+    cv::rectangle(image, swatch, ToScalar(kGrey), 1);
+    PutText(image, entries[i]->name, cv::Point(legend_x + kSwatchW + 8, y + 5), 0.45);
+  }
+}
+
 cv::Mat DrawStackedAreaPlot(const StackedAreaPlot& plot) {
   Validate(plot);
   const std::size_t n = plot.x.size();
@@ -194,64 +274,9 @@ cv::Mat DrawStackedAreaPlot(const StackedAreaPlot& plot) {
   cv::Mat image(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   const cv::Rect area(kLeft, top, columns, static_cast<int>(plot_h));
 
-  // Grid (under the areas), ticks and tick labels.
-  const double x_step = NiceStep(x_span);
-  const double eps_x = 1e-9 * x_step, eps_y = 1e-9 * y_step;
-  for (double x = std::ceil((x_lo - eps_x) / x_step) * x_step; x <= x_hi + eps_x; x += x_step) {
-    const cv::Point2d p(x_px(x), top + plot_h);
-    cv::line(image, cv::Point2d(p.x, top), p, kGridColor, 1);
-    cv::line(image, p, p + cv::Point2d(0, 5), kBlack, 1);
-    const std::string label = TickLabel(x, x_step);
-    const cv::Size size = TextSize(label, 0.45);
-    PutText(
-        image, label,
-        cv::Point(static_cast<int>(p.x) - size.width / 2, static_cast<int>(p.y) + 8 + size.height),
-        0.45);
-  }
-  for (double y = 0.0; y <= y_hi + eps_y; y += y_step) {
-    const cv::Point2d p(kLeft, y_px(y));
-    cv::line(image, p, cv::Point2d(kLeft + plot_w, p.y), kGridColor, 1);
-    cv::line(image, p, p - cv::Point2d(5, 0), kBlack, 1);
-    const std::string label = TickLabel(y, y_step);
-    const cv::Size size = TextSize(label, 0.45);
-    PutText(image, label,
-            cv::Point(kLeft - 8 - size.width, static_cast<int>(p.y) + size.height / 2), 0.45);
-  }
+  DrawGridAndTicks(image, x_lo, x_hi, x_span, y_hi, y_step, top, plot_w, plot_h, x_px, y_px);
 
-  // Areas, column by column: pixel row r belongs to a band when its centre r + 0.5 lies in
-  // [y_px(top of band), y_px(base of band)), so bands meet without gap or overlap and a band of
-  // zero height covers no pixel.
-  if (has_data) {
-    auto first_row = [&](double y) {  // first pixel row at or below y [value]
-      return std::clamp(static_cast<int>(std::ceil(y_px(y) - 0.5)), area.y, area.y + area.height);
-    };
-    std::vector<int> line_row(columns, -1);  // of the total, per column; -1: no data
-    for (int c = 0; c < columns; ++c) {
-      if (!in_data[c]) continue;
-      double base = 0.0;
-      for (std::size_t k = 0; k < k_count; ++k) {
-        const double top_value = base + means[c * k_count + k];
-        const cv::Vec3b color(plot.series[k].color.b, plot.series[k].color.g,
-                              plot.series[k].color.r);
-        for (int r = first_row(top_value); r < first_row(base); ++r) {
-          image.at<cv::Vec3b>(r, area.x + c) = color;
-        }
-        base = top_value;
-      }
-      line_row[c] = std::max(area.y, first_row(base) - 1);
-    }
-    // The total: a thin dark staircase on the pixels just above the stack, each column drawn up
-    // to one row below its neighbours' so that it is connected; it never covers an area's pixel.
-    for (int c = 0; c < columns; ++c) {
-      if (line_row[c] < 0) continue;
-      int from = line_row[c];
-      if (c > 0 && line_row[c - 1] >= 0) from = std::min(from, line_row[c - 1] + 1);
-      if (c + 1 < columns && line_row[c + 1] >= 0) from = std::min(from, line_row[c + 1] + 1);
-      for (int r = from; r <= line_row[c]; ++r) {
-        image.at<cv::Vec3b>(r, area.x + c) = kTotalColor;
-      }
-    }
-  }
+  if (has_data) DrawStack(image, area, plot.series, means, in_data, y_px);
 
   // Phase boundaries over the areas, labels above the frame.
   for (const Label& l : labels) {
@@ -279,15 +304,7 @@ cv::Mat DrawStackedAreaPlot(const StackedAreaPlot& plot) {
           cv::Point(kLeft + static_cast<int>(plot_w) / 2 - x_size.width / 2, height - 14), 0.55);
   PutVerticalText(image, plot.y_label, 6, top + static_cast<int>(plot_h) / 2, 0.55);
 
-  // Legend right of the plotting area, top of the stack first, as the areas are stacked.
-  const int legend_x = area.x + area.width + kLegendGap;
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    const int y = top + kLegendRow * static_cast<int>(i) + kLegendRow / 2;
-    const cv::Rect swatch(legend_x, y - kSwatchH / 2, kSwatchW, kSwatchH);
-    cv::rectangle(image, swatch, ToScalar(entries[i]->color), cv::FILLED);
-    cv::rectangle(image, swatch, ToScalar(kGrey), 1);
-    PutText(image, entries[i]->name, cv::Point(legend_x + kSwatchW + 8, y + 5), 0.45);
-  }
+  DrawLegend(image, entries, area.x + area.width + kLegendGap, top);
   return image;
 }
 

@@ -136,23 +136,16 @@ std::vector<Row> ReadRows(const std::filesystem::path& file) {
   return rows;
 }
 
-}  // namespace
+// The means of one policy over the campaign (the seed's comparison).
+struct PolicyStats {
+  int cycles = 0, completed = 0;
+  long long violations = 0;
+  Mean fill, time, energy;
+};
 
-int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std::ostream& err) {
-  std::vector<Row> rows;
-  try {
-    rows = ReadRows(o.database);
-  } catch (const std::exception& e) {
-    err << kCommand << ": " << e.what() << "\n";
-    return 2;
-  }
-  if (rows.empty()) {
-    err << kCommand << ": " << o.database.string()
-        << " holds no campaign cycles (its cycles table is empty)\n";
-    return 2;
-  }
-
-  // Table 6: the adaptive policy per week and strategy.
+// Table 6: the adaptive policy per week and strategy. Returns the strategies' labels.
+std::set<std::string> PrintTable6(const std::vector<Row>& rows, const ProductionReportOptions& o,
+                                  std::ostream& out) {
   std::set<std::string> labels;
   std::map<int, std::map<std::string, Cell>> weeks;
   std::map<std::string, Cell> all;
@@ -185,7 +178,12 @@ int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std
   out << "| all |";
   print_cells(all);
 
-  // Table 7: per material.
+  return labels;
+}
+
+// Table 7: the adaptive policy per material.
+void PrintTable7(const std::vector<Row>& rows, const ProductionReportOptions& o,
+                 std::ostream& out) {
   std::map<std::string, std::pair<int, int>> counts;  // JIO, Stairway
   std::map<std::string, Mean> material_time, material_energy;
   for (const Row& r : rows) {
@@ -202,13 +200,13 @@ int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std
         << Num(material_time[material].value(), "%.2f") << " | "
         << Num(material_energy[material].value(), "%.1f") << " |\n";
   }
+}
 
+// Every policy on the same shifts, the adaptive against the baseline, and what was not measured.
+std::map<std::string, PolicyStats> PrintPolicies(const std::vector<Row>& rows,
+                                                 const ProductionReportOptions& o,
+                                                 std::ostream& out) {
   // The seed's comparison: adaptive against the fixed Stairway #3 on the same shifts.
-  struct PolicyStats {
-    int cycles = 0, completed = 0;
-    long long violations = 0;
-    Mean fill, time, energy;
-  };
   std::map<std::string, PolicyStats> policies;
   for (const Row& r : rows) {
     PolicyStats& p = policies[r.policy];
@@ -257,6 +255,30 @@ int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std
           << " completed cycles not measured, left out of the mean\n";
     }
   }
+
+  return policies;
+}
+
+}  // namespace
+
+int RunProductionReport(const ProductionReportOptions& o, std::ostream& out, std::ostream& err) {
+  std::vector<Row> rows;
+  try {
+    rows = ReadRows(o.database);
+  } catch (const std::exception& e) {
+    err << kCommand << ": " << e.what() << "\n";
+    return 2;
+  }
+  if (rows.empty()) {
+    err << kCommand << ": " << o.database.string()
+        << " holds no campaign cycles (its cycles table is empty)\n";
+    return 2;
+  }
+
+  const std::set<std::string> labels = PrintTable6(rows, o, out);
+  PrintTable7(rows, o, out);
+  const std::map<std::string, PolicyStats> policies = PrintPolicies(rows, o, out);
+  const auto baseline = policies.find(o.baseline_policy);
 
   // Fig. 22.
   std::vector<plot::BoxGroup> time_groups, energy_groups;

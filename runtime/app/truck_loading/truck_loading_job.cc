@@ -276,6 +276,16 @@ struct TruckLoadingJob::State {
     return known;
   }
 
+  struct LoadPlan {
+    control::ExcavatorJointModels models;  ///< slowed by the last scan's dust warning
+    control::ScriptParameters params;
+    control::LoadingScript script;
+  };
+  struct LoadLoop;
+  DigExecution Dig(PassOutcome& out, int index, std::ostream* progress);
+  std::optional<LoadPlan> PlanLoad(const DigExecution& dig, PassOutcome& out,
+                                   std::ostream* progress);
+
   planning::DigPlan PlanDig(std::ostream* progress) {
     const control::HeightGrid map = TerrainMap();
     PlantDigModel model(machine, *functions, *kinematics, derivation.models, scenario.world,
@@ -454,37 +464,271 @@ std::string TruckLoadingJob::ConfigYaml() const {
   return y.str();
 }
 
-PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
-  State& s = *state_;
-  plant::Plant& plant = *s.plant;
-  PassOutcome out;
-  out.index = index;
-  out.min_truck_clearance = std::numeric_limits<double>::infinity();
-  out.min_person_clearance = std::numeric_limits<double>::infinity();
-  if (s.next_dig.status != planning::DigPlanStatus::kPlanned) {
-    out.failure = "no dig left: " + s.next_dig.why;
-    return out;
-  }
-  const double t_start = plant.time();
-  const double bed0 = s.truck.MaterialInBed(s.scenario.world.terrain);
+// The load phase of one pass (§4.4, §4.5): the script at 10 Hz, the servos at 100 Hz, the
+// look-ahead at 10 Hz and the truth check at 20 Hz, until the script's final rules settle or the
+// pass runs out of time.
+struct TruckLoadingJob::State::LoadLoop {
+  State& s;
+  plant::Plant& plant;
+  PassOutcome& out;
+  const int index;
+  std::ostream* progress;
+  const double t_start, bed0;
+  control::LoadingScript& script;
+  ExcavatorOnPlant excavator;
+  control::ExcavatorSimulator mirror;
+  const double t_load;
+  double next_script, next_safety;
+  double clear_since = std::numeric_limits<double>::quiet_NaN();
+  bool stopped = false, in_collision = false, finished = false;
+  control::ExcavatorCommand command;
+  std::string phase = "swing";
+  std::map<std::string, std::pair<double, double>> phase_start;  // time, energy
+  std::map<std::string, std::pair<double, double>> phase_total;
+  int person_box = -1;
+  double final_rules_since = std::numeric_limits<double>::quiet_NaN();
+  std::vector<control::EnvelopePoint> underside;
 
-  // 1. Dig (§4.2), executed by the dig motion on the machine.
-  out.dig = s.next_dig.action;
-  out.predicted_volume = s.next_dig.prediction.volume;
-  plant.SetPhase("dig");
-  const double e_dig0 = plant.energy().hydraulic;
-  control::DigMotion motion(*s.kinematics, ToStroke(out.dig), s.dig_settings);
-  const DigExecution dig = ExecuteDig(plant, *s.servo, *s.kinematics, motion, kControlPeriod);
-  out.dig_time = plant.time() - t_start;
-  out.dig_energy = plant.energy().hydraulic - e_dig0;
+  LoadLoop(State& state, PassOutcome& outcome, int pass, std::ostream* log, double start,
+           double bed_before, control::LoadingScript& load_script,
+           control::ExcavatorJointServo& servo, const control::ExcavatorJointModels& models)
+      : s(state),
+        plant(*state.plant),
+        out(outcome),
+        index(pass),
+        progress(log),
+        t_start(start),
+        bed0(bed_before),
+        script(load_script),
+        excavator(plant, servo),
+        mirror(models, excavator.Sense()),
+        t_load(plant.time()),
+        next_script(t_load),
+        next_safety(t_load) {
+    command.position = excavator.Sense().q;
+    plant.SetPhase(phase);
+    phase_start[phase] = {plant.time(), plant.energy().hydraulic};
+  }
+
+  void Run() {
+    while (plant.time() - t_start < s.options.max_pass_time) {
+      const double t = plant.time();
+      const control::ExcavatorState measured = excavator.Sense();
+      WalkPerson(t);
+      if (t >= next_script - 1e-9) {
+        next_script += control::LoadingScript::kPeriod;
+        if (ScriptStep(t, measured)) {
+          finished = true;
+          break;
+        }
+      }
+      if (t >= next_safety - 1e-9) {
+        next_safety += kSafetyPeriod;
+        SafetyCheck(t, measured);
+      }
+      excavator.Command(command);
+      mirror.Advance(kControlPeriod);
+      excavator.Advance(kControlPeriod);
+    }
+    SwitchPhase("idle");
+  }
+
+  void SwitchPhase(const std::string& next) {
+    if (next == phase) return;
+    if (progress) {
+      *progress << "  " << phase << " -> " << next << " at " << plant.time() - t_start
+                << " s, bucket holds " << plant.bucket().payload_volume() << " m3, bed "
+                << s.truck.MaterialInBed(s.scenario.world.terrain) - bed0 << " m3\n";
+    }
+    phase_total[phase].first += plant.time() - phase_start[phase].first;
+    phase_total[phase].second += plant.energy().hydraulic - phase_start[phase].second;
+    phase = next;
+    phase_start[phase] = {plant.time(), plant.energy().hydraulic};
+    plant.SetPhase(phase);
+  }
+
+  // A person walking into the yard.
+  void WalkPerson(double t) {
+    if (!s.options.person || s.options.person->pass != index ||
+        t - t_load < s.options.person->start_delay) {
+      return;
+    }
+    const PersonWalk& w = *s.options.person;
+    const Eigen::Vector2d p = w.At(t - t_load - w.start_delay);
+    int ix, iy;
+    const double ground = s.scenario.world.terrain.CellOf(p.x(), p.y(), ix, iy)
+                              ? s.scenario.world.terrain.height(ix, iy)
+                              : 0.0;
+    plant::OrientedBox box;
+    box.name = "person";
+    box.center = Eigen::Vector3d(p.x(), p.y(), ground + 0.9);
+    box.half_extents = Eigen::Vector3d(0.25, 0.25, 0.9);
+    box.semantic_class = core::SemanticClass::kPerson;
+    if (person_box < 0) {
+      s.scenario.world.obstacles.push_back(box);
+      person_box = static_cast<int>(s.scenario.world.obstacles.size()) - 1;
+    } else {
+      s.scenario.world.obstacles[person_box] = box;
+    }
+  }
+
+  // 10 Hz: the script's next step, the look-ahead's stop or resume, the phase booking. True
+  // once the script's final rules have settled.
+  bool ScriptStep(double t, const control::ExcavatorState& measured) {
+    const control::HeightGrid map = HeightGridFromWorld(s.scenario.world, Eigen::Vector2d::Zero(),
+                                                        kMapHalfSize, kMapResolution);
+    if (!stopped) {
+      const control::ScriptOutput step = script.Step(measured.q);
+      command = step.command;
+      mirror.Command(command);
+    }
+    // §4.5: predict the script's next 2.5 s (from the script's state after this evaluation).
+    // Stopped, the machine resumes only when the rest of its moves is clear: from rest, what
+    // stopped it lies further ahead than 2.5 s, and a 2.5 s check would let it creep up to a
+    // person in stop-and-go steps.
+    mirror.Resync(measured);
+    const control::ObstacleLookAhead& lookahead = stopped ? *s.resume_lookahead : *s.lookahead;
+    const control::LookAheadResult check =
+        lookahead.Check(measured, mirror, &script, control::LoadingScript::kPeriod, map,
+                        Eigen::Isometry3d::Identity());
+    if (check.stop()) {
+      if (!stopped) {
+        ++out.safety_stops;
+        if (progress) {
+          *progress << "  look-ahead stop at " << t - t_start << " s: " << check.reason;
+          if (check.collision) {
+            *progress << " (point " << check.collision->p_world.transpose() << " under cell "
+                      << check.collision->cell_height << " m)";
+          }
+          *progress << "\n";
+        }
+      }
+      stopped = true;
+      clear_since = std::numeric_limits<double>::quiet_NaN();
+      command = control::ExcavatorCommand{};
+      command.stop = true;
+      mirror.Command(command);
+    } else if (stopped) {
+      if (std::isnan(clear_since)) clear_since = t;
+      if (t - clear_since >= s.options.resume_after) {
+        if (progress) *progress << "  resumed at " << t - t_start << " s\n";
+        stopped = false;
+        command.position = script.Commands();
+        command.stop = false;
+        mirror.Command(command);
+      }
+    }
+    // Phase booking from the bucket's script: opening = dump, moving to dig = return.
+    const int bucket_rule = script.active_rule(control::ExcavatorJoint::kBucket);
+    SwitchPhase(bucket_rule == 0 ? "swing" : bucket_rule == 1 ? "dump" : "return");
+    if (!script.AtFinalRules()) return false;
+    if (std::isnan(final_rules_since)) final_rules_since = t;
+    // The machine settles within the servos' hold band, or a few seconds after the last rules
+    // began (a boom that rings around its target holds no pass back).
+    return script.Finished(measured, 0.05, 0.1) || t - final_rules_since > 6.0;
+  }
+
+  // 20 Hz: the linkage's underside against the true truck and any person (simulation truth),
+  // and the trace.
+  void SafetyCheck(double t, const control::ExcavatorState& measured) {
+    s.envelope->Underside(measured.q, Eigen::Isometry3d::Identity(), underside);
+    const double truck_clearance = control::MinClearance(underside, s.true_truck_boxes);
+    out.min_truck_clearance = std::min(out.min_truck_clearance, truck_clearance);
+    double person_clearance = std::numeric_limits<double>::infinity();
+    if (person_box >= 0) {
+      person_clearance =
+          control::MinClearance(underside, {ToObstacleBox(s.scenario.world.obstacles[person_box])});
+      out.min_person_clearance = std::min(out.min_person_clearance, person_clearance);
+    }
+    const bool colliding = truck_clearance < 0 || person_clearance < 0;
+    if (colliding && !in_collision) ++out.collisions;
+    in_collision = colliding;
+    TraceSample sample;
+    sample.t = t - t_load;
+    sample.phase = phase;
+    sample.p_world_tip = s.kinematics->TipPosition(measured.q);
+    int ix, iy;
+    sample.ground_below_tip =
+        s.scenario.world.terrain.CellOf(sample.p_world_tip.x(), sample.p_world_tip.y(), ix, iy)
+            ? s.scenario.world.terrain.height(ix, iy)
+            : 0.0;
+    sample.stopped = stopped;
+    out.trace.push_back(std::move(sample));
+  }
+
+  // The pass's figures once the loop is over: the bed scanned on the swing back, phase times and
+  // energies, what reached the bed, why it failed.
+  void Book(double swing_dump) {
+    // §2: the swing back scanned the bed as it is now.
+    if (finished) {
+      const int seen = s.MeasureBed(
+          swing_dump, excavator.Sense().q[control::JointIndex(control::ExcavatorJoint::kSwing)],
+          progress, &out.dust_warning);
+      out.bed_cells_seen = seen;
+      if (progress && out.dust_warning) {
+        *progress << "  dust warning on the swing-back scan: the next pass at " << s.speed_scale
+                  << " of full speed\n";
+      }
+      if (progress && seen >= 0) {
+        *progress << "  bed scanned on the swing back: " << seen << " cells seen, "
+                  << s.scanned_bed->known_count() << " of "
+                  << s.scanned_bed->cells_x() * s.scanned_bed->cells_y() << " known\n";
+      }
+    }
+    out.swing_time = phase_total["swing"].first;
+    out.swing_energy = phase_total["swing"].second;
+    out.dump_time = phase_total["dump"].first;
+    out.dump_energy = phase_total["dump"].second;
+    out.return_time = phase_total["return"].first;
+    out.return_energy = phase_total["return"].second;
+    out.total_time = plant.time() - t_start;
+    out.dumped_volume = s.truck.MaterialInBed(s.scenario.world.terrain) - bed0;
+    out.dumped_mass = out.dumped_volume * s.material_density;
+    if (person_box >= 0) {
+      s.scenario.world.obstacles.erase(s.scenario.world.obstacles.begin() + person_box);
+    }
+    out.completed = finished && out.collisions == 0;
+    if (!finished) {
+      std::ostringstream why;
+      why << "pass took longer than " << s.options.max_pass_time << " s (rules";
+      for (control::ExcavatorJoint j : control::kAllExcavatorJoints) {
+        why << " " << control::JointName(j) << " " << script.active_rule(j) + 1 << "/"
+            << script.script(j).rules.size();
+      }
+      why << "; q " << excavator.Sense().q.transpose() << " against "
+          << script.Commands().transpose() << ")";
+      out.failure = why.str();
+    }
+    if (out.collisions > 0) out.failure = "collision";
+  }
+};
+
+// 1. Dig (§4.2), executed by the dig motion on the machine.
+DigExecution TruckLoadingJob::State::Dig(PassOutcome& out, int index, std::ostream* progress) {
+  const double t_start = plant->time();
+  out.dig = next_dig.action;
+  out.predicted_volume = next_dig.prediction.volume;
+  plant->SetPhase("dig");
+  const double e_dig0 = plant->energy().hydraulic;
+  control::DigMotion motion(*kinematics, ToStroke(out.dig), dig_settings);
+  const DigExecution dig = ExecuteDig(*plant, *servo, *kinematics, motion, kControlPeriod);
+  out.dig_time = plant->time() - t_start;
+  out.dig_energy = plant->energy().hydraulic - e_dig0;
   out.dug_volume = dig.volume;
   if (progress) {
     *progress << "pass " << index + 1 << ": dig at swing " << out.dig.swing / kDeg << " deg, r "
               << out.dig.radius << " m: " << dig.volume << " m3 in " << out.dig_time << " s"
               << (dig.done ? "" : " (" + dig.failure + ")") << "\n";
   }
+  return dig;
+}
 
-  // 2. Plan: the next dig on the face as this one left it, the dump point on the bed.
+// 2. Plan: the next dig on the face as this one left it, the dump point on the bed, and the
+// loading script from where the dig ended. Empty when no script can be made (out.failure says
+// why).
+std::optional<TruckLoadingJob::State::LoadPlan> TruckLoadingJob::State::PlanLoad(
+    const DigExecution& dig, PassOutcome& out, std::ostream* progress) {
+  State& s = *this;
   s.next_dig = s.PlanDig(progress);
   out.dig_evaluations = s.next_dig.evaluations;
   // The bed as the scanner has seen it (heights in the recognised bed-corner frame, rim at 0),
@@ -518,12 +762,12 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   }
   // The pass ends where the next dig's motion begins: its approach point, at the attitude the
   // dig motion found reachable there.
-  control::ScriptSettings script_settings = s.script_settings;
-  script_settings.dig_approach_height = s.dig_settings.approach_height;
+  control::ScriptSettings settings = s.script_settings;
+  settings.dig_approach_height = s.dig_settings.approach_height;
   if (s.next_dig.status == planning::DigPlanStatus::kPlanned) {
     control::DigMotion next(*s.kinematics, ToStroke(s.next_dig.action), s.dig_settings);
     if (const std::optional<control::JointVector> q = next.ApproachPose()) {
-      script_settings.dig_attitude = (*q)[0] + (*q)[1] + (*q)[2];
+      settings.dig_attitude = (*q)[0] + (*q)[1] + (*q)[2];
     }
   }
   // When the pin cannot be put over the aimed point (beyond the arm's reach with the truck
@@ -535,18 +779,16 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   out.speed_scale = s.speed_scale;
   const control::ExcavatorJointModels models =
       SlowedModels(s.derivation.models, std::clamp(s.speed_scale, 0.05, 1.0));
-  control::ExcavatorJointServo servo(s.machine, *s.functions, models);
   control::ScriptParameters params;
   const Eigen::Vector2d aimed = goal.p_base_dump.head<2>();
   for (int attempt = 0;; ++attempt) {
     try {
-      params = control::ComputeScriptParameters(*s.envelope, models, dig.end_state, goal,
-                                                script_settings);
+      params = control::ComputeScriptParameters(*s.envelope, models, dig.end_state, goal, settings);
       break;
     } catch (const std::invalid_argument& e) {
       if (attempt == 3) {
         out.failure = std::string("script parameters: ") + e.what();
-        return out;
+        return std::nullopt;
       }
       goal.p_base_dump.head<2>() = aimed - (attempt + 1) * kPourOffset / 3.0 * aimed.normalized();
       if (progress) {
@@ -555,196 +797,29 @@ PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
       }
     }
   }
-  control::LoadingScript script = control::BuildLoadingScript(params, script_settings);
+  return LoadPlan{models, params, control::BuildLoadingScript(params, settings)};
+}
 
-  // 3. Load: script at 10 Hz, servos at 100 Hz, look-ahead at 10 Hz, truth check at 20 Hz.
-  ExcavatorOnPlant excavator(plant, servo);
-  control::ExcavatorSimulator mirror(models, excavator.Sense());
-  const double t_load = plant.time();
-  double next_script = t_load, next_safety = t_load;
-  double clear_since = std::numeric_limits<double>::quiet_NaN();
-  bool stopped = false, in_collision = false;
-  control::ExcavatorCommand command;
-  command.position = excavator.Sense().q;
-  std::string phase = "swing";
-  plant.SetPhase(phase);
-  std::map<std::string, std::pair<double, double>> phase_start;  // time, energy
-  phase_start[phase] = {plant.time(), plant.energy().hydraulic};
-  std::map<std::string, std::pair<double, double>> phase_total;
-  auto switch_phase = [&](const std::string& next) {
-    if (next == phase) return;
-    if (progress) {
-      *progress << "  " << phase << " -> " << next << " at " << plant.time() - t_start
-                << " s, bucket holds " << plant.bucket().payload_volume() << " m3, bed "
-                << s.truck.MaterialInBed(s.scenario.world.terrain) - bed0 << " m3\n";
-    }
-    phase_total[phase].first += plant.time() - phase_start[phase].first;
-    phase_total[phase].second += plant.energy().hydraulic - phase_start[phase].second;
-    phase = next;
-    phase_start[phase] = {plant.time(), plant.energy().hydraulic};
-    plant.SetPhase(phase);
-  };
-  int person_box = -1;
-  double final_rules_since = std::numeric_limits<double>::quiet_NaN();
-  std::vector<control::EnvelopePoint> underside;
-  bool finished = false;
-  while (plant.time() - t_start < s.options.max_pass_time) {
-    const double t = plant.time();
-    const control::ExcavatorState measured = excavator.Sense();
-    // A person walking into the yard.
-    if (s.options.person && s.options.person->pass == index &&
-        t - t_load >= s.options.person->start_delay) {
-      const PersonWalk& w = *s.options.person;
-      const Eigen::Vector2d p = w.At(t - t_load - w.start_delay);
-      int ix, iy;
-      const double ground = s.scenario.world.terrain.CellOf(p.x(), p.y(), ix, iy)
-                                ? s.scenario.world.terrain.height(ix, iy)
-                                : 0.0;
-      plant::OrientedBox box;
-      box.name = "person";
-      box.center = Eigen::Vector3d(p.x(), p.y(), ground + 0.9);
-      box.half_extents = Eigen::Vector3d(0.25, 0.25, 0.9);
-      box.semantic_class = core::SemanticClass::kPerson;
-      if (person_box < 0) {
-        s.scenario.world.obstacles.push_back(box);
-        person_box = static_cast<int>(s.scenario.world.obstacles.size()) - 1;
-      } else {
-        s.scenario.world.obstacles[person_box] = box;
-      }
-    }
-    if (t >= next_script - 1e-9) {
-      next_script += control::LoadingScript::kPeriod;
-      const control::HeightGrid map = HeightGridFromWorld(s.scenario.world, Eigen::Vector2d::Zero(),
-                                                          kMapHalfSize, kMapResolution);
-      if (!stopped) {
-        const control::ScriptOutput step = script.Step(measured.q);
-        command = step.command;
-        mirror.Command(command);
-      }
-      // §4.5: predict the script's next 2.5 s (from the script's state after this evaluation).
-      // Stopped, the machine resumes only when the rest of its moves is clear: from rest, what
-      // stopped it lies further ahead than 2.5 s, and a 2.5 s check would let it creep up to
-      // a person in stop-and-go steps.
-      mirror.Resync(measured);
-      const control::ObstacleLookAhead& lookahead = stopped ? *s.resume_lookahead : *s.lookahead;
-      const control::LookAheadResult check =
-          lookahead.Check(measured, mirror, &script, control::LoadingScript::kPeriod, map,
-                          Eigen::Isometry3d::Identity());
-      if (check.stop()) {
-        if (!stopped) {
-          ++out.safety_stops;
-          if (progress) {
-            *progress << "  look-ahead stop at " << t - t_start << " s: " << check.reason;
-            if (check.collision) {
-              *progress << " (point " << check.collision->p_world.transpose() << " under cell "
-                        << check.collision->cell_height << " m)";
-            }
-            *progress << "\n";
-          }
-        }
-        stopped = true;
-        clear_since = std::numeric_limits<double>::quiet_NaN();
-        command = control::ExcavatorCommand{};
-        command.stop = true;
-        mirror.Command(command);
-      } else if (stopped) {
-        if (std::isnan(clear_since)) clear_since = t;
-        if (t - clear_since >= s.options.resume_after) {
-          if (progress) *progress << "  resumed at " << t - t_start << " s\n";
-          stopped = false;
-          command.position = script.Commands();
-          command.stop = false;
-          mirror.Command(command);
-        }
-      }
-      // Phase booking from the bucket's script: opening = dump, moving to dig = return.
-      const int bucket_rule = script.active_rule(control::ExcavatorJoint::kBucket);
-      switch_phase(bucket_rule == 0 ? "swing" : bucket_rule == 1 ? "dump" : "return");
-      if (script.AtFinalRules()) {
-        if (std::isnan(final_rules_since)) final_rules_since = t;
-        // The machine settles within the servos' hold band, or a few seconds after the last
-        // rules began (a boom that rings around its target holds no pass back).
-        if (script.Finished(measured, 0.05, 0.1) || t - final_rules_since > 6.0) {
-          finished = true;
-          break;
-        }
-      }
-    }
-    if (t >= next_safety - 1e-9) {
-      next_safety += kSafetyPeriod;
-      s.envelope->Underside(measured.q, Eigen::Isometry3d::Identity(), underside);
-      const double truck_clearance = control::MinClearance(underside, s.true_truck_boxes);
-      out.min_truck_clearance = std::min(out.min_truck_clearance, truck_clearance);
-      double person_clearance = std::numeric_limits<double>::infinity();
-      if (person_box >= 0) {
-        person_clearance = control::MinClearance(
-            underside, {ToObstacleBox(s.scenario.world.obstacles[person_box])});
-        out.min_person_clearance = std::min(out.min_person_clearance, person_clearance);
-      }
-      const bool colliding = truck_clearance < 0 || person_clearance < 0;
-      if (colliding && !in_collision) ++out.collisions;
-      in_collision = colliding;
-      {
-        TraceSample sample;
-        sample.t = t - t_load;
-        sample.phase = phase;
-        sample.p_world_tip = s.kinematics->TipPosition(measured.q);
-        int ix, iy;
-        sample.ground_below_tip =
-            s.scenario.world.terrain.CellOf(sample.p_world_tip.x(), sample.p_world_tip.y(), ix, iy)
-                ? s.scenario.world.terrain.height(ix, iy)
-                : 0.0;
-        sample.stopped = stopped;
-        out.trace.push_back(std::move(sample));
-      }
-    }
-    excavator.Command(command);
-    mirror.Advance(kControlPeriod);
-    excavator.Advance(kControlPeriod);
+PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
+  State& s = *state_;
+  PassOutcome out;
+  out.index = index;
+  out.min_truck_clearance = std::numeric_limits<double>::infinity();
+  out.min_person_clearance = std::numeric_limits<double>::infinity();
+  if (s.next_dig.status != planning::DigPlanStatus::kPlanned) {
+    out.failure = "no dig left: " + s.next_dig.why;
+    return out;
   }
-  switch_phase("idle");
-  // §2: the swing back scanned the bed as it is now.
-  if (finished) {
-    const int seen =
-        s.MeasureBed(params.swing_dump,
-                     excavator.Sense().q[control::JointIndex(control::ExcavatorJoint::kSwing)],
-                     progress, &out.dust_warning);
-    out.bed_cells_seen = seen;
-    if (progress && out.dust_warning) {
-      *progress << "  dust warning on the swing-back scan: the next pass at " << s.speed_scale
-                << " of full speed\n";
-    }
-    if (progress && seen >= 0) {
-      *progress << "  bed scanned on the swing back: " << seen << " cells seen, "
-                << s.scanned_bed->known_count() << " of "
-                << s.scanned_bed->cells_x() * s.scanned_bed->cells_y() << " known\n";
-    }
-  }
-  out.swing_time = phase_total["swing"].first;
-  out.swing_energy = phase_total["swing"].second;
-  out.dump_time = phase_total["dump"].first;
-  out.dump_energy = phase_total["dump"].second;
-  out.return_time = phase_total["return"].first;
-  out.return_energy = phase_total["return"].second;
-  out.total_time = plant.time() - t_start;
-  out.dumped_volume = s.truck.MaterialInBed(s.scenario.world.terrain) - bed0;
-  out.dumped_mass = out.dumped_volume * s.material_density;
-  if (person_box >= 0) {
-    s.scenario.world.obstacles.erase(s.scenario.world.obstacles.begin() + person_box);
-  }
-  out.completed = finished && out.collisions == 0;
-  if (!finished) {
-    std::ostringstream why;
-    why << "pass took longer than " << s.options.max_pass_time << " s (rules";
-    for (control::ExcavatorJoint j : control::kAllExcavatorJoints) {
-      why << " " << control::JointName(j) << " " << script.active_rule(j) + 1 << "/"
-          << script.script(j).rules.size();
-    }
-    why << "; q " << excavator.Sense().q.transpose() << " against " << script.Commands().transpose()
-        << ")";
-    out.failure = why.str();
-  }
-  if (out.collisions > 0) out.failure = "collision";
+  const double t_start = s.plant->time();
+  const double bed0 = s.truck.MaterialInBed(s.scenario.world.terrain);
+  const DigExecution dig = s.Dig(out, index, progress);
+  std::optional<State::LoadPlan> plan = s.PlanLoad(dig, out, progress);
+  if (!plan) return out;
+  // 3. Load.
+  control::ExcavatorJointServo servo(s.machine, *s.functions, plan->models);
+  State::LoadLoop load(s, out, index, progress, t_start, bed0, plan->script, servo, plan->models);
+  load.Run();
+  load.Book(plan->params.swing_dump);
   if (progress) {
     char line[300];
     std::snprintf(line, sizeof line,

@@ -7,7 +7,7 @@
 
 #include "identification/weights/demo_scenes.h"
 #include "runtime/perception/pile_extraction.h"
-#include "runtime/planning/select_command.h"
+#include "runtime/sim/select_command.h"
 
 namespace autoshovel::identification {
 namespace {
@@ -34,7 +34,7 @@ Demonstration MakeOne(const model::MachineDescription& machine,
     Demonstration d;
     d.id = slot;
     d.kind = scene.kind;
-    d.map = planning::TruthMap(scene.scenario, options.map_resolution);
+    d.map = sim::TruthMap(scene.scenario, options.map_resolution);
     d.ground_plane = Eigen::Vector3d::Zero();  // the simulated floor is z = 0
     d.start = scene.start;
     perception::GridMap map = d.map;

@@ -33,7 +33,7 @@
 #include "runtime/core/file_output.h"
 #include "runtime/machines/machine_library.h"
 #include "runtime/model/description.h"
-#include "runtime/planning/select_command.h"
+#include "runtime/sim/select_command.h"
 
 namespace {
 
@@ -708,7 +708,7 @@ Command AddReportProduction(CLI::App& parent, const Globals&) {
 
 Command AddSelect(CLI::App& app, const Globals& g) {
   struct Cli {
-    autoshovel::planning::SelectOptions select;
+    autoshovel::sim::SelectOptions select;
     bool no_baseline = false;
   };
   auto c = std::make_shared<Cli>();
@@ -746,7 +746,7 @@ Command AddSelect(CLI::App& app, const Globals& g) {
   return {cmd, [c, &g]() -> int {
             c->select.models_dir = g.models_dir;
             c->select.baseline = !c->no_baseline;
-            return autoshovel::planning::RunSelect(c->select, std::cout, std::cerr);
+            return autoshovel::sim::RunSelect(c->select, std::cout, std::cerr);
           }};
 }
 

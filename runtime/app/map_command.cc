@@ -10,13 +10,13 @@
 #include "runtime/model/description.h"
 #include "runtime/perception/elevation_map.h"
 #include "runtime/perception/map_render.h"
-#include "runtime/perception/perceive_from_plant.h"
 #include "runtime/perception/pile_extraction.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
 #include "runtime/plant/scenario.h"
 #include "runtime/sensors/raycast.h"
+#include "runtime/sim/perceive_from_plant.h"
 
 namespace autoshovel::app {
 
@@ -44,15 +44,15 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     const auto t0 = std::chrono::steady_clock::now();
     perception::ElevationMap map({}, plant.state().hinge_xy);
     perception::SemanticMap semantic(map);
-    perception::PerceptionFromPlantOptions perceive;
+    sim::PerceptionFromPlantOptions perceive;
     perceive.lidar_frames = options.frames;
     perceive.lighting = lighting;
     perceive.truth_labels = options.truth_labels;
     perceive.segmenter = options.segmenter.empty()
                              ? options.models_dir + "/segmentation/yard_segmenter.onnx"
                              : options.segmenter;
-    const perception::PerceptionFromPlantStats stats =
-        perception::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic);
+    const sim::PerceptionFromPlantStats stats =
+        sim::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic);
     if (!stats.ground_plane_found) {
       err << "autoshovel map: too few ground cells to fit the ground plane\n";
       return 1;

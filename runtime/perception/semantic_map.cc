@@ -82,63 +82,25 @@ float InterpolatedHeight(const GridMap& g, const Eigen::MatrixXf& elevation,
 // Standard normal CDF.
 double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
-}  // namespace
+// A mapped cell as the camera sees it: the pixel its centre falls in, its forward depth and the
+// image rows its surface covers.
+struct Hit {
+  int cell, pixel;
+  float depth;
+  std::int16_t v_min, v_max;  // image rows the cell's surface covers
+};
 
-ClassProbabilities FromLabels(const std::vector<std::uint8_t>& labels, int width, int height) {
-  ClassProbabilities p;
-  p.width = width;
-  p.height = height;
-  const std::size_t plane = static_cast<std::size_t>(width) * height;
-  p.planes.assign(core::kNumSemanticClasses * plane, 0.0f);
-  for (std::size_t i = 0; i < plane && i < labels.size(); ++i) {
-    p.planes[std::min<int>(labels[i], core::kNumSemanticClasses - 1) * plane + i] = 1.0f;
-  }
-  return p;
-}
-
-SemanticMap::SemanticMap(ElevationMap& map, const SemanticMapConfig& config)
-    : map_(map), config_(config) {
-  GridMap& g = map_.map();
-  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
-                            "steep_obstacle_confidence", "height_ground_confidence", "class"}) {
-    if (!g.Exists(layer)) g.Add(layer, kNaN);
-  }
-  if (!g.Exists("semantic_frames")) g.Add("semantic_frames", 0.0f);
-  // A hole takes its nearest observed cell's class evidence with its height (Eq. 9's
-  // continuity assumption): a hole behind a person is not pile by its height alone.
-  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
-                            "steep_obstacle_confidence"}) {
-    map_.FillAlso(layer);
-  }
-}
-
-long SemanticMap::Project(const ClassProbabilities& probabilities, const model::Camera& camera,
-                          const Eigen::Isometry3d& T_world_camera) {
-  GridMap& g = map_.map();
-  const int w = probabilities.width, h = probabilities.height;
-  if (w <= 0 || h <= 0 ||
-      probabilities.planes.size() != static_cast<std::size_t>(core::kNumSemanticClasses) * w * h) {
-    return 0;
-  }
-  // The image may be smaller than the camera's (a network run at reduced resolution).
-  const double sx = static_cast<double>(w) / camera.width_px;
-  const double sy = static_cast<double>(h) / camera.height_px;
-  // World → optical: optical x = −body y, optical y = −body z, optical z = body x.
+// Pass 1 of SemanticMap::Project: where each mapped cell lands in the w × h image (the camera's
+// scaled by sx, sy) and how far it is; `nearest` (bw blocks of kBlock pixels a row) receives
+// the nearest depth per pixel block.
+std::vector<Hit> ProjectCells(const GridMap& g, const model::Camera& camera,
+                              const Eigen::Isometry3d& T_world_camera, int w, int h, double sx,
+                              double sy, int bw, std::vector<float>& nearest) {
   const Eigen::Isometry3d T_camera_world = T_world_camera.inverse();
   const Eigen::Matrix<float, 3, 3> R = T_camera_world.linear().cast<float>();
   const Eigen::Vector3f t = T_camera_world.translation().cast<float>();
   const Eigen::MatrixXf& elevation = g["elevation"];
   const int nx = g.size().x(), ny = g.size().y();
-
-  // Pass 1: where each cell lands and how far it is; the nearest depth per pixel block.
-  const int bw = (w + kBlock - 1) / kBlock, bh = (h + kBlock - 1) / kBlock;
-  std::vector<float> nearest(static_cast<std::size_t>(bw) * bh,
-                             std::numeric_limits<float>::infinity());
-  struct Hit {
-    int cell, pixel;
-    float depth;
-    std::int16_t v_min, v_max;  // image rows the cell's surface covers
-  };
   const Eigen::Vector3d camera_world = T_world_camera.translation();
   auto project_v = [&](const Eigen::Vector3f& p_world, float& v) {
     const Eigen::Vector3f p_body = R * p_world + t;
@@ -193,6 +155,62 @@ long SemanticMap::Project(const ClassProbabilities& probabilities, const model::
                       row(std::max(v_edge[0], v_edge[1]))});
     }
   }
+  return hits;
+}
+
+}  // namespace
+
+ClassProbabilities FromLabels(const std::vector<std::uint8_t>& labels, int width, int height) {
+  ClassProbabilities p;
+  p.width = width;
+  p.height = height;
+  const std::size_t plane = static_cast<std::size_t>(width) * height;
+  p.planes.assign(core::kNumSemanticClasses * plane, 0.0f);
+  for (std::size_t i = 0; i < plane && i < labels.size(); ++i) {
+    p.planes[std::min<int>(labels[i], core::kNumSemanticClasses - 1) * plane + i] = 1.0f;
+  }
+  return p;
+}
+
+SemanticMap::SemanticMap(ElevationMap& map, const SemanticMapConfig& config)
+    : map_(map), config_(config) {
+  GridMap& g = map_.map();
+  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
+                            "steep_obstacle_confidence", "height_ground_confidence", "class"}) {
+    if (!g.Exists(layer)) g.Add(layer, kNaN);
+  }
+  if (!g.Exists("semantic_frames")) g.Add("semantic_frames", 0.0f);
+  // A hole takes its nearest observed cell's class evidence with its height (Eq. 9's
+  // continuity assumption): a hole behind a person is not pile by its height alone.
+  for (const char* layer : {"ground_confidence", "pile_confidence", "obstacle_confidence",
+                            "steep_obstacle_confidence"}) {
+    map_.FillAlso(layer);
+  }
+}
+
+long SemanticMap::Project(const ClassProbabilities& probabilities, const model::Camera& camera,
+                          const Eigen::Isometry3d& T_world_camera) {
+  GridMap& g = map_.map();
+  const int w = probabilities.width, h = probabilities.height;
+  if (w <= 0 || h <= 0 ||
+      probabilities.planes.size() != static_cast<std::size_t>(core::kNumSemanticClasses) * w * h) {
+    return 0;
+  }
+  // The image may be smaller than the camera's (a network run at reduced resolution).
+  const double sx = static_cast<double>(w) / camera.width_px;
+  const double sy = static_cast<double>(h) / camera.height_px;
+  // World → optical: optical x = −body y, optical y = −body z, optical z = body x.
+  const Eigen::Matrix<float, 3, 3> R = T_world_camera.inverse().linear().cast<float>();
+  const Eigen::MatrixXf& elevation = g["elevation"];
+
+  // Pass 1: where each cell lands and how far it is; the nearest depth per pixel block.
+  const int bw = (w + kBlock - 1) / kBlock, bh = (h + kBlock - 1) / kBlock;
+  std::vector<float> nearest(static_cast<std::size_t>(bw) * bh,
+                             std::numeric_limits<float>::infinity());
+  const std::vector<Hit> hits = ProjectCells(g, camera, T_world_camera, w, h, sx, sy, bw, nearest);
+  const Eigen::Vector3d camera_world = T_world_camera.translation();
+  const int nx = g.size().x();
+
   // Where a pixel's ray first meets the mapped surface, as a forward depth (the Hit::depth
   // measure), cast lazily for the machine, person and wall pixels the footprints below look at.
   // Such a pixel counts in full for a cell only when it shows the cell or something in front of

@@ -4,7 +4,7 @@
 #include <iostream>
 #include <string>
 
-#include "runtime/planning/select_command.h"
+#include "runtime/sim/select_command.h"
 
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
                  "[--advance M] [--no-baseline]\n";
     return 2;
   }
-  autoshovel::planning::SelectOptions options;
+  autoshovel::sim::SelectOptions options;
   options.scenario = argv[1];
   options.png = argv[2];
   options.models_dir = std::string(AUTOSHOVEL_SOURCE_DIR) + "/models";
@@ -33,5 +33,5 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  return autoshovel::planning::RunSelect(options, std::cout, std::cerr);
+  return autoshovel::sim::RunSelect(options, std::cout, std::cerr);
 }

@@ -1,7 +1,7 @@
 // Algorithm 2 on the simulated yards (maps rasterised from the simulator's truth, so that the
 // tests are about selection, not perception), the obstacle checks against the true obstacle
 // boxes, determinism, and the Fig. 19 picture through RunSelect.
-#include "runtime/planning/select_command.h"
+#include "runtime/sim/select_command.h"
 
 #include <gtest/gtest.h>
 
@@ -39,7 +39,7 @@ struct Yard {
     machine =
         model::LoadMachineDescription(model::ResolveMachineDescription(scenario.machine, kModels));
     loader = LoaderGeometryFrom(machine, *generated::FindMachine(machine.name));
-    map = TruthMap(scenario);
+    map = sim::TruthMap(scenario);
     piles = perception::ExtractPiles(map, plane);
     start = {{scenario.start.x, scenario.start.y}, scenario.start.heading};
   }
@@ -256,7 +256,7 @@ TEST(ShovelPointSelection, CandidatesAlongTheFrontAtTheSpacing) {
 }
 
 TEST(SelectCommand, WritesTheCandidatePicture) {
-  SelectOptions options;
+  sim::SelectOptions options;
   options.scenario = "cone_pile";
   options.models_dir = kModels;
   options.truth_labels = true;  // the perceived map, with the simulator's labels
@@ -264,7 +264,7 @@ TEST(SelectCommand, WritesTheCandidatePicture) {
   options.png = ::testing::TempDir() + "/shovel_points_cone.png";
   std::filesystem::remove(options.png);
   std::ostringstream out, err;
-  EXPECT_EQ(RunSelect(options, out, err), 0) << err.str();
+  EXPECT_EQ(sim::RunSelect(options, out, err), 0) << err.str();
   std::printf("%s", out.str().c_str());
   EXPECT_NE(out.str().find("Eq. (18): selected"), std::string::npos);
   EXPECT_NE(out.str().find("Chen et al. 2024 best"), std::string::npos);
@@ -273,7 +273,7 @@ TEST(SelectCommand, WritesTheCandidatePicture) {
   // Bad input: one message, exit status 2.
   options.scenario = "no_such_yard";
   std::ostringstream out2, err2;
-  EXPECT_EQ(RunSelect(options, out2, err2), 2);
+  EXPECT_EQ(sim::RunSelect(options, out2, err2), 2);
   EXPECT_FALSE(err2.str().empty());
 }
 

@@ -20,7 +20,7 @@
 #include "identification/weights/expert_model.h"
 #include "runtime/model/description.h"
 #include "runtime/perception/pile_extraction.h"
-#include "runtime/planning/select_command.h"
+#include "runtime/sim/select_command.h"
 
 namespace autoshovel::identification {
 namespace {
@@ -114,7 +114,7 @@ TEST(Demonstrations, TheExpertPicksPileFrontPointsAwayFromObstacles) {
   ExpertModel expert;
   for (std::uint64_t seed = 100; seed < 130; ++seed) {
     const DemoScene s = RandomDemoScene(TheLoader().machine, seed);
-    perception::GridMap map = planning::TruthMap(s.scenario);
+    perception::GridMap map = sim::TruthMap(s.scenario);
     const auto piles = perception::ExtractPiles(map, Eigen::Vector3d::Zero());
     const auto candidates = planning::GenerateCandidates(map, piles, {});
     const int chosen = ChooseLikeAnExpert(s.scenario.world, candidates, s.start,

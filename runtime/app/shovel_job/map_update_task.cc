@@ -32,7 +32,7 @@ MapUpdateResult MapUpdateTask::Update(
   const bool camera = faults.Active(plant::FaultKind::kCameraBlackout, now) == nullptr &&
                       supervisor.AcceptFrame(SensorStream::kCamera, stamp_of("camera"), now);
   ++frames_arrived_;
-  perception::PerceptionFromPlantOptions perceive = config_.perceive;
+  sim::PerceptionFromPlantOptions perceive = config_.perceive;
   perceive.lidar_frames = !lidar ? 0 : calls_ == 0 ? 5 : 1;
   perceive.camera_frame = camera;
   const plant::FaultSpec* blind = faults.Active(plant::FaultKind::kLidarDeadSector, now);
@@ -47,8 +47,8 @@ MapUpdateResult MapUpdateTask::Update(
   perceive.lens_dirt_radius_px = dirt != nullptr ? dirt->radius * camera_model.width_px : 0.0;
   perceive.check_lidar_health = true;
   perceive.lens_dirt = &lens_dirt;
-  const perception::PerceptionFromPlantStats seen =
-      perception::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic);
+  const sim::PerceptionFromPlantStats seen =
+      sim::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic);
 
   MapUpdateResult result;
   result.camera_dirty_fraction = seen.camera_dirty_fraction;

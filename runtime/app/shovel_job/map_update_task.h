@@ -11,9 +11,9 @@
 #include "runtime/app/safety_supervisor.h"
 #include "runtime/app/shovel_job/cycle_log.h"
 #include "runtime/app/shovel_job/fault_schedule.h"
-#include "runtime/perception/perceive_from_plant.h"
 #include "runtime/plant/world.h"
 #include "runtime/sensors/rng.h"
+#include "runtime/sim/perceive_from_plant.h"
 
 namespace autoshovel::sensors {
 class RaycastScene;
@@ -26,9 +26,9 @@ class Plant;
 namespace autoshovel::app {
 
 struct MapUpdateConfig {
-  perception::PerceptionFromPlantOptions perceive;  ///< lighting, labels, segmenter
-  double blind_sector_cone = 0;                     ///< SupervisorConfig::blind_sector_cone [rad]
-  double max_masked_fraction = 1;                   ///< SupervisorConfig::max_masked_fraction [-]
+  sim::PerceptionFromPlantOptions perceive;  ///< lighting, labels, segmenter
+  double blind_sector_cone = 0;              ///< SupervisorConfig::blind_sector_cone [rad]
+  double max_masked_fraction = 1;            ///< SupervisorConfig::max_masked_fraction [-]
   double path_obstacle_margin = 0;
   double path_obstacle_confidence = 0.95;
   double path_obstacle_height = 0;  ///< [m] above the ground plane

@@ -228,10 +228,8 @@ PassPrediction PredictPass(const LoadingScript& script, const ExcavatorJointMode
   return out;
 }
 
-ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
-                                         const ExcavatorJointModels& models,
-                                         const ExcavatorState& dig_end, const LoadingGoal& goal,
-                                         const ScriptSettings& settings) {
+void ValidateScriptInputs(const ExcavatorJointModels& models, const ExcavatorState& dig_end,
+                          const LoadingGoal& goal, const ScriptSettings& settings) {
   Validate(settings);
   Validate(models);
   if (FirstNonFinite(dig_end.q) >= 0 || FirstNonFinite(dig_end.qd) >= 0) {
@@ -245,15 +243,19 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
   }
   for (const ObstacleBox& box : goal.truck) Validate(box, "ComputeScriptParameters: truck");
   if (std::isinf(goal.ground_height)) RequireFinite(goal.ground_height, "ground height");
+}
 
-  const ExcavatorKinematics& kinematics = envelope.kinematics();
+// The swing angles (dig and dump azimuths, unwrapped the short way from where the swing is), the
+// dig pose (the dig point raised by the approach height, the bucket at the dig attitude), the
+// starts and the bucket's carry and open angles.
+void SetSwingAndDigPose(const ExcavatorKinematics& kinematics, const ExcavatorState& dig_end,
+                        const LoadingGoal& goal, const ScriptSettings& settings,
+                        ScriptParameters& p) {
   const double eps = settings.arrival_tolerance;
   const int kBoom = JointIndex(ExcavatorJoint::kBoom);
   const int kStick = JointIndex(ExcavatorJoint::kStick);
   const int kBucket = JointIndex(ExcavatorJoint::kBucket);
   const int kSwing = JointIndex(ExcavatorJoint::kSwing);
-  ScriptParameters p;
-
   // Swing angles: the dig and dump azimuths, unwrapped to the short way from where the swing is.
   p.swing_start = dig_end.q[kSwing];
   p.swing_dig =
@@ -288,7 +290,15 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
   if (!(p.bucket_open > p.bucket_carry + 4 * eps)) {
     throw std::invalid_argument("ComputeScriptParameters: bucket margins leave no opening");
   }
+}
 
+// The truck's radial band and what must be cleared over it, then the bucket pin over the dump
+// point as low as the band test allows.
+void SetDumpPose(const LinkageEnvelope& envelope, const LoadingGoal& goal,
+                 const ScriptSettings& settings, ScriptParameters& p) {
+  const ExcavatorKinematics& kinematics = envelope.kinematics();
+  const int kBoom = JointIndex(ExcavatorJoint::kBoom);
+  const int kStick = JointIndex(ExcavatorJoint::kStick);
   // The truck's radial band and what must be cleared over it, from the boxes the pass can sweep.
   double max_width = 0;
   for (const LinkShape& shape : envelope.config().shapes)
@@ -377,7 +387,15 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
   p.boom_clear = chosen.boom;
   p.stick_spill = chosen.spill;
   p.stick_dump = chosen.dump;
+}
 
+// The thresholds that start the stick, open the bucket and sweep it, from the joint models.
+void SetTimingThresholds(const ExcavatorJointModels& models, const ScriptSettings& settings,
+                         ScriptParameters& p) {
+  const double eps = settings.arrival_tolerance;
+  const int kStick = JointIndex(ExcavatorJoint::kStick);
+  const int kBucket = JointIndex(ExcavatorJoint::kBucket);
+  const int kSwing = JointIndex(ExcavatorJoint::kSwing);
   // Timing thresholds from the joint models.
   const JointModelParams& swing_model = models[kSwing];
   const JointModelParams& stick_model = models[kStick];
@@ -402,6 +420,25 @@ ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
   p.bucket_dumped = p.bucket_open -
                     opening * std::clamp(open_speed * swing_model.latency, eps, 0.5 * bucket_span);
   p.bucket_sweep = 0.5 * (p.bucket_carry + p.bucket_open);
+}
+
+ScriptParameters ComputeScriptParameters(const LinkageEnvelope& envelope,
+                                         const ExcavatorJointModels& models,
+                                         const ExcavatorState& dig_end, const LoadingGoal& goal,
+                                         const ScriptSettings& settings) {
+  ValidateScriptInputs(models, dig_end, goal, settings);
+  const double eps = settings.arrival_tolerance;
+  const int kBoom = JointIndex(ExcavatorJoint::kBoom);
+  const int kSwing = JointIndex(ExcavatorJoint::kSwing);
+  ScriptParameters p;
+
+  SetSwingAndDigPose(envelope.kinematics(), dig_end, goal, settings, p);
+  SetDumpPose(envelope, goal, settings, p);
+  const double margin = settings.truck_clearance;
+
+  SetTimingThresholds(models, settings, p);
+  const JointModelParams& swing_model = models[kSwing];
+  const double swing_span = std::abs(p.swing_dump - p.swing_start);
 
   // Bisections on predicted passes. While the swing start is searched, lowering waits until the
   // swing is nearly back at the dig, so only the way out is judged.

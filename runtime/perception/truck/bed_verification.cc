@@ -86,45 +86,36 @@ void Validate(const VerificationParams& params) {
   require(params.min_cab_points >= 0, "min_cab_points must be non-negative");
 }
 
-// §4.1: the verification of a complete interpretation, a closer check of the truck's parameters.
-BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
-                          const std::vector<Scanline>& scanlines, const TruckBedModel& model,
-                          const VerificationParams& params) {
-  BedVerification v;
-  const auto fail = [&v](std::string reason) {
-    v.passed = false;
-    v.reason = std::move(reason);
-    return v;
-  };
-  if (!fit.ok) return fail("the bed fit is degenerate");
-  for (BedFace face : kAllBedFaces) {
-    for (int s : fit.face_segments[static_cast<std::size_t>(FaceIndex(face))]) {
-      v.support_points += static_cast<int>(segments[s].points.size());
-    }
-  }
+namespace {
 
-  // 1. Dimensions.
+// §4.1, 1: the fitted length, width and heights within the model's ranges ("" or why not).
+std::string CheckDimensions(const BedFit& fit, const TruckBedModel& model,
+                            const VerificationParams& params) {
   const double tol = params.dimension_tolerance;
   if (!model.inner_length.Contains(fit.length, tol)) {
-    return fail(Describe("length", fit.length, model.inner_length));
+    return Describe("length", fit.length, model.inner_length);
   }
   if (!model.inner_width.Contains(fit.width, tol)) {
-    return fail(Describe("width", fit.width, model.inner_width));
+    return Describe("width", fit.width, model.inner_width);
   }
   if (std::isfinite(fit.floor_z) && !model.wall_height.Contains(fit.rim_z - fit.floor_z, tol)) {
-    return fail(Describe("wall height", fit.rim_z - fit.floor_z, model.wall_height));
+    return Describe("wall height", fit.rim_z - fit.floor_z, model.wall_height);
   }
   if (std::isfinite(fit.floor_z) && std::isfinite(fit.ground_z) &&
       !model.floor_height.Contains(fit.floor_z - fit.ground_z, tol)) {
-    return fail(Describe("floor height", fit.floor_z - fit.ground_z, model.floor_height));
+    return Describe("floor height", fit.floor_z - fit.ground_z, model.floor_height);
   }
   const ParameterRange rim_range{model.floor_height.min + model.wall_height.min,
                                  model.floor_height.max + model.wall_height.max};
   if (std::isfinite(fit.ground_z) && !rim_range.Contains(fit.rim_z - fit.ground_z, tol)) {
-    return fail(Describe("rim height", fit.rim_z - fit.ground_z, rim_range));
+    return Describe("rim height", fit.rim_z - fit.ground_z, rim_range);
   }
+  return "";
+}
 
-  // 2. Planarity about the fitted rectangle.
+// §4.1, 2: planarity of the walls about the fitted rectangle ("" or why not).
+std::string CheckPlanarity(const BedFit& fit, const std::vector<LineSegment>& segments,
+                           const VerificationParams& params) {
   const Eigen::Vector2d along = fit.T_world_bed.linear().col(0).head<2>();
   const Eigen::Vector2d across = fit.T_world_bed.linear().col(1).head<2>();
   for (BedFace face : kAllBedFaces) {
@@ -136,14 +127,19 @@ BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
     if (rms > params.max_face_rms) {
       std::ostringstream out;
       out << "the " << BedFaceName(face) << " strays " << rms << " m (RMS) from the rectangle";
-      return fail(out.str());
+      return out.str();
     }
   }
+  return "";
+}
 
-  // 3. Coverage of the near outside face; the floor seen lies within the outline.
+// §4.1, 3: the floor seen lies within the outline; coverage of the near outside face.
+std::string CheckCoverage(const BedFit& fit, const std::vector<LineSegment>& segments,
+                          const VerificationParams& params, BedVerification& v) {
   const Eigen::Isometry3d T_bed_world = fit.T_world_bed.inverse();
   const double half_length = 0.5 * fit.length;
   const double half_width = 0.5 * fit.width;
+  // 3. Coverage of the near outside face; the floor seen lies within the outline.
   {
     int inside = 0;
     int total = 0;
@@ -158,7 +154,7 @@ BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
     if (total > 0 && inside < kMinFloorInside * total) {
       std::ostringstream out;
       out << "only " << inside << " of " << total << " floor returns lie within the bed";
-      return fail(out.str());
+      return out.str();
     }
   }
   {
@@ -174,11 +170,17 @@ BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
     if (v.near_coverage < params.min_near_coverage) {
       std::ostringstream out;
       out << "the near side covers only " << v.near_coverage << " of the bed length";
-      return fail(out.str());
+      return out.str();
     }
   }
+  return "";
+}
 
-  // 5. A chassis under the bed: the near wall's scanlines must not all reach the ground.
+// §4.1, 5: a chassis under the bed: the near wall's scanlines must not all reach the ground.
+std::string CheckChassis(const BedFit& fit, const std::vector<LineSegment>& segments,
+                         const VerificationParams& params, BedVerification& v) {
+  const Eigen::Isometry3d T_bed_world = fit.T_world_bed.inverse();
+  const double half_length = 0.5 * fit.length;
   if (std::isfinite(fit.ground_z)) {
     std::map<int, double> lowest;  // scanline → lowest near-wall return, world z
     for (int s : fit.face_segments[static_cast<std::size_t>(FaceIndex(BedFace::kNearSide))]) {
@@ -197,11 +199,20 @@ BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
       std::ostringstream out;
       out << "the near side reaches the ground along " << 100 * v.ground_contact
           << " % of its scanlines: no chassis under it";
-      return fail(out.str());
+      return out.str();
     }
   }
+  return "";
+}
 
-  // 4 and 6: one pass over all returns, in the bed frame (rim plane z = 0).
+// §4.1, 4 and 6: one pass over all returns, in the bed frame (rim plane z = 0): returns where an
+// empty bed leaves free space, and returns of a cab beyond either end.
+void CountFreeSpaceAndCab(const BedFit& fit, const std::vector<Scanline>& scanlines,
+                          const TruckBedModel& model, const VerificationParams& params,
+                          BedVerification& v) {
+  const Eigen::Isometry3d T_bed_world = fit.T_world_bed.inverse();
+  const double half_length = 0.5 * fit.length;
+  const double half_width = 0.5 * fit.width;
   const double margin = params.free_space_margin;
   const auto inside_outline = [&](const Eigen::Vector3d& p) {
     return std::abs(p.x()) < half_length - margin && std::abs(p.y()) < half_width - margin;
@@ -255,6 +266,32 @@ BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
       }
     }
   }
+}
+
+}  // namespace
+
+// §4.1: the verification of a complete interpretation, a closer check of the truck's parameters.
+BedVerification VerifyBed(BedFit& fit, const std::vector<LineSegment>& segments,
+                          const std::vector<Scanline>& scanlines, const TruckBedModel& model,
+                          const VerificationParams& params) {
+  BedVerification v;
+  const auto fail = [&v](std::string reason) {
+    v.passed = false;
+    v.reason = std::move(reason);
+    return v;
+  };
+  if (!fit.ok) return fail("the bed fit is degenerate");
+  for (BedFace face : kAllBedFaces) {
+    for (int s : fit.face_segments[static_cast<std::size_t>(FaceIndex(face))]) {
+      v.support_points += static_cast<int>(segments[s].points.size());
+    }
+  }
+
+  if (std::string why = CheckDimensions(fit, model, params); !why.empty()) return fail(why);
+  if (std::string why = CheckPlanarity(fit, segments, params); !why.empty()) return fail(why);
+  if (std::string why = CheckCoverage(fit, segments, params, v); !why.empty()) return fail(why);
+  if (std::string why = CheckChassis(fit, segments, params, v); !why.empty()) return fail(why);
+  CountFreeSpaceAndCab(fit, scanlines, model, params, v);
   const double allowed =
       std::max<double>(params.max_violations, params.max_violation_fraction * v.support_points);
   if (v.free_space_violations > allowed) {

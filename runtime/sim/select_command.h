@@ -1,10 +1,9 @@
-// `autoshovel select SCENARIO` (to be wired into the CLI by runtime/app): the semantic elevation
-// map of a simulated yard, shovel point selection on it (wheel-loader seed §5, Algorithm 2) and
-// the Chen et al. (2024) baseline, drawn as the seed's Fig. 19.
+// `autoshovel select SCENARIO`: the semantic elevation map of a simulated yard, shovel point
+// selection on it (wheel-loader seed §5, Algorithm 2) and the Chen et al. (2024) baseline, drawn
+// as the seed's Fig. 19.
 //
-// This is app-level wiring that lives beside the planner: it builds the map from the simulator
-// (runtime/plant, runtime/sensors), so it is its own library, autoshovel_select_command; the
-// planner library autoshovel_planning never sees the plant (DESIGN.md, Layout).
+// The simulation side (runtime/sim, docs/architecture.md): it builds the map from the simulator
+// (runtime/plant, runtime/sensors), which the planner library autoshovel_planning never sees.
 #pragma once
 
 #include <Eigen/Core>
@@ -16,7 +15,7 @@
 #include "runtime/perception/pile_extraction.h"
 #include "runtime/plant/scenario.h"
 
-namespace autoshovel::planning {
+namespace autoshovel::sim {
 
 struct SelectOptions {
   std::string scenario;    ///< name under <models_dir>/scenarios, or a path
@@ -50,4 +49,4 @@ int RunSelect(const SelectOptions& options, std::ostream& out, std::ostream& err
 /// floor: (0, 0, floor height).
 perception::GridMap TruthMap(const plant::Scenario& scenario, double resolution = 0.3);
 
-}  // namespace autoshovel::planning
+}  // namespace autoshovel::sim

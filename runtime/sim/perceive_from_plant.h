@@ -3,8 +3,8 @@
 // (or the simulator's labels) and projected, holes filled, Eq. (10)–(11) fused. One pipeline for
 // `autoshovel map`, `autoshovel select` and the closed loop, so they cannot drift apart.
 //
-// This links the simulator (plant, sensors): it is its own library, so that perception itself
-// never depends on the plant.
+// The simulation side (runtime/sim, docs/architecture.md): it links the plant and the simulated
+// sensors, which perception itself never depends on.
 #pragma once
 
 #include <string>
@@ -20,7 +20,7 @@
 #include "runtime/sensors/raycast.h"
 #include "runtime/sensors/rng.h"
 
-namespace autoshovel::perception {
+namespace autoshovel::sim {
 
 struct PerceptionFromPlantOptions {
   int lidar_frames = 5;      ///< per LiDAR, 0.1 s apart; 0: none arrives (a dropout)
@@ -36,7 +36,7 @@ struct PerceptionFromPlantOptions {
   double lens_dirt_radius_px = 0;                                 ///< 0: a clean lens
   bool check_lidar_health = false;  ///< look for blind sectors in every LiDAR's last frame
   /// When given, judges each camera frame for dirt; pixels it masks give the map no evidence.
-  LensDirtMonitor* lens_dirt = nullptr;
+  perception::LensDirtMonitor* lens_dirt = nullptr;
 };
 
 struct PerceptionFromPlantStats {
@@ -46,7 +46,7 @@ struct PerceptionFromPlantStats {
   bool ground_plane_found = false;  ///< false: too few ground cells; classes not fused
   std::string semantics;            ///< "simulator labels" or "network <file>"
   /// Blind sectors found (check_lidar_health), with the LiDAR's name.
-  std::vector<std::pair<std::string, AzimuthSector>> blind_sectors;
+  std::vector<std::pair<std::string, perception::AzimuthSector>> blind_sectors;
   double camera_masked_fraction = 0;  ///< of the last image, masked for dirt (or suspect)
   double camera_dirty_fraction = 0;   ///< of the last image, confirmed dirty (lens_dirt_monitor.h)
 };
@@ -56,6 +56,7 @@ struct PerceptionFromPlantStats {
 PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
                                            const sensors::RaycastScene& scene, sensors::Rng& rng,
                                            const PerceptionFromPlantOptions& options,
-                                           ElevationMap& map, SemanticMap& semantic);
+                                           perception::ElevationMap& map,
+                                           perception::SemanticMap& semantic);
 
-}  // namespace autoshovel::perception
+}  // namespace autoshovel::sim

@@ -1,4 +1,4 @@
-#include "runtime/planning/select_command.h"
+#include "runtime/sim/select_command.h"
 
 #include <chrono>
 #include <cmath>
@@ -10,7 +10,6 @@
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
 #include "runtime/perception/elevation_map.h"
-#include "runtime/perception/perceive_from_plant.h"
 #include "runtime/perception/semantic_map.h"
 #include "runtime/planning/candidate_render.h"
 #include "runtime/planning/chen2024_baseline.h"
@@ -18,8 +17,11 @@
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
 #include "runtime/sensors/raycast.h"
+#include "runtime/sim/perceive_from_plant.h"
 
-namespace autoshovel::planning {
+namespace autoshovel::sim {
+
+using namespace planning;  // the planner's selection, on a simulated yard
 
 perception::GridMap TruthMap(const plant::Scenario& scenario, double resolution) {
   const plant::Terrain& t = scenario.world.terrain;
@@ -81,15 +83,14 @@ bool PerceiveMap(const SelectOptions& options, plant::Scenario& scenario,
   sensors::RaycastScene scene(scenario.world, plant.OwnBodies());
   sensors::Rng rng(scenario.seed);
   perception::SemanticMap semantic(map);
-  perception::PerceptionFromPlantOptions perceive;
+  sim::PerceptionFromPlantOptions perceive;
   perceive.lidar_frames = options.frames;
   perceive.lighting = scenario.lighting;
   perceive.truth_labels = options.truth_labels;
   perceive.segmenter = options.segmenter.empty()
                            ? options.models_dir + "/segmentation/yard_segmenter.onnx"
                            : options.segmenter;
-  if (!perception::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic)
-           .ground_plane_found) {
+  if (!sim::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic).ground_plane_found) {
     err << "autoshovel select: too few ground cells to fit the ground plane\n";
     return false;
   }
@@ -213,4 +214,4 @@ int RunSelect(const SelectOptions& options, std::ostream& out, std::ostream& err
   }
 }
 
-}  // namespace autoshovel::planning
+}  // namespace autoshovel::sim

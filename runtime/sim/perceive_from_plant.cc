@@ -1,4 +1,4 @@
-#include "runtime/perception/perceive_from_plant.h"
+#include "runtime/sim/perceive_from_plant.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,9 @@
 #include "runtime/sensors/lidar.h"
 #include "runtime/sensors/sensor_pose.h"
 
-namespace autoshovel::perception {
+namespace autoshovel::sim {
+
+using namespace perception;  // the pipeline is perception's, run on the simulator's frames
 
 namespace {
 
@@ -30,7 +32,8 @@ const Segmenter& CachedSegmenter(const std::string& onnx_path) {
 PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
                                            const sensors::RaycastScene& scene, sensors::Rng& rng,
                                            const PerceptionFromPlantOptions& options,
-                                           ElevationMap& map, SemanticMap& semantic) {
+                                           perception::ElevationMap& map,
+                                           perception::SemanticMap& semantic) {
   const model::MachineDescription& machine = plant.machine();
   const plant::MachineState& s = plant.state();
   PerceptionFromPlantStats stats;
@@ -142,4 +145,4 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
   return stats;
 }
 
-}  // namespace autoshovel::perception
+}  // namespace autoshovel::sim

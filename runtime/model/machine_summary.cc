@@ -67,6 +67,39 @@ void SummarizeSlidingWindow(const MachineDescription& m, const InterpretedModel&
   window(boom.joint_min, summary.window_bottom_min, summary.window_bottom_max);
 }
 
+// Dump pose (SAE J732, ISO 7131) of a loader: the clearance and reach at 45°, or why not.
+void SummarizeDumpPose(const MachineDescription& m, const InterpretedModel& model,
+                       MachineSummary& s) {
+  // The boom at its upper limit, the bucket's discharge angle 45°,
+  // the angle of the floor (the longest flat section of the inside bottom: the profile's edge
+  // from the cutting edge, its first point, to the second) below horizontal. The floor runs
+  // from the heel up to the tip at angle β above the pin-to-tip line in the bucket frame, so
+  // the bucket frame is at φ₂ = −45° − β and the cutting edge is the bucket's lowest point.
+  const Eigen::Vector2d floor = m.bucket.profile[0] - m.bucket.profile[1];
+  s.dump_floor_to_edge_line = std::atan2(floor.y(), floor.x()) -
+                              std::atan2(m.bucket.profile[0].y(), m.bucket.profile[0].x());
+  const double phi2 = -std::numbers::pi / 4 - std::atan2(floor.y(), floor.x());
+  std::vector<double> dump_q = {m.links[0].joint_max, phi2 - m.links[0].joint_max};
+  double deepest = m.links[1].joint_min, shallowest = m.links[1].joint_max;
+  if (CylinderMovesWithEarlierJoints(m, 1)) {
+    const JointWindow w = ReachableJointWindow(m, 1, dump_q.data());
+    deepest = w.empty ? shallowest : std::max(deepest, w.min);
+    shallowest = w.empty ? deepest : std::min(shallowest, w.max);
+  }
+  s.dump_floor_at_limit = m.links[0].joint_max + deepest + std::atan2(floor.y(), floor.x());
+  const bool reachable = dump_q[1] >= deepest - 1e-9 && dump_q[1] <= shallowest + 1e-9;
+  if (reachable) {
+    s.dump_pose_reachable = true;
+    s.dump_pose = dump_q;
+    const Eigen::Vector4d pose = model.TipFromJoints(dump_q.data());
+    s.dump_clearance = pose[2];
+    // Reach is measured from the foremost point of the machine without its bucket; of the
+    // machine, a description knows the tyres: the front of the front tyres.
+    const double tyre_front = m.chassis.hinge_to_front_axle + m.chassis.wheel_radius;
+    s.dump_reach = pose[0] - tyre_front;
+  }
+}
+
 }  // namespace
 
 MachineSummary Summarize(const MachineDescription& m) {
@@ -137,34 +170,7 @@ MachineSummary Summarize(const MachineDescription& m) {
     s.carry_pose_definition =
         "boom at 20% of its range from the bottom, bucket racked back fully (as far as its "
         "cylinder reaches there)";
-    // Dump pose (SAE J732, ISO 7131): boom at its upper limit, the bucket's discharge angle 45°,
-    // the angle of the floor (the longest flat section of the inside bottom: the profile's edge
-    // from the cutting edge, its first point, to the second) below horizontal. The floor runs
-    // from the heel up to the tip at angle β above the pin-to-tip line in the bucket frame, so
-    // the bucket frame is at φ₂ = −45° − β and the cutting edge is the bucket's lowest point.
-    const Eigen::Vector2d floor = m.bucket.profile[0] - m.bucket.profile[1];
-    s.dump_floor_to_edge_line = std::atan2(floor.y(), floor.x()) -
-                                std::atan2(m.bucket.profile[0].y(), m.bucket.profile[0].x());
-    const double phi2 = -std::numbers::pi / 4 - std::atan2(floor.y(), floor.x());
-    std::vector<double> dump_q = {m.links[0].joint_max, phi2 - m.links[0].joint_max};
-    double deepest = m.links[1].joint_min, shallowest = m.links[1].joint_max;
-    if (CylinderMovesWithEarlierJoints(m, 1)) {
-      const JointWindow w = ReachableJointWindow(m, 1, dump_q.data());
-      deepest = w.empty ? shallowest : std::max(deepest, w.min);
-      shallowest = w.empty ? deepest : std::min(shallowest, w.max);
-    }
-    s.dump_floor_at_limit = m.links[0].joint_max + deepest + std::atan2(floor.y(), floor.x());
-    const bool reachable = dump_q[1] >= deepest - 1e-9 && dump_q[1] <= shallowest + 1e-9;
-    if (reachable) {
-      s.dump_pose_reachable = true;
-      s.dump_pose = dump_q;
-      const Eigen::Vector4d pose = model.TipFromJoints(dump_q.data());
-      s.dump_clearance = pose[2];
-      // Reach is measured from the foremost point of the machine without its bucket; of the
-      // machine, a description knows the tyres: the front of the front tyres.
-      const double tyre_front = m.chassis.hinge_to_front_axle + m.chassis.wheel_radius;
-      s.dump_reach = pose[0] - tyre_front;
-    }
+    SummarizeDumpPose(m, model, s);
   } else {
     s.carry_pose_definition = "every joint in the middle of its range";
   }

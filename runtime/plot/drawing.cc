@@ -49,4 +49,26 @@ void PutVerticalText(cv::Mat& image, const std::string& text, int x, int center_
     vertical(cv::Rect(0, 0, roi.width, roi.height)).copyTo(image(roi));
 }
 
+void DrawXGridTick(cv::Mat& image, const cv::Point2d& p, double top, const std::string& label) {
+  const cv::Scalar grid(225, 225, 225), black(0, 0, 0);
+  cv::line(image, cv::Point2d(p.x, top), p, grid, 1);
+  cv::line(image, p, p + cv::Point2d(0, 5), black, 1);
+  const cv::Size size = TextSize(label, 0.45);
+  PutText(
+      image, label,
+      cv::Point(static_cast<int>(p.x) - size.width / 2, static_cast<int>(p.y) + 8 + size.height),
+      0.45);
+}
+
+void DrawYGridTick(cv::Mat& image, const cv::Point2d& p, double right, const std::string& label) {
+  const cv::Scalar grid(225, 225, 225), black(0, 0, 0);
+  cv::line(image, p, cv::Point2d(right, p.y), grid, 1);
+  cv::line(image, p, p - cv::Point2d(5, 0), black, 1);
+  const cv::Size size = TextSize(label, 0.45);
+  PutText(
+      image, label,
+      cv::Point(static_cast<int>(p.x) - 8 - size.width, static_cast<int>(p.y) + size.height / 2),
+      0.45);
+}
+
 }  // namespace autoshovel::plot::internal

@@ -20,9 +20,10 @@ namespace {
 
 constexpr int kLeft = 90, kRight = 25, kTop = 50, kBottom = 65;  // margins [px]
 const cv::Scalar kBlack(0, 0, 0);
-const cv::Scalar kGridColor(225, 225, 225);
 
 using internal::DrawSegment;
+using internal::DrawXGridTick;
+using internal::DrawYGridTick;
 using internal::NiceStep;
 using internal::PutText;
 using internal::PutVerticalText;
@@ -117,24 +118,10 @@ cv::Mat DrawLinePlot(const LinePlot& plot) {
   // Grid, ticks and tick labels.
   const double eps_x = 1e-9 * x_step, eps_y = 1e-9 * y_step;
   for (double x = std::ceil((xr.lo - eps_x) / x_step) * x_step; x <= xr.hi + eps_x; x += x_step) {
-    const cv::Point2d p = to_px(x, yr.lo);
-    cv::line(image, cv::Point2d(p.x, kTop), p, kGridColor, 1);
-    cv::line(image, p, p + cv::Point2d(0, 5), kBlack, 1);
-    const std::string label = TickLabel(x, x_step);
-    const cv::Size size = TextSize(label, 0.45);
-    PutText(
-        image, label,
-        cv::Point(static_cast<int>(p.x) - size.width / 2, static_cast<int>(p.y) + 8 + size.height),
-        0.45);
+    DrawXGridTick(image, to_px(x, yr.lo), kTop, TickLabel(x, x_step));
   }
   for (double y = std::ceil((yr.lo - eps_y) / y_step) * y_step; y <= yr.hi + eps_y; y += y_step) {
-    const cv::Point2d p = to_px(xr.lo, y);
-    cv::line(image, p, cv::Point2d(kLeft + plot_w, p.y), kGridColor, 1);
-    cv::line(image, p, p - cv::Point2d(5, 0), kBlack, 1);
-    const std::string label = TickLabel(y, y_step);
-    const cv::Size size = TextSize(label, 0.45);
-    PutText(image, label,
-            cv::Point(kLeft - 8 - size.width, static_cast<int>(p.y) + size.height / 2), 0.45);
+    DrawYGridTick(image, to_px(xr.lo, y), kLeft + plot_w, TickLabel(y, y_step));
   }
 
   // Data, clipped to the plot area.

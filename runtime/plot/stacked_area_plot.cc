@@ -19,6 +19,8 @@ namespace autoshovel::plot {
 namespace {
 
 using internal::DrawSegment;
+using internal::DrawXGridTick;
+using internal::DrawYGridTick;
 using internal::NiceStep;
 using internal::PutText;
 using internal::PutVerticalText;
@@ -32,7 +34,6 @@ constexpr int kLabelRow = 18;                            // marker label rows ab
 constexpr int kMaxLabelRows = 3;
 constexpr int kLegendGap = 15, kSwatchW = 18, kSwatchH = 12, kLegendRow = 22;  // [px]
 const cv::Scalar kBlack(0, 0, 0);
-const cv::Scalar kGridColor(225, 225, 225);
 const cv::Vec3b kTotalColor(40, 40, 40);  // the stack's total line
 
 // Header contract: negative and non-finite values are drawn as 0.
@@ -103,24 +104,10 @@ void DrawGridAndTicks(cv::Mat& image, double x_lo, double x_hi, double x_span, d
   const double x_step = NiceStep(x_span);
   const double eps_x = 1e-9 * x_step, eps_y = 1e-9 * y_step;
   for (double x = std::ceil((x_lo - eps_x) / x_step) * x_step; x <= x_hi + eps_x; x += x_step) {
-    const cv::Point2d p(x_px(x), top + plot_h);
-    cv::line(image, cv::Point2d(p.x, top), p, kGridColor, 1);
-    cv::line(image, p, p + cv::Point2d(0, 5), kBlack, 1);
-    const std::string label = TickLabel(x, x_step);
-    const cv::Size size = TextSize(label, 0.45);
-    PutText(
-        image, label,
-        cv::Point(static_cast<int>(p.x) - size.width / 2, static_cast<int>(p.y) + 8 + size.height),
-        0.45);
+    DrawXGridTick(image, cv::Point2d(x_px(x), top + plot_h), top, TickLabel(x, x_step));
   }
   for (double y = 0.0; y <= y_hi + eps_y; y += y_step) {
-    const cv::Point2d p(kLeft, y_px(y));
-    cv::line(image, p, cv::Point2d(kLeft + plot_w, p.y), kGridColor, 1);
-    cv::line(image, p, p - cv::Point2d(5, 0), kBlack, 1);
-    const std::string label = TickLabel(y, y_step);
-    const cv::Size size = TextSize(label, 0.45);
-    PutText(image, label,
-            cv::Point(kLeft - 8 - size.width, static_cast<int>(p.y) + size.height / 2), 0.45);
+    DrawYGridTick(image, cv::Point2d(kLeft, y_px(y)), kLeft + plot_w, TickLabel(y, y_step));
   }
 }
 

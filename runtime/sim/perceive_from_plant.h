@@ -15,6 +15,7 @@
 #include "runtime/perception/lens_dirt_monitor.h"
 #include "runtime/perception/lidar_health.h"
 #include "runtime/perception/semantic_map.h"
+#include "runtime/perception/sensor_fusion.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/world.h"
 #include "runtime/sensors/raycast.h"
@@ -39,20 +40,17 @@ struct PerceptionFromPlantOptions {
   perception::LensDirtMonitor* lens_dirt = nullptr;
 };
 
-struct PerceptionFromPlantStats {
-  long returns_fused = 0;
-  long returns_on_machine = 0;
-  long holes_filled = 0;
-  bool ground_plane_found = false;  ///< false: too few ground cells; classes not fused
-  std::string semantics;            ///< "simulator labels" or "network <file>"
-  /// Blind sectors found (check_lidar_health), with the LiDAR's name.
-  std::vector<std::pair<std::string, perception::AzimuthSector>> blind_sectors;
-  double camera_masked_fraction = 0;  ///< of the last image, masked for dirt (or suspect)
-  double camera_dirty_fraction = 0;   ///< of the last image, confirmed dirty (lens_dirt_monitor.h)
-};
+using PerceptionFromPlantStats = perception::FusionStats;
 
-/// Updates `map` and `semantic` (built on `map`) with what the machine of `plant` senses in
-/// `scene` now. Throws what the segmenter throws for a bad network file.
+/// What the machine of `plant` senses in `scene` now, as the frames a driver would deliver
+/// (`lidar_frames` per LiDAR 0.1 s apart, then the camera's unless `camera_frame` is false),
+/// with the faults of `options` applied.
+perception::SensorFrames SimulateSensorFrames(const plant::Plant& plant,
+                                              const sensors::RaycastScene& scene, sensors::Rng& rng,
+                                              const PerceptionFromPlantOptions& options);
+
+/// SimulateSensorFrames, then perception::FuseSensorFrames into `map` and `semantic` (built on
+/// `map`). Throws what the segmenter throws for a bad network file.
 PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
                                            const sensors::RaycastScene& scene, sensors::Rng& rng,
                                            const PerceptionFromPlantOptions& options,

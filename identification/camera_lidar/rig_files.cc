@@ -21,12 +21,10 @@ struct Number {
   int line = 0, column = 0;
 };
 
+// The first problem refuses the file (core::RefuseInput).
 [[noreturn]] void Refuse(const std::string& source, int line, int column,
                          const std::string& message) {
-  core::DiagnosticSink sink;
-  sink.Add({source, line, column}, "", message);
-  sink.ThrowIfAny();
-  throw std::logic_error("unreachable");
+  core::RefuseInput({source, line, column}, message);
 }
 
 // The numbers of one line after `begin`, each with its column; stops at `#`. Refuses a token

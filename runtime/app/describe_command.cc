@@ -8,6 +8,7 @@
 
 #include "generated/registry.h"
 #include "runtime/core/diagnostics.h"
+#include "runtime/core/strings.h"
 #include "runtime/machines/machine_code.h"
 #include "runtime/model/description.h"
 #include "runtime/model/machine_summary.h"
@@ -17,11 +18,7 @@
 namespace autoshovel::app {
 namespace {
 
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
+using core::Fixed;
 
 double Deg(double radians) { return radians * 180.0 / std::numbers::pi; }
 

@@ -15,6 +15,7 @@
 #include "runtime/app/compare_run_options.h"
 #include "runtime/app/shovel_run.h"
 #include "runtime/core/file_output.h"
+#include "runtime/core/strings.h"
 #include "runtime/plot/stacked_area_plot.h"
 
 namespace autoshovel::app {
@@ -92,11 +93,7 @@ struct CaseResult {
   double contact_time = NAN, trigger_time = NAN, scoop_end_time = NAN;
 };
 
-std::string Fixed(double v, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", digits, v);
-  return buffer;
-}
+using core::Fixed;
 
 void PrintTable(const Case& c, const CaseResult& r, const std::string& machine, std::ostream& out) {
   const double n = std::max(1, r.completed);

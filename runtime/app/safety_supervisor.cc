@@ -6,15 +6,13 @@
 #include <cstdio>
 #include <numbers>
 
+#include "runtime/core/strings.h"
+
 namespace autoshovel::app {
 
 namespace {
 
-std::string Fixed(double x, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, x);
-  return text;
-}
+using core::Fixed;
 
 }  // namespace
 

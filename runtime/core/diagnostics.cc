@@ -4,6 +4,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 namespace autoshovel::core {
@@ -48,6 +49,13 @@ void DiagnosticSink::Add(SourceLocation where, std::string key_path, std::string
 
 void DiagnosticSink::ThrowIfAny() const {
   if (!diagnostics_.empty()) throw InputError(diagnostics_);
+}
+
+void RefuseInput(SourceLocation where, std::string message) {
+  DiagnosticSink sink;
+  sink.Add(std::move(where), "", std::move(message));
+  sink.ThrowIfAny();
+  throw std::logic_error("RefuseInput: the sink did not throw");  // unreachable
 }
 
 InputError::InputError(std::vector<Diagnostic> diagnostics)

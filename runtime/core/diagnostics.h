@@ -53,6 +53,9 @@ class DiagnosticSink {
   std::vector<Diagnostic> diagnostics_;
 };
 
+/// Refuses an input with the one problem found at `where` (a reader that stops at the first).
+[[noreturn]] void RefuseInput(SourceLocation where, std::string message);
+
 /// Thrown when an input file is refused. `what()` holds one line per diagnostic.
 class InputError : public std::runtime_error {
  public:

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <limits>
 
 namespace autoshovel::core {
@@ -33,6 +34,12 @@ std::string NearestWord(std::string_view word, const std::vector<std::string>& c
   }
   const std::size_t allowed = std::max<std::size_t>(2, word.size() / 3);
   return best_distance <= allowed ? best : std::string();
+}
+
+std::string Fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
 }
 
 std::string FormatNumber(double value) {

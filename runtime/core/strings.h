@@ -14,6 +14,9 @@ std::size_t EditDistance(std::string_view a, std::string_view b);
 /// plausible typo (distance above a third of the word's length, at least 2).
 std::string NearestWord(std::string_view word, const std::vector<std::string>& candidates);
 
+/// `value` with `digits` decimals, as printf's "%.*f" writes it (for tables and log lines).
+std::string Fixed(double value, int digits);
+
 /// Formats a double with the shortest representation that reads back to the same value.
 std::string FormatNumber(double value);
 

@@ -1,9 +1,10 @@
 // The progress lines of one cycle of the main job: "[cycle N] text" on the run's progress stream.
 #pragma once
 
-#include <cstdio>
 #include <ostream>
 #include <string>
+
+#include "runtime/core/strings.h"
 
 namespace autoshovel::app {
 
@@ -20,11 +21,6 @@ class CycleLog {
   int index_;
 };
 
-/// `value` with `digits` decimals, as printf's "%.*f" writes it.
-inline std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
-}
+using core::Fixed;
 
 }  // namespace autoshovel::app

@@ -17,12 +17,10 @@ namespace {
 
 constexpr std::uintmax_t kMaxPosesBytes = std::uintmax_t{16} << 20;
 
+// The first problem refuses the file (core::RefuseInput).
 [[noreturn]] void Refuse(const std::string& source, int line, int column,
                          const std::string& message) {
-  core::DiagnosticSink sink;
-  sink.Add({source, line, column}, "", message);
-  sink.ThrowIfAny();
-  throw std::logic_error("unreachable");
+  core::RefuseInput({source, line, column}, message);
 }
 
 }  // namespace

@@ -476,10 +476,15 @@ Plant::Plant(const model::MachineDescription& machine, const generated::MachineF
   y_[layout.y()] = initial.hinge_xy.y();
   y_[layout.heading()] = initial.heading;
   y_[layout.articulation()] = initial.articulation;
-  state_.time = 0;
+  // The clock starts at the initial state's time: the main job's cycles run on one machine
+  // clock (frame stamps, the map's process noise, a recording's timestamps) instead of each
+  // cycle's restarting at 0.
+  if (!std::isfinite(initial.time)) throw std::invalid_argument("Plant: initial time not finite");
+  state_.time = initial.time;
+  last_relax_time_ = initial.time;
   LoadSensing(OpeningReference(system_->held().spool_reference, system_->held().pilot_input),
               system_->held().section_supply, system_->held().pump_pressure);
-  integrator_->Reset(0.0, y_.data());
+  integrator_->Reset(initial.time, y_.data());
   dirty_ = false;
   UpdateState();
   UpdateResistance();

@@ -294,6 +294,71 @@ void CheckPcd(const std::string& path, bool& has_intensity) {
   }
 }
 
+// One value of a field of the blob's point `i` as a double (any PCD type).
+double FieldValue(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& field, std::size_t i) {
+  const std::uint8_t* p = blob.data.data() + i * blob.point_step + field.offset;
+  auto as = [p]<typename T>(T) {
+    T v;
+    std::memcpy(&v, p, sizeof v);
+    return static_cast<double>(v);
+  };
+  switch (field.datatype) {
+    case pcl::PCLPointField::INT8:
+      return as(std::int8_t{});
+    case pcl::PCLPointField::UINT8:
+      return as(std::uint8_t{});
+    case pcl::PCLPointField::INT16:
+      return as(std::int16_t{});
+    case pcl::PCLPointField::UINT16:
+      return as(std::uint16_t{});
+    case pcl::PCLPointField::INT32:
+      return as(std::int32_t{});
+    case pcl::PCLPointField::UINT32:
+      return as(std::uint32_t{});
+    case pcl::PCLPointField::FLOAT32:
+      return as(float{});
+    case pcl::PCLPointField::FLOAT64:
+      return as(double{});
+    default:
+      return 0.0;
+  }
+}
+
+// The optional per-point `ring` (laser index) and `time_offset` (firing time after the frame's
+// stamp, seconds) that recordings carry (runtime/recording): copied onto the points kept, which
+// are the file's points in order less those with a non-finite coordinate.
+void ReadRingAndTime(const pcl::PCLPointCloud2& blob, std::vector<sensors::LidarPoint>& points) {
+  const pcl::PCLPointField* ring = nullptr;
+  const pcl::PCLPointField* time = nullptr;
+  const pcl::PCLPointField *x = nullptr, *y = nullptr, *z = nullptr;
+  for (const pcl::PCLPointField& f : blob.fields) {
+    if (f.name == "ring") ring = &f;
+    if (f.name == "time_offset") time = &f;
+    if (f.name == "x") x = &f;
+    if (f.name == "y") y = &f;
+    if (f.name == "z") z = &f;
+  }
+  if ((ring == nullptr && time == nullptr) || x == nullptr || y == nullptr || z == nullptr) return;
+  const std::size_t n = static_cast<std::size_t>(blob.width) * blob.height;
+  if (blob.data.size() < n * blob.point_step) return;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n && kept < points.size(); ++i) {
+    if (!std::isfinite(FieldValue(blob, *x, i)) || !std::isfinite(FieldValue(blob, *y, i)) ||
+        !std::isfinite(FieldValue(blob, *z, i))) {
+      continue;
+    }
+    if (ring != nullptr) {
+      const double r = FieldValue(blob, *ring, i);
+      points[kept].ring = r >= 0 && r <= 65535 ? static_cast<std::uint16_t>(r) : 0;
+    }
+    if (time != nullptr) {
+      const double t = FieldValue(blob, *time, i);
+      points[kept].time_offset = std::isfinite(t) ? static_cast<float>(t) : 0.0f;
+    }
+    ++kept;
+  }
+}
+
 sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points,
                             PointCloudReadStats& stats) {
   bool has_intensity = false;
@@ -332,6 +397,7 @@ sensors::PointCloud ReadPcd(const std::string& path, std::size_t max_points,
       cloud.points.push_back(q);
     }
   }
+  ReadRingAndTime(blob, cloud.points);
   Reduce(cloud.points, max_points);
   return cloud;
 }

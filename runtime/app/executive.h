@@ -6,6 +6,7 @@
 // ScoopCycleOptions::decision_every.)
 #pragma once
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -30,7 +31,7 @@ class MultiRateExecutive {
     if (!(period >= base_period_ - 1e-12) || !std::isfinite(period)) {
       throw std::invalid_argument("executive: task '" + name + "' period below the base period");
     }
-    tasks_.push_back({std::move(name), period, now_, std::move(task), 0});
+    tasks_.push_back({std::move(name), period, now_, std::move(task), 0, 0.0});
   }
 
   /// Runs the tasks due now, then advances the clock by the base period.
@@ -39,7 +40,10 @@ class MultiRateExecutive {
       // Half a base period of slack: 1/7 s is not a multiple of 10 ms; the task runs at the
       // first base tick at or after its due time, and its schedule does not drift.
       if (now_ + 0.5 * base_period_ >= task.due) {
+        const auto w0 = std::chrono::steady_clock::now();
         task.run(now_);
+        task.seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
         ++task.calls;
         task.due += task.period;
       }
@@ -55,6 +59,14 @@ class MultiRateExecutive {
     }
     return 0;
   }
+  /// Wall time spent in the task named `name` so far [s] (0 if none by that name): the profile
+  /// (`run --profile`). The schedule never depends on it.
+  double Seconds(const std::string& name) const {
+    for (const Task& task : tasks_) {
+      if (task.name == name) return task.seconds;
+    }
+    return 0;
+  }
 
  private:
   struct Task {
@@ -63,6 +75,7 @@ class MultiRateExecutive {
     double due;
     std::function<void(double)> run;
     long calls;
+    double seconds;  ///< wall time in `run` [s]
   };
   double base_period_;
   double now_;

@@ -25,6 +25,7 @@
 #include "runtime/app/map_cloud_command.h"
 #include "runtime/app/map_command.h"
 #include "runtime/app/plant_step_command.h"
+#include "runtime/app/replay_command.h"
 #include "runtime/app/scenario_command.h"
 #include "runtime/app/shovel_job/shovel_cycle.h"
 #include "runtime/app/shovel_run.h"
@@ -301,6 +302,28 @@ Command AddMap(CLI::App& app, const Globals& g) {
             }
             c->map.models_dir = g.models_dir;
             return autoshovel::app::RunMap(c->map, std::cout, std::cerr);
+          }};
+}
+
+Command AddReplay(CLI::App& app, const Globals& g) {
+  auto c = std::make_shared<autoshovel::app::ReplayOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "replay",
+      "Run the main job's perception and shovel point selection on a recording (a real "
+      "machine's, or `run --record`'s): maps, selections and pictures, no plant "
+      "(docs/recording_format.md)");
+  cmd->add_option("recording", c->recording, "Recording folder")->required();
+  cmd->add_option("-o,--out", c->out, "Run folder (default: runs/<UTC timestamp>)");
+  cmd->add_flag("--truth", c->truth_labels,
+                "The camera frames' recorded labels instead of the segmentation network");
+  cmd->add_option("--segmenter", c->segmenter, "ONNX segmentation network");
+  cmd->add_flag(
+      "--no-figures", [c](std::int64_t) { c->figures = false; }, "Skip the per-cycle PNGs");
+  cmd->add_flag("--check", c->check,
+                "Exit 1 when a map or a selection differs from the recording's reference/");
+  return {cmd, [c, &g]() -> int {
+            c->models_dir = g.models_dir;
+            return autoshovel::app::RunReplay(*c, std::cout, std::cerr);
           }};
 }
 
@@ -774,6 +797,11 @@ int RunMainJob(RunCli& c, bool cycles_given, const Globals& g) {
     // Not loadable here: the shovel job reports what is wrong with it.
   }
   if (excavator) {
+    if (!c.run.record_dir.empty()) {
+      std::cerr << "autoshovel run: --record: the truck-loading job does not record yet (only "
+                   "the wheel loader's main job does: docs/recording_format.md)\n";
+      return 2;
+    }
     autoshovel::app::TruckLoadingOptions& truck = c.truck_loading;
     truck.scenario = c.run.scenario;
     truck.models_dir = g.models_dir;
@@ -894,6 +922,12 @@ Command AddRun(CLI::App& app, const Globals& g) {
   cmd->add_option("--shovel-weights", c->run.shovel_weights,
                   "Eq. (18) weights YAML from `autoshovel train weights` (default: Table 1)");
   cmd->add_flag("--no-figures", c->run_no_figures, "Skip the per-cycle PNGs");
+  cmd->add_flag("--profile", c->run.profile,
+                "Print where the wall time went, per executive task and component (and write "
+                "profile.csv in the run folder: docs/performance.md)");
+  cmd->add_option("--record", c->run.record_dir,
+                  "Record every map update's sensor frames into this new folder, for "
+                  "`autoshovel replay` (docs/recording_format.md)");
   cmd->add_option("--dig-evaluations", c->truck_loading.dig_evaluations,
                   "Excavator scenarios: plant simulations per dig plan")
       ->check(autoshovel::app::IntegerIn(1, 100000))
@@ -1005,6 +1039,7 @@ int main(int argc, char** argv) {
   commands.push_back(AddReportProduction(*report, g));
   commands.push_back(AddSelect(app, g));
   commands.push_back(AddRun(app, g));
+  commands.push_back(AddReplay(app, g));
   commands.push_back(AddCompare(app, g));
 
   // One line naming the command and the option for any refused command line (cli_checks.h).

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "runtime/app/shovel_job/shovel_cycle.h"
+#include "runtime/core/file_output.h"
 #include "runtime/core/strings.h"
 #include "runtime/optimal/warm_scoop_solver.h"
 #include "runtime/perception/elevation_map.h"
@@ -22,6 +23,7 @@
 #include "runtime/prediction/model_provenance.h"
 #include "runtime/prediction/penetration_predictor.h"
 #include "runtime/prediction/shipped_models.h"
+#include "runtime/recording/recording_writer.h"
 #include "runtime/results/plots.h"
 #include "runtime/results/report.h"
 #include "runtime/results/run_folder.h"
@@ -100,6 +102,7 @@ struct ShovelJob::State {
   /// Dirt on the lens stays from cycle to cycle, and so does what the monitor learnt of it.
   perception::LensDirtMonitor lens_dirt;
   planning::ShovelPointConfig selection;  ///< Eq. (18) weights: Table 1 or --shovel-weights
+  std::unique_ptr<recording::RecordingWriter> recorder;  ///< ShovelRunOptions::record_dir
   double cycle_clock = 0;  ///< each cycle's plant starts where the last one ended [s]
   int next_site = 0;
 
@@ -211,6 +214,20 @@ ShovelJob::ShovelJob(const ShovelRunOptions& options)
   map_config.length = size;
   st.map = std::make_unique<perception::ElevationMap>(map_config, g.origin + 0.5 * size);
   st.semantic = std::make_unique<perception::SemanticMap>(*st.map);
+  if (!options.record_dir.empty()) {
+    recording::Manifest manifest;
+    manifest.source = "autoshovel run " + scenario.name + " --seed " +
+                      std::to_string(options.seed) + " (simulated)";
+    manifest.map_resolution = map_config.resolution;
+    manifest.map_length = map_config.length;
+    manifest.map_center = g.origin + 0.5 * size;
+    st.recorder = std::make_unique<recording::RecordingWriter>(
+        options.record_dir, machine.source_file, std::move(manifest));
+  }
+}
+
+void ShovelJob::FinishRecording() {
+  if (state_->recorder != nullptr) state_->recorder->Close();
 }
 
 ShovelJob::~ShovelJob() = default;
@@ -320,7 +337,8 @@ CycleOutcome ShovelJob::RunCycleAt(int index, int site_index,
                            .semantic = *st.semantic,
                            .rng = st.rng,
                            .lens_dirt = st.lens_dirt,
-                           .optimal_solver = st.optimal_solver};
+                           .optimal_solver = st.optimal_solver,
+                           .recorder = st.recorder.get()};
   return RunShovelCycle(resources, st.sites[site_index], index, st.cycle_clock, &st.cycle_clock,
                         figures_dir, progress);
 }
@@ -361,6 +379,7 @@ int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::pat
 
   std::vector<results::ReportFigure> figures;
   int incomplete = 0;
+  RunProfile profile;
   const auto w0 = std::chrono::steady_clock::now();
   for (int i = 0; i < options.cycles; ++i) {
     std::ostringstream progress;
@@ -375,6 +394,7 @@ int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::pat
     std::istringstream lines(progress.str());
     for (std::string line; std::getline(lines, line);) log.Info(line);
     db.WriteCycle(info.run_id, cycle.record);
+    profile.Merge(cycle.profile);
     if (!cycle.record.completed) ++incomplete;
     for (std::size_t k = 0; k < cycle.figures.size(); ++k) {
       figures.push_back(
@@ -392,6 +412,37 @@ int RunShovelCommand(const ShovelRunOptions& options, const std::filesystem::pat
                   rec.material.c_str(), rec.strategy.c_str(), 100 * rec.fill_rate, rec.time_s.total,
                   rec.energy_kj.total, rec.safety_margin_m, cycle.failure.c_str(), elapsed, eta);
     out << line << std::flush;
+  }
+  if (options.profile) {
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    double simulated = 0;
+    for (const results::CycleRecord& rec : db.Cycles(info.run_id, false))
+      simulated += rec.time_s.total;
+    std::ostringstream table;
+    table << "profile: " << core::Fixed(wall, 2) << " s of wall time for "
+          << core::Fixed(simulated, 1) << " s simulated (real-time factor "
+          << core::Fixed(wall > 0 ? simulated / wall : 0.0, 2) << ")\n"
+          << profile.Table(wall);
+    out << table.str();
+    log.Info(table.str());
+    try {
+      core::WriteFileAtomically(folder->dir() / "profile.csv", profile.Csv());
+    } catch (const std::exception& e) {
+      err << "autoshovel run: " << e.what() << "\n";
+      return 2;
+    }
+  }
+  if (!options.record_dir.empty()) {
+    try {
+      job->FinishRecording();
+    } catch (const std::exception& e) {
+      err << "autoshovel run: " << e.what() << "\n";
+      log.Error(e.what());
+      return 2;
+    }
+    out << "recording: " << options.record_dir << " (replay it: autoshovel replay "
+        << options.record_dir << ")\n";
   }
   const std::vector<results::CycleRecord> cycles = db.Cycles(info.run_id, false);
   const std::filesystem::path fill_png = folder->FigurePath("fill_rate.png");

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/app/run_profile.h"
 #include "runtime/app/safety_supervisor.h"
 #include "runtime/control/scoop_cycle.h"
 #include "runtime/plant/energy_audit.h"
@@ -137,6 +138,12 @@ struct ShovelRunOptions {
   /// Integrate the plant's energy audit (plant/energy_audit.h) and return it with each cycle
   /// (CycleOutcome::energy_audit_*). It never changes the run; it costs time.
   bool energy_audit = false;
+  /// Record what the sensors delivered at every map update into this new folder
+  /// (docs/recording_format.md), for `autoshovel replay`; empty: no recording.
+  std::string record_dir;
+  /// Print (and write profile.csv) where the run's wall time went: per executive task and
+  /// component (docs/performance.md).
+  bool profile = false;
 };
 
 /// What one cycle did (one row of the results database, plus what the figures need).
@@ -156,6 +163,7 @@ struct ContactSnapshot {
 
 struct CycleOutcome {
   results::CycleRecord record;
+  RunProfile profile;  ///< wall time per executive task and component
   ContactSnapshot contact;
   control::ScoopResult scoop;
   std::string failure;           ///< empty when completed
@@ -206,6 +214,9 @@ class ShovelJob {
   /// (prediction::ProvenanceMismatch, runtime/prediction/model_provenance.h). Commands driving
   /// the job print it as a warning; it is not an error.
   std::string PredictorMachineMismatch() const;
+  /// Writes the recording's tables and manifest (ShovelRunOptions::record_dir); the recording is
+  /// complete only after this. Nothing without a recording. Throws core::OutputError.
+  void FinishRecording();
 
  private:
   CycleOutcome RunCycleAt(int index, int site, const std::filesystem::path& figures_dir,

@@ -152,10 +152,21 @@ if grep -q "resume" "$tmp/err"; then  # `run` has no --resume: it must not sugge
   echo "FAIL run-out-not-empty: suggests resuming: $(cat "$tmp/err")"
 fi
 refuses run-faults-missing "--faults" -- "${models[@]}" run --faults "$tmp/no_such.yaml" -o "$tmp/r8"
-for d in r1 r2 r3 r4 r5 r6 r7 r8 r9; do
+refuses run-record-not-empty "nonempty_run" -- "${models[@]}" run cone_pile --cycles 1 --record "$tmp/nonempty_run" -o "$tmp/r10"
+for d in r1 r2 r3 r4 r5 r6 r7 r8 r9 r10; do
   if [ -e "$tmp/$d" ]; then
     failed=$((failed + 1))
     echo "FAIL run-refused-leaves-no-folder: $d was created"
+  fi
+done
+# replay
+refuses replay-missing "no_such_recording: not a folder" -- "${models[@]}" replay "$tmp/no_such_recording" -o "$tmp/rp1"
+mkdir -p "$tmp/unfinished_recording"
+refuses replay-unfinished "did not finish" -- "${models[@]}" replay "$tmp/unfinished_recording" -o "$tmp/rp2"
+for d in rp1 rp2; do
+  if [ -e "$tmp/$d" ]; then
+    failed=$((failed + 1))
+    echo "FAIL replay-refused-leaves-no-folder: $d was created"
   fi
 done
 # compare

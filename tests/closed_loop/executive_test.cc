@@ -3,8 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include "runtime/app/run_profile.h"
 
 namespace autoshovel::app {
 namespace {
@@ -31,6 +35,41 @@ TEST(MultiRateExecutive, RunsEachTaskAtItsRateWithoutDrift) {
   EXPECT_EQ(order[0], "c");
   EXPECT_EQ(order[1], "d");
   EXPECT_NEAR(executive.now(), 10.0, 1e-9);
+}
+
+// The profile (run --profile): each task's wall time is its own, and it never moves the
+// schedule. A task that sleeps 2 ms per call has at least calls × 2 ms; one that does nothing
+// has far less.
+TEST(MultiRateExecutive, TimesEachTaskWithoutChangingItsSchedule) {
+  MultiRateExecutive executive(0.01);
+  executive.Add("idle", 0.01, [](double) {});
+  executive.Add("busy", 0.05,
+                [](double) { std::this_thread::sleep_for(std::chrono::milliseconds(2)); });
+  for (int i = 0; i < 100; ++i) executive.Step();
+  EXPECT_EQ(executive.Calls("busy"), 20);
+  EXPECT_GE(executive.Seconds("busy"), 20 * 0.002);
+  EXPECT_LT(executive.Seconds("idle"), executive.Seconds("busy"));
+  EXPECT_EQ(executive.Seconds("no such task"), 0.0);
+}
+
+TEST(RunProfile, AddsMergesAndKeepsItsOrder) {
+  RunProfile a, b;
+  a.Add("task map", 1.0, 7);
+  a.Add("sensor simulation", 0.75, 7, 1);
+  b.Add("sensor simulation", 0.25, 3, 1);
+  b.Add("plant integration", 2.0, 100);
+  a.Merge(b);
+  ASSERT_EQ(a.entries().size(), 3u);
+  EXPECT_EQ(a.entries()[1].name, "sensor simulation");
+  EXPECT_EQ(a.entries()[1].calls, 10);
+  EXPECT_DOUBLE_EQ(a.entries()[1].seconds, 1.0);
+  EXPECT_EQ(a.entries()[1].depth, 1);
+  EXPECT_EQ(a.entries()[2].name, "plant integration");
+  const std::string table = a.Table(4.0);
+  // 1 s of 4 s, 100 ms per call for the component (10 calls).
+  EXPECT_NE(table.find("25.0 %"), std::string::npos) << table;
+  EXPECT_NE(table.find("100.000"), std::string::npos) << table;
+  EXPECT_EQ(a.Csv().substr(0, 26), "entry,depth,calls,seconds\n");
 }
 
 TEST(MultiRateExecutive, RefusesBadPeriods) {

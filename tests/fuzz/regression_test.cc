@@ -24,6 +24,7 @@
 #include "runtime/core/diagnostics.h"
 #include "runtime/model/description.h"
 #include "runtime/perception/scan/scan_poses.h"
+#include "runtime/recording/recording_tables.h"
 #include "runtime/results/results_db.h"
 #include "tests/fuzz/hydraulic_log_formats.h"
 #include "tests/fuzz/refusal.h"
@@ -142,6 +143,30 @@ TEST(FuzzRegressions, Ply) {
 TEST(FuzzRegressions, ScanPoses) {
   ExpectBothKinds(CheckTarget("scan_poses", [](const std::string& path) {
     return Refusal([&] { perception::ReadScanPoses(path); });
+  }));
+}
+
+std::string TextOf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// The recording folder's tables and manifest (fuzz_recording_updates, _frames, _manifest).
+TEST(FuzzRegressions, RecordingUpdates) {
+  ExpectBothKinds(CheckTarget("recording_updates", [](const std::string& path) {
+    return Refusal([&] { recording::ParseUpdatesCsv(TextOf(path), path); });
+  }));
+}
+
+TEST(FuzzRegressions, RecordingFrames) {
+  ExpectBothKinds(CheckTarget("recording_frames", [](const std::string& path) {
+    return Refusal([&] { recording::ParseFramesCsv(TextOf(path), path); });
+  }));
+}
+
+TEST(FuzzRegressions, RecordingManifest) {
+  ExpectBothKinds(CheckTarget("recording_manifest", [](const std::string& path) {
+    return Refusal([&] { recording::ReadManifest(path); });
   }));
 }
 

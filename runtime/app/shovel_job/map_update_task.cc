@@ -47,8 +47,20 @@ MapUpdateResult MapUpdateTask::Update(
   perceive.lens_dirt_radius_px = dirt != nullptr ? dirt->radius * camera_model.width_px : 0.0;
   perceive.check_lidar_health = true;
   perceive.lens_dirt = &lens_dirt;
-  const sim::PerceptionFromPlantStats seen =
-      sim::PerceiveFromPlant(plant, scene, rng, perceive, map, semantic);
+  // The frames as the machine delivers them, then fused (sim::PerceiveFromPlant in two steps,
+  // so that a recorder can keep the frames: last_frames()).
+  const auto w_sim = std::chrono::steady_clock::now();
+  last_frames_ = sim::SimulateSensorFrames(plant, scene, rng, perceive);
+  const auto w_fuse = std::chrono::steady_clock::now();
+  simulation_seconds_ += std::chrono::duration<double>(w_fuse - w_sim).count();
+  const perception::FusionStats seen =
+      perception::FuseSensorFrames(plant.machine(), last_frames_,
+                                   {.truth_labels = perceive.truth_labels,
+                                    .segmenter = perceive.segmenter,
+                                    .lens_dirt = perceive.lens_dirt},
+                                   map, semantic);
+  fusion_seconds_ +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - w_fuse).count();
 
   MapUpdateResult result;
   result.camera_dirty_fraction = seen.camera_dirty_fraction;

@@ -11,6 +11,7 @@
 #include "runtime/app/safety_supervisor.h"
 #include "runtime/app/shovel_job/cycle_log.h"
 #include "runtime/app/shovel_job/fault_schedule.h"
+#include "runtime/perception/sensor_fusion.h"
 #include "runtime/plant/world.h"
 #include "runtime/sensors/rng.h"
 #include "runtime/sim/perceive_from_plant.h"
@@ -58,15 +59,24 @@ class MapUpdateTask {
 
   /// Sure obstacle cells at least `path_obstacle_height` above the ground plane on the last map.
   const std::vector<Eigen::Vector2d>& sure_cells() const { return sure_cells_; }
+  /// The frames the last update fused, in order (what a recording keeps).
+  const perception::SensorFrames& last_frames() const { return last_frames_; }
   long calls() const { return calls_; }
   double seconds() const { return seconds_; }  ///< wall time spent [s]
+  /// Of seconds(): simulating the sensors (sim::SimulateSensorFrames) and fusing their frames
+  /// (perception::FuseSensorFrames: elevation map, segmentation, semantic map) [s].
+  double simulation_seconds() const { return simulation_seconds_; }
+  double fusion_seconds() const { return fusion_seconds_; }
 
  private:
   MapUpdateConfig config_;
   std::vector<Eigen::Vector2d> sure_cells_;
+  perception::SensorFrames last_frames_;
   long frames_arrived_ = 0;  ///< every second one lags under a timestamp fault
   long calls_ = 0;
   double seconds_ = 0;
+  double simulation_seconds_ = 0;
+  double fusion_seconds_ = 0;
   bool dirt_reported_ = false;
 };
 

@@ -23,30 +23,36 @@
 #include "runtime/perception/semantic_map.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/poses.h"
+#include "runtime/recording/recording_writer.h"
+#include "runtime/recording/replay_check.h"
 #include "runtime/sensors/raycast.h"
 
 namespace autoshovel::app {
 
 namespace {
 
-bool InsideBin(const plant::Bin& bin, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d u(std::cos(bin.yaw), std::sin(bin.yaw)), v(-u.y(), u.x());
-  const Eigen::Vector2d d = p - bin.front_center;
-  return std::abs(d.dot(u)) <= bin.width / 2 && d.dot(v) >= -0.5 && d.dot(v) <= bin.depth;
-}
-
-// Piles of this site: inside its bin, or, in the open yard, within the stockpile area the yard's
-// plan gives (2 m beyond each open pile's footprint). A map pile elsewhere (noise far away,
-// where Eq. (11) falls back on height alone) is not a work area.
-std::function<bool(const Eigen::Vector2d&)> SiteArea(const plant::Scenario& scenario,
-                                                     const Site& site) {
-  return [&scenario, site](const Eigen::Vector2d& p) {
-    if (site.bin >= 0) return InsideBin(scenario.bins[site.bin], p);
-    return std::any_of(scenario.piles.begin(), scenario.piles.end(), [&](const plant::Pile& q) {
-      const double extent = std::max({q.base_radius, q.length / 2, q.width / 2});
-      return q.bin < 0 && (p - q.center).norm() <= extent + 2.0;
-    });
-  };
+// Where this site's piles lie: inside its bin, or, in the open yard, within the stockpile area
+// the yard's plan gives (2 m beyond each open pile's footprint). A map pile elsewhere (noise far
+// away, where Eq. (11) falls back on height alone) is not a work area. A recording keeps it as
+// it is (recording::WorkArea), so a replay selects on the same piles.
+recording::WorkArea SiteWorkArea(const plant::Scenario& scenario, const Site& site) {
+  recording::WorkArea area;
+  if (site.bin >= 0) {
+    const plant::Bin& bin = scenario.bins[site.bin];
+    area.kind = recording::WorkArea::Kind::kRectangle;
+    area.front_center = bin.front_center;
+    area.yaw = bin.yaw;
+    area.width = bin.width;
+    area.depth = bin.depth;
+    return area;
+  }
+  area.kind = recording::WorkArea::Kind::kDiscs;
+  for (const plant::Pile& q : scenario.piles) {
+    if (q.bin >= 0) continue;
+    const double extent = std::max({q.base_radius, q.length / 2, q.width / 2});
+    area.discs.emplace_back(q.center.x(), q.center.y(), extent + 2.0);
+  }
+  return area;
 }
 
 control::ScoopCycleOptions ScoopOptionsFor(const ShovelRunOptions& o,
@@ -156,7 +162,8 @@ class ShovelCycle {
         o_(r.options),
         machine_(r.machine),
         site_(site),
-        in_site_(SiteArea(r.scenario, site)),
+        work_area_(SiteWorkArea(r.scenario, site)),
+        in_site_([this](const Eigen::Vector2d& p) { return work_area_.Contains(p); }),
         log_(progress, index),
         start_(StartOf(r, site, start_clock)),
         plant_(machine_, r.functions, r.scenario.world, start_, PlantOptionsFor(o_)),
@@ -189,6 +196,11 @@ class ShovelCycle {
     rec.completed = false;
     r.scene.Update();  // the terrain as the last cycle left it
     out_.target_volume = scoop_options_.target_fill * machine_.bucket.rated_capacity;
+    if (r.recorder != nullptr) {
+      r.recorder->SetSelection(selection_.config(), o_.safety_distance + o_.selection_margin,
+                               o_.selection == SelectionMethod::kChen2024);
+      r.recorder->BeginCycle({.index = index, .site = site.name, .area = work_area_});
+    }
   }
 
   CycleOutcome Run(const std::filesystem::path& figures_dir, double* end_clock);
@@ -212,12 +224,16 @@ class ShovelCycle {
   void HandOver();
   void Control();
   void SafeStop(const std::string& reason);
+  long RecordUpdate(bool select, const planning::Pose2& select_pose);
   void Finish(const std::filesystem::path& figures_dir);
+  void Profile(const MultiRateExecutive& executive, double plant_seconds, long plant_steps,
+               double finish_seconds);
 
   CycleResources& r_;
   const ShovelRunOptions& o_;
   const model::MachineDescription& machine_;
   const Site& site_;
+  const recording::WorkArea work_area_;
   const std::function<bool(const Eigen::Vector2d&)> in_site_;
   const CycleLog log_;
   CycleOutcome out_;
@@ -289,10 +305,19 @@ void ShovelCycle::MapAndSelection() {
   // Selection re-runs until the remaining path is short (a goal that moved under the bucket
   // would be chased): commit 5 m before the handover; a new goal must beat the one being driven
   // to by 0.05 in F (hysteresis against dithering between near-equal candidates).
-  if (stage_ != Stage::kSelect && control_.remaining() <= o_.handover_distance + 5.0) return;
+  if (stage_ != Stage::kSelect && control_.remaining() <= o_.handover_distance + 5.0) {
+    RecordUpdate(false, {});
+    return;
+  }
   const control::Proprioception s = machine_io_.Sense();  // the localisation, jumps included
+  const long recorded = RecordUpdate(true, {s.hinge_xy, s.heading});
   const planning::ShovelCandidate* best = selection_.Select(
       r_.map.map(), r_.semantic.ground_plane(), planning::Pose2{s.hinge_xy, s.heading});
+  if (recorded >= 0) {
+    r_.recorder->AddReference(
+        recording::MapDigestRow(recorded, r_.map.map()),
+        recording::SelectionRow(recorded, out_.record.cycle, selection_.last_selection(), best));
+  }
   if (stage_ == Stage::kSelect) {
     if (best == nullptr) {
       out_.failure = selection_.NoPointReason(site_.name);
@@ -314,6 +339,27 @@ void ShovelCycle::MapAndSelection() {
     nav_.Start(*change.candidate, change.new_goal, selection_, now, r_.map.map(), r_.loader);
     if (!change.log.empty()) log_.Say(change.log);
   }
+}
+
+// The update just fused, its machine outline and (when selection runs on it) the localisation
+// the selection plans from, into the recording; without a selection, the map's digest too.
+// Returns the update's number, or −1 when nothing is recorded.
+long ShovelCycle::RecordUpdate(bool select, const planning::Pose2& select_pose) {
+  if (r_.recorder == nullptr) return -1;
+  const plant::MachineState& s = plant_.state();
+  recording::UpdateRow row;
+  row.stamp = plant_.time();
+  row.hinge_xy = s.hinge_xy;
+  row.heading = s.heading;
+  row.articulation = s.articulation;
+  // As sim::SimulateSensorFrames outlines the machine for the map.
+  row.tip_reach = (plant_.TipInWorld().head<2>() - s.hinge_xy).norm();
+  row.select = select;
+  row.select_xy = select_pose.xy;
+  row.select_heading = select_pose.heading;
+  const long update = r_.recorder->AddUpdate(row, mapping_.last_frames(), "camera");
+  if (!select) r_.recorder->AddReference(recording::MapDigestRow(update, r_.map.map()), "");
+  return update;
 }
 
 // The supervisor's 20 Hz checks (safety_supervisor.h): faults that put a person in the way, the
@@ -422,10 +468,15 @@ CycleOutcome ShovelCycle::Run(const std::filesystem::path& figures_dir, double* 
                   [this, run = task.run](double) { (this->*run)(); });
   }
   std::string last_phase;
+  double plant_seconds = 0;
+  long plant_steps = 0;
   while (stage_ != Stage::kDone) {
     executive.Step();
     if (stage_ == Stage::kDone) break;
+    const WallTimer plant_timer;
     plant_.Advance(1.0 / o_.control_rate);
+    plant_seconds += plant_timer.Seconds();
+    ++plant_steps;
     control::ScoopCycle* scoop = handover_.scoop.get();
     if (scoop != nullptr && scoop->phase_name() != last_phase) {
       last_phase = scoop->phase_name();
@@ -442,9 +493,29 @@ CycleOutcome ShovelCycle::Run(const std::filesystem::path& figures_dir, double* 
       break;
     }
   }
+  const WallTimer finish_timer;
   Finish(figures_dir);
+  Profile(executive, plant_seconds, plant_steps, finish_timer.Seconds());
   *end_clock = plant_.time();
   return std::move(out_);
+}
+
+// The cycle's wall time by executive task, the components inside them, the plant's integration
+// and the booking (run --profile).
+void ShovelCycle::Profile(const MultiRateExecutive& executive, double plant_seconds,
+                          long plant_steps, double finish_seconds) {
+  RunProfile& p = out_.profile;
+  for (const TaskSpec& task : Tasks()) {
+    p.Add(std::string("task ") + task.name, executive.Seconds(task.name),
+          executive.Calls(task.name));
+    if (task.run != &ShovelCycle::MapAndSelection) continue;
+    p.Add("sensor simulation (ray casting)", mapping_.simulation_seconds(), mapping_.calls(), 1);
+    p.Add("map fusion (elevation, segmentation, semantic)", mapping_.fusion_seconds(),
+          mapping_.calls(), 1);
+    p.Add("shovel point selection", selection_.seconds(), selection_.selections(), 1);
+  }
+  p.Add("plant integration", plant_seconds, plant_steps);
+  p.Add("cycle booking (figures, row)", finish_seconds, 1);
 }
 
 void ShovelCycle::Finish(const std::filesystem::path& figures_dir) {

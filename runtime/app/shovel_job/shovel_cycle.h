@@ -29,6 +29,9 @@ class WarmScoopSolver;
 namespace autoshovel::sensors {
 class RaycastScene;
 }
+namespace autoshovel::recording {
+class RecordingWriter;
+}
 namespace autoshovel::perception {
 class ElevationMap;
 class SemanticMap;
@@ -61,6 +64,8 @@ struct CycleResources {
   sensors::Rng& rng;
   perception::LensDirtMonitor& lens_dirt;
   optimal::WarmScoopSolver& optimal_solver;
+  /// Where every map update's frames go (ShovelRunOptions::record_dir); null: nowhere.
+  recording::RecordingWriter* recorder = nullptr;
 };
 
 /// Runs cycle `index` at `site`, its plant starting at machine time `start_clock`; `end_clock`

@@ -1,0 +1,243 @@
+#include "runtime/app/replay_command.h"
+
+#include <chrono>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <vector>
+
+#include "runtime/app/shovel_job/shovel_point_task.h"
+#include "runtime/core/diagnostics.h"
+#include "runtime/core/file_output.h"
+#include "runtime/core/strings.h"
+#include "runtime/machines/machine_code.h"
+#include "runtime/model/description.h"
+#include "runtime/perception/elevation_map.h"
+#include "runtime/perception/lens_dirt_monitor.h"
+#include "runtime/perception/machine_footprint.h"
+#include "runtime/perception/map_render.h"
+#include "runtime/perception/semantic_map.h"
+#include "runtime/perception/sensor_fusion.h"
+#include "runtime/planning/candidate_render.h"
+#include "runtime/recording/recording_reader.h"
+#include "runtime/recording/replay_check.h"
+#include "runtime/results/run_folder.h"
+#include "runtime/sensors/lidar.h"
+#include "runtime/sensors/sensor_pose.h"
+
+namespace autoshovel::app {
+
+namespace {
+
+const model::Lidar* LidarNamed(const model::MachineDescription& machine, const std::string& name) {
+  for (const model::Lidar& lidar : machine.sensors.lidars) {
+    if (lidar.name == name) return &lidar;
+  }
+  return nullptr;
+}
+
+// The frames of update `i` as the machine delivered them: clouds and image from their files,
+// poses from frames.csv, the machine's outline from updates.csv, and for a frame marked for the
+// health check the LiDAR's scan pattern at the frame's stamp (from the description).
+perception::SensorFrames LoadUpdate(const recording::Recording& rec, std::size_t i,
+                                    const model::MachineDescription& machine) {
+  const recording::UpdateRow& u = rec.updates()[i];
+  perception::SensorFrames frames;
+  frames.footprint =
+      perception::LoaderFootprint(machine, u.hinge_xy, u.heading, u.articulation, u.tip_reach);
+  for (const recording::FrameRow& f : rec.FramesOf(i)) {
+    if (f.kind == recording::FrameRow::Kind::kCamera) {
+      frames.camera = rec.ReadCamera(f);
+      frames.T_world_camera = f.T_world_sensor;
+      continue;
+    }
+    const model::Lidar* lidar = LidarNamed(machine, f.sensor);
+    if (lidar == nullptr) {
+      core::RefuseInput({(rec.dir() / "frames.csv").string(), 0, 0},
+                        "update " + std::to_string(i) + ": machine '" + machine.name +
+                            "' has no LiDAR '" + f.sensor + "'");
+    }
+    perception::LidarFrame frame;
+    frame.lidar = f.sensor;
+    frame.T_world_lidar = f.T_world_sensor;
+    frame.stamp = f.stamp;
+    frame.cloud = rec.ReadLidar(f);
+    if (f.health_check) {
+      for (const sensors::LidarRay& ray : sensors::LidarScanPattern(*lidar, f.stamp)) {
+        frame.health_check_rays.push_back(ray.direction);
+      }
+      frame.R_cab_lidar = sensors::PoseToIsometry(lidar->pose).linear();
+    }
+    frames.lidar.push_back(std::move(frame));
+  }
+  return frames;
+}
+
+std::string ReadTextOrEmpty(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// How many rows of `ours` equal the reference's, and the first that does not ("" when all do).
+struct Comparison {
+  long rows = 0, same = 0;
+  std::string first_difference;
+};
+
+Comparison Compare(const std::string& reference, const std::string& ours, const std::string& what) {
+  std::istringstream a(reference), b(ours);
+  std::string ra, rb;
+  Comparison c;
+  long line = 0;
+  while (true) {
+    const bool more_a = static_cast<bool>(std::getline(a, ra));
+    const bool more_b = static_cast<bool>(std::getline(b, rb));
+    if (!more_a && !more_b) break;
+    ++line;
+    if (line == 1) continue;  // the header
+    ++c.rows;
+    if (more_a && more_b && ra == rb) {
+      ++c.same;
+    } else if (c.first_difference.empty()) {
+      c.first_difference = what + " line " + std::to_string(line) + ": recording '" +
+                           (more_a ? ra : "(none)") + "', replay '" + (more_b ? rb : "(none)") +
+                           "'";
+    }
+  }
+  return c;
+}
+
+std::string ConfigYaml(const ReplayOptions& o, const recording::Recording& rec) {
+  return "command: replay\nrecording: " + o.recording + "\nsource: \"" + rec.manifest().source +
+         "\"\nsemantics: " + (o.truth_labels ? "recorded labels" : "network " + o.segmenter) +
+         "\nupdates: " + std::to_string(rec.updates().size()) + "\n";
+}
+
+}  // namespace
+
+int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err) {
+  ReplayOptions o = options;
+  if (o.segmenter.empty()) o.segmenter = o.models_dir + "/segmentation/yard_segmenter.onnx";
+  std::unique_ptr<recording::Recording> rec;
+  model::MachineDescription machine;
+  const generated::MachineFunctions* functions = nullptr;
+  try {
+    rec = std::make_unique<recording::Recording>(o.recording);
+    model::LoadOptions load;
+    load.models_dir = o.models_dir;
+    machine = model::LoadMachineDescription(rec->machine_path().string(), load);
+    functions = &machines::MachineFunctionsFor(machine);
+  } catch (const std::exception& e) {
+    err << "autoshovel replay: " << e.what() << "\n";
+    return 2;
+  }
+  const recording::Manifest& m = rec->manifest();
+  const std::unique_ptr<results::RunFolder> folder =
+      results::RunFolder::OpenWithConfig(o.out, ConfigYaml(o, *rec), err, "autoshovel replay");
+  if (!folder) return 2;
+  results::RunLog& log = folder->log();
+  out << "autoshovel replay: " << rec->updates().size() << " updates, " << rec->frame_count()
+      << " frames of " << machine.name << " (" << m.source << ") -> " << folder->dir().string()
+      << "\n";
+
+  const planning::LoaderGeometry loader = planning::LoaderGeometryFrom(machine, *functions);
+  perception::ElevationMapConfig map_config;
+  map_config.resolution = m.map_resolution;
+  map_config.length = m.map_length;
+  perception::ElevationMap map(map_config, m.map_center);
+  perception::SemanticMap semantic(map);
+  perception::LensDirtMonitor lens_dirt;
+  const perception::FusionOptions fusion{
+      .truth_labels = o.truth_labels, .segmenter = o.segmenter, .lens_dirt = &lens_dirt};
+  std::map<int, const recording::CycleInfo*> cycles;
+  for (const recording::CycleInfo& c : m.cycles) cycles[c.index] = &c;
+
+  std::string digests = std::string(recording::kMapDigestsHeader) + "\n";
+  std::string selections = std::string(recording::kSelectionsHeader) + "\n";
+  std::unique_ptr<ShovelPointTask> task;
+  int cycle = -1;
+  planning::Pose2 last_pose;
+  auto finish_cycle = [&]() {
+    if (task == nullptr || !o.figures) return;
+    const std::string n = std::to_string(cycle);
+    perception::WriteSemanticMapPng(map.map(), task->last_piles(),
+                                    folder->FigurePath("map_cycle_" + n + ".png").string(), 2);
+    if (task->selections() > 0) {
+      planning::WriteCandidatePng(map.map(), task->last_selection(),
+                                  m.chen2024 ? &task->last_baseline() : nullptr, last_pose, loader,
+                                  folder->FigurePath("candidates_cycle_" + n + ".png").string());
+    }
+  };
+  const auto w0 = std::chrono::steady_clock::now();
+  try {
+    for (std::size_t i = 0; i < rec->updates().size(); ++i) {
+      const recording::UpdateRow& u = rec->updates()[i];
+      if (u.cycle != cycle) {
+        finish_cycle();
+        cycle = u.cycle;
+        const recording::WorkArea area = cycles.at(cycle)->area;
+        task = std::make_unique<ShovelPointTask>(
+            m.selection, m.min_planned_clearance, m.chen2024, loader,
+            [area](const Eigen::Vector2d& p) { return area.Contains(p); });
+        log.Info("cycle " + std::to_string(cycle) + " at " + cycles.at(cycle)->site);
+      }
+      const perception::FusionStats fused = perception::FuseSensorFrames(
+          machine, LoadUpdate(*rec, i, machine), fusion, map, semantic);
+      if (u.select) {
+        last_pose = {u.select_xy, u.select_heading};
+        const planning::ShovelCandidate* best =
+            task->Select(map.map(), semantic.ground_plane(), last_pose);
+        selections +=
+            recording::SelectionRow(static_cast<long>(i), cycle, task->last_selection(), best) +
+            "\n";
+        if (best != nullptr && task->selections() == 1) log.Info(task->SelectedText(*best));
+      }
+      digests += recording::MapDigestRow(static_cast<long>(i), map.map()) + "\n";
+      log.Debug("update " + std::to_string(i) + ": " + std::to_string(fused.returns_fused) +
+                " returns fused, " + fused.semantics);
+    }
+    finish_cycle();
+    core::WriteFileAtomically(folder->dir() / "map_digests.csv", digests);
+    core::WriteFileAtomically(folder->dir() / "selections.csv", selections);
+  } catch (const std::exception& e) {
+    err << "autoshovel replay: " << e.what() << "\n";
+    log.Error(e.what());
+    return 2;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  out << "replayed " << rec->updates().size() << " updates in " << core::Fixed(seconds, 1) << " s ("
+      << core::Fixed(1e3 * seconds / static_cast<double>(rec->updates().size()), 1)
+      << " ms per update)\n";
+
+  const std::string ref_digests = ReadTextOrEmpty(rec->dir() / "reference" / "map_digests.csv");
+  const std::string ref_selections = ReadTextOrEmpty(rec->dir() / "reference" / "selections.csv");
+  if (ref_digests.empty()) {
+    out << "no reference/ in the recording: nothing to compare with\n";
+    return 0;
+  }
+  const Comparison maps = Compare(ref_digests, digests, "map_digests.csv");
+  const Comparison picks = Compare(ref_selections, selections, "selections.csv");
+  std::ostringstream summary;
+  summary << "against the recording machine: maps identical after " << maps.same << " of "
+          << maps.rows << " updates, selections identical at " << picks.same << " of "
+          << picks.rows;
+  out << summary.str() << "\n";
+  log.Info(summary.str());
+  for (const Comparison* c : {&maps, &picks}) {
+    if (!c->first_difference.empty()) {
+      out << "  first difference: " << c->first_difference << "\n";
+      log.Warning(c->first_difference);
+    }
+  }
+  const bool identical = maps.same == maps.rows && picks.same == picks.rows;
+  return o.check && !identical ? 1 : 0;
+}
+
+}  // namespace autoshovel::app

@@ -1,0 +1,29 @@
+// `autoshovel replay DIR`: the main job's perception and shovel point selection on a recorded run
+// (docs/recording_format.md), no plant: every update's frames are fused into the semantic
+// elevation map at their recorded timestamps and poses, and selection runs where the recording
+// machine ran it, from the localisation it had. The run folder gets the map digests and the
+// selections as CSV (the recording's reference/ has the same files from the machine), the map and
+// candidate pictures of each cycle, and the log.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+
+namespace autoshovel::app {
+
+struct ReplayOptions {
+  std::string recording;   ///< the recording folder
+  std::string out;         ///< run folder; empty: runs/<UTC timestamp>
+  std::string models_dir;  ///< for the machine's materials and the default segmenter
+  /// The camera frames' recorded labels instead of the network (a simulated recording).
+  bool truth_labels = false;
+  std::string segmenter;  ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
+  bool figures = true;
+  /// Exit 1 when a map or a selection differs from the recording's reference.
+  bool check = false;
+};
+
+/// Returns 0 on success, 1 when `check` found a difference, 2 on bad input.
+int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace autoshovel::app

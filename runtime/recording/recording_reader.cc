@@ -1,0 +1,149 @@
+#include "runtime/recording/recording_reader.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include "identification/camera_lidar/image_header.h"
+#include "identification/camera_lidar/point_cloud_io.h"
+#include "runtime/core/diagnostics.h"
+#include "runtime/core/input_file.h"
+#include "runtime/core/semantic_class.h"
+
+namespace autoshovel::recording {
+
+namespace {
+
+[[noreturn]] void Refuse(const std::string& source, int line, int column, const std::string& what) {
+  core::RefuseInput({source, line, column}, what);
+}
+
+std::string ReadText(const std::filesystem::path& path) {
+  const std::string why = core::NotARegularFile(path);
+  if (!why.empty()) Refuse(path.string(), 0, 0, why);
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) > kMaxCsvBytes) {
+    Refuse(path.string(), 0, 0, "larger than 1 GiB");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) Refuse(path.string(), 0, 0, "cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir_, ec)) Refuse(dir_.string(), 0, 0, "not a folder");
+  const std::filesystem::path manifest = dir_ / "recording.yaml";
+  if (!std::filesystem::exists(manifest, ec)) {
+    Refuse(manifest.string(), 0, 0,
+           "missing: not a recording, or one whose run did not finish (the manifest is written "
+           "last)");
+  }
+  manifest_ = ReadManifest(manifest);
+  const std::string updates_path = (dir_ / "updates.csv").string();
+  updates_ = ParseUpdatesCsv(ReadText(updates_path), updates_path);
+  std::set<int> cycles;
+  for (const CycleInfo& c : manifest_.cycles) cycles.insert(c.index);
+  for (std::size_t i = 0; i < updates_.size(); ++i) {
+    if (cycles.count(updates_[i].cycle) == 0) {
+      Refuse(
+          updates_path, updates_[i].line, 1,
+          "cycle " + std::to_string(updates_[i].cycle) + " is not among recording.yaml's cycles");
+    }
+  }
+  const std::string frames_path = (dir_ / "frames.csv").string();
+  frames_ = ParseFramesCsv(ReadText(frames_path), frames_path);
+  frame_range_.assign(updates_.size(), {0, 0});
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < updates_.size(); ++i) {
+    frame_range_[i].first = k;
+    int cameras = 0;
+    while (k < frames_.size() && frames_[k].update == static_cast<long>(i)) {
+      cameras += frames_[k].kind == FrameRow::Kind::kCamera;
+      if (cameras > 1) {
+        Refuse(frames_path, frames_[k].line, 1,
+               "update " + std::to_string(i) + " has more than one camera frame");
+      }
+      ++k;
+    }
+    frame_range_[i].second = k;
+  }
+  if (k < frames_.size()) {
+    Refuse(frames_path, frames_[k].line, 1,
+           "update " + std::to_string(frames_[k].update) + " is not in updates.csv");
+  }
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    for (const std::string* file : {&frames_[i].file, &frames_[i].labels_file}) {
+      if (file->empty()) continue;
+      const std::string why = core::NotARegularFile(dir_ / *file);
+      if (!why.empty()) {
+        Refuse(frames_path, frames_[i].line, 1, *file + ": " + why);
+      }
+    }
+  }
+}
+
+std::vector<FrameRow> Recording::FramesOf(std::size_t i) const {
+  return {frames_.begin() + static_cast<std::ptrdiff_t>(frame_range_.at(i).first),
+          frames_.begin() + static_cast<std::ptrdiff_t>(frame_range_.at(i).second)};
+}
+
+sensors::PointCloud Recording::ReadLidar(const FrameRow& frame) const {
+  sensors::PointCloud cloud = identification::ReadPointCloud((dir_ / frame.file).string());
+  cloud.sensor = frame.sensor;
+  cloud.stamp = frame.stamp;
+  return cloud;
+}
+
+sensors::CameraFrame Recording::ReadCamera(const FrameRow& frame) const {
+  const std::string path = (dir_ / frame.file).string();
+  identification::ReadImageHeader(path);  // refuses a bitmap too large before decoding it
+  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty() || image.depth() != CV_8U) {
+    Refuse(path, 0, 0, "OpenCV could not decode an 8-bit image");
+  }
+  if (image.channels() == 1) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
+  if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+  if (image.channels() != 3) Refuse(path, 0, 0, "expected a gray, BGR or BGRA image");
+  sensors::CameraFrame out;
+  out.stamp = frame.stamp;
+  out.width = image.cols;
+  out.height = image.rows;
+  image = image.isContinuous() ? image : image.clone();
+  out.bgr.assign(image.data, image.data + image.total() * 3);
+  if (frame.labels_file.empty()) return out;
+  const std::string labels_path = (dir_ / frame.labels_file).string();
+  const identification::ImageHeader header = identification::ReadImageHeader(labels_path);
+  if (header.width != out.width || header.height != out.height) {
+    Refuse(labels_path, 0, 0,
+           "labels are " + identification::ImageSizeText(header.width, header.height) +
+               ", the image " + identification::ImageSizeText(out.width, out.height));
+  }
+  cv::Mat labels = cv::imread(labels_path, cv::IMREAD_UNCHANGED);
+  if (labels.empty() || labels.type() != CV_8UC1) {
+    Refuse(labels_path, 0, 0, "expected an 8-bit single-channel PNG of class ids");
+  }
+  labels = labels.isContinuous() ? labels : labels.clone();
+  out.labels.assign(labels.data, labels.data + labels.total());
+  for (const std::uint8_t c : out.labels) {
+    if (c >= core::kNumSemanticClasses) {
+      Refuse(labels_path, 0, 0,
+             "class id " + std::to_string(c) + " is not a class (0.." +
+                 std::to_string(core::kNumSemanticClasses - 1) + ")");
+    }
+  }
+  return out;
+}
+
+}  // namespace autoshovel::recording

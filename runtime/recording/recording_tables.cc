@@ -1,0 +1,381 @@
+#include "runtime/recording/recording_tables.h"
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <set>
+#include <sstream>
+
+#include "runtime/core/diagnostics.h"
+#include "runtime/core/yaml_reader.h"
+
+namespace autoshovel::recording {
+
+namespace {
+
+struct Field {
+  std::string text;
+  int column = 1;  ///< 1-based character position
+};
+
+[[noreturn]] void Refuse(const std::string& source, int line, int column, const std::string& what) {
+  core::RefuseInput({source, line, column}, what);
+}
+
+std::vector<Field> SplitCsvLine(const std::string& line) {
+  std::vector<Field> fields;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    const std::size_t end = comma == std::string::npos ? line.size() : comma;
+    fields.push_back({line.substr(start, end - start), static_cast<int>(start) + 1});
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return fields;
+}
+
+// The rows of a CSV whose first line must be `header`, split into fields; each row with the
+// header's number of fields. A trailing CR (a file from Windows) is dropped.
+std::vector<std::pair<int, std::vector<Field>>> CsvRows(const std::string& text,
+                                                        const std::string& source,
+                                                        const std::string& header) {
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  const std::size_t columns = SplitCsvLine(header).size();
+  std::vector<std::pair<int, std::vector<Field>>> rows;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line_no == 1) {
+      if (line != header) {
+        Refuse(source, 1, 1,
+               "expected the header '" + header + "', got '" + line.substr(0, 200) + "'");
+      }
+      continue;
+    }
+    if (line.empty()) continue;
+    if (line.find('\0') != std::string::npos) Refuse(source, line_no, 1, "a NUL byte in the row");
+    std::vector<Field> fields = SplitCsvLine(line);
+    if (fields.size() != columns) {
+      Refuse(source, line_no, 1,
+             "expected " + std::to_string(columns) + " fields (" + header + "), got " +
+                 std::to_string(fields.size()));
+    }
+    rows.emplace_back(line_no, std::move(fields));
+  }
+  if (line_no == 0) Refuse(source, 0, 0, "empty: expected the header '" + header + "'");
+  return rows;
+}
+
+double Finite(const std::string& source, int line, const Field& f, const char* name) {
+  char* stop = nullptr;
+  errno = 0;
+  const double v = std::strtod(f.text.c_str(), &stop);
+  if (f.text.empty() || stop != f.text.c_str() + f.text.size() || errno == ERANGE ||
+      !std::isfinite(v)) {
+    Refuse(source, line, f.column,
+           std::string(name) + ": expected a finite number, got '" + f.text.substr(0, 40) + "'");
+  }
+  return v;
+}
+
+long Integer(const std::string& source, int line, const Field& f, const char* name, long min,
+             long max) {
+  char* stop = nullptr;
+  errno = 0;
+  const long v = std::strtol(f.text.c_str(), &stop, 10);
+  if (f.text.empty() || stop != f.text.c_str() + f.text.size() || errno == ERANGE || v < min ||
+      v > max) {
+    Refuse(source, line, f.column,
+           std::string(name) + ": expected an integer in [" + std::to_string(min) + ", " +
+               std::to_string(max) + "], got '" + f.text.substr(0, 40) + "'");
+  }
+  return v;
+}
+
+bool Flag(const std::string& source, int line, const Field& f, const char* name) {
+  if (f.text == "0") return false;
+  if (f.text == "1") return true;
+  Refuse(source, line, f.column,
+         std::string(name) + ": expected 0 or 1, got '" + f.text.substr(0, 40) + "'");
+}
+
+// A file named in frames.csv: relative, inside the folder, plain characters.
+void CheckRelativePath(const std::string& source, int line, const Field& f, const char* name) {
+  const std::string& p = f.text;
+  auto bad = [&](const std::string& why) {
+    Refuse(source, line, f.column, std::string(name) + " '" + p.substr(0, 80) + "': " + why);
+  };
+  if (p.empty()) bad("empty");
+  if (p.size() > 255) bad("longer than 255 characters");
+  if (p.front() == '/') bad("must be relative to the recording folder");
+  for (const char c : p) {
+    const bool ok =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '/' || c == '_' || c == '-' || c == '.';
+    if (!ok) bad("only letters, digits, '/', '_', '-' and '.' are allowed");
+  }
+  std::istringstream parts(p);
+  std::string part;
+  while (std::getline(parts, part, '/')) {
+    if (part == ".." || part == "." || part.empty()) bad("must not contain '.', '..' or '//'");
+  }
+}
+
+// Numbers of a YAML sequence under `key` (exactly `size` of them unless size is 0).
+std::vector<double> NumberSequence(core::MapReader& reader, const YAML::Node& node,
+                                   const std::string& key, std::size_t size) {
+  std::vector<double> out;
+  if (!node.IsSequence() || (size > 0 && node.size() != size)) {
+    reader.Error(key, size > 0 ? "expected a list of " + std::to_string(size) + " numbers"
+                               : "expected a list of numbers");
+    return out;
+  }
+  for (const YAML::Node& item : node) {
+    const std::string text = item.IsScalar() ? item.Scalar() : "";
+    char* stop = nullptr;
+    const double v = std::strtod(text.c_str(), &stop);
+    if (text.empty() || stop != text.c_str() + text.size() || !std::isfinite(v)) {
+      reader.Error(key, "expected finite numbers, got '" + text.substr(0, 40) + "'");
+      return {};
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
+void ReadSelection(core::MapReader s, Manifest& m) {
+  using core::NumberRule;
+  planning::ShovelPointConfig& c = m.selection;
+  m.chen2024 = s.Enum("method", {"ours", "chen2024"}) == "chen2024";
+  m.min_planned_clearance = s.Number("min_planned_clearance", NumberRule::NonNegative("m"));
+  const NumberRule weight = NumberRule::NonNegative("");
+  c.k_t = s.Number("k_t", weight);
+  c.k_s = s.Number("k_s", weight);
+  c.k_c = s.Number("k_c", weight);
+  c.k_e = s.Number("k_e", weight);
+  c.k_a = s.Number("k_a", weight);
+  c.torque_threshold = s.Number("torque_threshold", NumberRule::Any("m^4"));
+  c.safety_distance = s.Number("safety_distance", NumberRule::NonNegative("m"));
+  c.max_curvature = s.Number("max_curvature", NumberRule::Any("1/m"));
+  c.candidate_spacing = s.Number("candidate_spacing", NumberRule::Positive("m"));
+  if (const auto offsets = s.Raw("entry_angle_offsets", true)) {
+    c.entry_angle_offsets = NumberSequence(s, *offsets, "entry_angle_offsets", 0);
+    if (c.entry_angle_offsets.empty()) s.Error("entry_angle_offsets", "needs at least one angle");
+  }
+  c.normal_radius = s.Number("normal_radius", NumberRule::Positive("m"));
+  c.penetration_length = s.Number("penetration_length", NumberRule::Positive("m"));
+  c.scoop_advance = s.Number("scoop_advance", NumberRule::NonNegative("m"));
+  c.crowd_stop_distance = s.Number("crowd_stop_distance", NumberRule::NonNegative("m"));
+  c.concavity_tolerance = s.Number("concavity_tolerance", NumberRule::NonNegative(""));
+  c.entry_window = s.Number("entry_window", NumberRule::Positive("m"));
+  c.path_spacing = s.Number("path_spacing", NumberRule::Positive("m"));
+  c.max_drive_over_height = s.Number("max_drive_over_height", NumberRule::NonNegative("m"));
+  s.Finish();
+}
+
+CycleInfo ReadCycle(core::MapReader c) {
+  using core::NumberRule;
+  CycleInfo cycle;
+  cycle.index = c.Integer("index", 0, 1'000'000);
+  cycle.site = c.String("site");
+  if (auto r = c.OptionalMap("rectangle")) {
+    cycle.area.kind = WorkArea::Kind::kRectangle;
+    const auto center = r->Numbers<2>("front_center", NumberRule::Any("m"));
+    cycle.area.front_center = {center[0], center[1]};
+    cycle.area.yaw = r->Number("yaw", NumberRule::Any("rad"));
+    cycle.area.width = r->Number("width", NumberRule::Positive("m"));
+    cycle.area.depth = r->Number("depth", NumberRule::Positive("m"));
+    r->Finish();
+  } else if (const auto discs = c.Raw("discs", false)) {
+    cycle.area.kind = WorkArea::Kind::kDiscs;
+    if (!discs->IsSequence() || discs->size() == 0) {
+      c.Error("discs", "expected a list of [x, y, radius]");
+    } else {
+      for (const YAML::Node& d : *discs) {
+        const std::vector<double> v = NumberSequence(c, d, "discs", 3);
+        if (v.size() != 3) break;
+        if (!(v[2] > 0)) {
+          c.Error("discs", "a disc's radius must be > 0 m");
+          break;
+        }
+        cycle.area.discs.emplace_back(v[0], v[1], v[2]);
+      }
+    }
+  } else {
+    c.Error("site", "a cycle needs its work area: 'rectangle' or 'discs'");
+  }
+  c.Finish();
+  return cycle;
+}
+
+}  // namespace
+
+bool WorkArea::Contains(const Eigen::Vector2d& p) const {
+  if (kind == Kind::kRectangle) {
+    const Eigen::Vector2d u(std::cos(yaw), std::sin(yaw)), v(-u.y(), u.x());
+    const Eigen::Vector2d d = p - front_center;
+    return std::abs(d.dot(u)) <= width / 2 && d.dot(v) >= -0.5 && d.dot(v) <= depth;
+  }
+  for (const Eigen::Vector3d& disc : discs) {
+    if ((p - disc.head<2>()).norm() <= disc.z()) return true;
+  }
+  return false;
+}
+
+std::vector<UpdateRow> ParseUpdatesCsv(const std::string& text, const std::string& source) {
+  std::vector<UpdateRow> updates;
+  for (const auto& [line, f] : CsvRows(text, source, kUpdatesHeader)) {
+    UpdateRow u;
+    u.line = line;
+    u.update = Integer(source, line, f[0], "update", 0, 1'000'000'000);
+    if (u.update != static_cast<long>(updates.size())) {
+      Refuse(source, line, f[0].column,
+             "update: expected " + std::to_string(updates.size()) +
+                 " (updates are numbered 0, 1, 2, … in order), got " + f[0].text.substr(0, 20));
+    }
+    u.cycle = static_cast<int>(Integer(source, line, f[1], "cycle", 0, 1'000'000));
+    u.stamp = Finite(source, line, f[2], "stamp");
+    if (!updates.empty() && u.stamp < updates.back().stamp) {
+      Refuse(source, line, f[2].column,
+             "stamp: goes back in time (" + f[2].text.substr(0, 30) + " after " +
+                 std::to_string(updates.back().stamp) + ")");
+    }
+    u.hinge_xy = {Finite(source, line, f[3], "hinge_x"), Finite(source, line, f[4], "hinge_y")};
+    u.heading = Finite(source, line, f[5], "heading");
+    u.articulation = Finite(source, line, f[6], "articulation");
+    if (std::abs(u.articulation) > 1.2) {
+      Refuse(source, line, f[6].column,
+             "articulation: " + f[6].text.substr(0, 30) +
+                 " rad is beyond any loader's hinge "
+                 "(|γ| ≤ 1.2 rad; given in degrees?)");
+    }
+    u.tip_reach = Finite(source, line, f[7], "tip_reach");
+    if (!(u.tip_reach >= 0 && u.tip_reach <= 50)) {
+      Refuse(source, line, f[7].column, "tip_reach: must be in [0, 50] m");
+    }
+    u.select = Flag(source, line, f[8], "select");
+    if (u.select) {
+      u.select_xy = {Finite(source, line, f[9], "select_x"),
+                     Finite(source, line, f[10], "select_y")};
+      u.select_heading = Finite(source, line, f[11], "select_heading");
+    } else {
+      for (int k = 9; k <= 11; ++k) {
+        if (!f[k].text.empty()) {
+          Refuse(source, line, f[k].column, "a row with select 0 leaves the selection pose empty");
+        }
+      }
+    }
+    updates.push_back(u);
+  }
+  if (updates.empty()) Refuse(source, 0, 0, "no updates (rows after the header)");
+  return updates;
+}
+
+std::vector<FrameRow> ParseFramesCsv(const std::string& text, const std::string& source) {
+  std::vector<FrameRow> frames;
+  for (const auto& [line, f] : CsvRows(text, source, kFramesHeader)) {
+    FrameRow r;
+    r.line = line;
+    r.update = Integer(source, line, f[0], "update", 0, 1'000'000'000);
+    if (!frames.empty() && r.update < frames.back().update) {
+      Refuse(source, line, f[0].column, "update: frames must come in update order");
+    }
+    if (f[1].text == "lidar") {
+      r.kind = FrameRow::Kind::kLidar;
+    } else if (f[1].text == "camera") {
+      r.kind = FrameRow::Kind::kCamera;
+    } else {
+      Refuse(source, line, f[1].column,
+             "kind: expected 'lidar' or 'camera', got '" + f[1].text.substr(0, 40) + "'");
+    }
+    r.sensor = f[2].text;
+    if (r.sensor.empty() || r.sensor.size() > 64) {
+      Refuse(source, line, f[2].column, "sensor: expected the description's sensor name");
+    }
+    r.stamp = Finite(source, line, f[3], "stamp");
+    CheckRelativePath(source, line, f[4], "file");
+    r.file = f[4].text;
+    if (!f[5].text.empty()) {
+      if (r.kind != FrameRow::Kind::kCamera) {
+        Refuse(source, line, f[5].column, "labels_file: only a camera frame has labels");
+      }
+      CheckRelativePath(source, line, f[5], "labels_file");
+      r.labels_file = f[5].text;
+    }
+    r.health_check = Flag(source, line, f[6], "health_check");
+    if (r.health_check && r.kind != FrameRow::Kind::kLidar) {
+      Refuse(source, line, f[6].column, "health_check: only a LiDAR frame is checked");
+    }
+    Eigen::Vector3d t;
+    for (int i = 0; i < 3; ++i) t[i] = Finite(source, line, f[7 + i], "translation");
+    Eigen::Matrix3d R;
+    for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = Finite(source, line, f[10 + i], "rotation");
+    if (!((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6) ||
+        !(std::abs(R.determinant() - 1) < 1e-6)) {
+      Refuse(source, line, f[10].column,
+             "r00..r22: not a rotation matrix (R^T R = I and det R = 1 within 1e-6)");
+    }
+    if (t.cwiseAbs().maxCoeff() > 1e7) {
+      Refuse(source, line, f[7].column, "x, y, z: farther than 10000 km from the origin");
+    }
+    r.T_world_sensor.linear() = R;
+    r.T_world_sensor.translation() = t;
+    frames.push_back(std::move(r));
+  }
+  return frames;
+}
+
+Manifest ReadManifest(const std::filesystem::path& path) {
+  core::DiagnosticSink sink;
+  const core::YamlFile file(path, sink);
+  Manifest m;
+  if (file.ok()) {
+    using core::NumberRule;
+    core::MapReader root = core::MapReader::Root(file, nullptr);
+    const std::string format = root.String("format");
+    if (sink.empty() && format != kFormatName) {
+      root.Error("format", "expected '" + std::string(kFormatName) + "', got '" + format + "'");
+    }
+    const int version = root.Integer("version", 1, 1000);
+    if (sink.empty() && version != kFormatVersion) {
+      root.Error("version", "this build reads version " + std::to_string(kFormatVersion) +
+                                ", the recording is version " + std::to_string(version));
+    }
+    m.machine_file = root.String("machine");
+    m.source = root.OptionalString("source").value_or("");
+    {
+      core::MapReader map = root.Map("map");
+      m.map_resolution = map.Number("resolution", NumberRule::Closed(0.01, 10, "m"));
+      const auto length = map.Numbers<2>("length", NumberRule::Closed(1, 10000, "m"));
+      const auto center = map.Numbers<2>("center", NumberRule::Any("m"));
+      m.map_length = {length[0], length[1]};
+      m.map_center = {center[0], center[1]};
+      map.Finish();
+      if (sink.empty() &&
+          m.map_length.x() * m.map_length.y() / (m.map_resolution * m.map_resolution) > 1e8) {
+        map.Error("resolution", "more than 100 million cells");
+      }
+    }
+    ReadSelection(root.Map("selection"), m);
+    std::set<int> indices;
+    for (core::MapReader& c : root.MapList("cycles", true)) {
+      CycleInfo cycle = ReadCycle(c);
+      if (!indices.insert(cycle.index).second) {
+        c.Error("index", "cycle " + std::to_string(cycle.index) + " given twice");
+      }
+      m.cycles.push_back(std::move(cycle));
+    }
+    root.Finish();
+    if (sink.empty() && (m.machine_file.empty() || m.machine_file.find("..") != std::string::npos ||
+                         m.machine_file.front() == '/')) {
+      root.Error("machine", "must name a file inside the recording folder");
+    }
+  }
+  sink.ThrowIfAny();
+  return m;
+}
+
+}  // namespace autoshovel::recording

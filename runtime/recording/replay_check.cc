@@ -1,0 +1,42 @@
+#include "runtime/recording/replay_check.h"
+
+#include <cstring>
+
+#include "runtime/core/sha256.h"
+#include "runtime/core/strings.h"
+
+namespace autoshovel::recording {
+
+std::string MapDigest(const perception::GridMap& map) {
+  std::string bytes;
+  auto append = [&bytes](const void* p, std::size_t n) {
+    bytes.append(static_cast<const char*>(p), n);
+  };
+  const int size[2] = {map.size().x(), map.size().y()};
+  const double geometry[3] = {map.resolution(), map.position().x(), map.position().y()};
+  append(size, sizeof size);
+  append(geometry, sizeof geometry);
+  for (const std::string& name : map.layers()) {  // std::map order: by name
+    bytes += name;
+    bytes.push_back('\0');
+    const Eigen::MatrixXf& layer = map[name];
+    append(layer.data(), sizeof(float) * static_cast<std::size_t>(layer.size()));
+  }
+  return core::Sha256Hex(bytes);
+}
+
+std::string MapDigestRow(long update, const perception::GridMap& map) {
+  return std::to_string(update) + "," + MapDigest(map);
+}
+
+std::string SelectionRow(long update, int cycle, const planning::ShovelPointResult& selection,
+                         const planning::ShovelCandidate* best) {
+  std::string row = std::to_string(update) + "," + std::to_string(cycle) + "," +
+                    std::to_string(selection.ranked.size()) + "," +
+                    std::to_string(selection.feasible) + ",";
+  if (best == nullptr) return row + ",,,";
+  return row + core::FormatNumber(best->pose.xy.x()) + "," + core::FormatNumber(best->pose.xy.y()) +
+         "," + core::FormatNumber(best->pose.entry_heading) + "," + core::FormatNumber(best->score);
+}
+
+}  // namespace autoshovel::recording

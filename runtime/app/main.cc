@@ -317,6 +317,8 @@ Command AddReplay(CLI::App& app, const Globals& g) {
   cmd->add_flag("--truth", c->truth_labels,
                 "The camera frames' recorded labels instead of the segmentation network");
   cmd->add_option("--segmenter", c->segmenter, "ONNX segmentation network");
+  cmd->add_option("--predictor", c->predictor,
+                  "Penetration SVR (path without .model; default: the main job's)");
   cmd->add_flag(
       "--no-figures", [c](std::int64_t) { c->figures = false; }, "Skip the per-cycle PNGs");
   cmd->add_flag("--check", c->check,

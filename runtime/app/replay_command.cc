@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "runtime/app/shovel_job/scoop_handover.h"
 #include "runtime/app/shovel_job/shovel_point_task.h"
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/file_output.h"
@@ -22,6 +23,9 @@
 #include "runtime/perception/semantic_map.h"
 #include "runtime/perception/sensor_fusion.h"
 #include "runtime/planning/candidate_render.h"
+#include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/scoop_volume_prediction.h"
+#include "runtime/prediction/shipped_models.h"
 #include "runtime/recording/recording_reader.h"
 #include "runtime/recording/replay_check.h"
 #include "runtime/results/run_folder.h"
@@ -113,6 +117,54 @@ Comparison Compare(const std::string& reference, const std::string& ours, const 
   return c;
 }
 
+// V1 (Eq. 19) and V2 at each recorded decision of cycle `cycle`'s scoop, on `map` (the map the
+// scoop started from), as `predictions.csv` rows; the first decision at which κ(V1 + V2) reached
+// V_t goes to `log`.
+std::string ReplayScoopPredictions(const recording::Recording& rec,
+                                   const recording::CycleInfo& cycle,
+                                   const model::MachineDescription& machine,
+                                   const generated::MachineFunctions& functions,
+                                   const prediction::PenetrationPredictor& predictor,
+                                   const perception::GridMap& map, results::RunLog& log) {
+  std::string rows;
+  if (!cycle.scoop) return rows;
+  const model::Material* material = machine.FindMaterial(cycle.scoop->material);
+  if (material == nullptr) {
+    throw std::invalid_argument("recording.yaml: cycle " + std::to_string(cycle.index) +
+                                ": machine '" + machine.name + "' has no material '" +
+                                cycle.scoop->material + "'");
+  }
+  const prediction::HeightGrid grid = HeightGridOf(map);
+  const std::vector<Eigen::Vector3d> tip_path = rec.TipPathOf(cycle.index);
+  const double kappa = predictor.IntakeFactor(material->name);
+  double reached = NAN;
+  for (const recording::DecisionRow& d : rec.decisions()) {
+    if (d.cycle != cycle.index) continue;
+    const std::vector<Eigen::Vector3d> so_far(tip_path.begin(), tip_path.begin() + d.path_points);
+    const double v1 =
+        so_far.size() >= 2 ? prediction::Eq19Volume(grid, so_far, machine.bucket.width).volume : 0;
+    double v2 = NAN;
+    if (d.predict) {
+      v2 = prediction::PredictV2(machine, functions, grid, *material, predictor, so_far,
+                                 {.hinge_xy = d.hinge_xy,
+                                  .heading = d.heading,
+                                  .speed = d.speed,
+                                  .q_boom = d.q_boom,
+                                  .q_bucket = d.q_bucket},
+                                 v1, cycle.scoop->bucket_max, cycle.scoop->boom_lift)
+               .v2;
+      if (std::isnan(reached) && kappa * (v1 + v2) >= cycle.scoop->target_volume) reached = d.time;
+    }
+    rows += recording::PredictionRow(cycle.index, d.time, v1, v2) + "\n";
+  }
+  log.Info("cycle " + std::to_string(cycle.index) + ": " +
+           (std::isnan(reached)
+                ? std::string("kappa (V1 + V2) never reached V_t")
+                : "kappa (V1 + V2) reached V_t = " + core::Fixed(cycle.scoop->target_volume, 2) +
+                      " m3 at t = " + core::Fixed(reached, 2) + " s"));
+  return rows;
+}
+
 std::string ConfigYaml(const ReplayOptions& o, const recording::Recording& rec) {
   return "command: replay\nrecording: " + o.recording + "\nsource: \"" + rec.manifest().source +
          "\"\nsemantics: " + (o.truth_labels ? "recorded labels" : "network " + o.segmenter) +
@@ -146,6 +198,17 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
       << " frames of " << machine.name << " (" << m.source << ") -> " << folder->dir().string()
       << "\n";
 
+  std::unique_ptr<prediction::PenetrationPredictor> predictor;
+  if (!rec->decisions().empty()) {
+    try {
+      predictor =
+          std::make_unique<prediction::PenetrationPredictor>(prediction::PenetrationPredictor::Load(
+              o.predictor.empty() ? prediction::MainJobPredictor(o.models_dir) : o.predictor));
+    } catch (const std::exception& e) {
+      err << "autoshovel replay: " << e.what() << "\n";
+      return 2;
+    }
+  }
   const planning::LoaderGeometry loader = planning::LoaderGeometryFrom(machine, *functions);
   perception::ElevationMapConfig map_config;
   map_config.resolution = m.map_resolution;
@@ -160,11 +223,17 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
 
   std::string digests = std::string(recording::kMapDigestsHeader) + "\n";
   std::string selections = std::string(recording::kSelectionsHeader) + "\n";
+  std::string predictions = std::string(recording::kPredictionsHeader) + "\n";
   std::unique_ptr<ShovelPointTask> task;
   int cycle = -1;
   planning::Pose2 last_pose;
   auto finish_cycle = [&]() {
-    if (task == nullptr || !o.figures) return;
+    if (task == nullptr) return;
+    if (predictor != nullptr) {
+      predictions += ReplayScoopPredictions(*rec, *cycles.at(cycle), machine, *functions,
+                                            *predictor, map.map(), log);
+    }
+    if (!o.figures) return;
     const std::string n = std::to_string(cycle);
     perception::WriteSemanticMapPng(map.map(), task->last_piles(),
                                     folder->FigurePath("map_cycle_" + n + ".png").string(), 2);
@@ -205,6 +274,7 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
     finish_cycle();
     core::WriteFileAtomically(folder->dir() / "map_digests.csv", digests);
     core::WriteFileAtomically(folder->dir() / "selections.csv", selections);
+    core::WriteFileAtomically(folder->dir() / "predictions.csv", predictions);
   } catch (const std::exception& e) {
     err << "autoshovel replay: " << e.what() << "\n";
     log.Error(e.what());
@@ -218,25 +288,29 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
 
   const std::string ref_digests = ReadTextOrEmpty(rec->dir() / "reference" / "map_digests.csv");
   const std::string ref_selections = ReadTextOrEmpty(rec->dir() / "reference" / "selections.csv");
+  const std::string ref_predictions = ReadTextOrEmpty(rec->dir() / "reference" / "predictions.csv");
   if (ref_digests.empty()) {
     out << "no reference/ in the recording: nothing to compare with\n";
     return 0;
   }
   const Comparison maps = Compare(ref_digests, digests, "map_digests.csv");
   const Comparison picks = Compare(ref_selections, selections, "selections.csv");
+  const Comparison volumes = Compare(ref_predictions, predictions, "predictions.csv");
   std::ostringstream summary;
   summary << "against the recording machine: maps identical after " << maps.same << " of "
-          << maps.rows << " updates, selections identical at " << picks.same << " of "
-          << picks.rows;
+          << maps.rows << " updates, selections identical at " << picks.same << " of " << picks.rows
+          << ", V1 and V2 identical at " << volumes.same << " of " << volumes.rows
+          << " scoop decisions";
   out << summary.str() << "\n";
   log.Info(summary.str());
-  for (const Comparison* c : {&maps, &picks}) {
+  for (const Comparison* c : {&maps, &picks, &volumes}) {
     if (!c->first_difference.empty()) {
       out << "  first difference: " << c->first_difference << "\n";
       log.Warning(c->first_difference);
     }
   }
-  const bool identical = maps.same == maps.rows && picks.same == picks.rows;
+  const bool identical =
+      maps.same == maps.rows && picks.same == picks.rows && volumes.same == volumes.rows;
   return o.check && !identical ? 1 : 0;
 }
 

@@ -1,9 +1,11 @@
 // `autoshovel replay DIR`: the main job's perception and shovel point selection on a recorded run
 // (docs/recording_format.md), no plant: every update's frames are fused into the semantic
-// elevation map at their recorded timestamps and poses, and selection runs where the recording
-// machine ran it, from the localisation it had. The run folder gets the map digests and the
-// selections as CSV (the recording's reference/ has the same files from the machine), the map and
-// candidate pictures of each cycle, and the log.
+// elevation map at their recorded timestamps and poses, selection runs where the recording
+// machine ran it, from the localisation it had, and each scoop's volume prediction (V1, V2,
+// seed §6.1) runs at its recorded decisions on the map the scoop started from. The run folder
+// gets the map digests, the selections and the predictions as CSV (the recording's reference/
+// has the same files from the machine), the map and candidate pictures of each cycle, and the
+// log.
 #pragma once
 
 #include <iosfwd>
@@ -18,6 +20,8 @@ struct ReplayOptions {
   /// The camera frames' recorded labels instead of the network (a simulated recording).
   bool truth_labels = false;
   std::string segmenter;  ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
+  /// Penetration SVR (path without .model); empty: the main job's (prediction/shipped_models.h).
+  std::string predictor;
   bool figures = true;
   /// Exit 1 when a map or a selection differs from the recording's reference.
   bool check = false;

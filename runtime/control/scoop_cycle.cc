@@ -9,6 +9,7 @@
 
 #include "runtime/control/joint_angle_filter.h"
 #include "runtime/model/interpreted_model.h"
+#include "runtime/prediction/scoop_volume_prediction.h"
 
 namespace autoshovel::control {
 
@@ -153,8 +154,9 @@ struct ScoopCycle::Runtime {
   /// JointStalledUnderLoad's reports not yet acted on: (joint, reason).
   std::vector<std::pair<int, std::string>> pending_stalls;
   bool sequence_ended = false;  ///< scoop: a stalled boom ended the atomic actions
-  std::vector<Eigen::Vector3d> last_predicted_path;              ///< of the last V2 [m]
-  double last_v2 = NAN;                                          ///< [m³]
+  std::vector<Eigen::Vector3d> last_predicted_path;  ///< of the last V2 [m]
+  double last_v2 = NAN;                              ///< [m³]
+  double v2_this_decision = NAN;  ///< V2 if the running decision computed one [m³]
   std::optional<prediction::PenetrationFeatures> last_features;  ///< of the last V2
   double last_penetration = NAN;  ///< the predictor's travel of the last V2, NaN: failed [m]
   Eigen::Vector2d trigger_hinge = Eigen::Vector2d::Zero();
@@ -314,48 +316,22 @@ void ScoopCycle::EnterPhase(ScoopMachine& machine, Phase phase, const Propriocep
 }
 
 double ScoopCycle::ComputeV2(const Proprioception& s, double v1, Runtime& rt) {
-  // Features (penetration_predictor.h): v, V1, material, h1..h6 on the map k·Δl ahead of the
-  // tip along the heading, mean of five points across the bucket width. The pre-contact map is
-  // used: ahead of the bucket the pile is as it was.
-  prediction::PenetrationFeatures features;
-  features.speed = s.speed;
-  features.shoveled_volume = v1;
-  features.material = material_.name;
-  // Unknown cells count as floor; map noise below the floor as the floor.
-  features.heights = prediction::SampleHeightsAhead(
-      [&](double x, double y) {
-        const double h = map_.HeightAt(x, y);
-        return std::isfinite(h) ? std::max(h, 0.0) : 0.0;
-      },
-      rt.tip_path.back().head<2>(), s.heading, machine_.bucket.width);
-  rt.last_features = features;
-  const prediction::PenetrationPrediction d = predictor_->Predict(features);
-  if (!d.ok) {
+  prediction::V2Prediction v2 =
+      prediction::PredictV2(machine_, functions_, map_, material_, *predictor_, rt.tip_path,
+                            {.hinge_xy = s.hinge_xy,
+                             .heading = s.heading,
+                             .speed = s.speed,
+                             .q_boom = s.q_boom,
+                             .q_bucket = s.q_bucket},
+                            v1, limits_.bucket_max, options_.strategy.exit_boom_lift);
+  rt.last_features = v2.features;
+  if (!v2.ok) {
     ++rt.result.prediction_failures;
-    return 0;
+    if (std::isnan(v2.penetration)) return 0;
   }
-  rt.last_penetration = d.penetration;
-  try {
-    const std::vector<double> q = {s.q_boom, s.q_bucket};
-    prediction::ScoopPlan plan = prediction::ScoopPlanFromMachine(
-        machine_, functions_, q, 1.0, 1.0, std::max(limits_.bucket_max - s.q_bucket, 0.0),
-        options_.strategy.exit_boom_lift);
-    // The travel within d as the model predicts it, when it has a travel curve.
-    plan.travel_times = predictor_->scaling().travel_times;
-    plan.travel_at = d.travel;
-    prediction::MachineAtTrigger at;
-    at.hinge_xy = s.hinge_xy;
-    at.heading = s.heading;
-    at.speed = std::max(s.speed, 0.0);
-    at.q = q;
-    prediction::FutureVolume future =
-        prediction::PredictFutureVolume(machine_, map_, rt.tip_path, at, d.penetration, plan);
-    rt.last_predicted_path = std::move(future.path);
-    return future.total();
-  } catch (const std::exception&) {
-    ++rt.result.prediction_failures;
-    return 0;
-  }
+  rt.last_penetration = v2.penetration;
+  if (v2.ok) rt.last_predicted_path = std::move(v2.path);
+  return v2.v2;
 }
 
 void ScoopCycle::EndScoopPhase(ScoopMachine& machine, const Proprioception& s, Runtime& rt) {
@@ -476,6 +452,7 @@ void ScoopCycle::DecideCrowd(ScoopMachine& machine, const Proprioception& s, Run
   in.v2 = predict ? ComputeV2(s, rt.v1, rt) : 0.0;
   in.intake_factor = predictor_ != nullptr ? predictor_->IntakeFactor(material_.name) : 1.0;
   rt.last_v2 = predict ? in.v2 : NAN;
+  rt.v2_this_decision = rt.last_v2;
   rt.result.intake_factor = in.intake_factor;
   const bool fired = trigger_.Fire(in);
   std::optional<ScoopStrategy> strategy;
@@ -723,13 +700,21 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     }
   }
   if (rt.tick++ % options_.decision_every == 0) {
+    rt.v2_this_decision = NAN;
     Decide(machine, s, rt);
     if (digging && !rt.tip_path.empty()) {
       rt.result.samples.push_back({.time = s.time,
                                    .v1 = rt.v1,
                                    .v1_plus_v2 = rt.result.intake_factor * (rt.v1 + rt.last_v2),
                                    .triggered = !std::isnan(rt.result.trigger_time),
-                                   .tip = rt.tip_path.back()});
+                                   .tip = rt.tip_path.back(),
+                                   .state = {.hinge_xy = s.hinge_xy,
+                                             .heading = s.heading,
+                                             .speed = s.speed,
+                                             .q_boom = s.q_boom,
+                                             .q_bucket = s.q_bucket},
+                                   .path_points = rt.tip_path.size(),
+                                   .v2 = rt.v2_this_decision});
     }
   }
   if (rt.phase == Phase::kDone) return false;

@@ -44,6 +44,7 @@
 #include "runtime/core/actuator_command.h"
 #include "runtime/model/description.h"
 #include "runtime/prediction/penetration_predictor.h"
+#include "runtime/prediction/scoop_volume_prediction.h"
 #include "runtime/prediction/volume_estimation.h"
 
 namespace autoshovel::control {
@@ -192,6 +193,11 @@ struct ScoopSample {
   double v1_plus_v2 = NAN;
   bool triggered = false;                         ///< the scoop has been triggered
   Eigen::Vector3d tip = Eigen::Vector3d::Zero();  ///< bucket tip, world [m]
+  /// The state the decision saw (a recording keeps it: `autoshovel replay` predicts V2 again
+  /// from it): localisation, speed and the filtered joint angles.
+  prediction::DecisionState state;
+  std::size_t path_points = 0;  ///< ScoopResult::tip_path's points at this decision
+  double v2 = NAN;              ///< V2 computed at this decision [m³] (NaN: none was)
 };
 
 struct ScoopResult {

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,10 +44,20 @@ struct WorkArea {
   bool Contains(const Eigen::Vector2d& p) const;
 };
 
+/// The scoop a cycle made, as its volume prediction (seed §6.1) saw it: what `replay` needs to
+/// predict V1 and V2 again at each recorded decision.
+struct ScoopInfo {
+  std::string material;      ///< the material the machine was told it digs
+  double target_volume = 0;  ///< V_t [m³]
+  double bucket_max = 0;     ///< the bucket's curl limit the prediction's scoop curls to [rad]
+  double boom_lift = 0;      ///< the boom lift the prediction's scoop ends with [rad]
+};
+
 struct CycleInfo {
   int index = 0;     ///< the run's cycle number (its results row's `cycle`)
   std::string site;  ///< bin name or "open yard"
   WorkArea area;
+  std::optional<ScoopInfo> scoop;  ///< none: the cycle did not reach its scoop
 };
 
 /// recording.yaml.
@@ -93,6 +104,30 @@ struct FrameRow {
   Eigen::Isometry3d T_world_sensor = Eigen::Isometry3d::Identity();
   int line = 0;  ///< where the row is in frames.csv (for messages)
 };
+
+/// scoop.csv: one decision of a scoop's trigger (20 Hz from the approach on), the machine's state
+/// as the decision saw it.
+struct DecisionRow {
+  int cycle = 0;
+  double time = 0;  ///< [s]
+  Eigen::Vector2d hinge_xy = Eigen::Vector2d::Zero();
+  double heading = 0, speed = 0;    ///< [rad], [m/s]
+  double q_boom = 0, q_bucket = 0;  ///< the state estimate's joint angles [rad]
+  long path_points = 0;             ///< the cycle's tip path points (tip_path.csv) so far
+  bool predict = false;             ///< the decision predicted V2
+  int line = 0;
+};
+
+/// tip_path.csv: the bucket tip's path while digging, per cycle, world [m].
+struct TipPoint {
+  int cycle = 0;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  int line = 0;
+};
+
+inline constexpr const char* kScoopHeader =
+    "cycle,time,hinge_x,hinge_y,heading,speed,q_boom,q_bucket,path_points,predict";
+inline constexpr const char* kTipPathHeader = "cycle,x,y,z";
 
 inline constexpr const char* kUpdatesHeader =
     "update,cycle,stamp,hinge_x,hinge_y,heading,articulation,tip_reach,select,select_x,select_y,"

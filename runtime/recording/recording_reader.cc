@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -83,6 +84,33 @@ Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
     Refuse(frames_path, frames_[k].line, 1,
            "update " + std::to_string(frames_[k].update) + " is not in updates.csv");
   }
+  // The scoops (optional files: a recording whose cycles never scooped has none).
+  std::error_code exists_ec;
+  const std::filesystem::path scoop_path = dir_ / "scoop.csv";
+  const std::filesystem::path tip_path = dir_ / "tip_path.csv";
+  if (std::filesystem::exists(scoop_path, exists_ec)) {
+    decisions_ = ParseScoopCsv(ReadText(scoop_path), scoop_path.string());
+    tip_path_ = ParseTipPathCsv(ReadText(tip_path), tip_path.string());
+  }
+  std::map<int, long> points_of;
+  for (const TipPoint& t : tip_path_) ++points_of[t.cycle];
+  for (const DecisionRow& d : decisions_) {
+    const CycleInfo* cycle = nullptr;
+    for (const CycleInfo& c : manifest_.cycles) {
+      if (c.index == d.cycle) cycle = &c;
+    }
+    if (cycle == nullptr || !cycle->scoop) {
+      Refuse(scoop_path.string(), d.line, 1,
+             "cycle " + std::to_string(d.cycle) +
+                 " has no 'scoop' in recording.yaml (material, target volume)");
+    }
+    const long points = points_of[d.cycle];
+    if (d.path_points > points) {
+      Refuse(scoop_path.string(), d.line, 1,
+             "path_points " + std::to_string(d.path_points) + " but tip_path.csv has " +
+                 std::to_string(points) + " points of cycle " + std::to_string(d.cycle));
+    }
+  }
   for (std::size_t i = 0; i < frames_.size(); ++i) {
     for (const std::string* file : {&frames_[i].file, &frames_[i].labels_file}) {
       if (file->empty()) continue;
@@ -92,6 +120,14 @@ Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
       }
     }
   }
+}
+
+std::vector<Eigen::Vector3d> Recording::TipPathOf(int cycle) const {
+  std::vector<Eigen::Vector3d> path;
+  for (const TipPoint& t : tip_path_) {
+    if (t.cycle == cycle) path.push_back(t.p);
+  }
+  return path;
 }
 
 std::vector<FrameRow> Recording::FramesOf(std::size_t i) const {

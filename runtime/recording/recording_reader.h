@@ -33,6 +33,11 @@ class Recording {
   std::vector<FrameRow> FramesOf(std::size_t i) const;
   std::size_t frame_count() const { return frames_.size(); }
 
+  /// The scoops' trigger decisions (scoop.csv; none when the file is absent), and the tip path
+  /// of cycle `cycle` (tip_path.csv).
+  const std::vector<DecisionRow>& decisions() const { return decisions_; }
+  std::vector<Eigen::Vector3d> TipPathOf(int cycle) const;
+
   /// A LiDAR frame's points (sensor frame) stamped with the row's stamp and sensor. Throws
   /// core::InputError naming the file.
   sensors::PointCloud ReadLidar(const FrameRow& frame) const;
@@ -44,6 +49,8 @@ class Recording {
   Manifest manifest_;
   std::vector<UpdateRow> updates_;
   std::vector<FrameRow> frames_;
+  std::vector<DecisionRow> decisions_;
+  std::vector<TipPoint> tip_path_;
   std::vector<std::pair<std::size_t, std::size_t>> frame_range_;  ///< per update: [first, end)
 };
 

@@ -120,7 +120,11 @@ void CheckRelativePath(const std::string& source, int line, const Field& f, cons
   std::istringstream parts(p);
   std::string part;
   while (std::getline(parts, part, '/')) {
-    if (part == ".." || part == "." || part.empty()) bad("must not contain '.', '..' or '//'");
+    // "." and ".." leave the folder or go nowhere; "..." is a name, but no recorder writes one
+    // and a reader of the table would take it for "..".
+    if (part.empty() || part.find_first_not_of('.') == std::string::npos) {
+      bad("a part made only of dots ('.', '..') or an empty one ('//')");
+    }
   }
 }
 
@@ -206,6 +210,15 @@ CycleInfo ReadCycle(core::MapReader c) {
     }
   } else {
     c.Error("site", "a cycle needs its work area: 'rectangle' or 'discs'");
+  }
+  if (auto s = c.OptionalMap("scoop")) {
+    ScoopInfo scoop;
+    scoop.material = s->String("material");
+    scoop.target_volume = s->Number("target_volume", NumberRule::Positive("m^3"));
+    scoop.bucket_max = s->Number("bucket_max", NumberRule::Closed(-7, 7, "rad"));
+    scoop.boom_lift = s->Number("boom_lift", NumberRule::Closed(-7, 7, "rad"));
+    s->Finish();
+    cycle.scoop = scoop;
   }
   c.Finish();
   return cycle;
@@ -326,6 +339,50 @@ std::vector<FrameRow> ParseFramesCsv(const std::string& text, const std::string&
     frames.push_back(std::move(r));
   }
   return frames;
+}
+
+std::vector<DecisionRow> ParseScoopCsv(const std::string& text, const std::string& source) {
+  std::vector<DecisionRow> rows;
+  for (const auto& [line, f] : CsvRows(text, source, kScoopHeader)) {
+    DecisionRow d;
+    d.line = line;
+    d.cycle = static_cast<int>(Integer(source, line, f[0], "cycle", 0, 1'000'000));
+    d.time = Finite(source, line, f[1], "time");
+    if (!rows.empty() && rows.back().cycle == d.cycle && d.time < rows.back().time) {
+      Refuse(source, line, f[1].column, "time: goes back within cycle " + f[0].text);
+    }
+    d.hinge_xy = {Finite(source, line, f[2], "hinge_x"), Finite(source, line, f[3], "hinge_y")};
+    d.heading = Finite(source, line, f[4], "heading");
+    d.speed = Finite(source, line, f[5], "speed");
+    if (std::abs(d.speed) > 30) {
+      Refuse(source, line, f[5].column, "speed: beyond any loader (|v| <= 30 m/s; km/h?)");
+    }
+    d.q_boom = Finite(source, line, f[6], "q_boom");
+    d.q_bucket = Finite(source, line, f[7], "q_bucket");
+    if (std::abs(d.q_boom) > 7 || std::abs(d.q_bucket) > 7) {
+      Refuse(source, line, f[6].column, "q_boom, q_bucket: beyond a turn (radians?)");
+    }
+    d.path_points = Integer(source, line, f[8], "path_points", 1, 100'000'000);
+    d.predict = Flag(source, line, f[9], "predict");
+    rows.push_back(d);
+  }
+  return rows;
+}
+
+std::vector<TipPoint> ParseTipPathCsv(const std::string& text, const std::string& source) {
+  std::vector<TipPoint> points;
+  for (const auto& [line, f] : CsvRows(text, source, kTipPathHeader)) {
+    TipPoint t;
+    t.line = line;
+    t.cycle = static_cast<int>(Integer(source, line, f[0], "cycle", 0, 1'000'000));
+    if (!points.empty() && t.cycle < points.back().cycle) {
+      Refuse(source, line, f[0].column, "cycle: points must come grouped by cycle, in order");
+    }
+    t.p = {Finite(source, line, f[1], "x"), Finite(source, line, f[2], "y"),
+           Finite(source, line, f[3], "z")};
+    points.push_back(t);
+  }
+  return points;
 }
 
 Manifest ReadManifest(const std::filesystem::path& path) {

@@ -18,6 +18,12 @@ std::vector<UpdateRow> ParseUpdatesCsv(const std::string& text, const std::strin
 /// frames.csv: the header, then rows in update order, files relative to the folder, poses rigid.
 std::vector<FrameRow> ParseFramesCsv(const std::string& text, const std::string& source);
 
+/// scoop.csv: the header, then decisions in time order within each cycle.
+std::vector<DecisionRow> ParseScoopCsv(const std::string& text, const std::string& source);
+
+/// tip_path.csv: the header, then points grouped by cycle.
+std::vector<TipPoint> ParseTipPathCsv(const std::string& text, const std::string& source);
+
 /// recording.yaml. Throws core::InputError listing every problem.
 Manifest ReadManifest(const std::filesystem::path& path);
 

@@ -120,6 +120,12 @@ std::string ManifestText(const Manifest& m) {
   for (const CycleInfo& c : m.cycles) {
     y += "  - index: " + std::to_string(c.index) + "\n";
     y += "    site: " + Quoted(c.site) + "\n";
+    if (c.scoop) {
+      y += "    scoop: {material: " + Quoted(c.scoop->material) +
+           ", target_volume: " + Num(c.scoop->target_volume) +
+           ", bucket_max: " + Num(c.scoop->bucket_max) + ", boom_lift: " + Num(c.scoop->boom_lift) +
+           "}\n";
+    }
     if (c.area.kind == WorkArea::Kind::kRectangle) {
       y += "    rectangle: {front_center: " + Pair(c.area.front_center) +
            ", yaw: " + Num(c.area.yaw) + ", width: " + Num(c.area.width) +
@@ -175,6 +181,36 @@ RecordingWriter::RecordingWriter(std::filesystem::path dir, const std::string& d
   frames_csv_ = std::string(kFramesHeader) + "\n";
   digests_csv_ = std::string(kMapDigestsHeader) + "\n";
   selections_csv_ = std::string(kSelectionsHeader) + "\n";
+  scoop_csv_ = std::string(kScoopHeader) + "\n";
+  tip_path_csv_ = std::string(kTipPathHeader) + "\n";
+  predictions_csv_ = std::string(kPredictionsHeader) + "\n";
+}
+
+void RecordingWriter::SetScoop(const ScoopInfo& scoop) {
+  if (manifest_.cycles.empty()) throw std::logic_error("RecordingWriter: no cycle begun");
+  manifest_.cycles.back().scoop = scoop;
+}
+
+void RecordingWriter::AddScoop(const std::vector<DecisionRow>& decisions,
+                               const std::vector<double>& v1, const std::vector<double>& v2,
+                               const std::vector<Eigen::Vector3d>& tip_path) {
+  if (manifest_.cycles.empty()) throw std::logic_error("RecordingWriter: no cycle begun");
+  if (v1.size() != decisions.size() || v2.size() != decisions.size()) {
+    throw std::invalid_argument("RecordingWriter::AddScoop: one V1 and V2 per decision");
+  }
+  const int cycle = manifest_.cycles.back().index;
+  const std::string c = std::to_string(cycle);
+  for (std::size_t i = 0; i < decisions.size(); ++i) {
+    const DecisionRow& d = decisions[i];
+    scoop_csv_ += c + "," + Num(d.time) + "," + Num(d.hinge_xy.x()) + "," + Num(d.hinge_xy.y()) +
+                  "," + Num(d.heading) + "," + Num(d.speed) + "," + Num(d.q_boom) + "," +
+                  Num(d.q_bucket) + "," + std::to_string(d.path_points) + "," +
+                  (d.predict ? "1" : "0") + "\n";
+    predictions_csv_ += PredictionRow(cycle, d.time, v1[i], v2[i]) + "\n";
+  }
+  for (const Eigen::Vector3d& p : tip_path) {
+    tip_path_csv_ += c + "," + Num(p.x()) + "," + Num(p.y()) + "," + Num(p.z()) + "\n";
+  }
 }
 
 void RecordingWriter::SetSelection(const planning::ShovelPointConfig& config,
@@ -244,6 +280,9 @@ void RecordingWriter::Close() {
   core::CreateFolders(dir_ / "reference");
   core::WriteFileAtomically(dir_ / "reference" / "map_digests.csv", digests_csv_);
   core::WriteFileAtomically(dir_ / "reference" / "selections.csv", selections_csv_);
+  core::WriteFileAtomically(dir_ / "reference" / "predictions.csv", predictions_csv_);
+  core::WriteFileAtomically(dir_ / "scoop.csv", scoop_csv_);
+  core::WriteFileAtomically(dir_ / "tip_path.csv", tip_path_csv_);
   core::WriteFileAtomically(dir_ / "recording.yaml", ManifestText(manifest_));
   closed_ = true;
 }

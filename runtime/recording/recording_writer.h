@@ -33,6 +33,15 @@ class RecordingWriter {
   long AddUpdate(UpdateRow row, const perception::SensorFrames& frames,
                  const std::string& camera_name);
 
+  /// The scoop of the running cycle: what its volume prediction assumed.
+  void SetScoop(const ScoopInfo& scoop);
+
+  /// A scoop's trigger decisions (scoop.csv), the machine's V1 and V2 at each
+  /// (reference/predictions.csv; `v2` NaN where none was predicted), and its tip path
+  /// (tip_path.csv), for the running cycle.
+  void AddScoop(const std::vector<DecisionRow>& decisions, const std::vector<double>& v1,
+                const std::vector<double>& v2, const std::vector<Eigen::Vector3d>& tip_path);
+
   /// What the recording machine computed at the update just added, for checking a replay:
   /// reference/map_digests.csv and reference/selections.csv rows (replay_check.h).
   void AddReference(const std::string& map_digest_row, const std::string& selection_row);
@@ -48,6 +57,7 @@ class RecordingWriter {
   Manifest manifest_;
   long next_update_ = 0;
   std::string updates_csv_, frames_csv_, digests_csv_, selections_csv_;
+  std::string scoop_csv_, tip_path_csv_, predictions_csv_;
   bool closed_ = false;
 };
 

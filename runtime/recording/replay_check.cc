@@ -1,5 +1,6 @@
 #include "runtime/recording/replay_check.h"
 
+#include <cmath>
 #include <cstring>
 
 #include "runtime/core/sha256.h"
@@ -27,6 +28,11 @@ std::string MapDigest(const perception::GridMap& map) {
 
 std::string MapDigestRow(long update, const perception::GridMap& map) {
   return std::to_string(update) + "," + MapDigest(map);
+}
+
+std::string PredictionRow(int cycle, double time, double v1, double v2) {
+  return std::to_string(cycle) + "," + core::FormatNumber(time) + "," + core::FormatNumber(v1) +
+         "," + (std::isnan(v2) ? std::string() : core::FormatNumber(v2));
 }
 
 std::string SelectionRow(long update, int cycle, const planning::ShovelPointResult& selection,

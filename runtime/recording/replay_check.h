@@ -14,6 +14,11 @@ inline constexpr const char* kMapDigestsHeader = "update,map_sha256";
 inline constexpr const char* kSelectionsHeader =
     "update,cycle,candidates,feasible,best_x,best_y,best_heading,best_score";
 
+inline constexpr const char* kPredictionsHeader = "cycle,time,v1,v2";
+
+/// `cycle,time,v1,v2` of one trigger decision (V2 empty when NaN: not predicted).
+std::string PredictionRow(int cycle, double time, double v1, double v2);
+
 /// SHA-256 over the map's size, resolution, position and every layer (name and float bytes,
 /// in name order).
 std::string MapDigest(const perception::GridMap& map);

@@ -164,6 +164,18 @@ TEST(FuzzRegressions, RecordingFrames) {
   }));
 }
 
+TEST(FuzzRegressions, RecordingScoop) {
+  ExpectBothKinds(CheckTarget("recording_scoop", [](const std::string& path) {
+    return Refusal([&] { recording::ParseScoopCsv(TextOf(path), path); });
+  }));
+}
+
+TEST(FuzzRegressions, RecordingTipPath) {
+  ExpectBothKinds(CheckTarget("recording_tip_path", [](const std::string& path) {
+    return Refusal([&] { recording::ParseTipPathCsv(TextOf(path), path); });
+  }));
+}
+
 TEST(FuzzRegressions, RecordingManifest) {
   ExpectBothKinds(CheckTarget("recording_manifest", [](const std::string& path) {
     return Refusal([&] { recording::ReadManifest(path); });

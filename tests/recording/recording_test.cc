@@ -88,7 +88,7 @@ void WriteTestRecording(const fs::path& dir, std::mt19937& rng) {
   bin.yaw = 0.3;
   bin.width = 8;
   bin.depth = 6;
-  writer.BeginCycle({.index = 0, .site = "bin_1", .area = bin});
+  writer.BeginCycle({.index = 0, .site = "bin_1", .area = bin, .scoop = std::nullopt});
   UpdateRow row;
   row.stamp = 12.0;
   row.hinge_xy = {0.1, 0.2};
@@ -104,11 +104,24 @@ void WriteTestRecording(const fs::path& dir, std::mt19937& rng) {
   WorkArea yard;
   yard.kind = WorkArea::Kind::kDiscs;
   yard.discs = {{1, 2, 3.5}, {-4, 5, 2}};
-  writer.BeginCycle({.index = 1, .site = "open yard", .area = yard});
+  writer.BeginCycle({.index = 1, .site = "open yard", .area = yard, .scoop = std::nullopt});
   row.stamp = 20.0;
   row.select = false;
   EXPECT_EQ(writer.AddUpdate(row, perception::SensorFrames{}, "camera"), 2);
   writer.AddReference("2,abc", "");
+  writer.SetScoop(
+      {.material = "river_sand", .target_volume = 3.5, .bucket_max = 0.9, .boom_lift = 0.35});
+  const std::vector<Eigen::Vector3d> path = {{1.0 / 3.0, 2, -0.01}, {1.5, 2, -0.02}};
+  writer.AddScoop({{.cycle = 1,
+                    .time = 20.05,
+                    .hinge_xy = {0.2, 0.1},
+                    .heading = 0.5,
+                    .speed = 1.5,
+                    .q_boom = -0.52,
+                    .q_bucket = 0.21,
+                    .path_points = 2,
+                    .predict = true}},
+                  {0.0}, {0.125}, path);
   writer.Close();
 }
 
@@ -135,6 +148,15 @@ TEST(Recording, RoundTripIsBitExact) {
   EXPECT_TRUE(rec.updates()[1].select);
   EXPECT_EQ(rec.updates()[2].cycle, 1);
   EXPECT_TRUE(rec.FramesOf(2).empty());
+  ASSERT_TRUE(m.cycles[1].scoop.has_value());
+  EXPECT_EQ(m.cycles[1].scoop->material, "river_sand");
+  EXPECT_FALSE(m.cycles[0].scoop.has_value());
+  ASSERT_EQ(rec.decisions().size(), 1u);
+  EXPECT_EQ(rec.decisions()[0].q_boom, -0.52);
+  EXPECT_TRUE(rec.decisions()[0].predict);
+  ASSERT_EQ(rec.TipPathOf(1).size(), 2u);
+  EXPECT_EQ(rec.TipPathOf(1)[0].x(), 1.0 / 3.0);
+  EXPECT_TRUE(rec.TipPathOf(0).empty());
 
   // The frames read back as written.
   std::mt19937 again(7);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `autoshovel run --record` then `autoshovel replay --check`: replaying the recorded frames
-# reproduces the run's map after every update and every selection, byte for byte; a recording
-# with one pose changed does not (the check can fail).
+# reproduces the run's map after every update, every selection and the scoop's V1 and V2 at every
+# trigger decision, byte for byte; a recording with one pose changed does not (the check can
+# fail).
 #
 #   replay_test.sh AUTOSHOVEL SOURCE_DIR
 set -uo pipefail
@@ -18,8 +19,8 @@ fail() {
   --record "$tmp/rec" -o "$tmp/run" >"$tmp/run.out" 2>&1
 status=$?
 [ "$status" -le 1 ] || { cat "$tmp/run.out"; fail "run exited $status"; }
-for f in recording.yaml machine.yaml updates.csv frames.csv reference/map_digests.csv \
-  reference/selections.csv; do
+for f in recording.yaml machine.yaml updates.csv frames.csv scoop.csv tip_path.csv \
+  reference/map_digests.csv reference/selections.csv reference/predictions.csv; do
   [ -s "$tmp/rec/$f" ] || fail "the recording has no $f"
 done
 updates=$(($(wc -l <"$tmp/rec/updates.csv") - 1))
@@ -33,6 +34,9 @@ ls "$tmp/rec"/camera/*.png >/dev/null 2>&1 || fail "no camera frames"
   >"$tmp/replay.out" 2>&1 || { cat "$tmp/replay.out"; fail "replay --check exited $?"; }
 cmp "$tmp/rec/reference/map_digests.csv" "$tmp/replay/map_digests.csv" || fail "maps differ"
 cmp "$tmp/rec/reference/selections.csv" "$tmp/replay/selections.csv" || fail "selections differ"
+cmp "$tmp/rec/reference/predictions.csv" "$tmp/replay/predictions.csv" || fail "V1/V2 differ"
+predicted=$(awk -F, 'NR > 1 && $4 != ""' "$tmp/rec/reference/predictions.csv" | wc -l)
+[ "$predicted" -ge 1 ] || fail "no decision predicted V2"
 grep -q "maps identical after $updates of $updates updates" "$tmp/replay.out" ||
   { cat "$tmp/replay.out"; fail "replay does not report $updates identical maps"; }
 [ -s "$tmp/replay/figures/map_cycle_0.png" ] || fail "no map picture"
@@ -46,4 +50,5 @@ status=$?
 [ "$status" -eq 1 ] || { cat "$tmp/replay2.out"; fail "a moved frame was not found (exit $status)"; }
 grep -q "first difference: map_digests.csv line 2" "$tmp/replay2.out" ||
   { cat "$tmp/replay2.out"; fail "the difference is not at the first update"; }
-echo "replay_test: $updates updates, $selected selections reproduced; a moved frame detected"
+echo "replay_test: $updates updates, $selected selections, $predicted V2 predictions reproduced;" \
+  "a moved frame detected"

@@ -199,7 +199,8 @@ class ShovelCycle {
     if (r.recorder != nullptr) {
       r.recorder->SetSelection(selection_.config(), o_.safety_distance + o_.selection_margin,
                                o_.selection == SelectionMethod::kChen2024);
-      r.recorder->BeginCycle({.index = index, .site = site.name, .area = work_area_});
+      r.recorder->BeginCycle(
+          {.index = index, .site = site.name, .area = work_area_, .scoop = std::nullopt});
     }
   }
 
@@ -225,6 +226,7 @@ class ShovelCycle {
   void Control();
   void SafeStop(const std::string& reason);
   long RecordUpdate(bool select, const planning::Pose2& select_pose);
+  void RecordScoop();
   void Finish(const std::filesystem::path& figures_dir);
   void Profile(const MultiRateExecutive& executive, double plant_seconds, long plant_steps,
                double finish_seconds);
@@ -360,6 +362,33 @@ long ShovelCycle::RecordUpdate(bool select, const planning::Pose2& select_pose) 
   const long update = r_.recorder->AddUpdate(row, mapping_.last_frames(), "camera");
   if (!select) r_.recorder->AddReference(recording::MapDigestRow(update, r_.map.map()), "");
   return update;
+}
+
+// The scoop's trigger decisions, the machine's V1 and V2 at each and its tip path, into the
+// recording, with what the prediction assumed (material, V_t, the scoop it plans).
+void ShovelCycle::RecordScoop() {
+  if (r_.recorder == nullptr || handover_.material == nullptr) return;
+  r_.recorder->SetScoop(
+      {.material = handover_.material->name,
+       .target_volume = out_.target_volume,
+       .bucket_max = machine_.links[1].joint_max - scoop_options_.rack_back_margin,
+       .boom_lift = scoop_options_.strategy.exit_boom_lift});
+  std::vector<recording::DecisionRow> decisions;
+  std::vector<double> v1, v2;
+  for (const control::ScoopSample& sample : out_.scoop.samples) {
+    decisions.push_back({.cycle = out_.record.cycle,
+                         .time = sample.time,
+                         .hinge_xy = sample.state.hinge_xy,
+                         .heading = sample.state.heading,
+                         .speed = sample.state.speed,
+                         .q_boom = sample.state.q_boom,
+                         .q_bucket = sample.state.q_bucket,
+                         .path_points = static_cast<long>(sample.path_points),
+                         .predict = !std::isnan(sample.v2)});
+    v1.push_back(sample.v1);
+    v2.push_back(sample.v2);
+  }
+  r_.recorder->AddScoop(decisions, v1, v2, out_.scoop.tip_path);
 }
 
 // The supervisor's 20 Hz checks (safety_supervisor.h): faults that put a person in the way, the
@@ -527,6 +556,7 @@ void ShovelCycle::Finish(const std::filesystem::path& figures_dir) {
   out_.refused_frames = supervisor_.refused_frames();
   out_.speed_at_stop = stops_.speed;
   if (scooped) out_.scoop = handover_.scoop->Finish(machine_io_);
+  if (scooped) RecordScoop();
   const CycleEnd end{.scooped = scooped,
                      .t0 = t0_,
                      .time = plant_.time(),

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <vector>
@@ -28,6 +29,7 @@
 #include "runtime/prediction/shipped_models.h"
 #include "runtime/recording/recording_reader.h"
 #include "runtime/recording/replay_check.h"
+#include "runtime/results/report.h"
 #include "runtime/results/run_folder.h"
 #include "runtime/sensors/lidar.h"
 #include "runtime/sensors/sensor_pose.h"
@@ -125,7 +127,8 @@ std::string ReplayScoopPredictions(const recording::Recording& rec,
                                    const model::MachineDescription& machine,
                                    const generated::MachineFunctions& functions,
                                    const prediction::PenetrationPredictor& predictor,
-                                   const perception::GridMap& map, results::RunLog& log) {
+                                   const perception::GridMap& map, results::RunLog& log,
+                                   std::vector<std::string>& report_lines) {
   std::string rows;
   if (!cycle.scoop) return rows;
   const model::Material* material = machine.FindMaterial(cycle.scoop->material);
@@ -157,12 +160,38 @@ std::string ReplayScoopPredictions(const recording::Recording& rec,
     }
     rows += recording::PredictionRow(cycle.index, d.time, v1, v2) + "\n";
   }
-  log.Info("cycle " + std::to_string(cycle.index) + ": " +
-           (std::isnan(reached)
-                ? std::string("kappa (V1 + V2) never reached V_t")
-                : "kappa (V1 + V2) reached V_t = " + core::Fixed(cycle.scoop->target_volume, 2) +
-                      " m3 at t = " + core::Fixed(reached, 2) + " s"));
+  const std::string line =
+      "cycle " + std::to_string(cycle.index) + ": " +
+      (std::isnan(reached)
+           ? std::string("kappa (V1 + V2) never reached V_t")
+           : "kappa (V1 + V2) reached V_t = " + core::Fixed(cycle.scoop->target_volume, 2) +
+                 " m3 at t = " + core::Fixed(reached, 2) + " s");
+  log.Info(line);
+  report_lines.push_back(line);
   return rows;
+}
+
+// report.html: what was replayed, the comparison with the recording machine, each cycle's
+// selection and predicted trigger, and the figures.
+std::string ReplayReportHtml(const recording::Recording& rec, const std::vector<std::string>& lines,
+                             const std::vector<std::pair<std::string, std::string>>& figures) {
+  using results::HtmlEscape;
+  std::string h =
+      "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>autoshovel replay"
+      "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
+      "img{max-width:100%}li{margin:0.2em 0}</style></head><body>\n";
+  h += "<h1>Replay of " + HtmlEscape(rec.dir().string()) + "</h1>\n";
+  h += "<p>" + HtmlEscape(rec.manifest().source) + ": " + std::to_string(rec.updates().size()) +
+       " map updates, " + std::to_string(rec.frame_count()) + " sensor frames, " +
+       std::to_string(rec.decisions().size()) + " scoop decisions (docs/recording_format.md)." +
+       "</p>\n<ul>\n";
+  for (const std::string& line : lines) h += "<li>" + HtmlEscape(line) + "</li>\n";
+  h += "</ul>\n";
+  for (const auto& [title, png] : figures) {
+    h += "<h2>" + HtmlEscape(title) + "</h2>\n<img src=\"" + HtmlEscape(png) + "\" alt=\"" +
+         HtmlEscape(title) + "\">\n";
+  }
+  return h + "</body></html>\n";
 }
 
 std::string ConfigYaml(const ReplayOptions& o, const recording::Recording& rec) {
@@ -225,22 +254,35 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
   std::string selections = std::string(recording::kSelectionsHeader) + "\n";
   std::string predictions = std::string(recording::kPredictionsHeader) + "\n";
   std::unique_ptr<ShovelPointTask> task;
+  std::vector<std::string> report_lines;
+  std::vector<std::pair<std::string, std::string>> report_figures;
   int cycle = -1;
   planning::Pose2 last_pose;
+  // The selection that first gave the cycle a goal, for its picture.
+  struct Goal {
+    planning::ShovelPointResult selection;
+    std::vector<planning::Chen2024Candidate> baseline;
+    planning::Pose2 from;
+  };
+  std::optional<Goal> goal;
   auto finish_cycle = [&]() {
     if (task == nullptr) return;
     if (predictor != nullptr) {
       predictions += ReplayScoopPredictions(*rec, *cycles.at(cycle), machine, *functions,
-                                            *predictor, map.map(), log);
+                                            *predictor, map.map(), log, report_lines);
     }
     if (!o.figures) return;
     const std::string n = std::to_string(cycle);
     perception::WriteSemanticMapPng(map.map(), task->last_piles(),
                                     folder->FigurePath("map_cycle_" + n + ".png").string(), 2);
-    if (task->selections() > 0) {
-      planning::WriteCandidatePng(map.map(), task->last_selection(),
-                                  m.chen2024 ? &task->last_baseline() : nullptr, last_pose, loader,
+    report_figures.emplace_back("Cycle " + n + ": semantic elevation map layers",
+                                "figures/map_cycle_" + n + ".png");
+    if (goal) {
+      planning::WriteCandidatePng(map.map(), goal->selection,
+                                  m.chen2024 ? &goal->baseline : nullptr, goal->from, loader,
                                   folder->FigurePath("candidates_cycle_" + n + ".png").string());
+      report_figures.emplace_back("Cycle " + n + ": scored shovel points when its goal was chosen",
+                                  "figures/candidates_cycle_" + n + ".png");
     }
   };
   const auto w0 = std::chrono::steady_clock::now();
@@ -249,6 +291,7 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
       const recording::UpdateRow& u = rec->updates()[i];
       if (u.cycle != cycle) {
         finish_cycle();
+        goal.reset();
         cycle = u.cycle;
         const recording::WorkArea area = cycles.at(cycle)->area;
         task = std::make_unique<ShovelPointTask>(
@@ -265,7 +308,12 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
         selections +=
             recording::SelectionRow(static_cast<long>(i), cycle, task->last_selection(), best) +
             "\n";
-        if (best != nullptr && task->selections() == 1) log.Info(task->SelectedText(*best));
+        if (best != nullptr && !goal) {
+          goal = Goal{task->last_selection(), task->last_baseline(), last_pose};
+          log.Info(task->SelectedText(*best));
+          report_lines.push_back("cycle " + std::to_string(cycle) + ": " +
+                                 task->SelectedText(*best));
+        }
       }
       digests += recording::MapDigestRow(static_cast<long>(i), map.map()) + "\n";
       log.Debug("update " + std::to_string(i) + ": " + std::to_string(fused.returns_fused) +
@@ -289,9 +337,21 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
   const std::string ref_digests = ReadTextOrEmpty(rec->dir() / "reference" / "map_digests.csv");
   const std::string ref_selections = ReadTextOrEmpty(rec->dir() / "reference" / "selections.csv");
   const std::string ref_predictions = ReadTextOrEmpty(rec->dir() / "reference" / "predictions.csv");
+  auto write_report = [&]() -> bool {
+    try {
+      core::WriteFileAtomically(folder->dir() / "report.html",
+                                ReplayReportHtml(*rec, report_lines, report_figures));
+    } catch (const std::exception& e) {
+      err << "autoshovel replay: " << e.what() << "\n";
+      return false;
+    }
+    out << "report: " << (folder->dir() / "report.html").string() << "\n";
+    return true;
+  };
   if (ref_digests.empty()) {
     out << "no reference/ in the recording: nothing to compare with\n";
-    return 0;
+    report_lines.push_back("the recording has no reference/: nothing to compare with");
+    return write_report() ? 0 : 2;
   }
   const Comparison maps = Compare(ref_digests, digests, "map_digests.csv");
   const Comparison picks = Compare(ref_selections, selections, "selections.csv");
@@ -309,6 +369,13 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
       log.Warning(c->first_difference);
     }
   }
+  report_lines.push_back(summary.str());
+  for (const Comparison* c : {&maps, &picks, &volumes}) {
+    if (!c->first_difference.empty()) {
+      report_lines.push_back("first difference: " + c->first_difference);
+    }
+  }
+  if (!write_report()) return 2;
   const bool identical =
       maps.same == maps.rows && picks.same == picks.rows && volumes.same == volumes.rows;
   return o.check && !identical ? 1 : 0;

@@ -40,6 +40,8 @@ predicted=$(awk -F, 'NR > 1 && $4 != ""' "$tmp/rec/reference/predictions.csv" | 
 grep -q "maps identical after $updates of $updates updates" "$tmp/replay.out" ||
   { cat "$tmp/replay.out"; fail "replay does not report $updates identical maps"; }
 [ -s "$tmp/replay/figures/map_cycle_0.png" ] || fail "no map picture"
+[ -s "$tmp/replay/figures/candidates_cycle_0.png" ] || fail "no candidates picture"
+grep -q "maps identical after $updates of $updates" "$tmp/replay/report.html" || fail "no report"
 
 # One LiDAR frame's pose moved by 0.2 m: the maps from that update on must differ.
 awk -F, 'BEGIN { OFS = "," } NR == 2 { $8 = $8 + 0.2 } { print }' "$tmp/rec/frames.csv" \

@@ -26,6 +26,7 @@
 #include "runtime/app/shovel_run.h"
 #include "runtime/core/file_output.h"
 #include "runtime/core/progress_line.h"
+#include "runtime/perception/segmentation.h"
 #include "runtime/results/results_db.h"
 
 extern char** environ;
@@ -78,10 +79,20 @@ ShovelRunOptions JobOptions(const CampaignSpec& spec, const CampaignJob& job,
   return o;
 }
 
-// One worker: jobs k, k + n, …; returns the number of jobs that failed.
+// The segmentation network's threads for one of `workers` processes on this machine: OpenCV
+// runs it on a process-wide pool as large as the machine (segmentation.h), so n workers would
+// run n × cores threads on cores cores. Each takes its share, at least one.
+int InferenceThreadsPerWorker(int workers) {
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return std::max(1, cores / std::max(1, workers));
+}
+
+// One worker: jobs k, k + n, …; returns the number of jobs that failed. `local_workers`: the
+// workers on this machine (the network's threads are shared among them).
 int RunWorker(const CampaignSpec& spec, const std::vector<CampaignJob>& jobs,
               const std::filesystem::path& dir, const std::string& models_dir, int k, int n,
-              std::ostream& log, const std::function<void()>& after_cycle = {}) {
+              int local_workers, std::ostream& log, const std::function<void()>& after_cycle = {}) {
+  perception::SetInferenceThreads(InferenceThreadsPerWorker(local_workers));
   const results::ResultsDb merged(MergedPath(dir));
   results::ResultsDb shard(ShardPath(dir, k));
   int failed = 0;
@@ -338,8 +349,13 @@ int RunMpi(const CampaignOptions& o, const CampaignSpec& spec, const std::vector
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     PrintProgress(progress_line, base + fresh, spec.cycles(), fresh, seconds, final, last_done);
   };
+  // Ranks on this machine: Open MPI says how many (mpirun sets OMPI_COMM_WORLD_LOCAL_SIZE);
+  // without it every rank is taken to share one machine.
+  const char* local_size = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+  const int local_ranks =
+      local_size != nullptr && std::atoi(local_size) > 0 ? std::atoi(local_size) : size;
   int failed = RunWorker(
-      spec, jobs, dir, o.models_dir, rank, size, log,
+      spec, jobs, dir, o.models_dir, rank, size, local_ranks, log,
       rank == 0 ? std::function<void()>([&] { progress(false); }) : std::function<void()>());
   // The rank's log is the only record of why a job failed: losing it (a full disk) is a
   // failure of the rank, said on its standard error, not a silent success.
@@ -401,8 +417,10 @@ int RunCampaign(const CampaignOptions& o, std::ostream& out, std::ostream& err) 
             << o.coordinator_pid << ") is gone\n";
         return 1;
       }
-      return RunWorker(spec, jobs, dir, o.models_dir, o.worker_index, o.worker_count, out) == 0 ? 0
-                                                                                                : 1;
+      return RunWorker(spec, jobs, dir, o.models_dir, o.worker_index, o.worker_count,
+                       o.worker_count, out) == 0
+                 ? 0
+                 : 1;
     }
     if (StartedByMpirun()) return RunMpi(o, spec, jobs, dir, out, err);
     // Check that the jobs can be set up (scenario, machine, models) before starting workers.

@@ -309,9 +309,9 @@ Command AddReplay(CLI::App& app, const Globals& g) {
   auto c = std::make_shared<autoshovel::app::ReplayOptions>();
   CLI::App* cmd = app.add_subcommand(
       "replay",
-      "Run the main job's perception and shovel point selection on a recording (a real "
-      "machine's, or `run --record`'s): maps, selections and pictures, no plant "
-      "(docs/recording_format.md)");
+      "Run the main job's perception, shovel point selection and scoop volume prediction on "
+      "a recording (a real machine's, or `run --record`'s): maps, selections, V1/V2, pictures, "
+      "no plant (docs/recording_format.md)");
   cmd->add_option("recording", c->recording, "Recording folder")->required();
   cmd->add_option("-o,--out", c->out, "Run folder (default: runs/<UTC timestamp>)");
   cmd->add_flag("--truth", c->truth_labels,

@@ -15,6 +15,7 @@
 #include "runtime/app/shovel_job/path_watch.h"
 #include "runtime/app/shovel_job/shovel_cycle.h"
 #include "runtime/app/shovel_job/shovel_point_task.h"
+#include "runtime/app/stop_hold.h"
 
 namespace autoshovel::app {
 namespace {
@@ -206,6 +207,31 @@ TEST(Architecture, DiagramNamesEveryTaskAtItsRateAndJoinsOnlyKnownComponents) {
     joined.insert(from), joined.insert(to);
   }
   for (const std::string& n : nodes) EXPECT_TRUE(joined.count(n)) << n << " has no flow";
+}
+
+// The hold rule both jobs share: a reason stops at once, a new reason while stopped adds no
+// stop, and the machine goes on only after the checks have found no reason for resume_after
+// from the first clear check; a reason seen meanwhile starts the wait again.
+TEST(StopHold, StopsAtOnceAndResumesAfterTheReasonHasBeenGone) {
+  // Times in quarter seconds: exact in binary, so the 1 s boundary is exact.
+  SafetySupervisor supervisor;
+  StopHold hold(1.0);
+  using Change = StopHold::Change;
+  EXPECT_EQ(hold.Update(0.0, "", supervisor), Change::kNone);
+  EXPECT_EQ(hold.Update(0.25, "person ahead", supervisor), Change::kStopped);
+  EXPECT_TRUE(supervisor.stopped());
+  EXPECT_EQ(supervisor.reason(), "person ahead");
+  EXPECT_EQ(hold.Update(0.5, "person ahead", supervisor), Change::kNone);
+  EXPECT_EQ(hold.Update(0.75, "", supervisor), Change::kNone);       // clear from 0.75
+  EXPECT_EQ(hold.Update(1.5, "", supervisor), Change::kNone);        // 0.75 s clear
+  EXPECT_EQ(hold.Update(1.75, "again", supervisor), Change::kNone);  // seen again: wait anew
+  EXPECT_EQ(hold.Update(2.0, "", supervisor), Change::kNone);        // clear from 2.0
+  EXPECT_EQ(hold.Update(2.75, "", supervisor), Change::kNone);       // 0.75 s clear
+  EXPECT_EQ(hold.Update(3.0, "", supervisor), Change::kResumed);     // 1 s clear
+  EXPECT_FALSE(supervisor.stopped());
+  EXPECT_EQ(supervisor.safe_stops(), 1);
+  EXPECT_EQ(supervisor.recoveries(), 1);
+  EXPECT_EQ(hold.Update(3.25, "", supervisor), Change::kNone);
 }
 
 }  // namespace

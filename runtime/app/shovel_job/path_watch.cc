@@ -88,18 +88,20 @@ void PathWatch::Check(double time, const std::string& degraded,
                           : blocked ? "obstacle " + Fixed(ahead, 2) + " m ahead on the path; " +
                                           SureCellReport(map, blocking_cell, world)
                                     : "";
-  if (!why.empty() && !supervisor.stopped()) {
-    supervisor.Stop(why);
-    machine_io.HoldStop(true);
-    stops.Begin(truth.hinge_xy, truth.speed);
-    log.Say("stop at t = " + Fixed(time - t0, 2) + " s: " + why);
-  }
-  if (!why.empty()) last_reason_seen_ = time;
-  if (why.empty() && supervisor.stopped() && time - last_reason_seen_ >= config_.resume_after) {
-    log.Say("drives on at t = " + Fixed(time - t0, 2) + " s (was: " + supervisor.reason() + ")");
-    supervisor.Resume();
-    machine_io.HoldStop(false);
-    speed_pid.Reset(sensed.speed);  // its integral wound up against the brake
+  const std::string was = supervisor.reason();
+  switch (hold_.Update(time, why, supervisor)) {
+    case StopHold::Change::kStopped:
+      machine_io.HoldStop(true);
+      stops.Begin(truth.hinge_xy, truth.speed);
+      log.Say("stop at t = " + Fixed(time - t0, 2) + " s: " + why);
+      break;
+    case StopHold::Change::kResumed:
+      log.Say("drives on at t = " + Fixed(time - t0, 2) + " s (was: " + was + ")");
+      machine_io.HoldStop(false);
+      speed_pid.Reset(sensed.speed);  // its integral wound up against the brake
+      break;
+    case StopHold::Change::kNone:
+      break;
   }
   if (supervisor.stopped()) stops.Track(truth.hinge_xy);
 }

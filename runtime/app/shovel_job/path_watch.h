@@ -13,6 +13,7 @@
 #include "runtime/app/safety_supervisor.h"
 #include "runtime/app/shovel_job/cycle_log.h"
 #include "runtime/app/shovel_job/navigation_goal.h"
+#include "runtime/app/stop_hold.h"
 #include "runtime/control/speed_pid.h"
 #include "runtime/plant/world.h"
 
@@ -50,7 +51,7 @@ double ObstacleAheadOnPath(const NavigationGoal& nav,
 
 class PathWatch {
  public:
-  explicit PathWatch(const PathWatchConfig& config) : config_(config) {}
+  explicit PathWatch(const PathWatchConfig& config) : config_(config), hold_(config.resume_after) {}
 
   /// One 20 Hz check while navigating: `degraded` from the last map update, `sensed` what the
   /// machine senses, `truth` where it is (the stop record), `world` for the log's truth.
@@ -63,7 +64,7 @@ class PathWatch {
 
  private:
   PathWatchConfig config_;
-  double last_reason_seen_ = -1e9;  ///< when a reason to hold was last seen [s]
+  StopHold hold_;
 };
 
 }  // namespace autoshovel::app

@@ -12,6 +12,8 @@
 
 #include "generated/registry.h"
 #include "runtime/app/executive.h"
+#include "runtime/app/safety_supervisor.h"
+#include "runtime/app/stop_hold.h"
 #include "runtime/app/truck_loading/excavator_on_plant.h"
 #include "runtime/app/truck_loading/plant_dig_model.h"
 #include "runtime/app/truck_loading/world_height_grid.h"
@@ -479,8 +481,9 @@ struct TruckLoadingJob::State::LoadLoop {
   ExcavatorOnPlant excavator;
   control::ExcavatorSimulator mirror;
   const double t_load;
-  double clear_since = std::numeric_limits<double>::quiet_NaN();
-  bool stopped = false, in_collision = false, finished = false;
+  SafetySupervisor supervisor;  ///< the stop's reason, stops and recoveries
+  StopHold hold;
+  bool in_collision = false, finished = false;
   control::ExcavatorCommand command;
   std::string phase = "swing";
   std::map<std::string, std::pair<double, double>> phase_start;  // time, energy
@@ -502,7 +505,8 @@ struct TruckLoadingJob::State::LoadLoop {
         script(load_script),
         excavator(plant, servo),
         mirror(models, excavator.Sense()),
-        t_load(plant.time()) {
+        t_load(plant.time()),
+        hold(state.options.resume_after) {
     command.position = excavator.Sense().q;
     plant.SetPhase(phase);
     phase_start[phase] = {plant.time(), plant.energy().hydraulic};
@@ -578,7 +582,7 @@ struct TruckLoadingJob::State::LoadLoop {
   bool ScriptStep(double t, const control::ExcavatorState& measured) {
     const control::HeightGrid map = HeightGridFromWorld(s.scenario.world, Eigen::Vector2d::Zero(),
                                                         kMapHalfSize, kMapResolution);
-    if (!stopped) {
+    if (!supervisor.stopped()) {
       const control::ScriptOutput step = script.Step(measured.q);
       command = step.command;
       mirror.Command(command);
@@ -588,12 +592,17 @@ struct TruckLoadingJob::State::LoadLoop {
     // stopped it lies further ahead than 2.5 s, and a 2.5 s check would let it creep up to a
     // person in stop-and-go steps.
     mirror.Resync(measured);
-    const control::ObstacleLookAhead& lookahead = stopped ? *s.resume_lookahead : *s.lookahead;
+    const control::ObstacleLookAhead& lookahead =
+        supervisor.stopped() ? *s.resume_lookahead : *s.lookahead;
     const control::LookAheadResult check =
         lookahead.Check(measured, mirror, &script, control::LoadingScript::kPeriod, map,
                         Eigen::Isometry3d::Identity());
+    // The supervisor's hold rule, shared with the loader (stop_hold.h).
+    const std::string reason =
+        check.stop() ? (check.reason.empty() ? "look-ahead" : check.reason) : "";
+    const StopHold::Change change = hold.Update(t, reason, supervisor);
     if (check.stop()) {
-      if (!stopped) {
+      if (change == StopHold::Change::kStopped) {
         ++out.safety_stops;
         if (progress) {
           *progress << "  look-ahead stop at " << t - t_start << " s: " << check.reason;
@@ -604,20 +613,14 @@ struct TruckLoadingJob::State::LoadLoop {
           *progress << "\n";
         }
       }
-      stopped = true;
-      clear_since = std::numeric_limits<double>::quiet_NaN();
       command = control::ExcavatorCommand{};
       command.stop = true;
       mirror.Command(command);
-    } else if (stopped) {
-      if (std::isnan(clear_since)) clear_since = t;
-      if (t - clear_since >= s.options.resume_after) {
-        if (progress) *progress << "  resumed at " << t - t_start << " s\n";
-        stopped = false;
-        command.position = script.Commands();
-        command.stop = false;
-        mirror.Command(command);
-      }
+    } else if (change == StopHold::Change::kResumed) {
+      if (progress) *progress << "  resumed at " << t - t_start << " s\n";
+      command.position = script.Commands();
+      command.stop = false;
+      mirror.Command(command);
     }
     // Phase booking from the bucket's script: opening = dump, moving to dig = return.
     const int bucket_rule = script.active_rule(control::ExcavatorJoint::kBucket);
@@ -653,7 +656,7 @@ struct TruckLoadingJob::State::LoadLoop {
         s.scenario.world.terrain.CellOf(sample.p_world_tip.x(), sample.p_world_tip.y(), ix, iy)
             ? s.scenario.world.terrain.height(ix, iy)
             : 0.0;
-    sample.stopped = stopped;
+    sample.stopped = supervisor.stopped();
     out.trace.push_back(std::move(sample));
   }
 

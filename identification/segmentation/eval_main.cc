@@ -45,6 +45,8 @@ options:
   --jobs J           rendering threads (default 2)
   --models DIR       models folder (default: the source tree's models/)
   --confusion 1      also print the confusion matrix of all views (rows: truth)
+  --scale S          segment at S of the frame's resolution, probabilities brought back to
+                     full size (default 1; perception::Segmenter::Run)
 )";
 
 struct Sample {
@@ -123,7 +125,7 @@ std::string Percent(const std::optional<double>& v) {
 int Run(int argc, char** argv) {
   const identification::ToolArgs args(argc, argv,
                                       {"model", "seed", "count", "first", "scenarios", "data",
-                                       "split", "threads", "jobs", "models", "confusion"});
+                                       "split", "threads", "jobs", "models", "confusion", "scale"});
   if (args.help()) {
     std::cout << kUsage;
     return 0;
@@ -132,6 +134,8 @@ int Run(int argc, char** argv) {
       "model", std::string(AUTOSHOVEL_DEFAULT_MODELS_DIR) + "/segmentation/yard_segmenter.onnx");
   const std::int64_t threads = args.Int("threads", 1);
   if (threads < 1) throw std::invalid_argument("--threads must be ≥ 1");
+  const double scale = std::stod(args.String("scale", "1"));
+  if (!(scale > 0 && scale <= 1)) throw std::invalid_argument("--scale must be in (0, 1]");
 
   std::string what;
   const std::vector<Sample> samples = args.has("data") ? Read(args, what) : Render(args, what);
@@ -144,7 +148,7 @@ int Run(int argc, char** argv) {
   std::vector<double> ms;
   for (const Sample& s : samples) {
     const auto t0 = std::chrono::steady_clock::now();
-    const perception::SegmentationResult r = segmenter.Run(s.frame);
+    const perception::SegmentationResult r = segmenter.Run(s.frame, scale);
     ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     for (const int k : {0, 1 + static_cast<int>(s.lighting)}) {
@@ -153,7 +157,8 @@ int Run(int argc, char** argv) {
     }
   }
 
-  std::cout << "model " << model_path << "\nheld-out set: " << what << "\n\n";
+  std::cout << "model " << model_path << " at scale " << scale << "\nheld-out set: " << what
+            << "\n\n";
   std::cout << "| class | all | normal | bright | dim | share of pixels |\n"
                "| --- | --- | --- | --- | --- | --- |\n";
   const double total_pixels =

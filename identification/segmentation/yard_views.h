@@ -51,9 +51,10 @@ struct YardView {
 
 class YardViewSampler {
  public:
-  /// Loads the scenarios (names or paths; empty: every scenario under `<models_dir>/scenarios`)
-  /// and every wheel-loader description under `models_dir` that has generated code. Throws
-  /// std::runtime_error when a scenario or machine cannot be loaded, or none is left.
+  /// Loads the scenarios (names or paths; empty: every scenario under `<models_dir>/scenarios`
+  /// whose machine is one of these loaders) and every wheel-loader description under
+  /// `models_dir` that has generated code. Throws std::runtime_error when a scenario or machine
+  /// cannot be loaded, a named scenario is not a loader's, or none is left.
   explicit YardViewSampler(const std::string& models_dir,
                            const std::vector<std::string>& scenarios = {});
   ~YardViewSampler();

@@ -317,6 +317,10 @@ Command AddReplay(CLI::App& app, const Globals& g) {
   cmd->add_flag("--truth", c->truth_labels,
                 "The camera frames' recorded labels instead of the segmentation network");
   cmd->add_option("--segmenter", c->segmenter, "ONNX segmentation network");
+  cmd->add_option("--segmentation-scale", c->segmentation_scale,
+                  "Run the network at this fraction of the camera's resolution")
+      ->check(autoshovel::app::FiniteIn(0.1, 1))
+      ->capture_default_str();
   cmd->add_option("--predictor", c->predictor,
                   "Penetration SVR (path without .model; default: the main job's)");
   cmd->add_flag(
@@ -869,6 +873,11 @@ Command AddRun(CLI::App& app, const Globals& g) {
   cmd->add_flag("--truth", c->run.truth_labels,
                 "Simulator labels instead of the segmentation network");
   cmd->add_option("--segmenter", c->run.segmenter, "ONNX segmentation network");
+  cmd->add_option("--segmentation-scale", c->run.segmentation_scale,
+                  "Run the network at this fraction of the camera's resolution "
+                  "(docs/performance.md)")
+      ->check(autoshovel::app::FiniteIn(0.1, 1))
+      ->capture_default_str();
   cmd->add_option("--predictor", c->run.predictor, "Penetration SVR (path without .model)");
   cmd->add_option("--policy", c->run_policy,
                   "auto | just_in_out | stairway | stairway_fixed | optimal")

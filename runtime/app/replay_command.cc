@@ -245,8 +245,10 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
   perception::ElevationMap map(map_config, m.map_center);
   perception::SemanticMap semantic(map);
   perception::LensDirtMonitor lens_dirt;
-  const perception::FusionOptions fusion{
-      .truth_labels = o.truth_labels, .segmenter = o.segmenter, .lens_dirt = &lens_dirt};
+  const perception::FusionOptions fusion{.truth_labels = o.truth_labels,
+                                         .segmenter = o.segmenter,
+                                         .segmentation_scale = o.segmentation_scale,
+                                         .lens_dirt = &lens_dirt};
   std::map<int, const recording::CycleInfo*> cycles;
   for (const recording::CycleInfo& c : m.cycles) cycles[c.index] = &c;
 

@@ -20,6 +20,7 @@ struct ReplayOptions {
   /// The camera frames' recorded labels instead of the network (a simulated recording).
   bool truth_labels = false;
   std::string segmenter;  ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
+  double segmentation_scale = 1.0;  ///< perception::FusionOptions::segmentation_scale
   /// Penetration SVR (path without .model); empty: the main job's (prediction/shipped_models.h).
   std::string predictor;
   bool figures = true;

@@ -47,6 +47,9 @@ struct ShovelRunOptions {
   std::vector<std::string> bins;
   bool truth_labels = false;  ///< simulator labels instead of the segmentation network
   std::string segmenter;      ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
+  /// perception::FusionOptions::segmentation_scale: the network at this fraction of the
+  /// camera's resolution (1: full).
+  double segmentation_scale = 1.0;
   /// SVR model prefix; empty: prediction::MainJobPredictor (models/prediction/
   /// penetration_svr_fast, trained for the scoop profile below).
   std::string predictor;

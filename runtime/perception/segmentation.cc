@@ -149,6 +149,48 @@ SegmentationResult Segmenter::Run(const sensors::CameraFrame& frame) const {
   return result;
 }
 
+SegmentationResult Segmenter::Run(const sensors::CameraFrame& frame, double scale) const {
+  if (!(scale > 0 && scale <= 1)) {
+    throw std::invalid_argument("Segmenter::Run: scale must be in (0, 1], got " +
+                                std::to_string(scale));
+  }
+  if (scale == 1) return Run(frame);
+  const int w = frame.width, h = frame.height;
+  if (w <= 0 || h <= 0 || frame.bgr.size() != 3 * static_cast<std::size_t>(w) * h) {
+    return Run(frame);  // refuses it with the full-size message
+  }
+  const cv::Mat image(h, w, CV_8UC3, const_cast<std::uint8_t*>(frame.bgr.data()));
+  sensors::CameraFrame small;
+  small.stamp = frame.stamp;
+  small.width = std::max(16, static_cast<int>(std::lround(w * scale)));
+  small.height = std::max(16, static_cast<int>(std::lround(h * scale)));
+  cv::Mat shrunk;
+  cv::resize(image, shrunk, cv::Size(small.width, small.height), 0, 0, cv::INTER_AREA);
+  small.bgr.assign(shrunk.data, shrunk.data + shrunk.total() * 3);
+  const SegmentationResult coarse = Run(small);
+  SegmentationResult result;
+  result.width = w;
+  result.height = h;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  const std::size_t coarse_n = static_cast<std::size_t>(coarse.width) * coarse.height;
+  result.probabilities.resize(kClasses * n);
+  for (int c = 0; c < kClasses; ++c) {
+    const cv::Mat plane(coarse.height, coarse.width, CV_32F,
+                        const_cast<float*>(coarse.probabilities.data() + c * coarse_n));
+    cv::Mat full(h, w, CV_32F, result.probabilities.data() + c * n);
+    cv::resize(plane, full, full.size(), 0, 0, cv::INTER_LINEAR);
+  }
+  result.labels.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    int best = 0;
+    for (int c = 1; c < kClasses; ++c) {
+      if (result.probabilities[c * n + i] > result.probabilities[best * n + i]) best = c;
+    }
+    result.labels[i] = static_cast<std::uint8_t>(best);
+  }
+  return result;
+}
+
 void SetInferenceThreads(int threads) { cv::setNumThreads(threads); }
 
 }  // namespace autoshovel::perception

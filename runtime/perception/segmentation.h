@@ -55,6 +55,12 @@ class Segmenter {
   /// a frame without pixels or whose bgr buffer does not hold width × height × 3 bytes. Calls
   /// from several threads are serialised (one network instance).
   SegmentationResult Run(const sensors::CameraFrame& frame) const;
+  /// The same at `scale` of the frame's resolution (0 < scale ≤ 1; issue 45): the image is
+  /// shrunk (area averaging, sides at least 16 px), segmented, and the class probabilities
+  /// are brought back to the frame's size by bilinear interpolation (which keeps them summing
+  /// to 1); labels are their argmax. Inference costs about scale² of the full frame's.
+  /// Throws std::invalid_argument for a scale outside (0, 1].
+  SegmentationResult Run(const sensors::CameraFrame& frame, double scale) const;
 
   const std::string& model_path() const;
 

@@ -113,7 +113,8 @@ FusionStats FuseSensorFrames(const model::MachineDescription& machine, const Sen
     probabilities = FromLabels(image.labels, image.width, image.height);
     stats.semantics = "simulator labels";
   } else {
-    SegmentationResult result = CachedSegmenter(options.segmenter).Run(image);
+    SegmentationResult result =
+        CachedSegmenter(options.segmenter).Run(image, options.segmentation_scale);
     probabilities.width = result.width;
     probabilities.height = result.height;
     probabilities.planes = std::move(result.probabilities);

@@ -63,6 +63,7 @@ PerceptionFromPlantStats PerceiveFromPlant(const plant::Plant& plant,
   const perception::SensorFrames frames = SimulateSensorFrames(plant, scene, rng, options);
   const perception::FusionOptions fusion{.truth_labels = options.truth_labels,
                                          .segmenter = options.segmenter,
+                                         .segmentation_scale = options.segmentation_scale,
                                          .lens_dirt = options.lens_dirt};
   return perception::FuseSensorFrames(plant.machine(), frames, fusion, map, semantic);
 }

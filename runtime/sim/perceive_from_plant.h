@@ -27,8 +27,9 @@ struct PerceptionFromPlantOptions {
   int lidar_frames = 5;      ///< per LiDAR, 0.1 s apart; 0: none arrives (a dropout)
   bool camera_frame = true;  ///< false: no usable camera frame arrives (a blackout)
   plant::Lighting lighting = plant::Lighting::kNormal;
-  bool truth_labels = false;  ///< the simulator's per-pixel labels instead of the network
-  std::string segmenter;      ///< ONNX network (needed unless truth_labels)
+  bool truth_labels = false;        ///< the simulator's per-pixel labels instead of the network
+  std::string segmenter;            ///< ONNX network (needed unless truth_labels)
+  double segmentation_scale = 1.0;  ///< perception::FusionOptions::segmentation_scale
 
   // Faults (plant/fault_spec.h) and the health checks that find them.
   std::string dead_lidar;  ///< this LiDAR returns nothing within `dead_sector` ("": none)

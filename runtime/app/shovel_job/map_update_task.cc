@@ -57,6 +57,7 @@ MapUpdateResult MapUpdateTask::Update(
       perception::FuseSensorFrames(plant.machine(), last_frames_,
                                    {.truth_labels = perceive.truth_labels,
                                     .segmenter = perceive.segmenter,
+                                    .segmentation_scale = perceive.segmentation_scale,
                                     .lens_dirt = perceive.lens_dirt},
                                    map, semantic);
   fusion_seconds_ +=

@@ -107,6 +107,7 @@ MapUpdateConfig MapUpdateConfigFor(const CycleResources& r) {
   config.perceive.lighting = r.scenario.lighting;
   config.perceive.truth_labels = r.options.truth_labels;
   config.perceive.segmenter = r.segmenter;
+  config.perceive.segmentation_scale = r.options.segmentation_scale;
   config.blind_sector_cone = r.options.supervisor.blind_sector_cone;
   config.max_masked_fraction = r.options.supervisor.max_masked_fraction;
   config.path_obstacle_margin = r.options.path_obstacle_margin;

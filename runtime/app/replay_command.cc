@@ -200,6 +200,177 @@ std::string ConfigYaml(const ReplayOptions& o, const recording::Recording& rec) 
          "\nupdates: " + std::to_string(rec.updates().size()) + "\n";
 }
 
+// One replay: the recording and the machine, the map the frames build, a cycle's selection task,
+// and what the run folder gets (the three tables, the report's lines and figures).
+class Replayer {
+ public:
+  Replayer(const ReplayOptions& o, const recording::Recording& rec,
+           const model::MachineDescription& machine, const generated::MachineFunctions& functions,
+           const prediction::PenetrationPredictor* predictor, results::RunFolder& folder)
+      : o_(o),
+        rec_(rec),
+        m_(rec.manifest()),
+        machine_(machine),
+        functions_(functions),
+        predictor_(predictor),
+        folder_(folder),
+        loader_(planning::LoaderGeometryFrom(machine, functions)),
+        map_(MapConfig(m_), m_.map_center),
+        semantic_(map_),
+        fusion_{.truth_labels = o.truth_labels,
+                .segmenter = o.segmenter,
+                .segmentation_scale = o.segmentation_scale,
+                .lens_dirt = &lens_dirt_} {
+    for (const recording::CycleInfo& c : m_.cycles) cycles_[c.index] = &c;
+  }
+
+  // Update `i`: its frames fused, the selection where the machine ran one, the map's digest.
+  void Update(std::size_t i) {
+    const recording::UpdateRow& u = rec_.updates()[i];
+    if (u.cycle != cycle_) BeginCycle(u.cycle);
+    const perception::FusionStats fused = perception::FuseSensorFrames(
+        machine_, LoadUpdate(rec_, i, machine_), fusion_, map_, semantic_);
+    if (u.select) {
+      last_pose_ = {u.select_xy, u.select_heading};
+      const planning::ShovelCandidate* best =
+          task_->Select(map_.map(), semantic_.ground_plane(), last_pose_);
+      selections_ +=
+          recording::SelectionRow(static_cast<long>(i), cycle_, task_->last_selection(), best) +
+          "\n";
+      if (best != nullptr && !goal_) {
+        goal_ = Goal{task_->last_selection(), task_->last_baseline(), last_pose_};
+        folder_.log().Info(task_->SelectedText(*best));
+        report_lines_.push_back("cycle " + std::to_string(cycle_) + ": " +
+                                task_->SelectedText(*best));
+      }
+    }
+    digests_ += recording::MapDigestRow(static_cast<long>(i), map_.map()) + "\n";
+    folder_.log().Debug("update " + std::to_string(i) + ": " + std::to_string(fused.returns_fused) +
+                        " returns fused, " + fused.semantics);
+  }
+
+  // The running cycle's end: its scoop's predictions on the map it started from, its pictures.
+  void FinishCycle() {
+    if (task_ == nullptr) return;
+    if (predictor_ != nullptr) {
+      predictions_ += ReplayScoopPredictions(rec_, *cycles_.at(cycle_), machine_, functions_,
+                                             *predictor_, map_.map(), folder_.log(), report_lines_);
+    }
+    if (!o_.figures) return;
+    const std::string n = std::to_string(cycle_);
+    perception::WriteSemanticMapPng(map_.map(), task_->last_piles(),
+                                    folder_.FigurePath("map_cycle_" + n + ".png").string(), 2);
+    report_figures_.emplace_back("Cycle " + n + ": semantic elevation map layers",
+                                 "figures/map_cycle_" + n + ".png");
+    if (goal_) {
+      planning::WriteCandidatePng(map_.map(), goal_->selection,
+                                  m_.chen2024 ? &goal_->baseline : nullptr, goal_->from, loader_,
+                                  folder_.FigurePath("candidates_cycle_" + n + ".png").string());
+      report_figures_.emplace_back("Cycle " + n + ": scored shovel points when its goal was chosen",
+                                   "figures/candidates_cycle_" + n + ".png");
+    }
+  }
+
+  void WriteTables() const {
+    core::WriteFileAtomically(folder_.dir() / "map_digests.csv", digests_);
+    core::WriteFileAtomically(folder_.dir() / "selections.csv", selections_);
+    core::WriteFileAtomically(folder_.dir() / "predictions.csv", predictions_);
+  }
+
+  // Compares the tables with the recording's reference/, says so on `out`, the log and the
+  // report, and writes report.html. Returns 0 (identical, or nothing to compare), 1 (a
+  // difference, with --check), 2 (the report could not be written).
+  int CompareAndReport(std::ostream& out, std::ostream& err) {
+    const std::filesystem::path ref = rec_.dir() / "reference";
+    const std::string ref_digests = ReadTextOrEmpty(ref / "map_digests.csv");
+    bool identical = true;
+    if (ref_digests.empty()) {
+      out << "no reference/ in the recording: nothing to compare with\n";
+      report_lines_.push_back("the recording has no reference/: nothing to compare with");
+    } else {
+      const Comparison maps = Compare(ref_digests, digests_, "map_digests.csv");
+      const Comparison picks =
+          Compare(ReadTextOrEmpty(ref / "selections.csv"), selections_, "selections.csv");
+      const Comparison volumes =
+          Compare(ReadTextOrEmpty(ref / "predictions.csv"), predictions_, "predictions.csv");
+      std::ostringstream summary;
+      summary << "against the recording machine: maps identical after " << maps.same << " of "
+              << maps.rows << " updates, selections identical at " << picks.same << " of "
+              << picks.rows << ", V1 and V2 identical at " << volumes.same << " of " << volumes.rows
+              << " scoop decisions";
+      out << summary.str() << "\n";
+      folder_.log().Info(summary.str());
+      report_lines_.push_back(summary.str());
+      for (const Comparison* c : {&maps, &picks, &volumes}) {
+        if (c->first_difference.empty()) continue;
+        out << "  first difference: " << c->first_difference << "\n";
+        folder_.log().Warning(c->first_difference);
+        report_lines_.push_back("first difference: " + c->first_difference);
+      }
+      identical =
+          maps.same == maps.rows && picks.same == picks.rows && volumes.same == volumes.rows;
+    }
+    try {
+      core::WriteFileAtomically(folder_.dir() / "report.html",
+                                ReplayReportHtml(rec_, report_lines_, report_figures_));
+    } catch (const std::exception& e) {
+      err << "autoshovel replay: " << e.what() << "\n";
+      return 2;
+    }
+    out << "report: " << (folder_.dir() / "report.html").string() << "\n";
+    return o_.check && !identical ? 1 : 0;
+  }
+
+ private:
+  // The selection that first gave the cycle a goal, for its picture.
+  struct Goal {
+    planning::ShovelPointResult selection;
+    std::vector<planning::Chen2024Candidate> baseline;
+    planning::Pose2 from;
+  };
+
+  static perception::ElevationMapConfig MapConfig(const recording::Manifest& m) {
+    perception::ElevationMapConfig config;
+    config.resolution = m.map_resolution;
+    config.length = m.map_length;
+    return config;
+  }
+
+  void BeginCycle(int cycle) {
+    FinishCycle();
+    goal_.reset();
+    cycle_ = cycle;
+    const recording::WorkArea area = cycles_.at(cycle)->area;
+    task_ = std::make_unique<ShovelPointTask>(
+        m_.selection, m_.min_planned_clearance, m_.chen2024, loader_,
+        [area](const Eigen::Vector2d& p) { return area.Contains(p); });
+    folder_.log().Info("cycle " + std::to_string(cycle) + " at " + cycles_.at(cycle)->site);
+  }
+
+  const ReplayOptions& o_;
+  const recording::Recording& rec_;
+  const recording::Manifest& m_;
+  const model::MachineDescription& machine_;
+  const generated::MachineFunctions& functions_;
+  const prediction::PenetrationPredictor* predictor_;
+  results::RunFolder& folder_;
+  const planning::LoaderGeometry loader_;
+  perception::ElevationMap map_;
+  perception::SemanticMap semantic_;
+  perception::LensDirtMonitor lens_dirt_;
+  const perception::FusionOptions fusion_;
+  std::map<int, const recording::CycleInfo*> cycles_;
+  std::string digests_ = std::string(recording::kMapDigestsHeader) + "\n";
+  std::string selections_ = std::string(recording::kSelectionsHeader) + "\n";
+  std::string predictions_ = std::string(recording::kPredictionsHeader) + "\n";
+  std::unique_ptr<ShovelPointTask> task_;
+  int cycle_ = -1;
+  planning::Pose2 last_pose_;
+  std::optional<Goal> goal_;
+  std::vector<std::string> report_lines_;
+  std::vector<std::pair<std::string, std::string>> report_figures_;
+};
+
 }  // namespace
 
 int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err) {
@@ -208,126 +379,38 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
   std::unique_ptr<recording::Recording> rec;
   model::MachineDescription machine;
   const generated::MachineFunctions* functions = nullptr;
+  std::unique_ptr<prediction::PenetrationPredictor> predictor;
   try {
     rec = std::make_unique<recording::Recording>(o.recording);
     model::LoadOptions load;
     load.models_dir = o.models_dir;
     machine = model::LoadMachineDescription(rec->machine_path().string(), load);
     functions = &machines::MachineFunctionsFor(machine);
+    if (!rec->decisions().empty()) {
+      predictor =
+          std::make_unique<prediction::PenetrationPredictor>(prediction::PenetrationPredictor::Load(
+              o.predictor.empty() ? prediction::MainJobPredictor(o.models_dir) : o.predictor));
+    }
   } catch (const std::exception& e) {
     err << "autoshovel replay: " << e.what() << "\n";
     return 2;
   }
-  const recording::Manifest& m = rec->manifest();
   const std::unique_ptr<results::RunFolder> folder =
       results::RunFolder::OpenWithConfig(o.out, ConfigYaml(o, *rec), err, "autoshovel replay");
   if (!folder) return 2;
-  results::RunLog& log = folder->log();
   out << "autoshovel replay: " << rec->updates().size() << " updates, " << rec->frame_count()
-      << " frames of " << machine.name << " (" << m.source << ") -> " << folder->dir().string()
-      << "\n";
-
-  std::unique_ptr<prediction::PenetrationPredictor> predictor;
-  if (!rec->decisions().empty()) {
-    try {
-      predictor =
-          std::make_unique<prediction::PenetrationPredictor>(prediction::PenetrationPredictor::Load(
-              o.predictor.empty() ? prediction::MainJobPredictor(o.models_dir) : o.predictor));
-    } catch (const std::exception& e) {
-      err << "autoshovel replay: " << e.what() << "\n";
-      return 2;
-    }
-  }
-  const planning::LoaderGeometry loader = planning::LoaderGeometryFrom(machine, *functions);
-  perception::ElevationMapConfig map_config;
-  map_config.resolution = m.map_resolution;
-  map_config.length = m.map_length;
-  perception::ElevationMap map(map_config, m.map_center);
-  perception::SemanticMap semantic(map);
-  perception::LensDirtMonitor lens_dirt;
-  const perception::FusionOptions fusion{.truth_labels = o.truth_labels,
-                                         .segmenter = o.segmenter,
-                                         .segmentation_scale = o.segmentation_scale,
-                                         .lens_dirt = &lens_dirt};
-  std::map<int, const recording::CycleInfo*> cycles;
-  for (const recording::CycleInfo& c : m.cycles) cycles[c.index] = &c;
-
-  std::string digests = std::string(recording::kMapDigestsHeader) + "\n";
-  std::string selections = std::string(recording::kSelectionsHeader) + "\n";
-  std::string predictions = std::string(recording::kPredictionsHeader) + "\n";
-  std::unique_ptr<ShovelPointTask> task;
-  std::vector<std::string> report_lines;
-  std::vector<std::pair<std::string, std::string>> report_figures;
-  int cycle = -1;
-  planning::Pose2 last_pose;
-  // The selection that first gave the cycle a goal, for its picture.
-  struct Goal {
-    planning::ShovelPointResult selection;
-    std::vector<planning::Chen2024Candidate> baseline;
-    planning::Pose2 from;
-  };
-  std::optional<Goal> goal;
-  auto finish_cycle = [&]() {
-    if (task == nullptr) return;
-    if (predictor != nullptr) {
-      predictions += ReplayScoopPredictions(*rec, *cycles.at(cycle), machine, *functions,
-                                            *predictor, map.map(), log, report_lines);
-    }
-    if (!o.figures) return;
-    const std::string n = std::to_string(cycle);
-    perception::WriteSemanticMapPng(map.map(), task->last_piles(),
-                                    folder->FigurePath("map_cycle_" + n + ".png").string(), 2);
-    report_figures.emplace_back("Cycle " + n + ": semantic elevation map layers",
-                                "figures/map_cycle_" + n + ".png");
-    if (goal) {
-      planning::WriteCandidatePng(map.map(), goal->selection,
-                                  m.chen2024 ? &goal->baseline : nullptr, goal->from, loader,
-                                  folder->FigurePath("candidates_cycle_" + n + ".png").string());
-      report_figures.emplace_back("Cycle " + n + ": scored shovel points when its goal was chosen",
-                                  "figures/candidates_cycle_" + n + ".png");
-    }
-  };
+      << " frames of " << machine.name << " (" << rec->manifest().source << ") -> "
+      << folder->dir().string() << "\n";
   const auto w0 = std::chrono::steady_clock::now();
+  std::unique_ptr<Replayer> replay;
   try {
-    for (std::size_t i = 0; i < rec->updates().size(); ++i) {
-      const recording::UpdateRow& u = rec->updates()[i];
-      if (u.cycle != cycle) {
-        finish_cycle();
-        goal.reset();
-        cycle = u.cycle;
-        const recording::WorkArea area = cycles.at(cycle)->area;
-        task = std::make_unique<ShovelPointTask>(
-            m.selection, m.min_planned_clearance, m.chen2024, loader,
-            [area](const Eigen::Vector2d& p) { return area.Contains(p); });
-        log.Info("cycle " + std::to_string(cycle) + " at " + cycles.at(cycle)->site);
-      }
-      const perception::FusionStats fused = perception::FuseSensorFrames(
-          machine, LoadUpdate(*rec, i, machine), fusion, map, semantic);
-      if (u.select) {
-        last_pose = {u.select_xy, u.select_heading};
-        const planning::ShovelCandidate* best =
-            task->Select(map.map(), semantic.ground_plane(), last_pose);
-        selections +=
-            recording::SelectionRow(static_cast<long>(i), cycle, task->last_selection(), best) +
-            "\n";
-        if (best != nullptr && !goal) {
-          goal = Goal{task->last_selection(), task->last_baseline(), last_pose};
-          log.Info(task->SelectedText(*best));
-          report_lines.push_back("cycle " + std::to_string(cycle) + ": " +
-                                 task->SelectedText(*best));
-        }
-      }
-      digests += recording::MapDigestRow(static_cast<long>(i), map.map()) + "\n";
-      log.Debug("update " + std::to_string(i) + ": " + std::to_string(fused.returns_fused) +
-                " returns fused, " + fused.semantics);
-    }
-    finish_cycle();
-    core::WriteFileAtomically(folder->dir() / "map_digests.csv", digests);
-    core::WriteFileAtomically(folder->dir() / "selections.csv", selections);
-    core::WriteFileAtomically(folder->dir() / "predictions.csv", predictions);
+    replay = std::make_unique<Replayer>(o, *rec, machine, *functions, predictor.get(), *folder);
+    for (std::size_t i = 0; i < rec->updates().size(); ++i) replay->Update(i);
+    replay->FinishCycle();
+    replay->WriteTables();
   } catch (const std::exception& e) {
     err << "autoshovel replay: " << e.what() << "\n";
-    log.Error(e.what());
+    folder->log().Error(e.what());
     return 2;
   }
   const double seconds =
@@ -335,52 +418,7 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
   out << "replayed " << rec->updates().size() << " updates in " << core::Fixed(seconds, 1) << " s ("
       << core::Fixed(1e3 * seconds / static_cast<double>(rec->updates().size()), 1)
       << " ms per update)\n";
-
-  const std::string ref_digests = ReadTextOrEmpty(rec->dir() / "reference" / "map_digests.csv");
-  const std::string ref_selections = ReadTextOrEmpty(rec->dir() / "reference" / "selections.csv");
-  const std::string ref_predictions = ReadTextOrEmpty(rec->dir() / "reference" / "predictions.csv");
-  auto write_report = [&]() -> bool {
-    try {
-      core::WriteFileAtomically(folder->dir() / "report.html",
-                                ReplayReportHtml(*rec, report_lines, report_figures));
-    } catch (const std::exception& e) {
-      err << "autoshovel replay: " << e.what() << "\n";
-      return false;
-    }
-    out << "report: " << (folder->dir() / "report.html").string() << "\n";
-    return true;
-  };
-  if (ref_digests.empty()) {
-    out << "no reference/ in the recording: nothing to compare with\n";
-    report_lines.push_back("the recording has no reference/: nothing to compare with");
-    return write_report() ? 0 : 2;
-  }
-  const Comparison maps = Compare(ref_digests, digests, "map_digests.csv");
-  const Comparison picks = Compare(ref_selections, selections, "selections.csv");
-  const Comparison volumes = Compare(ref_predictions, predictions, "predictions.csv");
-  std::ostringstream summary;
-  summary << "against the recording machine: maps identical after " << maps.same << " of "
-          << maps.rows << " updates, selections identical at " << picks.same << " of " << picks.rows
-          << ", V1 and V2 identical at " << volumes.same << " of " << volumes.rows
-          << " scoop decisions";
-  out << summary.str() << "\n";
-  log.Info(summary.str());
-  for (const Comparison* c : {&maps, &picks, &volumes}) {
-    if (!c->first_difference.empty()) {
-      out << "  first difference: " << c->first_difference << "\n";
-      log.Warning(c->first_difference);
-    }
-  }
-  report_lines.push_back(summary.str());
-  for (const Comparison* c : {&maps, &picks, &volumes}) {
-    if (!c->first_difference.empty()) {
-      report_lines.push_back("first difference: " + c->first_difference);
-    }
-  }
-  if (!write_report()) return 2;
-  const bool identical =
-      maps.same == maps.rows && picks.same == picks.rows && volumes.same == volumes.rows;
-  return o.check && !identical ? 1 : 0;
+  return replay->CompareAndReport(out, err);
 }
 
 }  // namespace autoshovel::app

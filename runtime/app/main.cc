@@ -314,13 +314,19 @@ Command AddReplay(CLI::App& app, const Globals& g) {
       "no plant (docs/recording_format.md)");
   cmd->add_option("recording", c->recording, "Recording folder")->required();
   cmd->add_option("-o,--out", c->out, "Run folder (default: runs/<UTC timestamp>)");
-  cmd->add_flag("--truth", c->truth_labels,
-                "The camera frames' recorded labels instead of the segmentation network");
+  cmd->add_flag(
+      "--truth", [c](std::int64_t) { c->truth_labels = true; },
+      "The camera frames' recorded labels instead of the segmentation network (default: as the "
+      "recording machine did)");
+  cmd->add_flag(
+      "--network", [c](std::int64_t) { c->truth_labels = false; },
+      "The segmentation network, whatever the recording machine used");
   cmd->add_option("--segmenter", c->segmenter, "ONNX segmentation network");
-  cmd->add_option("--segmentation-scale", c->segmentation_scale,
-                  "Run the network at this fraction of the camera's resolution")
-      ->check(autoshovel::app::FiniteIn(0.1, 1))
-      ->capture_default_str();
+  cmd->add_option_function<double>(
+         "--segmentation-scale", [c](const double& scale) { c->segmentation_scale = scale; },
+         "Run the network at this fraction of the camera's resolution (default: the recording "
+         "machine's, else 1)")
+      ->check(autoshovel::app::FiniteIn(0.1, 1));
   cmd->add_option("--predictor", c->predictor,
                   "Penetration SVR (path without .model; default: the main job's)");
   cmd->add_flag(

@@ -196,7 +196,8 @@ std::string ReplayReportHtml(const recording::Recording& rec, const std::vector<
 
 std::string ConfigYaml(const ReplayOptions& o, const recording::Recording& rec) {
   return "command: replay\nrecording: " + o.recording + "\nsource: \"" + rec.manifest().source +
-         "\"\nsemantics: " + (o.truth_labels ? "recorded labels" : "network " + o.segmenter) +
+         "\"\nsemantics: " +
+         (o.truth_labels.value_or(false) ? "recorded labels" : "network " + o.segmenter) +
          "\nupdates: " + std::to_string(rec.updates().size()) + "\n";
 }
 
@@ -217,9 +218,9 @@ class Replayer {
         loader_(planning::LoaderGeometryFrom(machine, functions)),
         map_(MapConfig(m_), m_.map_center),
         semantic_(map_),
-        fusion_{.truth_labels = o.truth_labels,
+        fusion_{.truth_labels = o.truth_labels.value_or(false),
                 .segmenter = o.segmenter,
-                .segmentation_scale = o.segmentation_scale,
+                .segmentation_scale = o.segmentation_scale.value_or(1.0),
                 .lens_dirt = &lens_dirt_} {
     for (const recording::CycleInfo& c : m_.cycles) cycles_[c.index] = &c;
   }
@@ -395,6 +396,9 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
     err << "autoshovel replay: " << e.what() << "\n";
     return 2;
   }
+  // The semantics the recording machine used, unless told otherwise.
+  if (!o.truth_labels) o.truth_labels = rec->manifest().truth_labels.value_or(false);
+  if (!o.segmentation_scale) o.segmentation_scale = rec->manifest().segmentation_scale;
   const std::unique_ptr<results::RunFolder> folder =
       results::RunFolder::OpenWithConfig(o.out, ConfigYaml(o, *rec), err, "autoshovel replay");
   if (!folder) return 2;

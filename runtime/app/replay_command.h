@@ -9,6 +9,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 #include <string>
 
 namespace autoshovel::app {
@@ -17,10 +18,12 @@ struct ReplayOptions {
   std::string recording;   ///< the recording folder
   std::string out;         ///< run folder; empty: runs/<UTC timestamp>
   std::string models_dir;  ///< for the machine's materials and the default segmenter
-  /// The camera frames' recorded labels instead of the network (a simulated recording).
-  bool truth_labels = false;
+  /// The camera frames' recorded labels instead of the network (a simulated recording); unset:
+  /// as the recording machine did (its manifest's `perception`), else the network.
+  std::optional<bool> truth_labels;
   std::string segmenter;  ///< ONNX network; empty: models/segmentation/yard_segmenter.onnx
-  double segmentation_scale = 1.0;  ///< perception::FusionOptions::segmentation_scale
+  /// perception::FusionOptions::segmentation_scale; unset: the recording machine's, else 1.
+  std::optional<double> segmentation_scale;
   /// Penetration SVR (path without .model); empty: the main job's (prediction/shipped_models.h).
   std::string predictor;
   bool figures = true;

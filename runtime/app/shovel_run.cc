@@ -223,6 +223,7 @@ ShovelJob::ShovelJob(const ShovelRunOptions& options)
     manifest.map_center = g.origin + 0.5 * size;
     st.recorder = std::make_unique<recording::RecordingWriter>(
         options.record_dir, machine.source_file, std::move(manifest));
+    st.recorder->SetPerception(options.truth_labels, options.segmentation_scale);
   }
 }
 

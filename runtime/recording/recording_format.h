@@ -72,6 +72,11 @@ struct Manifest {
   planning::ShovelPointConfig selection;
   double min_planned_clearance = 0;  ///< [m]
   bool chen2024 = false;
+  /// How the recording machine labelled its camera frames (optional in the file): the
+  /// simulator's labels or the network, and the network's scale. `replay` takes these unless
+  /// told otherwise, so that it reproduces the machine's maps.
+  std::optional<bool> truth_labels;
+  double segmentation_scale = 1.0;
   std::vector<CycleInfo> cycles;
 };
 

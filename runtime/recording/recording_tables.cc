@@ -416,6 +416,11 @@ Manifest ReadManifest(const std::filesystem::path& path) {
         map.Error("resolution", "more than 100 million cells");
       }
     }
+    if (auto p = root.OptionalMap("perception")) {
+      m.truth_labels = p->Enum("semantics", {"labels", "network"}) == "labels";
+      m.segmentation_scale = p->Number("segmentation_scale", NumberRule::Closed(0.1, 1, ""), 1.0);
+      p->Finish();
+    }
     ReadSelection(root.Map("selection"), m);
     std::set<int> indices;
     for (core::MapReader& c : root.MapList("cycles", true)) {

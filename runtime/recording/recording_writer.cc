@@ -88,6 +88,10 @@ std::string ManifestText(const Manifest& m) {
   y += "  resolution: " + Num(m.map_resolution) + "\n";
   y += "  length: " + Pair(m.map_length) + "\n";
   y += "  center: " + Pair(m.map_center) + "\n";
+  if (m.truth_labels) {
+    y += "perception: {semantics: " + std::string(*m.truth_labels ? "labels" : "network") +
+         ", segmentation_scale: " + Num(m.segmentation_scale) + "}\n";
+  }
   y += "selection:\n";
   y += "  method: " + std::string(m.chen2024 ? "chen2024" : "ours") + "\n";
   y += "  min_planned_clearance: " + Num(m.min_planned_clearance) + "\n";
@@ -211,6 +215,11 @@ void RecordingWriter::AddScoop(const std::vector<DecisionRow>& decisions,
   for (const Eigen::Vector3d& p : tip_path) {
     tip_path_csv_ += c + "," + Num(p.x()) + "," + Num(p.y()) + "," + Num(p.z()) + "\n";
   }
+}
+
+void RecordingWriter::SetPerception(bool truth_labels, double segmentation_scale) {
+  manifest_.truth_labels = truth_labels;
+  manifest_.segmentation_scale = segmentation_scale;
 }
 
 void RecordingWriter::SetSelection(const planning::ShovelPointConfig& config,

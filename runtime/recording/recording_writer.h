@@ -25,6 +25,9 @@ class RecordingWriter {
   void SetSelection(const planning::ShovelPointConfig& config, double min_planned_clearance,
                     bool chen2024);
 
+  /// How the camera frames are labelled (manifest `perception`).
+  void SetPerception(bool truth_labels, double segmentation_scale);
+
   /// Updates from here on belong to `cycle`.
   void BeginCycle(const CycleInfo& cycle);
 

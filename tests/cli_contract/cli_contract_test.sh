@@ -163,7 +163,9 @@ done
 refuses replay-missing "no_such_recording: not a folder" -- "${models[@]}" replay "$tmp/no_such_recording" -o "$tmp/rp1"
 mkdir -p "$tmp/unfinished_recording"
 refuses replay-unfinished "did not finish" -- "${models[@]}" replay "$tmp/unfinished_recording" -o "$tmp/rp2"
-for d in rp1 rp2; do
+refuses replay-scale "--segmentation-scale" -- "${models[@]}" replay "$tmp/unfinished_recording" --segmentation-scale 5 -o "$tmp/rp3"
+refuses run-scale "--segmentation-scale" -- "${models[@]}" run --segmentation-scale nan -o "$tmp/rp4"
+for d in rp1 rp2 rp3 rp4; do
   if [ -e "$tmp/$d" ]; then
     failed=$((failed + 1))
     echo "FAIL replay-refused-leaves-no-folder: $d was created"

@@ -83,6 +83,7 @@ perception::SensorFrames TestFrames(std::mt19937& rng, bool camera) {
 // A recording of two cycles, three updates, written to `dir`.
 void WriteTestRecording(const fs::path& dir, std::mt19937& rng) {
   RecordingWriter writer(dir, WriteDescription(dir.string() + "_src").string(), TestManifest());
+  writer.SetPerception(true, 0.75);
   WorkArea bin;
   bin.front_center = {10.0 / 3.0, 5.0};
   bin.yaw = 0.3;
@@ -138,6 +139,8 @@ TEST(Recording, RoundTripIsBitExact) {
   EXPECT_EQ(m.selection.max_curvature, expected.selection.max_curvature);
   EXPECT_EQ(m.selection.entry_angle_offsets, expected.selection.entry_angle_offsets);
   EXPECT_TRUE(m.chen2024);
+  EXPECT_EQ(m.truth_labels, std::optional<bool>(true));
+  EXPECT_EQ(m.segmentation_scale, 0.75);
   ASSERT_EQ(m.cycles.size(), 2u);
   EXPECT_EQ(m.cycles[0].area.front_center.x(), 10.0 / 3.0);
   EXPECT_EQ(m.cycles[1].area.kind, WorkArea::Kind::kDiscs);

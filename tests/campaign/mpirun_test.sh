@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `mpirun -np 2 autoshovel campaign`: two ranks share a 2-cycle campaign and store both cycles,
-# the same rows a local run stores. Catches a binary whose MPI_Init is not Open MPI's (Ipopt's
-# sequential MUMPS exports a stub that once answered it: CMakeLists.txt,
-# autoshovel_link_mpi_first).
+# the same rows a local run stores. Catches a binary whose MPI_Init is not Open MPI's: Ipopt's
+# sequential MUMPS defines a do-nothing MPI_Init of its own, which once answered the call (see
+# autoshovel_link_mpi_first in CMakeLists.txt).
 #
 #   mpirun_test.sh AUTOSHOVEL SOURCE_DIR
 set -uo pipefail

@@ -24,6 +24,12 @@
 // exposure maps radiance E to 8 bits through an sRGB-like gamma 1/2.2, then sensor noise
 // (Gaussian, σ² = read² + shot·DN) is added and the value is rounded and clipped.
 //
+// Cost (issue 45; tests/bench/sensor_stages_bench, docs/performance.md). Each box is tested only
+// against the pixels its projection covers, not by walking every ray through the yard's box grid;
+// the terrain ray is cut at the nearest box; a shadow ray stops at its first occluder. What
+// every pixel sees is what RaycastScene::Cast of its ray finds. The gamma comes from a table and
+// the noise from a ziggurat generator (Boost.Random), on a stream of the frame's own.
+//
 // Lighting conditions (what the segmentation must survive, cf. the seed's §4.2 data set):
 // - kNormal: sun at the given direction, ambient sky light 0.30, direct 0.75, hard shadows,
 //   little noise (read 1 DN).
@@ -77,8 +83,13 @@ bool ProjectToPixel(const model::Camera& camera, const Eigen::Vector3d& p_optica
 /// Unit ray through image coordinates (u, v), optical frame.
 Eigen::Vector3d PixelRay(const model::Camera& camera, double u, double v);
 
-/// Renders one frame seen from T_world_body (camera body frame in the world). Draws three
-/// normal variates per pixel from `rng`, in row-major pixel order.
+/// 255·x^(1/2.2) for x clamped to [0, 1]: the camera's gamma, from a table (within 0.02 DN of
+/// std::pow).
+double GammaEncode(double exposed);
+
+/// Renders one frame seen from T_world_body (camera body frame in the world). Draws one number
+/// from `rng`, which seeds the frame's own noise stream (three normal variates per pixel, in
+/// row-major pixel order).
 CameraFrame SimulateCameraFrame(const model::Camera& camera, const RaycastScene& scene,
                                 const Eigen::Isometry3d& T_world_body, double stamp,
                                 const CameraOptions& options, Rng& rng);

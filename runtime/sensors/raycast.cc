@@ -1,7 +1,9 @@
 #include "runtime/sensors/raycast.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 
 namespace autoshovel::sensors {
@@ -462,12 +464,129 @@ RayHit RaycastScene::CastBoxes(const Eigen::Vector3d& origin, const Eigen::Vecto
   return hit;
 }
 
+bool RaycastScene::IntersectBoxAt(int index, const Eigen::Vector3d& origin,
+                                  const Eigen::Vector3d& direction, double max_range, double& range,
+                                  Eigen::Vector3d& normal) const {
+  const PreparedBox& p = prepared_[static_cast<std::size_t>(index)];
+  return SlabTest(p.center, p.half, p.c, p.s, origin, direction, max_range, range, normal);
+}
+
+RayHit RaycastScene::BoxHit(int index, const Eigen::Vector3d& origin,
+                            const Eigen::Vector3d& direction, double range,
+                            const Eigen::Vector3d& normal) const {
+  RayHit hit;
+  hit.hit = true;
+  hit.range = range;
+  hit.point = origin + range * direction;
+  hit.normal = normal;
+  hit.box = index;
+  hit.semantic_class = boxes_[static_cast<std::size_t>(index)].semantic_class;
+  hit.reflectivity = boxes_[static_cast<std::size_t>(index)].reflectivity;
+  return hit;
+}
+
 RayHit RaycastScene::Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                           double max_range) const {
+  // The boxes first: the sensors sit on the machine, whose own boxes stop many rays within a
+  // few metres, and the terrain walk is then cut short at them. (Terrain first was measured
+  // 20 % slower in the closed loop: the box walk is cheap for a ray that looks down, since it
+  // ends where the ray leaves the boxes' height band.)
   RayHit box = CastBoxes(origin, direction, max_range);
   RayHit terrain;
   if (TraverseTerrain(origin, direction, box.hit ? box.range : max_range, terrain)) return terrain;
   return box;
+}
+
+ParallelRayBoxes::ParallelRayBoxes(const RaycastScene& scene, const Eigen::Vector3d& direction)
+    : scene_(&scene) {
+  if (!direction.allFinite() || !(direction.norm() > 0)) {
+    throw std::invalid_argument("ParallelRayBoxes: the direction must be finite and non-zero");
+  }
+  direction_ = direction.normalized();
+  // An orthonormal basis of the plane across the rays.
+  e1_ = direction_.unitOrthogonal();
+  e2_ = direction_.cross(e1_);
+  const std::vector<plant::OrientedBox>& boxes = scene.boxes();
+  if (boxes.empty()) return;
+  // Each box's shadow bounds on the plane: its eight corners projected.
+  std::vector<Eigen::Vector4d> bounds(boxes.size());  // lo1, lo2, hi1, hi2
+  double lo1 = kInf, lo2 = kInf, hi1 = -kInf, hi2 = -kInf;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const plant::OrientedBox& b = boxes[i];
+    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+    const Eigen::Vector3d h = b.half_extents.cwiseAbs();
+    Eigen::Vector4d& f = bounds[i];
+    f << kInf, kInf, -kInf, -kInf;
+    for (int k = 0; k < 8; ++k) {
+      const double x = (k & 1 ? 1 : -1) * h.x(), y = (k & 2 ? 1 : -1) * h.y();
+      const double z = (k & 4 ? 1 : -1) * h.z();
+      const Eigen::Vector3d p = b.center + Eigen::Vector3d(c * x - s * y, s * x + c * y, z);
+      const double a = p.dot(e1_), d = p.dot(e2_);
+      f[0] = std::min(f[0], a), f[1] = std::min(f[1], d);
+      f[2] = std::max(f[2], a), f[3] = std::max(f[3], d);
+    }
+    if (!f.allFinite()) everywhere_ = true;
+    lo1 = std::min(lo1, f[0]), lo2 = std::min(lo2, f[1]);
+    hi1 = std::max(hi1, f[2]), hi2 = std::max(hi2, f[3]);
+  }
+  if (everywhere_) return;
+  // Cells of 1 m (most boxes are walls and machine parts a few metres long), larger for a
+  // huge yard, so that the grid stays within 256 × 256.
+  const double margin = 1e-6;
+  cell_ = std::max(1.0, std::max(hi1 - lo1, hi2 - lo2) / 256.0);
+  x0_ = lo1 - margin, y0_ = lo2 - margin;
+  nx_ = std::max(1, static_cast<int>(std::ceil((hi1 - lo1 + 2 * margin) / cell_)));
+  ny_ = std::max(1, static_cast<int>(std::ceil((hi2 - lo2 + 2 * margin) / cell_)));
+  auto span = [&](const Eigen::Vector4d& f, int& ix0, int& iy0, int& ix1, int& iy1) {
+    ix0 = std::clamp(static_cast<int>(std::floor((f[0] - x0_) / cell_)), 0, nx_ - 1);
+    iy0 = std::clamp(static_cast<int>(std::floor((f[1] - y0_) / cell_)), 0, ny_ - 1);
+    ix1 = std::clamp(static_cast<int>(std::floor((f[2] - x0_) / cell_)), 0, nx_ - 1);
+    iy1 = std::clamp(static_cast<int>(std::floor((f[3] - y0_) / cell_)), 0, ny_ - 1);
+  };
+  std::vector<int> count(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+  for (const Eigen::Vector4d& f : bounds) {
+    int ix0, iy0, ix1, iy1;
+    span(f, ix0, iy0, ix1, iy1);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) ++count[iy * nx_ + ix + 1];
+    }
+  }
+  for (std::size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
+  cell_start_ = count;
+  box_index_.resize(count.back());
+  for (std::size_t i = 0; i < bounds.size(); ++i) {
+    int ix0, iy0, ix1, iy1;
+    span(bounds[i], ix0, iy0, ix1, iy1);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) box_index_[count[iy * nx_ + ix]++] = static_cast<int>(i);
+    }
+  }
+}
+
+bool ParallelRayBoxes::Occluded(const Eigen::Vector3d& origin, double max_range) const {
+  if (!origin.allFinite()) return false;
+  const int n_boxes = static_cast<int>(scene_->boxes().size());
+  double range;
+  Eigen::Vector3d normal;
+  if (everywhere_) {
+    for (int i = 0; i < n_boxes; ++i) {
+      if (scene_->IntersectBoxAt(i, origin, direction_, max_range, range, normal)) return true;
+    }
+    return false;
+  }
+  if (n_boxes == 0) return false;
+  // A ray's shadow-plane coordinates are its origin's: a box it meets casts its shadow there.
+  const double a = origin.dot(e1_), d = origin.dot(e2_);
+  const int ix = static_cast<int>(std::floor((a - x0_) / cell_));
+  const int iy = static_cast<int>(std::floor((d - y0_) / cell_));
+  if (ix < 0 || iy < 0 || ix >= nx_ || iy >= ny_) return false;
+  const int cell = iy * nx_ + ix;
+  for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
+    if (scene_->IntersectBoxAt(box_index_[k], origin, direction_, max_range, range, normal)) {
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace autoshovel::sensors

@@ -99,6 +99,16 @@ class RaycastScene {
   RayHit CastBoxes(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                    double max_range) const;
 
+  /// Ray against box `index` of boxes() alone (the slab test CastBoxes applies to each box,
+  /// with the box's yaw prepared): its entry range in [0, max_range] and outward normal, or
+  /// false when it misses, enters beyond max_range, or starts inside the box.
+  bool IntersectBoxAt(int index, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                      double max_range, double& range, Eigen::Vector3d& normal) const;
+  /// The RayHit of box `index` of boxes() met at `range` along the ray with outward `normal`, as
+  /// Cast would report it.
+  RayHit BoxHit(int index, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                double range, const Eigen::Vector3d& normal) const;
+
   const plant::World& world() const { return *world_; }
   /// The world's obstacles followed by the extra boxes, as of the last update.
   const std::vector<plant::OrientedBox>& boxes() const { return boxes_; }
@@ -152,6 +162,30 @@ class RaycastScene {
   BoxGrid box_grid_;
   std::vector<Level> levels_;  // levels_[0]: (nx + 1) × (ny + 1) patches
   int grid_nx_ = 0, grid_ny_ = 0;
+};
+
+/// The boxes of a scene binned across one direction, for many parallel rays: a camera's shadow
+/// rays towards the sun. Each box's shadow, its outline projected along the direction onto the
+/// plane across it, is entered in the cells of a uniform grid on that plane that it touches, so a
+/// ray tests only the boxes whose shadow covers its origin. Built per frame (the machine's own
+/// boxes move), O(boxes + cells they cover).
+class ParallelRayBoxes {
+ public:
+  /// `direction` need not be unit length; a zero or non-finite one is refused
+  /// (std::invalid_argument).
+  ParallelRayBoxes(const RaycastScene& scene, const Eigen::Vector3d& direction);
+  /// Whether a box lies along origin + t·direction, t ∈ [0, max_range]: exactly
+  /// scene.CastBoxes(origin, direction, max_range).hit.
+  bool Occluded(const Eigen::Vector3d& origin, double max_range) const;
+  const Eigen::Vector3d& direction() const { return direction_; }
+
+ private:
+  const RaycastScene* scene_;
+  Eigen::Vector3d direction_, e1_, e2_;
+  double x0_ = 0, y0_ = 0, cell_ = 1;
+  int nx_ = 0, ny_ = 0;
+  bool everywhere_ = false;  // a box without a finite outline: every ray tests every box
+  std::vector<int> cell_start_, box_index_;
 };
 
 }  // namespace autoshovel::sensors

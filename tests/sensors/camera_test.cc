@@ -217,5 +217,62 @@ TEST(Camera, SameSeedIsByteIdenticalAndAnotherSeedDiffers) {
   EXPECT_TRUE(fa.labels == fc.labels);  // labels are ground truth, noise-free
 }
 
+// The camera tests each box only over the pixels its projection covers. Every pixel must still see
+// what RaycastScene::Cast of its ray finds: boxes in front, one the camera sits in (never seen
+// from inside), one reaching behind the camera (clipped at its centre's plane), one wholly
+// behind, and two twins at the same place (a later box wins a tie, as in Cast).
+TEST(Camera, EveryPixelSeesWhatItsRayCastFinds) {
+  plant::World world = testing::Yard();
+  const model::Camera& cam = Xcmg().sensors.camera;
+  const Eigen::Isometry3d T_world_body = LevelCameraAt({0, 0, 3.0});
+  const Eigen::Vector3d c = T_world_body.translation();
+  std::vector<plant::OrientedBox> own = {
+      MakeBox("cab", c + Eigen::Vector3d(-0.3, 0, 0), {0.8, 0.7, 0.6}, 0.0,
+              SemanticClass::kOwnLoader),
+      MakeBox("hood_below", c + Eigen::Vector3d(-0.5, 0.2, -1.1), {2.5, 1.0, 0.35}, 0.1,
+              SemanticClass::kOwnLoader),
+      MakeBox("counterweight_behind", c + Eigen::Vector3d(-4.0, 0, -1.5), {0.8, 1.2, 0.8}, 0.0,
+              SemanticClass::kOwnLoader),
+      MakeBox("bucket", c + Eigen::Vector3d(4.0, 0, -2.4), {0.6, 1.4, 0.5}, 0.1,
+              SemanticClass::kOwnLoader),
+      MakeBox("bucket_twin", c + Eigen::Vector3d(4.0, 0, -2.4), {0.6, 1.4, 0.5}, 0.1,
+              SemanticClass::kPerson)};
+  const RaycastScene scene(world, own);
+  CameraOptions options;
+  options.lighting = Lighting::kDim;
+  Rng rng(4);
+  const CameraFrame frame = SimulateCameraFrame(cam, scene, T_world_body, 0, options, rng);
+  const Eigen::Isometry3d T_world_optical = OpticalInWorld(T_world_body);
+  int mismatches = 0, below = 0, twin = 0;
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const Eigen::Vector3d d = T_world_optical.linear() * PixelRay(cam, u, v);
+      const RayHit hit = scene.Cast(T_world_optical.translation(), d, options.max_range);
+      const auto expected = hit.hit ? hit.semantic_class : SemanticClass::kOther;
+      mismatches += LabelAt(frame, {u, v}) != expected;
+      below += hit.box == 1;
+      twin += hit.box == 4;
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  // The boxes that matter are in view: the one reaching behind the camera and the twins.
+  EXPECT_GT(below, 100);
+  EXPECT_GT(twin, 100);
+}
+
+// The gamma table against std::pow: within 0.02 DN everywhere, and exact at both ends.
+TEST(Camera, GammaTableFollowsThePowerLaw) {
+  double worst = 0;
+  for (int k = 0; k <= 2000000; ++k) {
+    const double x = k / 2000000.0;
+    worst = std::max(worst, std::abs(GammaEncode(x) - 255.0 * std::pow(x, 1.0 / 2.2)));
+  }
+  EXPECT_LT(worst, 0.02);
+  EXPECT_DOUBLE_EQ(GammaEncode(0.0), 0.0);
+  EXPECT_DOUBLE_EQ(GammaEncode(1.0), 255.0);
+  EXPECT_DOUBLE_EQ(GammaEncode(-0.5), 0.0);  // clamped
+  EXPECT_DOUBLE_EQ(GammaEncode(3.0), 255.0);
+}
+
 }  // namespace
 }  // namespace autoshovel::sensors

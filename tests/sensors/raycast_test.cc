@@ -320,6 +320,46 @@ TEST(RaycastScene, BoxGridMatchesTestingEveryBox) {
   EXPECT_GT(ties, 5);
 }
 
+// Shadow rays towards the sun test only the boxes whose shadow covers their origin: the answer
+// must be CastBoxes' for any origin, including ones inside a box, on its faces' planes, or far
+// outside the shadows' grid.
+TEST(ParallelRayBoxes, OccludedIsExactlyWhetherCastBoxesHits) {
+  plant::World world = FlatWorld(60, 60, 0.1);
+  std::mt19937 rng(20261207);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 40; ++i) {
+    const Eigen::Vector3d half(0.1 + 3 * std::abs(u(rng)), 0.1 + 3 * std::abs(u(rng)),
+                               0.2 + 1.5 * std::abs(u(rng)));
+    world.obstacles.push_back(MakeBox("b" + std::to_string(i),
+                                      {25 * u(rng), 25 * u(rng), half.z() + 0.3 * u(rng)}, half,
+                                      kPi * u(rng), SemanticClass::kWall));
+  }
+  const RaycastScene scene(world);
+  int occluded = 0, checked = 0;
+  for (const Eigen::Vector3d& sun :
+       {Eigen::Vector3d(-0.5, -0.5, 0.70710678118654757), Eigen::Vector3d(0.2, 0.9, 0.3),
+        Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 0, 0)}) {
+    const ParallelRayBoxes boxes(scene, sun);
+    const Eigen::Vector3d d = sun.normalized();
+    for (int k = 0; k < 6000; ++k) {
+      const Eigen::Vector3d o(35 * u(rng), 35 * u(rng), 0.01 + 2.5 * std::abs(u(rng)));
+      const double max_range = k % 4 == 0 ? 3.0 : 400.0;
+      const bool expected = scene.CastBoxes(o, d, max_range).hit;
+      ASSERT_EQ(boxes.Occluded(o, max_range), expected)
+          << "origin " << o.transpose() << " towards " << d.transpose();
+      occluded += expected;
+      ++checked;
+    }
+  }
+  // Both answers must occur often, or the comparison says little.
+  EXPECT_GT(occluded, checked / 20);
+  EXPECT_LT(occluded, checked - checked / 20);
+  EXPECT_THROW(ParallelRayBoxes(scene, Eigen::Vector3d::Zero()), std::invalid_argument);
+  const plant::World bare = FlatWorld(10, 10, 0.1);
+  const RaycastScene empty(bare);
+  EXPECT_FALSE(ParallelRayBoxes(empty, Eigen::Vector3d::UnitZ()).Occluded({1, 1, 0.1}, 100));
+}
+
 TEST(RaycastScene, RaysLeavingTheYardOrBeyondRangeReturnNothing) {
   const plant::World world = FlatWorld(10, 10, 0.05);
   const RaycastScene scene(world);

@@ -31,9 +31,11 @@
 #include "runtime/app/shovel_run.h"
 #include "runtime/app/train_segmentation.h"
 #include "runtime/app/truck_loading/truck_loading_job.h"
+#include "runtime/app/truck_loading/truck_replay.h"
 #include "runtime/core/file_output.h"
 #include "runtime/machines/machine_library.h"
 #include "runtime/model/description.h"
+#include "runtime/recording/scan_tables.h"
 #include "runtime/sim/select_command.h"
 
 namespace {
@@ -311,7 +313,8 @@ Command AddReplay(CLI::App& app, const Globals& g) {
       "replay",
       "Run the main job's perception, shovel point selection and scoop volume prediction on "
       "a recording (a real machine's, or `run --record`'s): maps, selections, V1/V2, pictures, "
-      "no plant (docs/recording_format.md)");
+      "no plant; on a truck-loading recording, truck recognition and the bed map from its "
+      "scans (docs/recording_format.md)");
   cmd->add_option("recording", c->recording, "Recording folder")->required();
   cmd->add_option("-o,--out", c->out, "Run folder (default: runs/<UTC timestamp>)");
   cmd->add_flag(
@@ -332,9 +335,17 @@ Command AddReplay(CLI::App& app, const Globals& g) {
   cmd->add_flag(
       "--no-figures", [c](std::int64_t) { c->figures = false; }, "Skip the per-cycle PNGs");
   cmd->add_flag("--check", c->check,
-                "Exit 1 when a map or a selection differs from the recording's reference/");
+                "Exit 1 when a map, a selection, the truck or a bed map differs from the "
+                "recording's reference/");
   return {cmd, [c, &g]() -> int {
             c->models_dir = g.models_dir;
+            // The manifest says which job recorded it; an unreadable one goes to the main job's
+            // reader, which says what is wrong with it.
+            if (autoshovel::recording::IsTruckLoadingManifest(std::filesystem::path(c->recording) /
+                                                              "recording.yaml")) {
+              return autoshovel::app::RunTruckReplay(c->recording, c->out, c->check, std::cout,
+                                                     std::cerr);
+            }
             return autoshovel::app::RunReplay(*c, std::cout, std::cerr);
           }};
 }
@@ -809,12 +820,8 @@ int RunMainJob(RunCli& c, bool cycles_given, const Globals& g) {
     // Not loadable here: the shovel job reports what is wrong with it.
   }
   if (excavator) {
-    if (!c.run.record_dir.empty()) {
-      std::cerr << "autoshovel run: --record: the truck-loading job does not record yet (only "
-                   "the wheel loader's main job does: docs/recording_format.md)\n";
-      return 2;
-    }
     autoshovel::app::TruckLoadingOptions& truck = c.truck_loading;
+    truck.record_dir = c.run.record_dir;
     truck.scenario = c.run.scenario;
     truck.models_dir = g.models_dir;
     truck.seed = c.run.seed;
@@ -943,8 +950,9 @@ Command AddRun(CLI::App& app, const Globals& g) {
                 "Print where the wall time went, per executive task and component (and write "
                 "profile.csv in the run folder: docs/performance.md)");
   cmd->add_option("--record", c->run.record_dir,
-                  "Record every map update's sensor frames into this new folder, for "
-                  "`autoshovel replay` (docs/recording_format.md)");
+                  "Record every map update's sensor frames (truck loading: the rangefinder's "
+                  "scans) into this new folder, for `autoshovel replay` "
+                  "(docs/recording_format.md)");
   cmd->add_option("--dig-evaluations", c->truck_loading.dig_evaluations,
                   "Excavator scenarios: plant simulations per dig plan")
       ->check(autoshovel::app::IntegerIn(1, 100000))

@@ -91,34 +91,6 @@ std::string ReadTextOrEmpty(const std::filesystem::path& path) {
 }
 
 // How many rows of `ours` equal the reference's, and the first that does not ("" when all do).
-struct Comparison {
-  long rows = 0, same = 0;
-  std::string first_difference;
-};
-
-Comparison Compare(const std::string& reference, const std::string& ours, const std::string& what) {
-  std::istringstream a(reference), b(ours);
-  std::string ra, rb;
-  Comparison c;
-  long line = 0;
-  while (true) {
-    const bool more_a = static_cast<bool>(std::getline(a, ra));
-    const bool more_b = static_cast<bool>(std::getline(b, rb));
-    if (!more_a && !more_b) break;
-    ++line;
-    if (line == 1) continue;  // the header
-    ++c.rows;
-    if (more_a && more_b && ra == rb) {
-      ++c.same;
-    } else if (c.first_difference.empty()) {
-      c.first_difference = what + " line " + std::to_string(line) + ": recording '" +
-                           (more_a ? ra : "(none)") + "', replay '" + (more_b ? rb : "(none)") +
-                           "'";
-    }
-  }
-  return c;
-}
-
 // V1 (Eq. 19) and V2 at each recorded decision of cycle `cycle`'s scoop, on `map` (the map the
 // scoop started from), as `predictions.csv` rows; the first decision at which κ(V1 + V2) reached
 // V_t goes to `log`.
@@ -289,11 +261,12 @@ class Replayer {
       out << "no reference/ in the recording: nothing to compare with\n";
       report_lines_.push_back("the recording has no reference/: nothing to compare with");
     } else {
-      const Comparison maps = Compare(ref_digests, digests_, "map_digests.csv");
-      const Comparison picks =
-          Compare(ReadTextOrEmpty(ref / "selections.csv"), selections_, "selections.csv");
-      const Comparison volumes =
-          Compare(ReadTextOrEmpty(ref / "predictions.csv"), predictions_, "predictions.csv");
+      const recording::Comparison maps =
+          recording::CompareTables(ref_digests, digests_, "map_digests.csv");
+      const recording::Comparison picks = recording::CompareTables(
+          ReadTextOrEmpty(ref / "selections.csv"), selections_, "selections.csv");
+      const recording::Comparison volumes = recording::CompareTables(
+          ReadTextOrEmpty(ref / "predictions.csv"), predictions_, "predictions.csv");
       std::ostringstream summary;
       summary << "against the recording machine: maps identical after " << maps.same << " of "
               << maps.rows << " updates, selections identical at " << picks.same << " of "
@@ -302,7 +275,7 @@ class Replayer {
       out << summary.str() << "\n";
       folder_.log().Info(summary.str());
       report_lines_.push_back(summary.str());
-      for (const Comparison* c : {&maps, &picks, &volumes}) {
+      for (const recording::Comparison* c : {&maps, &picks, &volumes}) {
         if (c->first_difference.empty()) continue;
         out << "  first difference: " << c->first_difference << "\n";
         folder_.log().Warning(c->first_difference);

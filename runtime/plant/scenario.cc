@@ -704,15 +704,17 @@ std::vector<std::string> FindScenarios(const std::string& models_dir) {
 std::string ResolveScenario(const std::string& name_or_path, const std::string& models_dir) {
   std::error_code error;
   if (fs::is_regular_file(name_or_path, error)) return name_or_path;
-  // A name that exists but is no file (a folder, a named pipe) is said so, not "no such file".
-  if (fs::exists(name_or_path, error)) {
-    throw std::runtime_error(name_or_path + ": " + core::NotARegularFile(name_or_path));
-  }
   std::vector<std::string> names;
   for (const auto& file : FindScenarios(models_dir)) {
     const std::string stem = fs::path(file).stem().string();
     if (stem == name_or_path) return file;
     names.push_back(stem);
+  }
+  // A path that exists but is no file (a folder, a named pipe) is said so, not "no such file".
+  // It is asked after the names: a folder called `truck_loading` in the working directory (a
+  // run folder, a build tree's test folder) must not hide the scenario of that name.
+  if (fs::exists(name_or_path, error)) {
+    throw std::runtime_error(name_or_path + ": " + core::NotARegularFile(name_or_path));
   }
   std::string message = "unknown scenario '" + name_or_path + "' (no such file, and no " +
                         name_or_path + ".yaml under " + models_dir +

@@ -17,30 +17,9 @@
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/input_file.h"
 #include "runtime/core/semantic_class.h"
+#include "runtime/recording/csv_rows.h"
 
 namespace autoshovel::recording {
-
-namespace {
-
-[[noreturn]] void Refuse(const std::string& source, int line, int column, const std::string& what) {
-  core::RefuseInput({source, line, column}, what);
-}
-
-std::string ReadText(const std::filesystem::path& path) {
-  const std::string why = core::NotARegularFile(path);
-  if (!why.empty()) Refuse(path.string(), 0, 0, why);
-  std::error_code ec;
-  if (std::filesystem::file_size(path, ec) > kMaxCsvBytes) {
-    Refuse(path.string(), 0, 0, "larger than 1 GiB");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) Refuse(path.string(), 0, 0, "cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-}  // namespace
 
 Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
   std::error_code ec;
@@ -53,7 +32,7 @@ Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
   }
   manifest_ = ReadManifest(manifest);
   const std::string updates_path = (dir_ / "updates.csv").string();
-  updates_ = ParseUpdatesCsv(ReadText(updates_path), updates_path);
+  updates_ = ParseUpdatesCsv(ReadTableFile(updates_path), updates_path);
   std::set<int> cycles;
   for (const CycleInfo& c : manifest_.cycles) cycles.insert(c.index);
   for (std::size_t i = 0; i < updates_.size(); ++i) {
@@ -64,7 +43,7 @@ Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
     }
   }
   const std::string frames_path = (dir_ / "frames.csv").string();
-  frames_ = ParseFramesCsv(ReadText(frames_path), frames_path);
+  frames_ = ParseFramesCsv(ReadTableFile(frames_path), frames_path);
   frame_range_.assign(updates_.size(), {0, 0});
   std::size_t k = 0;
   for (std::size_t i = 0; i < updates_.size(); ++i) {
@@ -89,8 +68,8 @@ Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
   const std::filesystem::path scoop_path = dir_ / "scoop.csv";
   const std::filesystem::path tip_path = dir_ / "tip_path.csv";
   if (std::filesystem::exists(scoop_path, exists_ec)) {
-    decisions_ = ParseScoopCsv(ReadText(scoop_path), scoop_path.string());
-    tip_path_ = ParseTipPathCsv(ReadText(tip_path), tip_path.string());
+    decisions_ = ParseScoopCsv(ReadTableFile(scoop_path), scoop_path.string());
+    tip_path_ = ParseTipPathCsv(ReadTableFile(tip_path), tip_path.string());
   }
   std::map<int, long> points_of;
   for (const TipPoint& t : tip_path_) ++points_of[t.cycle];

@@ -11,14 +11,12 @@
 #include <utility>
 #include <vector>
 
+#include "runtime/recording/csv_rows.h"
 #include "runtime/recording/recording_format.h"
 #include "runtime/recording/recording_tables.h"
 #include "runtime/sensors/sensor_data.h"
 
 namespace autoshovel::recording {
-
-/// The largest updates.csv or frames.csv read: 1 GiB (about five million frames).
-inline constexpr std::uintmax_t kMaxCsvBytes = std::uintmax_t{1} << 30;
 
 class Recording {
  public:

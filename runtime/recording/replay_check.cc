@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 #include "runtime/core/sha256.h"
 #include "runtime/core/strings.h"
@@ -43,6 +44,30 @@ std::string SelectionRow(long update, int cycle, const planning::ShovelPointResu
   if (best == nullptr) return row + ",,,";
   return row + core::FormatNumber(best->pose.xy.x()) + "," + core::FormatNumber(best->pose.xy.y()) +
          "," + core::FormatNumber(best->pose.entry_heading) + "," + core::FormatNumber(best->score);
+}
+
+Comparison CompareTables(const std::string& reference, const std::string& ours,
+                         const std::string& what) {
+  std::istringstream a(reference), b(ours);
+  std::string ra, rb;
+  Comparison c;
+  long line = 0;
+  while (true) {
+    const bool more_a = static_cast<bool>(std::getline(a, ra));
+    const bool more_b = static_cast<bool>(std::getline(b, rb));
+    if (!more_a && !more_b) break;
+    ++line;
+    if (line == 1) continue;  // the header
+    ++c.rows;
+    if (more_a && more_b && ra == rb) {
+      ++c.same;
+    } else if (c.first_difference.empty()) {
+      c.first_difference = what + " line " + std::to_string(line) + ": recording '" +
+                           (more_a ? ra : "(none)") + "', replay '" + (more_b ? rb : "(none)") +
+                           "'";
+    }
+  }
+  return c;
 }
 
 }  // namespace autoshovel::recording

@@ -31,4 +31,13 @@ std::string MapDigestRow(long update, const perception::GridMap& map);
 std::string SelectionRow(long update, int cycle, const planning::ShovelPointResult& selection,
                          const planning::ShovelCandidate* best);
 
+/// Two tables of the same header compared row by row (the header skipped): rows, rows alike, and
+/// the first difference as `what line N: recording '…', replay '…'`.
+struct Comparison {
+  long rows = 0, same = 0;
+  std::string first_difference;
+};
+Comparison CompareTables(const std::string& reference, const std::string& ours,
+                         const std::string& what);
+
 }  // namespace autoshovel::recording

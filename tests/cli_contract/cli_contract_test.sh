@@ -153,7 +153,8 @@ if grep -q "resume" "$tmp/err"; then  # `run` has no --resume: it must not sugge
 fi
 refuses run-faults-missing "--faults" -- "${models[@]}" run --faults "$tmp/no_such.yaml" -o "$tmp/r8"
 refuses run-record-not-empty "nonempty_run" -- "${models[@]}" run cone_pile --cycles 1 --record "$tmp/nonempty_run" -o "$tmp/r10"
-for d in r1 r2 r3 r4 r5 r6 r7 r8 r9 r10; do
+refuses truck-record-not-empty "nonempty_run" -- "${models[@]}" run truck_loading --cycles 1 --record "$tmp/nonempty_run" -o "$tmp/r11"
+for d in r1 r2 r3 r4 r5 r6 r7 r8 r9 r10 r11; do
   if [ -e "$tmp/$d" ]; then
     failed=$((failed + 1))
     echo "FAIL run-refused-leaves-no-folder: $d was created"

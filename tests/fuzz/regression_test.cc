@@ -25,9 +25,11 @@
 #include "runtime/model/description.h"
 #include "runtime/perception/scan/scan_poses.h"
 #include "runtime/recording/recording_tables.h"
+#include "runtime/recording/scan_tables.h"
 #include "runtime/results/results_db.h"
 #include "tests/fuzz/hydraulic_log_formats.h"
 #include "tests/fuzz/refusal.h"
+#include "tests/fuzz/scan_recording_fixture.h"
 
 namespace autoshovel::fuzz {
 namespace {
@@ -179,6 +181,38 @@ TEST(FuzzRegressions, RecordingTipPath) {
 TEST(FuzzRegressions, RecordingManifest) {
   ExpectBothKinds(CheckTarget("recording_manifest", [](const std::string& path) {
     return Refusal([&] { recording::ReadManifest(path); });
+  }));
+}
+
+// The truck-loading recording's tables and manifest (fuzz_recording_scans, _scanlines,
+// _scan_points, _scan_manifest), the later tables read against scan_recording_fixture.h.
+TEST(FuzzRegressions, RecordingScans) {
+  ExpectBothKinds(CheckTarget("recording_scans", [](const std::string& path) {
+    return Refusal([&] { recording::ParseScansCsv(TextOf(path), path); });
+  }));
+}
+
+TEST(FuzzRegressions, RecordingScanlines) {
+  ExpectBothKinds(CheckTarget("recording_scanlines", [](const std::string& path) {
+    return Refusal([&] {
+      auto scans = ScansWithoutScanlines();
+      recording::ParseScanlinesCsv(TextOf(path), path, scans);
+    });
+  }));
+}
+
+TEST(FuzzRegressions, RecordingScanPoints) {
+  ExpectBothKinds(CheckTarget("recording_scan_points", [](const std::string& path) {
+    return Refusal([&] {
+      auto scans = ScansWithScanlines();
+      recording::ParseScanPointsCsv(TextOf(path), path, scans);
+    });
+  }));
+}
+
+TEST(FuzzRegressions, RecordingScanManifest) {
+  ExpectBothKinds(CheckTarget("recording_scan_manifest", [](const std::string& path) {
+    return Refusal([&] { recording::ReadScanManifest(path); });
   }));
 }
 

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "runtime/app/truck_loading/bed_picture.h"
 #include "runtime/app/truck_loading/truck_loading_job.h"
 #include "runtime/plot/bar_chart.h"
 #include "runtime/plot/image_file.h"
@@ -57,41 +58,7 @@ results::CycleRecord ToRecord(const PassOutcome& pass, const TruckLoadingJob& jo
 }  // namespace
 
 void TruckLoadingJob::WriteBedPng(const std::filesystem::path& path) const {
-  // Top view of the bed, 24 px per 15 cm cell, the cab end at the top: colour from the floor
-  // (blue) to the rim (red), grey where the map has no data.
-  const planning::BedHeightMap map = BedMap();
-  const double rim = truck().wall_height;
-  const int px = 24;
-  cv::Mat gray(map.cells_x() * px, map.cells_y() * px, CV_8UC1, cv::Scalar(0));
-  cv::Mat known(gray.size(), CV_8UC1, cv::Scalar(0));
-  for (int ix = 0; ix < map.cells_x(); ++ix) {
-    for (int iy = 0; iy < map.cells_y(); ++iy) {
-      if (!map.known(ix, iy)) continue;
-      const double f = std::clamp(map.height(ix, iy) / rim, 0.0, 1.0);
-      // Row 0 at the cab (largest bed x), column 0 on the bed's right (smallest y).
-      const cv::Rect cell(iy * px, (map.cells_x() - 1 - ix) * px, px, px);
-      gray(cell).setTo(cv::Scalar(static_cast<int>(std::lround(255 * f))));
-      known(cell).setTo(cv::Scalar(255));
-    }
-  }
-  cv::Mat color;
-  cv::applyColorMap(gray, color, cv::COLORMAP_JET);
-  color.setTo(cv::Scalar(128, 128, 128), known == 0);
-  for (int ix = 0; ix <= map.cells_x(); ++ix) {
-    cv::line(color, {0, ix * px}, {color.cols, ix * px}, cv::Scalar(40, 40, 40), 1);
-  }
-  for (int iy = 0; iy <= map.cells_y(); ++iy) {
-    cv::line(color, {iy * px, 0}, {iy * px, color.rows}, cv::Scalar(40, 40, 40), 1);
-  }
-  cv::Mat framed;
-  cv::copyMakeBorder(color, framed, 40, 10, 10, 10, cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
-  const planning::FillSummary fill = Fill();
-  char title[160];
-  std::snprintf(title, sizeof title, "cab ^  mean %.2f m, std %.2f m (rim %.2f m)",
-                fill.mean_height_m, fill.std_height_m, rim);
-  cv::putText(framed, title, {10, 26}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
-              cv::LINE_AA);
-  plot::WriteImageFile(path, framed);
+  WriteBedHeightPng(BedMap(), truck().wall_height, path);
 }
 
 int RunTruckLoadingCommand(const TruckLoadingOptions& options, const std::filesystem::path& out_dir,
@@ -174,6 +141,18 @@ int RunTruckLoadingCommand(const TruckLoadingOptions& options, const std::filesy
       out << "run stopped after pass " << i + 1 << ": " << pass.failure << "\n";
       log.Error("run stopped after pass " + std::to_string(i + 1) + ": " + pass.failure);
       break;
+    }
+  }
+
+  if (!options.record_dir.empty()) {
+    try {
+      job->CloseRecording();
+      out << "recording: " << options.record_dir << " (autoshovel replay " << options.record_dir
+          << ")\n";
+    } catch (const std::exception& e) {
+      err << "autoshovel run truck_loading: --record: " << e.what() << "\n";
+      log.Error(std::string("--record: ") + e.what());
+      return 2;
     }
   }
 

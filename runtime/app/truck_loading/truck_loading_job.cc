@@ -16,6 +16,7 @@
 #include "runtime/app/stop_hold.h"
 #include "runtime/app/truck_loading/excavator_on_plant.h"
 #include "runtime/app/truck_loading/plant_dig_model.h"
+#include "runtime/app/truck_loading/scan_record.h"
 #include "runtime/app/truck_loading/world_height_grid.h"
 #include "runtime/app/truck_scan/truck_scanner.h"
 #include "runtime/app/truck_scan/world_rangefinder_scene.h"
@@ -37,6 +38,7 @@
 #include "runtime/planning/dump/dump_planner.h"
 #include "runtime/plant/plant.h"
 #include "runtime/plant/scenario.h"
+#include "runtime/recording/scan_recording.h"
 #include "runtime/sensors/raycast.h"
 #include "runtime/sensors/rng.h"
 
@@ -163,6 +165,9 @@ struct TruckLoadingJob::State {
   std::unique_ptr<TruckScanner> scanner;
   std::optional<perception::TruckRecognitionResult> recognised;
   std::optional<planning::BedHeightMap> scanned_bed;
+  /// `--record`: the scans as they are made, and what the machine made of them.
+  std::unique_ptr<recording::ScanRecordingWriter> recorder;
+  int current_pass = 0;
   sensors::Rng rng;
   double speed_scale = 1.0;  ///< for the next pass, from the last scan's dust warning
 
@@ -239,6 +244,12 @@ struct TruckLoadingJob::State {
     recognised = r;
     if (report.bed_map) scanned_bed = *report.bed_map;
     speed_scale = report.scan.min_speed_scale;
+    if (recorder) {
+      const int scan = recorder->AddScan(
+          ToRecordedScan(report.scan, recording::ScanKind::kRecognition, current_pass));
+      recorder->SetTruckReference(TruckReferenceRow(r, report.truck_below_machine));
+      if (scanned_bed) recorder->AddBedMapReference(BedMapReferenceRow(scan, *scanned_bed));
+    }
   }
 
   /// §2, §4.3: the bed measured while the machine swings back from the truck (dump → dig at the
@@ -268,13 +279,11 @@ struct TruckLoadingJob::State {
     // §3: what this scan saw of dust sets the next pass's speed.
     speed_scale = scan.min_speed_scale;
     if (dust_warning) *dust_warning = scan.dust_warning;
-    int known = 0;
-    for (int ix = 0; ix < seen.cells_x() && ix < scanned_bed->cells_x(); ++ix) {
-      for (int iy = 0; iy < seen.cells_y() && iy < scanned_bed->cells_y(); ++iy) {
-        if (!seen.known(ix, iy)) continue;
-        scanned_bed->SetHeight(ix, iy, seen.height(ix, iy));
-        ++known;
-      }
+    const int known = FuseBedScan(*scanned_bed, seen);
+    if (recorder) {
+      const int number =
+          recorder->AddScan(ToRecordedScan(scan, recording::ScanKind::kBed, current_pass));
+      recorder->AddBedMapReference(BedMapReferenceRow(number, *scanned_bed));
     }
     return known;
   }
@@ -342,8 +351,9 @@ TruckLoadingJob::TruckLoadingJob(const TruckLoadingOptions& options)
     }
   }
   s.scenario = plant::LoadScenario(plant::ResolveScenario(options.scenario, options.models_dir));
-  s.machine = model::LoadMachineDescription(
-      model::ResolveMachineDescription(s.scenario.machine, options.models_dir));
+  const std::string description_path =
+      model::ResolveMachineDescription(s.scenario.machine, options.models_dir);
+  s.machine = model::LoadMachineDescription(description_path);
   if (s.machine.kind != model::MachineKind::kExcavator) {
     throw std::invalid_argument("truck_loading: scenario " + s.scenario.name + " names " +
                                 s.machine.name + ", which is not an excavator");
@@ -406,6 +416,17 @@ TruckLoadingJob::TruckLoadingJob(const TruckLoadingOptions& options)
   if (s.next_dig.status != planning::DigPlanStatus::kPlanned) {
     throw std::runtime_error("truck_loading: no feasible first dig: " + s.next_dig.why);
   }
+  if (!options.record_dir.empty()) {
+    if (!options.recognise_truck) {
+      throw std::invalid_argument(
+          "truck_loading: --record keeps the scans, and with the truck taken from the truth "
+          "(no recognition) there are none");
+    }
+    recording::ScanManifest manifest;
+    manifest.scanner = "left_scanner";
+    s.recorder = std::make_unique<recording::ScanRecordingWriter>(options.record_dir,
+                                                                  description_path, manifest);
+  }
   if (options.recognise_truck) s.RecogniseTruck(s.next_dig.action.swing, az);
   control::DigMotion first(*s.kinematics, ToStroke(s.next_dig.action), s.dig_settings);
   const std::optional<control::JointVector> q0 = first.ApproachPose();
@@ -423,6 +444,10 @@ TruckLoadingJob::TruckLoadingJob(const TruckLoadingOptions& options)
 }
 
 TruckLoadingJob::~TruckLoadingJob() = default;
+
+void TruckLoadingJob::CloseRecording() {
+  if (state_->recorder) state_->recorder->Close();
+}
 
 const TruckPlacement& TruckLoadingJob::truck() const { return state_->truck; }
 const TruckRecognitionCheck& TruckLoadingJob::recognition() const { return state_->recognition; }
@@ -806,6 +831,7 @@ std::optional<TruckLoadingJob::State::LoadPlan> TruckLoadingJob::State::PlanLoad
 
 PassOutcome TruckLoadingJob::RunPass(int index, std::ostream* progress) {
   State& s = *state_;
+  s.current_pass = index;
   PassOutcome out;
   out.index = index;
   out.min_truck_clearance = std::numeric_limits<double>::infinity();

@@ -97,6 +97,10 @@ struct TruckLoadingOptions {
   /// Dust clouds the scans see; their §3 warning slows the next pass (recognise_truck only).
   std::vector<DustCloud> dust;
   bool figures = true;
+  /// Keep the rangefinder's scans and what recognition and the bed map made of them in this
+  /// folder (docs/recording_format.md, "Truck loading"), for `autoshovel replay`; empty: none.
+  /// The folder is complete after CloseRecording().
+  std::string record_dir;
 };
 
 /// The first-pass scan's outcome against the truth.
@@ -141,6 +145,10 @@ class TruckLoadingJob {
   /// std::runtime_error / std::invalid_argument naming what is wrong.
   explicit TruckLoadingJob(const TruckLoadingOptions& options);
   ~TruckLoadingJob();
+
+  /// Writes the recording's tables and manifest (TruckLoadingOptions::record_dir). Throws
+  /// core::OutputError. Nothing without a recording.
+  void CloseRecording();
 
   /// Runs pass `index`: dig, plan, load. `progress` (may be null) gets one line per phase.
   PassOutcome RunPass(int index, std::ostream* progress);

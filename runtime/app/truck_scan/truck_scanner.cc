@@ -383,8 +383,13 @@ TruckScanReport TruckScanner::ScanAndRecognize(const sensors::RangefinderScene& 
                                                const Eigen::Isometry3d& T_world_base,
                                                std::span<const TruckScanMotion> phases,
                                                sensors::Rng& rng) const {
+  return Recognize(Scan(scene, T_world_base, phases, rng), T_world_base);
+}
+
+TruckScanReport TruckScanner::Recognize(TruckScan scan,
+                                        const Eigen::Isometry3d& T_world_base) const {
   TruckScanReport report;
-  report.scan = Scan(scene, T_world_base, phases, rng);
+  report.scan = std::move(scan);
   if (config_.truck_ground != TruckGround::kBelowMachine) {
     report.recognition = recognizer_.Recognize(report.scan.scanlines);
   }
@@ -403,12 +408,7 @@ TruckScanReport TruckScanner::ScanAndRecognize(const sensors::RangefinderScene& 
     report.recognition.reason = why;
     report.truck_below_machine = false;
   }
-  if (report.recognition.found) {
-    report.bed_map = BedMapFromScan(
-        report.recognition, report.scan.scanlines,
-        BedMapConfigFor(report.recognition, config_.recognition.model.wall_height.max,
-                        config_.bed_cell_size));
-  }
+  if (report.recognition.found) report.bed_map = BedMap(report.scan, report.recognition);
   return report;
 }
 
@@ -419,11 +419,17 @@ planning::BedHeightMap TruckScanner::MeasureBed(const sensors::RangefinderScene&
                                                 sensors::Rng& rng, TruckScan* scan_out) const {
   Require(truck.found, "TruckScanner::MeasureBed: no truck was recognised (" + truck.reason + ")");
   TruckScan scan = Scan(scene, T_world_base, motion, rng);
-  planning::BedHeightMap map = BedMapFromScan(
-      truck, scan.scanlines,
-      BedMapConfigFor(truck, config_.recognition.model.wall_height.max, config_.bed_cell_size));
+  planning::BedHeightMap map = BedMap(scan, truck);
   if (scan_out) *scan_out = std::move(scan);
   return map;
+}
+
+planning::BedHeightMap TruckScanner::BedMap(const TruckScan& scan,
+                                            const perception::TruckRecognitionResult& truck) const {
+  Require(truck.found, "TruckScanner::BedMap: no truck was recognised (" + truck.reason + ")");
+  return BedMapFromScan(
+      truck, scan.scanlines,
+      BedMapConfigFor(truck, config_.recognition.model.wall_height.max, config_.bed_cell_size));
 }
 
 }  // namespace autoshovel::app

@@ -255,6 +255,15 @@ class TruckScanner {
                                    const Eigen::Isometry3d& T_world_base,
                                    const TruckScanMotion& motion, sensors::Rng& rng) const;
 
+  /// Recognition (§4.1) and the bed map (§4.3) of a scan already made: what ScanAndRecognize
+  /// does after Scan. A recorded scan replays through this (autoshovel replay).
+  TruckScanReport Recognize(TruckScan scan, const Eigen::Isometry3d& T_world_base) const;
+
+  /// The bed map (§4.3) of a recognised truck from a scan already made. Throws
+  /// std::invalid_argument when `truck.found` is false.
+  planning::BedHeightMap BedMap(const TruckScan& scan,
+                                const perception::TruckRecognitionResult& truck) const;
+
   /// The bed map of an already recognised truck from a new scan (the swing back of each pass).
   /// `scan`, when given, receives the scan itself (its dust warning, for one).
   planning::BedHeightMap MeasureBed(const sensors::RangefinderScene& scene,

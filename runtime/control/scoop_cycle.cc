@@ -664,6 +664,54 @@ const char* ScoopCycle::phase_name() const {
   return rt_ == nullptr ? "idle" : PhaseName(static_cast<int>(rt_->phase));
 }
 
+double ScoopCycle::SpeedTarget(const Proprioception& s, Runtime& rt) {
+  double speed_target = options_.attack_speed;
+  if (rt.drive_held && !rt.drive_hold_started) {
+    // Brake from the speed the machine has, not from the profile's reference: stalled in the
+    // pile, the reference stays at the attack speed with the PI's integral wound up, and
+    // ramping that down keeps pushing for seconds (over a metre once the stairway's lifts free
+    // the bucket) past where the look-ahead, reckoning v / f + v² / 2 a_dec, asked for the stop.
+    rt.speed_pid->Reset(std::max(s.speed, 0.0));
+    rt.drive_hold_started = true;
+  }
+  switch (rt.phase) {
+    case Phase::kApproach:
+    case Phase::kCrowd:
+      break;
+    case Phase::kScoop:
+      if (rt.plan) {
+        // The plan: the speed now, the joints where the plan has them one valve dead time
+        // ahead (what is commanded now reaches the spools then).
+        const double t = s.time - rt.plan_start;
+        speed_target = std::max(PlanAt(rt.plan->time, rt.plan->speed, t), 0.0);
+        rt.targets.boom = PlanAt(rt.plan->time, rt.plan->q_boom, t + plan_lead_);
+        rt.targets.bucket = PlanAt(rt.plan->time, rt.plan->q_bucket, t + plan_lead_);
+        break;
+      }
+      // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
+      // rate once the final rack/lift runs and the arm moves.
+      if (rt.finishing_drive && rt.arm_moving) {
+        if (std::isnan(rt.slowing_since)) rt.slowing_since = s.time;
+        speed_target = std::max(
+            options_.attack_speed - options_.scoop_deceleration * (s.time - rt.slowing_since), 0.0);
+      }
+      if (BoomPinnedByTheDrive(s, rt)) speed_target = 0;
+      if (rt.drive_held) speed_target = 0;
+      break;
+    case Phase::kLevel:
+    case Phase::kShake:
+      speed_target = 0;
+      break;
+    case Phase::kRetreat:
+      speed_target = rt.stopping ? 0.0 : -options_.retreat_speed;
+      break;
+    case Phase::kDone:
+      speed_target = 0;
+      break;
+  }
+  return speed_target;
+}
+
 bool ScoopCycle::Tick(ScoopMachine& machine) {
   if (rt_ == nullptr) throw std::logic_error("ScoopCycle::Tick before Start");
   Runtime& rt = *rt_;
@@ -726,50 +774,7 @@ bool ScoopCycle::Tick(ScoopMachine& machine) {
     rt.arm_moving = true;
     rt.result.arm_motion_after_trigger = s.time - rt.result.trigger_time;
   }
-  double speed_target = options_.attack_speed;
-  if (rt.drive_held && !rt.drive_hold_started) {
-    // Brake from the speed the machine has, not from the profile's reference: stalled in the
-    // pile, the reference stays at the attack speed with the PI's integral wound up, and
-    // ramping that down keeps pushing for seconds (over a metre once the stairway's lifts free
-    // the bucket) past where the look-ahead, reckoning v / f + v² / 2 a_dec, asked for the stop.
-    rt.speed_pid->Reset(std::max(s.speed, 0.0));
-    rt.drive_hold_started = true;
-  }
-  switch (rt.phase) {
-    case Phase::kApproach:
-    case Phase::kCrowd:
-      break;
-    case Phase::kScoop:
-      if (rt.plan) {
-        // The plan: the speed now, the joints where the plan has them one valve dead time
-        // ahead (what is commanded now reaches the spools then).
-        const double t = s.time - rt.plan_start;
-        speed_target = std::max(PlanAt(rt.plan->time, rt.plan->speed, t), 0.0);
-        rt.targets.boom = PlanAt(rt.plan->time, rt.plan->q_boom, t + plan_lead_);
-        rt.targets.bucket = PlanAt(rt.plan->time, rt.plan->q_bucket, t + plan_lead_);
-        break;
-      }
-      // Crowd through the hydraulic delay (Fig. 21 (a)–(b)), then decelerate at the fixed
-      // rate once the final rack/lift runs and the arm moves.
-      if (rt.finishing_drive && rt.arm_moving) {
-        if (std::isnan(rt.slowing_since)) rt.slowing_since = s.time;
-        speed_target = std::max(
-            options_.attack_speed - options_.scoop_deceleration * (s.time - rt.slowing_since), 0.0);
-      }
-      if (BoomPinnedByTheDrive(s, rt)) speed_target = 0;
-      if (rt.drive_held) speed_target = 0;
-      break;
-    case Phase::kLevel:
-    case Phase::kShake:
-      speed_target = 0;
-      break;
-    case Phase::kRetreat:
-      speed_target = rt.stopping ? 0.0 : -options_.retreat_speed;
-      break;
-    case Phase::kDone:
-      speed_target = 0;
-      break;
-  }
+  const double speed_target = SpeedTarget(s, rt);
   core::ActuatorCommand& command = rt.command;
   rt.speed_pid->SetTarget(speed_target);
   const DriveCommand drive = rt.speed_pid->Update(s.speed, options_.tick);

@@ -338,6 +338,10 @@ class ScoopCycle {
   /// Scoop phase, every tick: whether the drive is to ease because the boom, opened to lift,
   /// has stalled for ScoopCycleOptions::boom_stall_time (latched until the next action).
   bool BoomPinnedByTheDrive(const Proprioception& s, Runtime& rt) const;
+  /// The drive's speed reference this tick, by phase (the scoop's plan, Fig. 21's crowd and
+  /// deceleration, a held or pinned drive, the retreat); resets the speed PID where a hold
+  /// begins.
+  double SpeedTarget(const Proprioception& s, Runtime& rt);
   /// Acts on one JointStalledUnderLoad report (see there).
   void HoldStalledJoint(const Proprioception& s, Runtime& rt, int joint,
                         const std::string& reason) const;

@@ -184,6 +184,42 @@ void ScoopModel::Evaluate(const T* x, const T* u, T* xdot, T* path) const {
 }
 
 template <typename T>
+void ScoopModel::SoilForces(const T& depth, const T& depth_in, const T& bx, const T& bz,
+                            const T& vpx, const T& vpz, T& soil_s, T& soil_z) const {
+  using std::atan2;
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const double eps_d = options_.depth_smoothing;
+  // Reece's equation with McKyes' factors for the cut ahead of the edge (plant.cc
+  // UpdateResistance): the opening's rise is the blade, the material above it surcharge.
+  const T rake_raw = atan2(bz, T(-bx));
+  const T rake = SmoothMin(SmoothMax(rake_raw, T(rake_min_), 0.02), T(rake_max_), 0.02);
+  const T blade_height = SmoothMax(bz, T(0.3), 0.01);
+  const T cut_depth = SmoothMin(depth_in, blade_height, eps_d);
+  const T surcharge = unit_weight_ * Positive(T(depth - blade_height), eps_d);
+  const T n_gamma = factor_curves_[0].Height(rake);
+  const T n_c = factor_curves_[1].Height(rake);
+  const T n_q = factor_curves_[2].Height(rake);
+  const T n_a = factor_curves_[3].Height(rake);
+  const T reece =
+      width_ * (unit_weight_ * cut_depth * cut_depth * n_gamma + cohesion_ * cut_depth * n_c +
+                surcharge * cut_depth * n_q + adhesion_ * cut_depth * n_a);
+  const T cut = reece * sin(rake + delta_);
+  const T press = reece * cos(rake + delta_);
+  const T column = sqrt(bx * bx + 1e-4) + 0.1;
+  const T lift = 2.0 * column *
+                 (0.5 * k0_ * unit_weight_ * depth_in * depth_in * tan_phi_ + cohesion_ * depth_in);
+  const T withdraw = tan_delta_ * unit_weight_ * depth_in * column * width_;
+  const double eps_v = options_.resistance_speed;
+  const T sigma_s = SmoothSign(vpx, eps_v), sigma_z = SmoothSign(vpz, eps_v);
+  const T forward = 0.5 * (1.0 + sigma_s), rising = 0.5 * (1.0 + sigma_z);
+  soil_s = -sigma_s * (forward * cut + (1.0 - forward) * withdraw);
+  soil_z = -sigma_z * (rising * lift + (1.0 - rising) * cut) -
+           press * 0.5 * (sigma_s + sqrt(sigma_s * sigma_s + 1e-4));
+}
+
+template <typename T>
 void ScoopModel::EvaluateDetailed(const T* x, const T* u, T* xdot, T* path, T* extras) const {
   using std::atan2;
   using std::cos;
@@ -242,32 +278,8 @@ void ScoopModel::EvaluateDetailed(const T* x, const T* u, T* xdot, T* path, T* e
   const T intake =
       width_ * submerged * opening_length * Positive(T(vmx * nx + vmz * nz), 0.02) * open_fraction;
 
-  // Reece's equation with McKyes' factors for the cut ahead of the edge (plant.cc
-  // UpdateResistance): the opening's rise is the blade, the material above it surcharge.
-  const T rake_raw = atan2(bz, T(-bx));
-  const T rake = SmoothMin(SmoothMax(rake_raw, T(rake_min_), 0.02), T(rake_max_), 0.02);
-  const T blade_height = SmoothMax(bz, T(0.3), 0.01);
-  const T cut_depth = SmoothMin(depth_in, blade_height, eps_d);
-  const T surcharge = unit_weight_ * Positive(T(depth - blade_height), eps_d);
-  const T n_gamma = factor_curves_[0].Height(rake);
-  const T n_c = factor_curves_[1].Height(rake);
-  const T n_q = factor_curves_[2].Height(rake);
-  const T n_a = factor_curves_[3].Height(rake);
-  const T reece =
-      width_ * (unit_weight_ * cut_depth * cut_depth * n_gamma + cohesion_ * cut_depth * n_c +
-                surcharge * cut_depth * n_q + adhesion_ * cut_depth * n_a);
-  const T cut = reece * sin(rake + delta_);
-  const T press = reece * cos(rake + delta_);
-  const T column = sqrt(bx * bx + 1e-4) + 0.1;
-  const T lift = 2.0 * column *
-                 (0.5 * k0_ * unit_weight_ * depth_in * depth_in * tan_phi_ + cohesion_ * depth_in);
-  const T withdraw = tan_delta_ * unit_weight_ * depth_in * column * width_;
-  const double eps_v = options_.resistance_speed;
-  const T sigma_s = SmoothSign(vpx, eps_v), sigma_z = SmoothSign(vpz, eps_v);
-  const T forward = 0.5 * (1.0 + sigma_s), rising = 0.5 * (1.0 + sigma_z);
-  const T soil_s = -sigma_s * (forward * cut + (1.0 - forward) * withdraw);
-  const T soil_z = -sigma_z * (rising * lift + (1.0 - rising) * cut) -
-                   press * 0.5 * (sigma_s + sqrt(sigma_s * sigma_s + 1e-4));
+  T soil_s, soil_z;
+  SoilForces(depth, depth_in, bx, bz, vpx, vpz, soil_s, soil_z);
 
   // The arm by inverse dynamics: the joint accelerations are the controls, the cylinder forces
   // follow from M q̈ + bias + b q̇ − J_tipᵀ F = Gᵀ f, G the cylinders' length gradients.

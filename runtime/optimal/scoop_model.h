@@ -141,6 +141,12 @@ class ScoopModel {
   /// Evaluate, and with `extras` (12 values) the probe's quantities in ScoopModelProbe order.
   template <typename T>
   void EvaluateDetailed(const T* x, const T* u, T* xdot, T* path, T* extras) const;
+  /// The soil's reaction on the bucket along the travel (soil_s) and vertically (soil_z) [N]:
+  /// Reece's cut ahead of the edge, the lift and withdrawal of the column above it, by the
+  /// tip's velocity (vpx, vpz); `bx`, `bz` the opening from edge to rim.
+  template <typename T>
+  void SoilForces(const T& depth, const T& depth_in, const T& bx, const T& bz, const T& vpx,
+                  const T& vpz, T& soil_s, T& soil_z) const;
 
   std::string machine_name_;
   PileProfile pile_;

@@ -18,18 +18,13 @@
 #include "runtime/core/input_file.h"
 #include "runtime/core/semantic_class.h"
 #include "runtime/recording/csv_rows.h"
+#include "runtime/recording/folder_checks.h"
 
 namespace autoshovel::recording {
 
 Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
   std::error_code ec;
-  if (!std::filesystem::is_directory(dir_, ec)) Refuse(dir_.string(), 0, 0, "not a folder");
-  const std::filesystem::path manifest = dir_ / "recording.yaml";
-  if (!std::filesystem::exists(manifest, ec)) {
-    Refuse(manifest.string(), 0, 0,
-           "missing: not a recording, or one whose run did not finish (the manifest is written "
-           "last)");
-  }
+  const std::filesystem::path manifest = ManifestOf(dir_);
   manifest_ = ReadManifest(manifest);
   const std::string updates_path = (dir_ / "updates.csv").string();
   updates_ = ParseUpdatesCsv(ReadTableFile(updates_path), updates_path);

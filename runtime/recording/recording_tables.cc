@@ -10,6 +10,7 @@
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/yaml_reader.h"
 #include "runtime/recording/csv_rows.h"
+#include "runtime/recording/folder_checks.h"
 
 namespace autoshovel::recording {
 
@@ -304,15 +305,7 @@ Manifest ReadManifest(const std::filesystem::path& path) {
   if (file.ok()) {
     using core::NumberRule;
     core::MapReader root = core::MapReader::Root(file, nullptr);
-    const std::string format = root.String("format");
-    if (sink.empty() && format != kFormatName) {
-      root.Error("format", "expected '" + std::string(kFormatName) + "', got '" + format + "'");
-    }
-    const int version = root.Integer("version", 1, 1000);
-    if (sink.empty() && version != kFormatVersion) {
-      root.Error("version", "this build reads version " + std::to_string(kFormatVersion) +
-                                ", the recording is version " + std::to_string(version));
-    }
+    CheckFormatAndVersion(root, sink);
     m.machine_file = root.String("machine");
     m.source = root.OptionalString("source").value_or("");
     {

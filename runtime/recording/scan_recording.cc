@@ -10,6 +10,7 @@
 #include "runtime/core/sha256.h"
 #include "runtime/core/strings.h"
 #include "runtime/recording/csv_rows.h"
+#include "runtime/recording/folder_checks.h"
 #include "runtime/recording/recording_format.h"
 #include "runtime/recording/scan_tables.h"
 
@@ -112,13 +113,7 @@ void ScanRecordingWriter::Close() {
 
 ScanRecording::ScanRecording(const std::filesystem::path& dir) : dir_(dir) {
   std::error_code ec;
-  if (!std::filesystem::is_directory(dir_, ec)) Refuse(dir_.string(), 0, 0, "not a folder");
-  const std::filesystem::path manifest = dir_ / "recording.yaml";
-  if (!std::filesystem::exists(manifest, ec)) {
-    Refuse(manifest.string(), 0, 0,
-           "missing: not a recording, or one whose run did not finish (the manifest is written "
-           "last)");
-  }
+  const std::filesystem::path manifest = ManifestOf(dir_);
   manifest_ = ReadScanManifest(manifest);
   const std::filesystem::path machine = machine_path();
   if (!std::filesystem::is_regular_file(machine, ec)) {

@@ -9,6 +9,7 @@
 #include "runtime/core/diagnostics.h"
 #include "runtime/core/yaml_reader.h"
 #include "runtime/recording/csv_rows.h"
+#include "runtime/recording/folder_checks.h"
 #include "runtime/recording/recording_format.h"
 
 namespace autoshovel::recording {
@@ -163,15 +164,7 @@ ScanManifest ReadScanManifest(const std::filesystem::path& path) {
   if (file.ok()) {
     using core::NumberRule;
     core::MapReader root = core::MapReader::Root(file, nullptr);
-    const std::string format = root.String("format");
-    if (sink.empty() && format != kFormatName) {
-      root.Error("format", "expected '" + std::string(kFormatName) + "', got '" + format + "'");
-    }
-    m.version = root.Integer("version", 1, 1000);
-    if (sink.empty() && m.version != kFormatVersion) {
-      root.Error("version", "this build reads version " + std::to_string(kFormatVersion) +
-                                ", the recording is version " + std::to_string(m.version));
-    }
+    m.version = CheckFormatAndVersion(root, sink);
     root.Enum("job", {kTruckLoadingJob});
     m.machine_file = root.String("machine");
     m.scanner = root.String("scanner");

@@ -358,6 +358,7 @@ int RunReplay(const ReplayOptions& options, std::ostream& out, std::ostream& err
     rec = std::make_unique<recording::Recording>(o.recording);
     model::LoadOptions load;
     load.models_dir = o.models_dir;
+    load.overlays = rec->overlay_paths();
     machine = model::LoadMachineDescription(rec->machine_path().string(), load);
     functions = &machines::MachineFunctionsFor(machine);
     if (!rec->decisions().empty()) {

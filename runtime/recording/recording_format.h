@@ -63,7 +63,10 @@ struct CycleInfo {
 /// recording.yaml.
 struct Manifest {
   std::string machine_file = "machine.yaml";  ///< relative to the folder
-  std::string source;                         ///< who wrote it, free text
+  /// Identification overlays applied on top of the description, in order (model::LoadOptions::
+  /// overlays), each a file in the folder: what the machine ran with after calibration.
+  std::vector<std::string> overlays;
+  std::string source;  ///< who wrote it, free text
   // The elevation map's grid (perception::ElevationMapConfig; the rest at its defaults).
   double map_resolution = 0.3;
   Eigen::Vector2d map_length = Eigen::Vector2d::Zero();

@@ -22,10 +22,21 @@
 
 namespace autoshovel::recording {
 
+std::vector<std::string> Recording::overlay_paths() const {
+  std::vector<std::string> paths;
+  for (const std::string& overlay : manifest_.overlays) paths.push_back((dir_ / overlay).string());
+  return paths;
+}
+
 Recording::Recording(const std::filesystem::path& dir) : dir_(dir) {
   std::error_code ec;
   const std::filesystem::path manifest = ManifestOf(dir_);
   manifest_ = ReadManifest(manifest);
+  for (const std::string& overlay : manifest_.overlays) {
+    if (!std::filesystem::is_regular_file(dir_ / overlay, ec)) {
+      Refuse(manifest.string(), 0, 0, "overlays: " + (dir_ / overlay).string() + " is missing");
+    }
+  }
   const std::string updates_path = (dir_ / "updates.csv").string();
   updates_ = ParseUpdatesCsv(ReadTableFile(updates_path), updates_path);
   std::set<int> cycles;

@@ -26,6 +26,8 @@ class Recording {
   const std::filesystem::path& dir() const { return dir_; }
   const Manifest& manifest() const { return manifest_; }
   std::filesystem::path machine_path() const { return dir_ / manifest_.machine_file; }
+  /// The overlays' paths, in the order they apply.
+  std::vector<std::string> overlay_paths() const;
   const std::vector<UpdateRow>& updates() const { return updates_; }
   /// Frames of updates()[i], in the order they are fused.
   std::vector<FrameRow> FramesOf(std::size_t i) const;

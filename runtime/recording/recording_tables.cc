@@ -307,6 +307,7 @@ Manifest ReadManifest(const std::filesystem::path& path) {
     core::MapReader root = core::MapReader::Root(file, nullptr);
     CheckFormatAndVersion(root, sink);
     m.machine_file = root.String("machine");
+    if (root.Has("overlays")) m.overlays = root.Strings("overlays", false);
     m.source = root.OptionalString("source").value_or("");
     {
       core::MapReader map = root.Map("map");
@@ -336,9 +337,16 @@ Manifest ReadManifest(const std::filesystem::path& path) {
       m.cycles.push_back(std::move(cycle));
     }
     root.Finish();
-    if (sink.empty() && (m.machine_file.empty() || m.machine_file.find("..") != std::string::npos ||
-                         m.machine_file.front() == '/')) {
+    auto inside = [](const std::string& name) {
+      return !name.empty() && name.find("..") == std::string::npos && name.front() != '/';
+    };
+    if (sink.empty() && !inside(m.machine_file)) {
       root.Error("machine", "must name a file inside the recording folder");
+    }
+    for (const std::string& overlay : m.overlays) {
+      if (sink.empty() && !inside(overlay)) {
+        root.Error("overlays", "'" + overlay + "' must name a file inside the recording folder");
+      }
     }
   }
   sink.ThrowIfAny();

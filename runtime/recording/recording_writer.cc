@@ -83,6 +83,13 @@ std::string ManifestText(const Manifest& m) {
   y += std::string("format: ") + kFormatName + "\n";
   y += "version: " + std::to_string(kFormatVersion) + "\n";
   y += "machine: " + Quoted(m.machine_file) + "\n";
+  if (!m.overlays.empty()) {
+    y += "overlays: [";
+    for (std::size_t i = 0; i < m.overlays.size(); ++i) {
+      y += (i > 0 ? ", " : "") + Quoted(m.overlays[i]);
+    }
+    y += "]\n";
+  }
   y += "source: " + Quoted(m.source) + "\n";
   y += "map:\n";
   y += "  resolution: " + Num(m.map_resolution) + "\n";
@@ -188,6 +195,13 @@ RecordingWriter::RecordingWriter(std::filesystem::path dir, const std::string& d
   scoop_csv_ = std::string(kScoopHeader) + "\n";
   tip_path_csv_ = std::string(kTipPathHeader) + "\n";
   predictions_csv_ = std::string(kPredictionsHeader) + "\n";
+}
+
+void RecordingWriter::AddOverlay(const std::string& overlay_path) {
+  const std::string name = "overlay_" + std::to_string(manifest_.overlays.size()) + "_" +
+                           std::filesystem::path(overlay_path).filename().string();
+  core::WriteFileAtomically(dir_ / name, core::ReadFileBytes(overlay_path));
+  manifest_.overlays.push_back(name);
 }
 
 void RecordingWriter::SetScoop(const ScoopInfo& scoop) {

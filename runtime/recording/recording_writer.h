@@ -25,6 +25,11 @@ class RecordingWriter {
   void SetSelection(const planning::ShovelPointConfig& config, double min_planned_clearance,
                     bool chen2024);
 
+  /// An identification overlay the machine ran with (model::LoadOptions::overlays), copied byte
+  /// for byte into the folder as `overlay_<n>_<file name>`; overlays apply in the order added.
+  /// Throws core::OutputError.
+  void AddOverlay(const std::string& overlay_path);
+
   /// How the camera frames are labelled (manifest `perception`).
   void SetPerception(bool truth_labels, double segmentation_scale);
 

@@ -84,6 +84,9 @@ perception::SensorFrames TestFrames(std::mt19937& rng, bool camera) {
 void WriteTestRecording(const fs::path& dir, std::mt19937& rng) {
   RecordingWriter writer(dir, WriteDescription(dir.string() + "_src").string(), TestManifest());
   writer.SetPerception(true, 0.75);
+  const fs::path overlay = dir.string() + "_src/arm calibration.overlay.yaml";
+  std::ofstream(overlay) << "# not parsed by the recording library\nmachine: test_loader\n";
+  writer.AddOverlay(overlay.string());
   WorkArea bin;
   bin.front_center = {10.0 / 3.0, 5.0};
   bin.yaw = 0.3;
@@ -141,6 +144,12 @@ TEST(Recording, RoundTripIsBitExact) {
   EXPECT_TRUE(m.chen2024);
   EXPECT_EQ(m.truth_labels, std::optional<bool>(true));
   EXPECT_EQ(m.segmentation_scale, 0.75);
+  // The overlay is copied into the folder and named in the manifest, in order.
+  ASSERT_EQ(m.overlays, std::vector<std::string>{"overlay_0_arm calibration.overlay.yaml"});
+  ASSERT_EQ(rec.overlay_paths().size(), 1u);
+  std::ifstream overlay(rec.overlay_paths()[0]);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(overlay), {}),
+            "# not parsed by the recording library\nmachine: test_loader\n");
   ASSERT_EQ(m.cycles.size(), 2u);
   EXPECT_EQ(m.cycles[0].area.front_center.x(), 10.0 / 3.0);
   EXPECT_EQ(m.cycles[1].area.kind, WorkArea::Kind::kDiscs);
@@ -314,6 +323,11 @@ TEST(Recording, DamagedFoldersAreRefusedWithTheFile) {
                            Replace(d / "recording.yaml", "  resolution:", "  resolutoin:");
                          })
                 .find("resolution"),
+            std::string::npos);
+  EXPECT_NE(RefusalAfter(
+                "missing_overlay",
+                [](const fs::path& d) { fs::remove(d / "overlay_0_arm calibration.overlay.yaml"); })
+                .find("overlays: "),
             std::string::npos);
   EXPECT_NE(RefusalAfter("cycle",
                          [](const fs::path& d) { Replace(d / "updates.csv", "\n2,1,", "\n2,5,"); })

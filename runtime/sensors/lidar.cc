@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <vector>
 
 namespace autoshovel::sensors {
 namespace {
@@ -63,17 +64,25 @@ std::vector<LidarRay> LidarScanPattern(const model::Lidar& lidar, double stamp) 
     const int columns = std::max(1, static_cast<int>(std::lround(fov / step)));
     const double column_period = 1.0 / (lidar.rate * columns_per_revolution);
     rays.reserve(static_cast<std::size_t>(columns) * lidar.lines);
+    // Each ring's elevation and each column's azimuth once: the same directions FromAngles gives
+    // ray by ray, with a sine and cosine per ring and per column instead of per ray.
+    std::vector<double> ring_cos(lidar.lines), ring_sin(lidar.lines);
+    for (int ring = 0; ring < lidar.lines; ++ring) {
+      const double elevation = lidar.lines == 1 ? 0.0
+                                                : -0.5 * lidar.vertical_fov +
+                                                      ring * lidar.vertical_fov / (lidar.lines - 1);
+      ring_cos[ring] = std::cos(elevation);
+      ring_sin[ring] = std::sin(elevation);
+    }
     for (int c = 0; c < columns; ++c) {
       // Clockwise from above: azimuth decreases with time.
       const double azimuth = 0.5 * fov - (c + 0.5) * step;
+      const double ca = std::cos(azimuth), sa = std::sin(azimuth);
       const float time_offset = static_cast<float>(c * column_period);
       for (int ring = 0; ring < lidar.lines; ++ring) {
-        const double elevation =
-            lidar.lines == 1
-                ? 0.0
-                : -0.5 * lidar.vertical_fov + ring * lidar.vertical_fov / (lidar.lines - 1);
-        rays.push_back(
-            {FromAngles(azimuth, elevation), static_cast<std::uint16_t>(ring), time_offset});
+        const double ce = ring_cos[ring];
+        rays.push_back({Eigen::Vector3d(ce * ca, ce * sa, ring_sin[ring]),
+                        static_cast<std::uint16_t>(ring), time_offset});
       }
     }
   } else if (lidar.model == "non_repetitive") {

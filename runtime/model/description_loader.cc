@@ -802,15 +802,17 @@ std::string ResolveMachineDescription(const std::string& name_or_path,
   namespace fs = std::filesystem;
   std::error_code error;
   if (fs::is_regular_file(name_or_path, error)) return name_or_path;
-  // A name that exists but is no file (a folder, a named pipe) is said so, not "no such file".
-  if (fs::exists(name_or_path, error)) {
-    throw std::runtime_error(name_or_path + ": " + core::NotARegularFile(name_or_path));
-  }
   std::vector<std::string> names;
   for (const auto& file : FindMachineDescriptions(models_dir)) {
     const std::string stem = fs::path(file).stem().string();
     if (stem == name_or_path) return file;
     names.push_back(stem);
+  }
+  // A path that exists but is no file (a folder, a named pipe) is said so, not "no such file".
+  // It is asked after the names: a folder called `xcmg_968ev` in the working directory (a run
+  // folder named after the machine) must not hide the description of that name.
+  if (fs::exists(name_or_path, error)) {
+    throw std::runtime_error(name_or_path + ": " + core::NotARegularFile(name_or_path));
   }
   std::string list;
   for (const auto& name : names) list += (list.empty() ? "" : ", ") + name;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 
@@ -50,6 +51,29 @@ TEST(Description, UnknownMachineNamesSuggestTheNearest) {
     EXPECT_NE(std::string(e.what()).find("did you mean 'xcmg_968ev'"), std::string::npos)
         << e.what();
   }
+}
+
+// A folder named like a shipped machine in the working directory (a run folder named after it)
+// does not hide the description; a folder that names no machine is still said to be a folder.
+TEST(Description, AFolderOfTheSameNameDoesNotHideTheMachine) {
+  const std::filesystem::path before = std::filesystem::current_path();
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "description_resolve_cwd";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "xcmg_968ev");
+  std::filesystem::create_directories(dir / "no_such_machine");
+  std::filesystem::current_path(dir);
+  const std::string resolved = ResolveMachineDescription("xcmg_968ev", kModels);
+  std::string folder_error;
+  try {
+    ResolveMachineDescription("no_such_machine", kModels);
+  } catch (const std::runtime_error& e) {
+    folder_error = e.what();
+  }
+  std::filesystem::current_path(before);
+  EXPECT_EQ(std::filesystem::path(resolved).filename(), "xcmg_968ev.yaml");
+  EXPECT_NE(folder_error.find("no_such_machine: "), std::string::npos) << folder_error;
+  EXPECT_NE(folder_error.find("folder"), std::string::npos) << folder_error;
 }
 
 // A loader's derived figures sit in the range of its class (spec sheets of 5–6 t loaders:

@@ -123,6 +123,30 @@ TEST(Scenarios, ResolveByNameOrPathAndSuggest) {
   }
 }
 
+// A folder named like a shipped scenario in the working directory (build/tests/truck_loading in
+// a build tree, a run folder named after the scenario) does not hide the scenario; a folder that
+// names none is still said to be a folder.
+TEST(Scenarios, AFolderOfTheSameNameDoesNotHideTheScenario) {
+  const std::filesystem::path before = std::filesystem::current_path();
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "scenario_resolve_cwd";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "cone_pile");
+  std::filesystem::create_directories(dir / "no_such_scenario");
+  std::filesystem::current_path(dir);
+  const std::string resolved = ResolveScenario("cone_pile", kModels);
+  std::string folder_error;
+  try {
+    ResolveScenario("no_such_scenario", kModels);
+  } catch (const std::runtime_error& e) {
+    folder_error = e.what();
+  }
+  std::filesystem::current_path(before);
+  EXPECT_EQ(resolved, ScenarioFile("cone_pile"));
+  EXPECT_NE(folder_error.find("no_such_scenario: "), std::string::npos) << folder_error;
+  EXPECT_NE(folder_error.find("folder"), std::string::npos) << folder_error;
+}
+
 TEST(Scenarios, ConeVolumeIsOneThirdPiRSquaredH) {
   const Scenario s = LoadScenario(ScenarioFile("cone_pile"));
   const Pile* cone = s.FindPile("gravel_cone");

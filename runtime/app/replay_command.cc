@@ -38,13 +38,6 @@ namespace autoshovel::app {
 
 namespace {
 
-const model::Lidar* LidarNamed(const model::MachineDescription& machine, const std::string& name) {
-  for (const model::Lidar& lidar : machine.sensors.lidars) {
-    if (lidar.name == name) return &lidar;
-  }
-  return nullptr;
-}
-
 // The frames of update `i` as the machine delivered them: clouds and image from their files,
 // poses from frames.csv, the machine's outline from updates.csv, and for a frame marked for the
 // health check the LiDAR's scan pattern at the frame's stamp (from the description).
@@ -60,7 +53,7 @@ perception::SensorFrames LoadUpdate(const recording::Recording& rec, std::size_t
       frames.T_world_camera = f.T_world_sensor;
       continue;
     }
-    const model::Lidar* lidar = LidarNamed(machine, f.sensor);
+    const model::Lidar* lidar = machine.FindLidar(f.sensor);
     if (lidar == nullptr) {
       core::RefuseInput({(rec.dir() / "frames.csv").string(), 0, 0},
                         "update " + std::to_string(i) + ": machine '" + machine.name +

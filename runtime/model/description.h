@@ -15,6 +15,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "runtime/core/diagnostics.h"
@@ -278,6 +279,8 @@ struct MachineDescription {
   /// Index of the actuator driving joint `joint_index`, or -1.
   int ActuatorOfJoint(std::size_t joint_index) const;
   const Material* FindMaterial(const std::string& material_name) const;
+  /// The LiDAR named `lidar_name` in sensors.lidars, or null.
+  const Lidar* FindLidar(std::string_view lidar_name) const;
   /// Location recorded for `key_path`, else the file itself.
   core::SourceLocation LocationOf(const std::string& key_path) const;
 };

@@ -756,6 +756,13 @@ int MachineDescription::ActuatorOfJoint(std::size_t joint_index) const {
   return -1;
 }
 
+const Lidar* MachineDescription::FindLidar(std::string_view lidar_name) const {
+  for (const Lidar& lidar : sensors.lidars) {
+    if (lidar.name == lidar_name) return &lidar;
+  }
+  return nullptr;
+}
+
 const Material* MachineDescription::FindMaterial(const std::string& material_name) const {
   for (const auto& material : materials) {
     if (material.name == material_name) return &material;

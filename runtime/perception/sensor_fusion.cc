@@ -22,9 +22,7 @@ const Segmenter& CachedSegmenter(const std::string& onnx_path) {
 }
 
 const model::Lidar& LidarNamed(const model::MachineDescription& machine, const std::string& name) {
-  for (const model::Lidar& lidar : machine.sensors.lidars) {
-    if (lidar.name == name) return lidar;
-  }
+  if (const model::Lidar* lidar = machine.FindLidar(name)) return *lidar;
   throw std::invalid_argument("FuseSensorFrames: machine '" + machine.name + "' has no LiDAR '" +
                               name + "'");
 }

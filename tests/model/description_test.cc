@@ -41,6 +41,9 @@ TEST(Description, XcmgArmMatchesTheSeedAndIsInSI) {
   ASSERT_NE(m.FindMaterial("river_sand"), nullptr);
   EXPECT_TRUE(m.FindMaterial("river_sand")->difficult);
   EXPECT_FALSE(m.FindMaterial("big_gravel")->difficult);
+  ASSERT_NE(m.FindLidar("top_16"), nullptr);
+  EXPECT_EQ(m.FindLidar("top_16")->name, "top_16");
+  EXPECT_EQ(m.FindLidar("top_1"), nullptr);  // no prefix match
 }
 
 TEST(Description, UnknownMachineNamesSuggestTheNearest) {

@@ -88,12 +88,11 @@ std::vector<perception::Scanline> WithoutStandingLevel(
 
 sensors::ScannerConfig ScannerConfigFromDescription(const model::MachineDescription& machine,
                                                     std::string_view lidar_name) {
-  for (const model::Lidar& lidar : machine.sensors.lidars) {
-    if (lidar.name != lidar_name) continue;
+  if (const model::Lidar* lidar = machine.FindLidar(lidar_name)) {
     sensors::ScannerConfig config;  // timing, active arc, pan range: the library's
     // The LiDAR spins about its z; the rangefinder's mirror circle lies in its scanner frame's
     // x–z plane (spinning about −y, z the pan axis): scanner = lidar turned by −90° about x.
-    config.T_cab_scanner = sensors::PoseToIsometry(lidar.pose) *
+    config.T_cab_scanner = sensors::PoseToIsometry(lidar->pose) *
                            Eigen::AngleAxisd(-0.5 * kPi, Eigen::Vector3d::UnitX());
     return config;
   }

@@ -343,6 +343,15 @@ Command AddReplay(CLI::App& app, const Globals& g) {
             // reader, which says what is wrong with it.
             if (autoshovel::recording::IsTruckLoadingManifest(std::filesystem::path(c->recording) /
                                                               "recording.yaml")) {
+              // The camera and predictor options belong to the loader's replay: said, not
+              // silently ignored.
+              if (c->truth_labels || c->segmentation_scale || !c->segmenter.empty() ||
+                  !c->predictor.empty()) {
+                std::cerr << "autoshovel replay: " << c->recording
+                          << " is a truck-loading recording (scans only): --truth, --network, "
+                             "--segmenter, --segmentation-scale and --predictor do not apply\n";
+                return 2;
+              }
               return autoshovel::app::RunTruckReplay(c->recording, c->out, c->check, std::cout,
                                                      std::cerr);
             }

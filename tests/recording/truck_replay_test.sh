@@ -40,6 +40,13 @@ grep -q "truck 1/1 identical, bed maps $scans/$scans identical" "$tmp/replay.out
   { cat "$tmp/replay.out"; fail "replay does not report $scans identical bed maps"; }
 [ -s "$tmp/replay/figures/bed_map.png" ] || fail "no bed map picture"
 
+# The loader's camera options do not apply to a truck recording: refused, no run folder.
+"$autoshovel" "${models[@]}" replay "$tmp/rec" --truth -o "$tmp/replay_truth" >"$tmp/truth.out" 2>&1
+status=$?
+[ "$status" -eq 2 ] || { cat "$tmp/truth.out"; fail "--truth on a truck recording: exit $status"; }
+grep -q "is a truck-loading recording" "$tmp/truth.out" || { cat "$tmp/truth.out"; fail "no reason given"; }
+[ ! -e "$tmp/replay_truth" ] || fail "a refused replay left a run folder"
+
 # The swing-back scan's readings 0.2 m higher: its bed map must differ, the truck not.
 awk -F, 'BEGIN { OFS = "," } $1 == 1 && $6 == 1 { $5 = $5 + 0.2 } { print }' \
   "$tmp/rec/scan_points.csv" >"$tmp/points.csv" && mv "$tmp/points.csv" "$tmp/rec/scan_points.csv"

@@ -65,6 +65,51 @@ bool ClipSlab(double p0, double d, double lo, double hi, double& t_lo, double& t
   return t_lo <= t_hi;
 }
 
+// Rectangles (lo_x, lo_y, hi_x, hi_y) binned on a uniform grid over [x_lo, x_hi] × [y_lo, y_hi]
+// in compressed rows: the rectangles touching cell k are index[cell_start[k] .. cell_start[k+1]).
+// Cells of `min_cell`, larger where the extent would need more than 256 per side. Shared by the
+// scene's box grid (footprints) and ParallelRayBoxes (shadows on the plane across the sun).
+struct UniformBins {
+  double x0 = 0, y0 = 0, cell = 1;  // corner of cell (0, 0), cell size
+  int nx = 0, ny = 0;
+  std::vector<int> cell_start, index;
+};
+
+UniformBins BinRectangles(const std::vector<Eigen::Vector4d>& rects, double x_lo, double y_lo,
+                          double x_hi, double y_hi, double min_cell) {
+  UniformBins b;
+  const double margin = 1e-6;
+  b.cell = std::max(min_cell, std::max(x_hi - x_lo, y_hi - y_lo) / 256.0);
+  b.x0 = x_lo - margin, b.y0 = y_lo - margin;
+  b.nx = std::max(1, static_cast<int>(std::ceil((x_hi - x_lo + 2 * margin) / b.cell)));
+  b.ny = std::max(1, static_cast<int>(std::ceil((y_hi - y_lo + 2 * margin) / b.cell)));
+  auto span = [&](const Eigen::Vector4d& f, int& ix0, int& iy0, int& ix1, int& iy1) {
+    ix0 = std::clamp(static_cast<int>(std::floor((f[0] - b.x0) / b.cell)), 0, b.nx - 1);
+    iy0 = std::clamp(static_cast<int>(std::floor((f[1] - b.y0) / b.cell)), 0, b.ny - 1);
+    ix1 = std::clamp(static_cast<int>(std::floor((f[2] - b.x0) / b.cell)), 0, b.nx - 1);
+    iy1 = std::clamp(static_cast<int>(std::floor((f[3] - b.y0) / b.cell)), 0, b.ny - 1);
+  };
+  std::vector<int> count(static_cast<std::size_t>(b.nx) * b.ny + 1, 0);
+  for (const Eigen::Vector4d& f : rects) {
+    int ix0, iy0, ix1, iy1;
+    span(f, ix0, iy0, ix1, iy1);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) ++count[iy * b.nx + ix + 1];
+    }
+  }
+  for (std::size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
+  b.cell_start = count;
+  b.index.resize(count.back());
+  for (std::size_t i = 0; i < rects.size(); ++i) {
+    int ix0, iy0, ix1, iy1;
+    span(rects[i], ix0, iy0, ix1, iy1);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) b.index[count[iy * b.nx + ix]++] = static_cast<int>(i);
+    }
+  }
+  return b;
+}
+
 }  // namespace
 
 bool IntersectBox(const plant::OrientedBox& box, const Eigen::Vector3d& origin,
@@ -134,37 +179,10 @@ void RaycastScene::BuildBoxGrid() {
     return;
   }
   // Cells of 2 m (a wall's thickness to a machine's length), larger for a huge yard.
-  const double margin = 1e-6;
-  g.cell = std::max(2.0, std::max(x_hi - x_lo, y_hi - y_lo) / 256.0);
-  g.x0 = x_lo - margin, g.y0 = y_lo - margin;
-  g.nx = std::max(1, static_cast<int>(std::ceil((x_hi - x_lo + 2 * margin) / g.cell)));
-  g.ny = std::max(1, static_cast<int>(std::ceil((y_hi - y_lo + 2 * margin) / g.cell)));
-  auto span = [&](const Eigen::Vector4d& f, int& ix0, int& iy0, int& ix1, int& iy1) {
-    ix0 = std::clamp(static_cast<int>(std::floor((f[0] - g.x0) / g.cell)), 0, g.nx - 1);
-    iy0 = std::clamp(static_cast<int>(std::floor((f[1] - g.y0) / g.cell)), 0, g.ny - 1);
-    ix1 = std::clamp(static_cast<int>(std::floor((f[2] - g.x0) / g.cell)), 0, g.nx - 1);
-    iy1 = std::clamp(static_cast<int>(std::floor((f[3] - g.y0) / g.cell)), 0, g.ny - 1);
-  };
-  std::vector<int> count(static_cast<std::size_t>(g.nx) * g.ny + 1, 0);
-  for (const Eigen::Vector4d& f : footprint) {
-    int ix0, iy0, ix1, iy1;
-    span(f, ix0, iy0, ix1, iy1);
-    for (int iy = iy0; iy <= iy1; ++iy) {
-      for (int ix = ix0; ix <= ix1; ++ix) ++count[iy * g.nx + ix + 1];
-    }
-  }
-  for (std::size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
-  g.cell_start = count;
-  g.box_index.resize(count.back());
-  for (std::size_t i = 0; i < footprint.size(); ++i) {
-    int ix0, iy0, ix1, iy1;
-    span(footprint[i], ix0, iy0, ix1, iy1);
-    for (int iy = iy0; iy <= iy1; ++iy) {
-      for (int ix = ix0; ix <= ix1; ++ix) {
-        g.box_index[count[iy * g.nx + ix]++] = static_cast<int>(i);
-      }
-    }
-  }
+  const UniformBins bins = BinRectangles(footprint, x_lo, y_lo, x_hi, y_hi, 2.0);
+  g.x0 = bins.x0, g.y0 = bins.y0, g.cell = bins.cell, g.nx = bins.nx, g.ny = bins.ny;
+  g.cell_start = bins.cell_start;
+  g.box_index = bins.index;
 }
 
 float RaycastScene::PatchMax(int px, int py) const {
@@ -456,11 +474,7 @@ RayHit RaycastScene::CastBoxes(const Eigen::Vector3d& origin, const Eigen::Vecto
       }
     }
   }
-  if (hit.hit) {
-    hit.point = origin + hit.range * direction;
-    hit.semantic_class = boxes_[hit.box].semantic_class;
-    hit.reflectivity = boxes_[hit.box].reflectivity;
-  }
+  if (hit.hit) return BoxHit(hit.box, origin, direction, hit.range, hit.normal);
   return hit;
 }
 
@@ -531,36 +545,11 @@ ParallelRayBoxes::ParallelRayBoxes(const RaycastScene& scene, const Eigen::Vecto
   }
   if (everywhere_) return;
   // Cells of 1 m (most boxes are walls and machine parts a few metres long), larger for a
-  // huge yard, so that the grid stays within 256 × 256.
-  const double margin = 1e-6;
-  cell_ = std::max(1.0, std::max(hi1 - lo1, hi2 - lo2) / 256.0);
-  x0_ = lo1 - margin, y0_ = lo2 - margin;
-  nx_ = std::max(1, static_cast<int>(std::ceil((hi1 - lo1 + 2 * margin) / cell_)));
-  ny_ = std::max(1, static_cast<int>(std::ceil((hi2 - lo2 + 2 * margin) / cell_)));
-  auto span = [&](const Eigen::Vector4d& f, int& ix0, int& iy0, int& ix1, int& iy1) {
-    ix0 = std::clamp(static_cast<int>(std::floor((f[0] - x0_) / cell_)), 0, nx_ - 1);
-    iy0 = std::clamp(static_cast<int>(std::floor((f[1] - y0_) / cell_)), 0, ny_ - 1);
-    ix1 = std::clamp(static_cast<int>(std::floor((f[2] - x0_) / cell_)), 0, nx_ - 1);
-    iy1 = std::clamp(static_cast<int>(std::floor((f[3] - y0_) / cell_)), 0, ny_ - 1);
-  };
-  std::vector<int> count(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
-  for (const Eigen::Vector4d& f : bounds) {
-    int ix0, iy0, ix1, iy1;
-    span(f, ix0, iy0, ix1, iy1);
-    for (int iy = iy0; iy <= iy1; ++iy) {
-      for (int ix = ix0; ix <= ix1; ++ix) ++count[iy * nx_ + ix + 1];
-    }
-  }
-  for (std::size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
-  cell_start_ = count;
-  box_index_.resize(count.back());
-  for (std::size_t i = 0; i < bounds.size(); ++i) {
-    int ix0, iy0, ix1, iy1;
-    span(bounds[i], ix0, iy0, ix1, iy1);
-    for (int iy = iy0; iy <= iy1; ++iy) {
-      for (int ix = ix0; ix <= ix1; ++ix) box_index_[count[iy * nx_ + ix]++] = static_cast<int>(i);
-    }
-  }
+  // huge yard.
+  UniformBins bins = BinRectangles(bounds, lo1, lo2, hi1, hi2, 1.0);
+  x0_ = bins.x0, y0_ = bins.y0, cell_ = bins.cell, nx_ = bins.nx, ny_ = bins.ny;
+  cell_start_ = std::move(bins.cell_start);
+  box_index_ = std::move(bins.index);
 }
 
 bool ParallelRayBoxes::Occluded(const Eigen::Vector3d& origin, double max_range) const {

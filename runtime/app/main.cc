@@ -263,8 +263,18 @@ Command AddMap(CLI::App& app, const Globals& g) {
                   "Poses of a sequence: lines 'name x y z roll pitch yaw' (the cloud's file "
                   "name; metres, degrees) in the first cloud's frame");
   cmd->add_option("--reference", c->map_cloud.references,
-                  "A scan of the same place empty, from the same scanner pose (repeatable): "
-                  "heaps are measured above it, not above the floor plane");
+                  "A scan of the same place empty (repeatable), from the same scanner pose "
+                  "unless --register: heaps are measured above it, not above the floor plane");
+  cmd->add_flag("--register", c->map_cloud.register_reference,
+                "--reference was taken from another set-up: register it onto the scan "
+                "(generalized ICP) first; the scans must share unchanged structure (walls, "
+                "floor around the heap, surroundings)");
+  cmd->add_option("--floor", c->map_cloud.floor,
+                  "The floor, when the scan does not show it: the plane a x + b y + c z = d in "
+                  "the first cloud's frame (a,b,c,d; e.g. surveyed, or from the bin's drawings)")
+      ->check(autoshovel::app::FiniteIn(-1e5, 1e5))
+      ->expected(4)
+      ->delimiter(',');
   cmd->add_option("--cell", c->map_cloud.cell, "Cell edge [m] (default: the extent / 250)")
       ->check(autoshovel::app::FiniteIn(0.001, 10));
   cmd->add_option("--up", c->map_cloud.up, "Gravity up in the first cloud's frame: x y z")

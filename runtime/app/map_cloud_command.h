@@ -17,9 +17,14 @@ struct MapCloudOptions {
   /// frame, R = Rz(yaw) Ry(pitch) Rx(roll); all clouds or none (6 values each).
   std::vector<double> poses;
   std::string poses_file;  ///< or a poses file (scan_poses.h): a line per cloud, by file name
-  /// Scans of the same place empty, in the first cloud's frame (the scanner not moved): heaps
-  /// are measured above them instead of above the floor plane.
+  /// Scans of the same place empty, in the first cloud's frame (the scanner not moved) or, with
+  /// `register_reference`, registered onto the scans: heaps are measured above them instead of
+  /// above the floor plane.
   std::vector<std::string> references;
+  bool register_reference = false;
+  /// The floor a x + b y + c z = d in the first cloud's frame (4 values), when the scan does not
+  /// show it.
+  std::vector<double> floor;
   double cell = 0;                  ///< [m]; 0: from the data
   std::vector<double> up;           ///< gravity up in the first cloud's frame (3 values), if known
   double alpha_d = 4e-6;            ///< σp² = α_d d²

@@ -99,6 +99,13 @@ refuses scenario-fifo "fifo.yaml: is a named pipe" -- "${models[@]}" scenario "$
 # map
 refuses map-frames-zero "--frames" -- "${models[@]}" map cone_pile --frames 0
 refuses map-advance-inf "--advance" -- "${models[@]}" map cone_pile --advance inf
+balls="$source_dir/tests/data/pile_scans/balls_25.pcd"
+empty_box="$source_dir/tests/data/pile_scans/empty_box.pcd"
+refuses map-cloud-floor-three "--floor" -- map --cloud "$balls" --floor 0,0,1 --output-dir "$tmp/m1"
+refuses map-cloud-floor-nan "--floor" -- map --cloud "$balls" --floor 0,0,nan,1 --output-dir "$tmp/m2"
+refuses map-cloud-floor-and-reference "--floor or --reference" -- map --cloud "$balls" --floor 0,0,1,0 --reference "$empty_box" --output-dir "$tmp/m3"
+refuses map-cloud-register-alone "--register" -- map --cloud "$balls" --register --output-dir "$tmp/m4"
+refuses map-cloud-floor-zero "--floor" -- map --cloud "$balls" --floor 0,0,0,1 --output-dir "$tmp/m5"
 # select
 refuses select-top-zero "--top" -- "${models[@]}" select cone_pile --top 0
 refuses select-safety-nan "--safety-distance" -- "${models[@]}" select cone_pile --safety-distance nan

@@ -12,6 +12,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 namespace autoshovel::perception {
 
@@ -84,6 +86,63 @@ bool LargestPlane(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud,
   return !inliers.empty();
 }
 
+// The ground frame on `plane`: z along its normal; x the scanner's direction of view projected on
+// it (so the pictures look the way the scanner looked); origin on the plane below `centroid`.
+Eigen::Isometry3d GroundFrame(const ScanPlane& plane, const Eigen::Vector3d& centroid,
+                              const Eigen::Vector3d& scanner_origin) {
+  const Eigen::Vector3d z = plane.normal;
+  Eigen::Vector3d view = centroid - scanner_origin;
+  view -= view.dot(z) * z;
+  if (view.norm() < 1e-6) view = z.unitOrthogonal();
+  const Eigen::Vector3d x = view.normalized(), y = z.cross(x);
+  Eigen::Isometry3d T_scan_ground = Eigen::Isometry3d::Identity();
+  T_scan_ground.linear() << x, y, z;
+  T_scan_ground.translation() = centroid - (z.dot(centroid) - plane.offset) * z;
+  return T_scan_ground.inverse();
+}
+
+Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points,
+                         const std::vector<int>& indices) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const int i : indices) c += points[static_cast<std::size_t>(i)];
+  return c / static_cast<double>(std::max<std::size_t>(1, indices.size()));
+}
+
+// The user's floor n·p = d: unit normal facing the scanner (or `up`); its noise from the points
+// within `threshold` of it, if the scan shows any of it.
+ScanPlane GivenFloor(const Eigen::Vector4d& given, const std::vector<Eigen::Vector3d>& points,
+                     const Eigen::Vector3d& scanner_origin,
+                     const std::optional<Eigen::Vector3d>& up, double threshold,
+                     std::vector<int>& inliers) {
+  const double norm = given.head<3>().norm();
+  if (!given.allFinite() || !(norm > 0)) {
+    throw std::invalid_argument("the floor plane needs a finite, non-zero normal");
+  }
+  ScanPlane plane;
+  plane.normal = given.head<3>() / norm;
+  plane.offset = given.w() / norm;
+  const double side = up ? plane.normal.dot(*up) : plane.normal.dot(scanner_origin) - plane.offset;
+  if (side < 0) {
+    plane.normal = -plane.normal;
+    plane.offset = -plane.offset;
+  }
+  std::vector<double> distances;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = std::abs(plane.normal.dot(points[i]) - plane.offset);
+    if (d < threshold) {
+      inliers.push_back(static_cast<int>(i));
+      distances.push_back(d);
+    }
+  }
+  plane.inliers = static_cast<int>(inliers.size());
+  if (distances.size() >= 3) {
+    auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+    std::nth_element(distances.begin(), middle, distances.end());
+    plane.noise = 1.4826 * *middle;
+  }
+  return plane;
+}
+
 }  // namespace
 
 ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
@@ -110,99 +169,121 @@ ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
                         static_cast<float>(p.z()));
   }
 
-  // The floor: among the largest planes (taken off one after the other), the one with the
-  // scene above it. A heap that covers most of a bin's floor offers a large, gently sloping
-  // plane of its own, with the floor and the walls' feet below it; the floor has (almost)
-  // everything on its scanner side. With `up` given, planes steeper than 30° to it are walls.
-  struct Candidate {
-    ScanPlane plane;
-    std::vector<int> inliers;
-    double above = 0;  // share of all points on the plane or on its upper side
-  };
-  std::vector<Candidate> candidates;
   std::vector<char> taken(points.size(), 0);
-  for (int attempt = 0; attempt < options.floor_candidates; ++attempt) {
-    pcl::IndicesPtr remaining(new pcl::Indices);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (!taken[i]) remaining->push_back(static_cast<int>(i));
-    }
-    std::vector<int> inliers;
-    if (remaining->size() < options.min_ground_fraction * static_cast<double>(points.size()) ||
-        !LargestPlane(cloud, remaining, ground.threshold, inliers) ||
-        inliers.size() < options.min_ground_fraction * static_cast<double>(points.size())) {
-      break;
-    }
-    for (const int i : inliers) taken[static_cast<std::size_t>(i)] = 1;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const int i : inliers) centroid += points[static_cast<std::size_t>(i)];
-    centroid /= static_cast<double>(inliers.size());
-    const Eigen::Vector3d hint = options.up.value_or(scanner_origin - centroid);
-    ScanPlane plane = Refit(points, inliers, hint);
-    std::vector<int> close;
-    for (const int i : inliers) {
-      if (std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset) <
-          0.5 * ground.threshold) {
-        close.push_back(i);
+  std::vector<int> inliers;
+  if (options.floor) {
+    ground.floor =
+        GivenFloor(*options.floor, points, scanner_origin, options.up, ground.threshold, inliers);
+    ground.floor_given = true;
+    ground.ok = true;
+  } else {
+    // The floor: among the largest planes (taken off one after the other), the one with the
+    // scene above it. A heap that covers most of a bin's floor offers a large, gently sloping
+    // plane of its own, with the floor and the walls' feet below it; the floor has (almost)
+    // everything on its scanner side. With `up` given, planes steeper than 30° to it are walls.
+    struct Candidate {
+      ScanPlane plane;
+      std::vector<int> inliers;
+      double above = 0;  // share of all points on the plane or on its upper side
+    };
+    std::vector<Candidate> candidates;
+    for (int attempt = 0; attempt < options.floor_candidates; ++attempt) {
+      pcl::IndicesPtr remaining(new pcl::Indices);
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        if (!taken[i]) remaining->push_back(static_cast<int>(i));
       }
+      std::vector<int> found;
+      if (remaining->size() < options.min_ground_fraction * static_cast<double>(points.size()) ||
+          !LargestPlane(cloud, remaining, ground.threshold, found) ||
+          found.size() < options.min_ground_fraction * static_cast<double>(points.size())) {
+        break;
+      }
+      for (const int i : found) taken[static_cast<std::size_t>(i)] = 1;
+      const Eigen::Vector3d hint = options.up.value_or(scanner_origin - Centroid(points, found));
+      ScanPlane plane = Refit(points, found, hint);
+      std::vector<int> close;
+      for (const int i : found) {
+        if (std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset) <
+            0.5 * ground.threshold) {
+          close.push_back(i);
+        }
+      }
+      if (close.size() >= 3) plane = Refit(points, close, hint);
+      plane.inliers = static_cast<int>(found.size());
+      if (options.up && plane.normal.dot(options.up->normalized()) < std::cos(0.5236)) continue;
+      Candidate c{plane, std::move(found), 0};
+      long above = 0;
+      for (const auto& p : points) {
+        above += plane.normal.dot(p) - plane.offset > -2 * ground.threshold ? 1 : 0;
+      }
+      c.above = static_cast<double>(above) / static_cast<double>(points.size());
+      candidates.push_back(std::move(c));
+      // Planes come off largest first: the first with the scene above it is the floor.
+      if (candidates.back().above >= options.floor_min_above) break;
     }
-    if (close.size() >= 3) plane = Refit(points, close, hint);
-    plane.inliers = static_cast<int>(inliers.size());
-    if (options.up && plane.normal.dot(options.up->normalized()) < std::cos(0.5236)) continue;
-    Candidate c{plane, inliers, 0};
-    long above = 0;
-    for (const auto& p : points) {
-      above += plane.normal.dot(p) - plane.offset > -2 * ground.threshold ? 1 : 0;
-    }
-    c.above = static_cast<double>(above) / static_cast<double>(points.size());
-    candidates.push_back(std::move(c));
-  }
-  // The largest candidate with the scene standing on it; failing that, the one with the most
-  // of the scene above it (a heap covering the whole floor leaves no plane below everything).
-  const Candidate* chosen = nullptr;
-  for (const Candidate& c : candidates) {
-    if (c.above < options.floor_min_above) continue;
-    if (chosen == nullptr || c.plane.inliers > chosen->plane.inliers) chosen = &c;
-  }
-  if (chosen == nullptr) {
+    // The largest candidate with the scene standing on it.
+    const Candidate* chosen = nullptr;
+    const Candidate* largest = nullptr;
     for (const Candidate& c : candidates) {
-      if (chosen == nullptr || c.above > chosen->above) chosen = &c;
+      ground.best_above = std::max(ground.best_above, c.above);
+      if (largest == nullptr || c.plane.inliers > largest->plane.inliers) largest = &c;
+      if (c.above < options.floor_min_above) continue;
+      if (chosen == nullptr || c.plane.inliers > chosen->plane.inliers) chosen = &c;
     }
-  }
-  if (chosen != nullptr) {
+    if (largest == nullptr) {
+      ground.failure = "no floor: no plane holds " +
+                       std::to_string(static_cast<int>(100 * options.min_ground_fraction)) +
+                       " % of the " + std::to_string(points.size()) +
+                       " points; scan some ground around the heap, or give --reference "
+                       "(a scan of the empty place)";
+      return ground;
+    }
+    if (chosen == nullptr) {
+      // No plane bounds the scene: the scan shows no floor (see the header).
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    "no floor in view: no plane has the scene above it (the best has %.1f %% of "
+                    "the points above it, a floor %.0f %%); the scan shows one surface, the top "
+                    "of a heap that hides the floor. Its relief and form are mapped; for its "
+                    "volume give the floor (--floor a,b,c,d: the plane a x + b y + c z = d in "
+                    "the first cloud's frame) or a scan of the empty place (--reference)",
+                    100 * ground.best_above, 100 * options.floor_min_above);
+      ground.failure = text;
+      // The surface's mean plane: least squares over every point (the largest RANSAC plane may
+      // be one flank of the heap).
+      std::vector<int> all(points.size());
+      for (std::size_t i = 0; i < points.size(); ++i) all[i] = static_cast<int>(i);
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (const auto& p : points) mean += p;
+      mean /= static_cast<double>(points.size());
+      ScanPlane surface = Refit(points, all, options.up.value_or(scanner_origin - mean));
+      surface.inliers = largest->plane.inliers;
+      surface.noise = largest->plane.noise;
+      ground.surface = surface;
+      ground.T_ground_scan = GroundFrame(surface, mean, scanner_origin);
+      return ground;
+    }
     ground.floor = chosen->plane;
     ground.ok = true;
+    inliers = chosen->inliers;
   }
-  if (!ground.ok) {
-    ground.failure = "no floor: no plane holds " +
-                     std::to_string(static_cast<int>(100 * options.min_ground_fraction)) +
-                     " % of the " + std::to_string(points.size()) +
-                     " points; scan some ground around the heap, or give --reference "
-                     "(a scan of the empty place)";
-    return ground;
-  }
-  const std::vector<int>& inliers = chosen->inliers;
-  // The ground frame: z along the floor normal; x the scanner's direction of view projected on
-  // the floor (so the pictures look the way the scanner looked); origin below the floor's centroid.
-  const Eigen::Vector3d z = ground.floor.normal;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const int i : inliers) centroid += points[static_cast<std::size_t>(i)];
-  centroid /= static_cast<double>(inliers.size());
-  Eigen::Vector3d view = centroid - scanner_origin;
-  view -= view.dot(z) * z;
-  if (view.norm() < 1e-6) view = z.unitOrthogonal();
-  const Eigen::Vector3d x = view.normalized(), y = z.cross(x);
-  Eigen::Matrix3d R_scan_ground;
-  R_scan_ground << x, y, z;
-  const Eigen::Vector3d origin = centroid - (z.dot(centroid) - ground.floor.offset) * z;
-  Eigen::Isometry3d T_scan_ground = Eigen::Isometry3d::Identity();
-  T_scan_ground.linear() = R_scan_ground;
-  T_scan_ground.translation() = origin;
-  ground.T_ground_scan = T_scan_ground.inverse();
+  if (!inliers.empty()) {
+    centroid = Centroid(points, inliers);
+  } else {  // a given floor the scan does not show: below the points' centroid
+    for (const auto& p : points) centroid += p;
+    centroid /= static_cast<double>(points.size());
+  }
+  ground.T_ground_scan = GroundFrame(ground.floor, centroid, scanner_origin);
+  const Eigen::Vector3d z = ground.floor.normal;
 
-  // Walls: further large planes, steep to the floor.
+  // Walls: further large planes, steep to the floor. Gentler planes (slabs of a heap's flanks,
+  // which stand no steeper than the material's angle of repose) are taken off and passed over.
   std::fill(taken.begin(), taken.end(), 0);
   for (const int i : inliers) taken[static_cast<std::size_t>(i)] = 1;
-  for (int k = 0; k < options.max_walls; ++k) {
+  for (int k = 0;
+       k < 3 * options.max_walls && static_cast<int>(ground.walls.size()) < options.max_walls;
+       ++k) {
     pcl::IndicesPtr next(new pcl::Indices);
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (!taken[i]) next->push_back(static_cast<int>(i));

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "runtime/plot/image_file.h"
 
@@ -46,16 +47,26 @@ void WriteLayerPng(const std::string& path, const GridMap& map, const LayerPictu
     if (picture.square_root) v = std::sqrt(std::max(0.0, v));
     return v * picture.scale;
   };
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  // The colour bar spans the 0.5–99.5 % of the values (all of them for labels): one stray cell
+  // must not squeeze the rest of the map into a single colour. Cells beyond are drawn in the
+  // end colours, and the bar's end says so (">=", "<=").
+  std::vector<double> values;
   for (int x = 0; x < nx; ++x) {
     for (int y = 0; y < ny; ++y) {
       const double v = value_of(x, y);
-      if (!std::isfinite(v)) continue;
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
+      if (std::isfinite(v)) values.push_back(v);
     }
   }
-  if (!std::isfinite(lo)) lo = 0, hi = 1;
+  double lo = 0, hi = 1;
+  bool clipped_lo = false, clipped_hi = false;
+  if (!values.empty()) {
+    std::sort(values.begin(), values.end());
+    const std::size_t cut = picture.categorical ? 0 : values.size() / 200;
+    lo = values[cut];
+    hi = values[values.size() - 1 - cut];
+    clipped_lo = values.front() < lo;
+    clipped_hi = values.back() > hi;
+  }
   if (hi <= lo) hi = lo + 1e-9;
   cv::Mat ramp(1, 256, CV_8U), colours;
   for (int i = 0; i < 256; ++i) ramp.at<std::uint8_t>(0, i) = static_cast<std::uint8_t>(i);
@@ -98,10 +109,12 @@ void WriteLayerPng(const std::string& path, const GridMap& map, const LayerPictu
       cv::line(canvas, {x_bar, margin + i}, {x_bar + 20, margin + i}, colour(v));
     }
     char text[64];
-    std::snprintf(text, sizeof text, "%.3g %s", hi, picture.unit.c_str());
+    std::snprintf(text, sizeof text, "%s%.3g %s", clipped_hi ? ">= " : "", hi,
+                  picture.unit.c_str());
     cv::putText(canvas, text, {x_bar + 24, margin + 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0},
                 1, cv::LINE_AA);
-    std::snprintf(text, sizeof text, "%.3g %s", lo, picture.unit.c_str());
+    std::snprintf(text, sizeof text, "%s%.3g %s", clipped_lo ? "<= " : "", lo,
+                  picture.unit.c_str());
     cv::putText(canvas, text, {x_bar + 24, margin + map_h}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 {0, 0, 0}, 1, cv::LINE_AA);
   } else {

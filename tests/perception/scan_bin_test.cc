@@ -13,6 +13,7 @@
 #include <random>
 
 #include "runtime/perception/scan/scan_map.h"
+#include "tests/perception/synthetic_scan.h"
 
 namespace autoshovel::perception {
 namespace {
@@ -68,46 +69,16 @@ bool Solid(const Height& material, const Eigen::Vector3d& p) {
   return p.x() > kHalf || std::abs(p.y()) > kHalf;
 }
 
-// A scan from `scanner` towards `target` (world, z up) in the scanner's frame: z along the line of
-// sight, x to its right; a ray per 3 mrad over ±0.6 × ±0.45 rad, 3 mm range noise.
+// A scan from `scanner` towards `target`: a ray per 3 mrad over ±0.6 × ±0.45 rad, 3 mm range
+// noise (synthetic_scan.h).
 ScanCloud ScanBin(const Height& material, const Eigen::Vector3d& scanner,
                   const Eigen::Vector3d& target, unsigned seed,
                   Eigen::Isometry3d& T_world_scanner) {
-  const Eigen::Vector3d z = (target - scanner).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  T_world_scanner = Eigen::Isometry3d::Identity();
-  T_world_scanner.linear() << x, y, z;
-  T_world_scanner.translation() = scanner;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, 0.003);
-  ScanCloud scan;
-  constexpr double kStep = 0.02;
-  for (double a = -0.6; a <= 0.6; a += 0.003) {
-    for (double b = -0.45; b <= 0.45; b += 0.003) {
-      const Eigen::Vector3d d = (z + a * x + b * y).normalized();
-      double t0 = 0, t1 = 0;
-      bool hit = false;
-      for (double t = 0.1; t < 15; t += kStep) {
-        if (Solid(material, scanner + t * d)) {
-          t0 = t - kStep;
-          t1 = t;
-          hit = true;
-          break;
-        }
-      }
-      if (!hit) continue;
-      for (int i = 0; i < 25; ++i) {
-        const double t = 0.5 * (t0 + t1);
-        (Solid(material, scanner + t * d) ? t1 : t0) = t;
-      }
-      sensors::LidarPoint point;
-      point.p_sensor =
-          (T_world_scanner.inverse() * (scanner + (t1 + noise(rng)) * d)).cast<float>();
-      scan.cloud.points.push_back(point);
-    }
-  }
-  return scan;
+  ScanPattern pattern;
+  pattern.half_a = 0.6, pattern.half_b = 0.45, pattern.step = 0.003;
+  pattern.march = 0.02, pattern.near = 0.1, pattern.far = 15, pattern.bisections = 25;
+  return ScanSolid([&](const Eigen::Vector3d& p) { return Solid(material, p); }, scanner, target,
+                   seed, T_world_scanner, pattern);
 }
 
 const Eigen::Vector3d kScanner(-2.0, 0.2, 4.5), kTarget(0.4, 0.0, 0.3);

@@ -16,6 +16,7 @@
 #include "identification/camera_lidar/point_cloud_io.h"
 #include "runtime/perception/scan/geotiff_export.h"
 #include "runtime/perception/scan/scan_poses.h"
+#include "tests/perception/synthetic_scan.h"
 
 namespace autoshovel::perception {
 namespace {
@@ -31,48 +32,11 @@ struct ConeHeap {
   double Volume() const { return kPi * radius * radius * height / 3.0; }
 };
 
-// Scans the heightfield from `scanner` (world) over a grid of directions around `target`,
-// returning points in the scanner's frame: z along the line of sight to the target (the range
-// axis), x to its right, as a Livox-style scanner writes them.
+// Scans the cone heap on the floor z = 0 (synthetic_scan.h).
 ScanCloud Scan(const ConeHeap& heap, const Eigen::Vector3d& scanner, const Eigen::Vector3d& target,
                unsigned seed, Eigen::Isometry3d& T_world_scanner) {
-  const Eigen::Vector3d z = (target - scanner).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  T_world_scanner = Eigen::Isometry3d::Identity();
-  T_world_scanner.linear() << x, y, z;
-  T_world_scanner.translation() = scanner;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, 0.003);
-  ScanCloud scan;
-  for (double a = -0.45; a <= 0.45; a += 0.0025) {
-    for (double b = -0.35; b <= 0.35; b += 0.0025) {
-      const Eigen::Vector3d d = (z + a * x + b * y).normalized();
-      // March to the first crossing of the heightfield, then bisect.
-      double t0 = 0, t1 = 0;
-      bool hit = false;
-      for (double t = 0.05; t < 20; t += 0.01) {
-        const Eigen::Vector3d p = scanner + t * d;
-        if (p.z() <= heap.Surface(p.x(), p.y())) {
-          t0 = t - 0.01;
-          t1 = t;
-          hit = true;
-          break;
-        }
-      }
-      if (!hit) continue;
-      for (int i = 0; i < 30; ++i) {
-        const double t = 0.5 * (t0 + t1);
-        const Eigen::Vector3d p = scanner + t * d;
-        (p.z() <= heap.Surface(p.x(), p.y()) ? t1 : t0) = t;
-      }
-      const Eigen::Vector3d p_world = scanner + (t1 + noise(rng)) * d;
-      sensors::LidarPoint point;
-      point.p_sensor = (T_world_scanner.inverse() * p_world).cast<float>();
-      scan.cloud.points.push_back(point);
-    }
-  }
-  return scan;
+  return ScanSolid([&](const Eigen::Vector3d& p) { return p.z() <= heap.Surface(p.x(), p.y()); },
+                   scanner, target, seed, T_world_scanner);
 }
 
 TEST(ScanMap, TwoScansOfAConeGiveItsVolume) {

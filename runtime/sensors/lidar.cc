@@ -118,7 +118,13 @@ double LidarReturnProbability(const model::Lidar& lidar, double range, double re
 
 PointCloud SimulateLidarFrame(const model::Lidar& lidar, const RaycastScene& scene,
                               const Eigen::Isometry3d& T_world_sensor, double stamp, Rng& rng) {
-  const std::vector<LidarRay> rays = LidarScanPattern(lidar, stamp);
+  return SimulateLidarFrame(lidar, scene, T_world_sensor, stamp, rng,
+                            LidarScanPattern(lidar, stamp));
+}
+
+PointCloud SimulateLidarFrame(const model::Lidar& lidar, const RaycastScene& scene,
+                              const Eigen::Isometry3d& T_world_sensor, double stamp, Rng& rng,
+                              const std::vector<LidarRay>& rays) {
   PointCloud cloud;
   cloud.stamp = stamp;
   cloud.sensor = lidar.name;

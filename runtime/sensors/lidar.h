@@ -83,5 +83,10 @@ double LidarReturnProbability(const model::Lidar& lidar, double range, double re
 /// noise. Draws from `rng` in ray order (two draws per ray that hits).
 PointCloud SimulateLidarFrame(const model::Lidar& lidar, const RaycastScene& scene,
                               const Eigen::Isometry3d& T_world_sensor, double stamp, Rng& rng);
+/// The same with the frame's pattern already computed (LidarScanPattern(lidar, stamp)), for a
+/// caller that needs the rays too (the blind-sector check): the pattern is computed once.
+PointCloud SimulateLidarFrame(const model::Lidar& lidar, const RaycastScene& scene,
+                              const Eigen::Isometry3d& T_world_sensor, double stamp, Rng& rng,
+                              const std::vector<LidarRay>& rays);
 
 }  // namespace autoshovel::sensors

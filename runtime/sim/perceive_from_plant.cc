@@ -28,7 +28,9 @@ perception::SensorFrames SimulateSensorFrames(const plant::Plant& plant,
       frame.lidar = lidar.name;
       frame.T_world_lidar = T_world_lidar;
       frame.stamp = s.time + 0.1 * k;
-      frame.cloud = sensors::SimulateLidarFrame(lidar, scene, T_world_lidar, frame.stamp, rng);
+      const std::vector<sensors::LidarRay> rays = sensors::LidarScanPattern(lidar, frame.stamp);
+      frame.cloud =
+          sensors::SimulateLidarFrame(lidar, scene, T_world_lidar, frame.stamp, rng, rays);
       if (dead) {
         std::erase_if(frame.cloud.points, [&](const sensors::LidarPoint& p) {
           const double azimuth = std::atan2(p.p_sensor.y(), p.p_sensor.x());
@@ -36,9 +38,8 @@ perception::SensorFrames SimulateSensorFrames(const plant::Plant& plant,
         });
       }
       if (options.check_lidar_health && k + 1 == options.lidar_frames) {
-        for (const sensors::LidarRay& ray : sensors::LidarScanPattern(lidar, frame.stamp)) {
-          frame.health_check_rays.push_back(ray.direction);
-        }
+        frame.health_check_rays.reserve(rays.size());
+        for (const sensors::LidarRay& ray : rays) frame.health_check_rays.push_back(ray.direction);
         frame.R_cab_lidar = sensors::PoseToIsometry(lidar.pose).linear();
       }
       frames.lidar.push_back(std::move(frame));

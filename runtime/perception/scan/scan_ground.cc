@@ -143,6 +143,93 @@ ScanPlane GivenFloor(const Eigen::Vector4d& given, const std::vector<Eigen::Vect
   return plane;
 }
 
+struct FloorCandidate {
+  ScanPlane plane;
+  std::vector<int> inliers;
+  double above = 0;  // share of all points on the plane or on its upper side
+};
+
+// The floor's candidates: the largest planes, taken off one after the other, up to the first
+// with the scene above it (planes come off largest first, so that one is the floor). A heap that
+// covers most of a bin's floor offers a large, gently sloping plane of its own, with the floor
+// and the walls' feet below it; the floor has (almost) everything on its scanner side. With `up`
+// given, planes steeper than 30° to it are passed over.
+std::vector<FloorCandidate> FloorCandidates(const std::vector<Eigen::Vector3d>& points,
+                                            const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud,
+                                            const Eigen::Vector3d& scanner_origin,
+                                            const ScanGroundOptions& options, double threshold) {
+  std::vector<FloorCandidate> candidates;
+  std::vector<char> taken(points.size(), 0);
+  for (int attempt = 0; attempt < options.floor_candidates; ++attempt) {
+    pcl::IndicesPtr remaining(new pcl::Indices);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!taken[i]) remaining->push_back(static_cast<int>(i));
+    }
+    std::vector<int> found;
+    if (remaining->size() < options.min_ground_fraction * static_cast<double>(points.size()) ||
+        !LargestPlane(cloud, remaining, threshold, found) ||
+        found.size() < options.min_ground_fraction * static_cast<double>(points.size())) {
+      break;
+    }
+    for (const int i : found) taken[static_cast<std::size_t>(i)] = 1;
+    const Eigen::Vector3d hint = options.up.value_or(scanner_origin - Centroid(points, found));
+    ScanPlane plane = Refit(points, found, hint);
+    std::vector<int> close;
+    for (const int i : found) {
+      if (std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset) <
+          0.5 * threshold) {
+        close.push_back(i);
+      }
+    }
+    if (close.size() >= 3) plane = Refit(points, close, hint);
+    plane.inliers = static_cast<int>(found.size());
+    if (options.up && plane.normal.dot(options.up->normalized()) < std::cos(0.5236)) continue;
+    FloorCandidate c{plane, std::move(found), 0};
+    long above = 0;
+    for (const auto& p : points) {
+      above += plane.normal.dot(p) - plane.offset > -2 * threshold ? 1 : 0;
+    }
+    c.above = static_cast<double>(above) / static_cast<double>(points.size());
+    candidates.push_back(std::move(c));
+    // Planes come off largest first: the first with the scene above it is the floor.
+    if (candidates.back().above >= options.floor_min_above) break;
+  }
+  return candidates;
+}
+
+// Walls: further large planes, steep to the floor (normal `up`), after the floor's `inliers`.
+// Gentler planes (slabs of a heap's flanks, which stand no steeper than the material's angle of
+// repose) are taken off and passed over.
+std::vector<ScanPlane> FindWalls(const std::vector<Eigen::Vector3d>& points,
+                                 const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud,
+                                 const std::vector<int>& inliers, const Eigen::Vector3d& up,
+                                 const Eigen::Vector3d& scanner_origin,
+                                 const ScanGroundOptions& options, double threshold) {
+  std::vector<ScanPlane> walls;
+  std::vector<char> taken(points.size(), 0);
+  for (const int i : inliers) taken[static_cast<std::size_t>(i)] = 1;
+  for (int k = 0; k < 3 * options.max_walls && static_cast<int>(walls.size()) < options.max_walls;
+       ++k) {
+    pcl::IndicesPtr next(new pcl::Indices);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!taken[i]) next->push_back(static_cast<int>(i));
+    }
+    if (next->size() < options.min_plane_fraction * static_cast<double>(points.size())) break;
+    std::vector<int> wall_inliers;
+    if (!LargestPlane(cloud, next, threshold, wall_inliers)) break;
+    if (wall_inliers.size() < options.min_plane_fraction * static_cast<double>(points.size())) {
+      break;
+    }
+    for (const int i : wall_inliers) taken[static_cast<std::size_t>(i)] = 1;
+    const ScanPlane wall =
+        Refit(points, wall_inliers, scanner_origin - Centroid(points, wall_inliers));
+    if (std::acos(std::min(1.0, std::abs(wall.normal.dot(up)))) >= options.wall_min_tilt) {
+      walls.push_back(wall);
+    }
+  }
+  return walls;
+}
+
 }  // namespace
 
 ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
@@ -169,7 +256,6 @@ ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
                         static_cast<float>(p.z()));
   }
 
-  std::vector<char> taken(points.size(), 0);
   std::vector<int> inliers;
   if (options.floor) {
     ground.floor =
@@ -177,54 +263,12 @@ ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
     ground.floor_given = true;
     ground.ok = true;
   } else {
-    // The floor: among the largest planes (taken off one after the other), the one with the
-    // scene above it. A heap that covers most of a bin's floor offers a large, gently sloping
-    // plane of its own, with the floor and the walls' feet below it; the floor has (almost)
-    // everything on its scanner side. With `up` given, planes steeper than 30° to it are walls.
-    struct Candidate {
-      ScanPlane plane;
-      std::vector<int> inliers;
-      double above = 0;  // share of all points on the plane or on its upper side
-    };
-    std::vector<Candidate> candidates;
-    for (int attempt = 0; attempt < options.floor_candidates; ++attempt) {
-      pcl::IndicesPtr remaining(new pcl::Indices);
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        if (!taken[i]) remaining->push_back(static_cast<int>(i));
-      }
-      std::vector<int> found;
-      if (remaining->size() < options.min_ground_fraction * static_cast<double>(points.size()) ||
-          !LargestPlane(cloud, remaining, ground.threshold, found) ||
-          found.size() < options.min_ground_fraction * static_cast<double>(points.size())) {
-        break;
-      }
-      for (const int i : found) taken[static_cast<std::size_t>(i)] = 1;
-      const Eigen::Vector3d hint = options.up.value_or(scanner_origin - Centroid(points, found));
-      ScanPlane plane = Refit(points, found, hint);
-      std::vector<int> close;
-      for (const int i : found) {
-        if (std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset) <
-            0.5 * ground.threshold) {
-          close.push_back(i);
-        }
-      }
-      if (close.size() >= 3) plane = Refit(points, close, hint);
-      plane.inliers = static_cast<int>(found.size());
-      if (options.up && plane.normal.dot(options.up->normalized()) < std::cos(0.5236)) continue;
-      Candidate c{plane, std::move(found), 0};
-      long above = 0;
-      for (const auto& p : points) {
-        above += plane.normal.dot(p) - plane.offset > -2 * ground.threshold ? 1 : 0;
-      }
-      c.above = static_cast<double>(above) / static_cast<double>(points.size());
-      candidates.push_back(std::move(c));
-      // Planes come off largest first: the first with the scene above it is the floor.
-      if (candidates.back().above >= options.floor_min_above) break;
-    }
+    const std::vector<FloorCandidate> candidates =
+        FloorCandidates(points, cloud, scanner_origin, options, ground.threshold);
     // The largest candidate with the scene standing on it.
-    const Candidate* chosen = nullptr;
-    const Candidate* largest = nullptr;
-    for (const Candidate& c : candidates) {
+    const FloorCandidate* chosen = nullptr;
+    const FloorCandidate* largest = nullptr;
+    for (const FloorCandidate& c : candidates) {
       ground.best_above = std::max(ground.best_above, c.above);
       if (largest == nullptr || c.plane.inliers > largest->plane.inliers) largest = &c;
       if (c.above < options.floor_min_above) continue;
@@ -277,32 +321,7 @@ ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
   ground.T_ground_scan = GroundFrame(ground.floor, centroid, scanner_origin);
   const Eigen::Vector3d z = ground.floor.normal;
 
-  // Walls: further large planes, steep to the floor. Gentler planes (slabs of a heap's flanks,
-  // which stand no steeper than the material's angle of repose) are taken off and passed over.
-  std::fill(taken.begin(), taken.end(), 0);
-  for (const int i : inliers) taken[static_cast<std::size_t>(i)] = 1;
-  for (int k = 0;
-       k < 3 * options.max_walls && static_cast<int>(ground.walls.size()) < options.max_walls;
-       ++k) {
-    pcl::IndicesPtr next(new pcl::Indices);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (!taken[i]) next->push_back(static_cast<int>(i));
-    }
-    if (next->size() < options.min_plane_fraction * static_cast<double>(points.size())) break;
-    std::vector<int> wall_inliers;
-    if (!LargestPlane(cloud, next, ground.threshold, wall_inliers)) break;
-    if (wall_inliers.size() < options.min_plane_fraction * static_cast<double>(points.size())) {
-      break;
-    }
-    for (const int i : wall_inliers) taken[static_cast<std::size_t>(i)] = 1;
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (const int i : wall_inliers) c += points[static_cast<std::size_t>(i)];
-    c /= static_cast<double>(wall_inliers.size());
-    const ScanPlane wall = Refit(points, wall_inliers, scanner_origin - c);
-    if (std::acos(std::min(1.0, std::abs(wall.normal.dot(z)))) >= options.wall_min_tilt) {
-      ground.walls.push_back(wall);
-    }
-  }
+  ground.walls = FindWalls(points, cloud, inliers, z, scanner_origin, options, ground.threshold);
   return ground;
 }
 

@@ -208,13 +208,18 @@ void SubtractReference(GridMap& grid, const GridMap& ref) {
 // 200 k-point bin scan, as long as the rest of the mapping). Returns how many were dropped.
 long DropIsolatedReturns(std::vector<ScanCloud>& clouds, std::vector<Eigen::Vector3d>& points,
                          double voxel, int min_neighbours) {
-  auto key = [&](const Eigen::Vector3d& p, int dx, int dy, int dz) {
-    const auto ix = static_cast<std::int64_t>(std::floor(p.x() / voxel)) + dx;
-    const auto iy = static_cast<std::int64_t>(std::floor(p.y() / voxel)) + dy;
-    const auto iz = static_cast<std::int64_t>(std::floor(p.z() / voxel)) + dz;
-    return (ix * 73856093) ^ (iy * 19349663) ^ (iz * 83492791);
+  // Voxel indices clamped to ±1.1e12 (a finite coordinate of 1e30 m would overflow the cast);
+  // points that far out share the end voxels, which only makes them less likely to be dropped.
+  // The hash mixes them in unsigned arithmetic, where overflow wraps.
+  auto index = [&](double v, int d) {
+    return static_cast<std::uint64_t>(
+        static_cast<std::int64_t>(std::clamp(std::floor(v / voxel), -1.1e12, 1.1e12)) + d);
   };
-  std::unordered_map<std::int64_t, int> count;
+  auto key = [&](const Eigen::Vector3d& p, int dx, int dy, int dz) {
+    return (index(p.x(), dx) * 73856093u) ^ (index(p.y(), dy) * 19349663u) ^
+           (index(p.z(), dz) * 83492791u);
+  };
+  std::unordered_map<std::uint64_t, int> count;
   count.reserve(points.size());
   for (const auto& p : points) ++count[key(p, 0, 0, 0)];
   std::vector<char> isolated(points.size(), 0);

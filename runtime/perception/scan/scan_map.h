@@ -30,7 +30,9 @@
 // asks (scan_registration.h; `register_reference`).
 //
 // Walls. With the floor, the walls found (scan_ground.h) bound the heaps: cells on or behind a
-// wall's inner face are marked in layer "wall" and belong to no heap.
+// wall's inner face are marked in layer "wall" and belong to no heap. The face's plane is taken
+// as unbounded, which suits one bin per scan (cells hidden behind a wall and filled by Eq. 9 from
+// its top are left out with it); a divider between two bins in one scan would hide the second.
 #pragma once
 
 #include <Eigen/Geometry>

@@ -162,7 +162,7 @@ void PrintFloorAndMap(const perception::ScanMap& map, bool reference, std::ostre
   out << "\n";
 }
 
-void PrintHeaps(const perception::ScanMap& map, std::ostream& out) {
+void PrintHeaps(const perception::ScanMap& map, bool reference, std::ostream& out) {
   char line[400];
   out << "  | heap | volume m^3 | +/- m^3 (1 sigma) | floor +/- m^3 | on filled cells m^3 | "
          "area m^2 | peak m | form |\n  | --- | --- | --- | --- | --- | --- | --- | --- |\n";
@@ -178,11 +178,22 @@ void PrintHeaps(const perception::ScanMap& map, std::ostream& out) {
     total_variance += h.volume_sigma * h.volume_sigma;
     total_bias += h.floor_bias;
   }
-  std::snprintf(line, sizeof line,
-                "  total %.4g m^3 +/- %.2g (1 sigma); the floor's RMS scatter under the heaps "
-                "could move it by %.2g\n",
-                total, std::sqrt(total_variance), total_bias);
+  std::snprintf(line, sizeof line, "  total %.4g m^3 +/- %.2g (1 sigma)", total,
+                std::sqrt(total_variance));
   out << line;
+  if (reference) {
+    out << "; heights above the reference scan: its measured floor replaces the plane\n";
+  } else if (map.ground.floor_given) {
+    std::snprintf(line, sizeof line,
+                  "; the floor is the one given: its own error is not in these figures (the "
+                  "scan's points near it scatter %.2g m^3 over the heaps)\n",
+                  total_bias);
+    out << line;
+  } else {
+    std::snprintf(line, sizeof line,
+                  "; the floor's RMS scatter under the heaps could move it by %.2g\n", total_bias);
+    out << line;
+  }
 }
 
 // The CSV (with a floor), the pictures, the GeoTIFF and the cell centres.
@@ -281,7 +292,7 @@ int RunMapCloud(const MapCloudOptions& options, std::ostream& out, std::ostream&
     out << line;
     PrintFloorAndMap(map, reference, out);
     if (map.floor_found) {
-      PrintHeaps(map, out);
+      PrintHeaps(map, reference, out);
     } else {
       std::snprintf(line, sizeof line,
                     "  form of the surface: %s (centre %+.3f m against its mean; heights spread "

@@ -10,9 +10,63 @@
 
 #include "identification/hydraulics/residual_plot.h"
 #include "identification/hydraulics/valve_chain_model.h"
+#include "identification/hydraulics/valve_model.h"
 #include "runtime/plot/line_plot.h"
 
 namespace autoshovel::identification {
+
+namespace {
+
+// A direction's identified joint rate at duty u [rad/s]: its flow characteristic up to the
+// highest level logged; beyond it, not known, extended along its last secant (from the previous
+// knot, or the dead band) rather than held flat, which would claim a saturation nobody saw.
+double Characteristic(const DirectionFit& d, double u) {
+  std::vector<double> rates;
+  for (const Estimate& e : d.rates) rates.push_back(e.value);
+  if (rates.empty()) return 0.0;
+  const double last = d.levels.back();
+  if (u <= last) return Opening<double>(u, d.dead_band.value, d.levels, rates);
+  const double before = d.levels.size() > 1 ? d.levels[d.levels.size() - 2] : d.dead_band.value;
+  const double rate_before = d.levels.size() > 1 ? rates[rates.size() - 2] : 0.0;
+  const double slope = last > before ? (rates.back() - rate_before) / (last - before) : 0.0;
+  return rates.back() + slope * (u - last);
+}
+
+}  // namespace
+
+double FullOpeningRate(const DirectionFit& direction) {
+  if (direction.rates.empty() || !(direction.rates.back().value > 0)) return 0.0;
+  return Characteristic(direction, 1.0);
+}
+
+void AssignPlantFlow(NamedChain& result, const model::MachineDescription& machine,
+                     const generated::MachineFunctions& functions, int actuator) {
+  constexpr double kLpm = 1e-3 / 60;                    // m³/s per l/min
+  constexpr double kDegrees = 180 / 3.141592653589793;  // per radian
+  const ActuatorKinematics kinematics(machine, functions, actuator);
+  std::vector<double> flows;
+  std::string note = "l/min at full duty:";
+  for (const DirectionFit& d : result.chain.directions) {
+    const double lever = std::abs(kinematics.Lever(d.angle_center));
+    const double area = d.sign > 0 ? kinematics.area_extend() : kinematics.area_retract();
+    const double rate = FullOpeningRate(d);
+    flows.push_back(rate * area * lever / kLpm);
+    char part[200];
+    std::snprintf(
+        part, sizeof part, "%s %s %.2f deg/s x %s area x lever %.3f m/rad at %.1f deg = %.1f",
+        flows.size() > 1 ? ";" : "", d.sign > 0 ? "extending" : "retracting", rate * kDegrees,
+        d.sign > 0 ? "cap" : "annulus", lever, d.angle_center * kDegrees, flows.back());
+    note += part;
+  }
+  result.rated_flow_lpm = 0;
+  result.opening_scale.clear();
+  if (flows.empty()) return;
+  result.rated_flow_lpm = *std::max_element(flows.begin(), flows.end());
+  for (const double q : flows) {
+    result.opening_scale.push_back(result.rated_flow_lpm > 0 ? q / result.rated_flow_lpm : 1.0);
+  }
+  result.rated_flow_note = note;
+}
 
 namespace {
 
@@ -223,22 +277,11 @@ std::string ChainOverlayText(const std::string& header, const std::vector<NamedC
     }
     if (dirs.size() == 2)
       text << "      dead_zone: 0                # the opening curves hold the dead bands\n";
-    for (const DirectionFit& d : dirs) {
-      std::vector<double> rates;
-      for (const Estimate& e : d.rates) rates.push_back(e.value);
-      if (rates.empty() || !(rates.back() > 0)) continue;
-      // Beyond the highest logged level the characteristic is not known: extended along its
-      // last secant (from the previous knot, or the dead band) rather than held flat, which
-      // would claim a saturation nobody saw.
-      const double last = d.levels.back();
-      const double before = d.levels.size() > 1 ? d.levels[d.levels.size() - 2] : d.dead_band.value;
-      const double rate_before = d.levels.size() > 1 ? rates[rates.size() - 2] : 0.0;
-      const double slope = last > before ? (rates.back() - rate_before) / (last - before) : 0.0;
-      auto characteristic = [&](double u) {
-        return u <= last ? Opening<double>(u, d.dead_band.value, d.levels, rates)
-                         : rates.back() + slope * (u - last);
-      };
-      const double top = characteristic(1.0);
+    for (std::size_t k = 0; k < dirs.size(); ++k) {
+      const DirectionFit& d = dirs[k];
+      const double top = FullOpeningRate(d);
+      if (!(top > 0)) continue;
+      const double share = k < r.opening_scale.size() ? r.opening_scale[k] : 1.0;
       text << "      opening_curve_" << (d.sign > 0 ? "extend" : "retract") << ": [";
       std::vector<double> duties = {d.dead_band.value};
       for (double u = std::floor(d.dead_band.value * 20 + 1) / 20; u <= 1.0 + 1e-9; u += 0.05) {
@@ -246,7 +289,8 @@ std::string ChainOverlayText(const std::string& header, const std::vector<NamedC
       }
       double previous = 0;
       for (std::size_t i = 0; i < duties.size(); ++i) {
-        const double opening = i == 0 ? 0.0 : std::max(previous, characteristic(duties[i]) / top);
+        const double opening =
+            i == 0 ? 0.0 : std::max(previous, share * Characteristic(d, duties[i]) / top);
         previous = opening;
         std::snprintf(line, sizeof line, "%s[%.3f, %.4f]", i == 0 ? "" : ", ", duties[i],
                       std::min(opening, 1.0));
@@ -259,7 +303,7 @@ std::string ChainOverlayText(const std::string& header, const std::vector<NamedC
                     "supply %.2f deg/s, the rest %.0f ms late (lag %.0f ms); motion lag + %.0f ms "
                     "at full opening; angle gain c1 %.3f "
                     "c2 %.3f; load coefficient %.3f\n",
-                    d.sign > 0 ? "positive" : "negative", rates.back() * kDeg,
+                    d.sign > 0 ? "positive" : "negative", d.rates.back().value * kDeg,
                     d.supply_capacity.value * kDeg, d.supply_delay.value * kMs,
                     d.supply_lag.value * kMs, d.motion_lag_slope.value * kMs, d.gain_linear.value,
                     d.gain_quadratic.value, d.load_coefficient.value);

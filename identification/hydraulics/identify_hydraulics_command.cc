@@ -329,24 +329,8 @@ int RunChain(const IdentifyHydraulicsOptions& options, const model::MachineDescr
       fit.area_ratio = (cap - actuator.rod * actuator.rod) / cap;
     }
     fit.events.joint_sense = JointSense(machine, functions, a);
-    NamedChain named{actuator.name, IdentifyValveChain(group, fit), 0.0, ""};
-    // The rated flow that makes the description's cylinder move the joint at the identified
-    // rate of the highest level (full opening) at the logs' centre angle: the plant's flow at
-    // full spool and rated drop (docs/hydraulic_identification.md, "Into the plant").
-    if (!named.chain.directions.empty()) {
-      const DirectionFit& d = named.chain.directions.front();
-      const ActuatorKinematics kinematics(machine, functions, a);
-      const double lever = std::abs(kinematics.Lever(d.angle_center));
-      const double area = d.sign > 0 ? kinematics.area_extend() : kinematics.area_retract();
-      const double rate = d.rates.empty() ? 0.0 : d.rates.back().value;
-      named.rated_flow_lpm = rate * area * lever / kLpm;
-      char note[200];
-      std::snprintf(note, sizeof note,
-                    "l/min: %.2f deg/s at %.0f %% duty x %s area x lever %.3f m/rad at %.1f deg",
-                    rate * 180 / std::numbers::pi, d.levels.back() * 100,
-                    d.sign > 0 ? "cap" : "annulus", lever, d.angle_center * 180 / std::numbers::pi);
-      named.rated_flow_note = note;
-    }
+    NamedChain named{actuator.name, IdentifyValveChain(group, fit), 0.0, "", {}};
+    AssignPlantFlow(named, machine, functions, a);
     results.push_back(std::move(named));
   }
   const double fit_seconds = Seconds(start) - read_seconds;

@@ -225,7 +225,7 @@ TEST(ValveChain, RecoversTheChainFromStepLogs) {
   const ChainIdentification result = IdentifyValveChain(Campaign(truth), options);
   ASSERT_EQ(result.directions.size(), 1u);
   const DirectionFit& d = result.directions[0];
-  PrintChainTable({"synthetic boom", result, 0.0, ""}, std::cout);
+  PrintChainTable({"synthetic boom", result, 0.0, "", {}}, std::cout);
   ASSERT_EQ(d.levels.size(), truth.knots.size());
   // Delays per stage within 10 ms.
   EXPECT_NEAR(d.pilot_delay.value, truth.pilot_delay, 0.010);

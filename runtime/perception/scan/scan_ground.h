@@ -13,12 +13,13 @@
 //
 // No floor in view. Where no candidate has the scene above it, there is no floor in the scan:
 // typically the top of a heap that fills a bin wall to wall, scanned from above (the real site
-// bins are such scans: every point lies within ±0.4 m of one gently tilted surface). Taking the
-// best-fitting plane as the floor would report the heap's bumps above its own mean surface as its
-// volume, so no floor is claimed: `ok` is false, the failure says why, and `surface` holds the
-// heap top's mean plane, so that the caller can still map the surface's relief and its form
-// (heaped or drawn down). The floor can then be given (`floor`: a surveyed plane, or
-// the bin's floor known from its drawings) or measured on a scan of the empty place.
+// bins are such scans: but for one stray return, every point lies within −0.45…+0.64 m of one
+// gently tilted surface). Taking the best-fitting plane as the floor would report the heap's
+// bumps above its own mean surface as its volume, so no floor is claimed: `ok` is false, the
+// failure says why, and `surface` holds the heap top's mean plane, so that the caller can still
+// map the surface's relief and its form (heaped or drawn down). The floor can then be given
+// (`floor`: a surveyed plane, or the bin's floor known from its drawings) or measured on a scan
+// of the empty place.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -47,7 +48,7 @@ struct ScanGroundOptions {
   int floor_candidates = 8;           ///< largest planes considered for the floor
   /// The floor has this share of the points above it (within 2 thresholds): everything stands
   /// on it but a few stray returns. A slab of a heap's surface has far fewer (the real bin scans'
-  /// best slabs: 79 and 95 %), and so had the floor inside the lab box, above the ground the box
+  /// best slabs: 79 and 94 %), and so had the floor inside the lab box, above the ground the box
   /// stands on (95 %, where the ground has 99.9 %).
   double floor_min_above = 0.99;
   /// The floor given by the user, n·p = d in the cloud's frame (n = xyz, d = w; n need not be

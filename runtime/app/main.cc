@@ -253,7 +253,8 @@ Command AddMap(CLI::App& app, const Globals& g) {
   cmd->add_option("scenario", c->map.scenario, "Scenario name or .yaml path (or give --cloud)");
   cmd->add_option("--cloud", c->map_cloud.clouds,
                   "A scan to map (repeatable): .pcd (ascii, binary, binary_compressed, any "
-                  "extra fields) or KITTI .bin, in any frame: the floor is found from the data");
+                  "extra fields), .ply (ascii or binary) or KITTI .bin, in any frame: the floor "
+                  "and walls are found from the data");
   cmd->add_option("--pose", c->map_cloud.poses,
                   "Per --cloud (all or none): the scanner's x y z [m] roll pitch yaw [deg] in "
                   "the first cloud's frame, R = Rz(yaw) Ry(pitch) Rx(roll)")

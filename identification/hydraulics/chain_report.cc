@@ -17,6 +17,9 @@ namespace autoshovel::identification {
 
 namespace {
 
+constexpr double kDeg = 180 / 3.141592653589793;
+constexpr double kMs = 1e3;
+
 // A direction's identified joint rate at duty u [rad/s]: its flow characteristic up to the
 // highest level logged; beyond it, not known, extended along its last secant (from the previous
 // knot, or the dead band) rather than held flat, which would claim a saturation nobody saw.
@@ -41,8 +44,7 @@ double FullOpeningRate(const DirectionFit& direction) {
 
 void AssignPlantFlow(NamedChain& result, const model::MachineDescription& machine,
                      const generated::MachineFunctions& functions, int actuator) {
-  constexpr double kLpm = 1e-3 / 60;                    // m³/s per l/min
-  constexpr double kDegrees = 180 / 3.141592653589793;  // per radian
+  constexpr double kLpm = 1e-3 / 60;  // m³/s per l/min
   const ActuatorKinematics kinematics(machine, functions, actuator);
   std::vector<double> flows;
   std::string note = "l/min at full duty:";
@@ -52,10 +54,10 @@ void AssignPlantFlow(NamedChain& result, const model::MachineDescription& machin
     const double rate = FullOpeningRate(d);
     flows.push_back(rate * area * lever / kLpm);
     char part[200];
-    std::snprintf(
-        part, sizeof part, "%s %s %.2f deg/s x %s area x lever %.3f m/rad at %.1f deg = %.1f",
-        flows.size() > 1 ? ";" : "", d.sign > 0 ? "extending" : "retracting", rate * kDegrees,
-        d.sign > 0 ? "cap" : "annulus", lever, d.angle_center * kDegrees, flows.back());
+    std::snprintf(part, sizeof part,
+                  "%s %s %.2f deg/s x %s area x lever %.3f m/rad at %.1f deg = %.1f",
+                  flows.size() > 1 ? ";" : "", d.sign > 0 ? "extending" : "retracting", rate * kDeg,
+                  d.sign > 0 ? "cap" : "annulus", lever, d.angle_center * kDeg, flows.back());
     note += part;
   }
   result.rated_flow_lpm = 0;
@@ -69,9 +71,6 @@ void AssignPlantFlow(NamedChain& result, const model::MachineDescription& machin
 }
 
 namespace {
-
-constexpr double kDeg = 180 / 3.141592653589793;
-constexpr double kMs = 1e3;
 
 // "  71 ms [ 64,  80]" or "at bound" / "held".
 std::string Cell(const Estimate& e, double scale, const char* format) {

@@ -14,18 +14,33 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 namespace autoshovel::perception {
 
 namespace {
 
+Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points,
+                         const std::vector<int>& indices) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const int i : indices) c += points[static_cast<std::size_t>(i)];
+  return c / static_cast<double>(std::max<std::size_t>(1, indices.size()));
+}
+
+// The robust σ of distances to a plane: 1.4826 · their median (the median absolute deviation
+// of a normal distribution's σ); 0 for none.
+double RobustSigma(std::vector<double> distances) {
+  if (distances.empty()) return 0.0;
+  auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  return 1.4826 * *middle;
+}
+
 // Least-squares plane through `points[i]` for i in `indices`; normal oriented like `hint`.
 ScanPlane Refit(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
                 const Eigen::Vector3d& hint) {
   ScanPlane plane;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const int i : indices) mean += points[static_cast<std::size_t>(i)];
-  mean /= static_cast<double>(std::max<std::size_t>(1, indices.size()));
+  const Eigen::Vector3d mean = Centroid(points, indices);
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (const int i : indices) {
     const Eigen::Vector3d d = points[static_cast<std::size_t>(i)] - mean;
@@ -41,11 +56,7 @@ ScanPlane Refit(const std::vector<Eigen::Vector3d>& points, const std::vector<in
     distances.push_back(
         std::abs(plane.normal.dot(points[static_cast<std::size_t>(i)]) - plane.offset));
   }
-  if (!distances.empty()) {
-    auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
-    std::nth_element(distances.begin(), middle, distances.end());
-    plane.noise = 1.4826 * *middle;
-  }
+  plane.noise = RobustSigma(std::move(distances));
   return plane;
 }
 
@@ -101,13 +112,6 @@ Eigen::Isometry3d GroundFrame(const ScanPlane& plane, const Eigen::Vector3d& cen
   return T_scan_ground.inverse();
 }
 
-Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points,
-                         const std::vector<int>& indices) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const int i : indices) c += points[static_cast<std::size_t>(i)];
-  return c / static_cast<double>(std::max<std::size_t>(1, indices.size()));
-}
-
 // The user's floor n·p = d: unit normal facing the scanner (or `up`); its noise from the points
 // within `threshold` of it, if the scan shows any of it.
 ScanPlane GivenFloor(const Eigen::Vector4d& given, const std::vector<Eigen::Vector3d>& points,
@@ -135,11 +139,7 @@ ScanPlane GivenFloor(const Eigen::Vector4d& given, const std::vector<Eigen::Vect
     }
   }
   plane.inliers = static_cast<int>(inliers.size());
-  if (distances.size() >= 3) {
-    auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
-    std::nth_element(distances.begin(), middle, distances.end());
-    plane.noise = 1.4826 * *middle;
-  }
+  if (distances.size() >= 3) plane.noise = RobustSigma(std::move(distances));
   return plane;
 }
 
@@ -232,6 +232,16 @@ std::vector<ScanPlane> FindWalls(const std::vector<Eigen::Vector3d>& points,
 
 }  // namespace
 
+double ScanExtent(const std::vector<Eigen::Vector3d>& points) {
+  if (points.empty()) return 0.0;
+  Eigen::Vector3d lo = points.front(), hi = points.front();
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).norm();
+}
+
 ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
                           const Eigen::Vector3d& scanner_origin, const ScanGroundOptions& options) {
   ScanGround ground;
@@ -239,12 +249,7 @@ ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points,
     ground.failure = "too few points (" + std::to_string(points.size()) + ") to find a floor";
     return ground;
   }
-  Eigen::Vector3d lo = points.front(), hi = points.front();
-  for (const auto& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const double extent = (hi - lo).norm();
+  const double extent = ScanExtent(points);
   ground.threshold =
       options.threshold > 0 ? options.threshold : std::clamp(0.005 * extent, 0.005, 0.05);
   // RANSAC on a scan meets degenerate samples by the thousand; PCL warns about each one.

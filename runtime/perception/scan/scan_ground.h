@@ -74,6 +74,10 @@ struct ScanGround {
   double threshold = 0;  ///< the RANSAC distance used [m]
 };
 
+/// The diagonal of the points' bounding box [m] (0 for none): the scale the floor's RANSAC
+/// threshold, the map's cell and the registration's distances are taken from.
+double ScanExtent(const std::vector<Eigen::Vector3d>& points);
+
 ScanGround FindScanGround(const std::vector<Eigen::Vector3d>& points_scan,
                           const Eigen::Vector3d& scanner_origin_scan,
                           const ScanGroundOptions& options = {});

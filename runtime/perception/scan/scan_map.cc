@@ -151,16 +151,6 @@ std::vector<Heap> FindHeaps(GridMap& map, double min_height, int min_cells, doub
   return heaps;
 }
 
-// The diagonal of the points' bounding box [m].
-double Extent(const std::vector<Eigen::Vector3d>& points) {
-  Eigen::Vector3d lo = points.front(), hi = points.front();
-  for (const auto& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  return (hi - lo).norm();
-}
-
 // Points at the scanner's own origin are "no return" (Livox drivers and CloudCompare exports
 // write them as 0 0 0): dropped and counted, so that they neither form a "plane" through the
 // origin nor a spike in the map. Appends the kept points, in the first cloud's frame.
@@ -331,7 +321,7 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
   }
   out.points = static_cast<long>(points.size());
   if (!points.empty()) {
-    const double voxel = 2 * std::max(0.005, Extent(points) / 250.0);
+    const double voxel = 2 * std::max(0.005, ScanExtent(points) / 250.0);
     out.points_isolated = DropIsolatedReturns(kept, points, voxel, options.min_neighbours);
     out.points_isolated +=
         DropIsolatedReturns(kept_reference, reference_points, voxel, options.min_neighbours);
@@ -412,10 +402,9 @@ ScanMap BuildScanMap(const std::vector<ScanCloud>& clouds, const ScanMapOptions&
     }
     return map.FillHoles();
   };
-  std::vector<ScanCloud> mapped = kept;
-  DropWallReturns(mapped, out.ground);
+  DropWallReturns(kept, out.ground);
   DropWallReturns(kept_reference, out.ground);
-  out.cells_filled = build(mapped, out.map, out.points_used);
+  out.cells_filled = build(kept, out.map, out.points_used);
   GridMap& grid = out.map.map();
   // The floor's height error (σ / √inliers, shifts the whole heap) and its RMS scatter (the
   // floor_bias bound); a reference's measured floor replaces both with its cells' variances.

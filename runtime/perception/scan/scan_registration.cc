@@ -12,6 +12,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "runtime/perception/scan/scan_ground.h"
+
 namespace autoshovel::perception {
 
 namespace {
@@ -51,14 +53,10 @@ ScanRegistration RegisterScans(const std::vector<Eigen::Vector3d>& source,
   if (source.size() < 100 || target.size() < 100) {
     throw std::invalid_argument("registration needs at least 100 points in each scan");
   }
-  Eigen::Vector3d lo = target.front(), hi = target.front(), centre = Eigen::Vector3d::Zero();
-  for (const auto& p : target) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-    centre += p;
-  }
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : target) centre += p;
   centre /= static_cast<double>(target.size());
-  const double extent = (hi - lo).norm();
+  const double extent = ScanExtent(target);
   ScanRegistration result;
   result.voxel = options.voxel > 0 ? options.voxel : std::max(0.002, 0.004 * extent);
   const double start = options.start_distance > 0 ? options.start_distance : 0.08 * extent;
